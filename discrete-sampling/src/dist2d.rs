@@ -1,0 +1,269 @@
+//! Piecewise-constant 2D distributions over `[0, 1)²`: a marginal over rows
+//! and a conditional per row (pbrt's `PiecewiseConstant2D`), each a 1D
+//! sampler, by default a [`GuideTable`] as in the paper's Fig. 8.
+
+use std::f64::consts::PI;
+
+use rand::distr::Distribution;
+
+use crate::weights::{ONE_MINUS_EPSILON, checked_total, unit_f64};
+use crate::{DiscreteSampler, Error, GuideTable, InvertibleSampler};
+
+/// A point drawn from a [`Distribution2D`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample2D {
+    /// `[x, y]` in `[0, 1)²`: `x` runs along a row (columns), `y` down the
+    /// rows, as in an image.
+    pub point: [f64; 2],
+    /// The cell, `[column, row]`.
+    pub cell: [usize; 2],
+    /// Density of `point` with respect to area in `[0, 1)²`.
+    pub pdf: f64,
+}
+
+/// A piecewise-constant density over `[0, 1)²` given by a `width × height`
+/// grid of non-negative weights (an image, row-major, row 0 first).
+///
+/// Sampling draws a row from the marginal with `u[1]` and a column from that
+/// row's conditional with `u[0]`, then places the point inside the cell with
+/// the remapped remainders, so one pair of variates makes one point and
+/// stratified pairs stay stratified (with an invertible `S`).
+///
+/// `S` is the 1D sampler of the marginal and of every row: [`GuideTable`]
+/// by default; [`CdfBisection`](crate::CdfBisection) gives the classic
+/// method without the table (the paper's Fig. 8 compares the two).
+///
+/// # Example
+/// ```
+/// use discrete_sampling::Distribution2D;
+/// // A 4×2 image whose right half is three times as bright.
+/// let image = [1.0f32, 1.0, 3.0, 3.0, 1.0, 1.0, 3.0, 3.0];
+/// let d = Distribution2D::new(&image, 4, 2)?;
+/// let s = d.sample_u([0.9, 0.2]);
+/// assert_eq!(s.cell, [3, 0]);
+/// assert!((s.pdf - 1.5).abs() < 1e-12); // 3 / mean(2)
+/// assert_eq!(d.pdf(s.point), s.pdf);
+/// # Ok::<(), discrete_sampling::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+pub struct Distribution2D<S = GuideTable> {
+    width: usize,
+    height: usize,
+    marginal: S,
+    rows: Vec<S>,
+}
+
+impl Distribution2D<GuideTable> {
+    /// Builds the distribution of a `width × height` grid with guide tables.
+    ///
+    /// # Errors
+    /// [`Error::DimensionMismatch`] when `weights.len() != width · height`,
+    /// and the weight errors of [`Error`] with `index = row · width + column`.
+    pub fn new<W: Copy + Into<f64>>(
+        weights: &[W],
+        width: usize,
+        height: usize,
+    ) -> Result<Self, Error> {
+        Self::with_sampler(weights, width, height)
+    }
+
+    /// Builds the distribution of an equirectangular (latitude–longitude)
+    /// environment map: each row is weighted by `sin θ` of its centre, where
+    /// row 0 is the top (`θ = 0`), so that [`pdf_solid_angle`] is
+    /// proportional to the map's value. Without this weighting the poles,
+    /// which the map stretches over whole rows, are drawn far too often.
+    ///
+    /// # Errors
+    /// As for [`new`](Self::new).
+    pub fn from_equirect<W: Copy + Into<f64>>(
+        luminance: &[W],
+        width: usize,
+        height: usize,
+    ) -> Result<Self, Error> {
+        Self::from_equirect_with_sampler(luminance, width, height)
+    }
+}
+
+impl<S: DiscreteSampler> Distribution2D<S> {
+    /// Builds the distribution with rows and marginal of sampler type `S`.
+    ///
+    /// # Errors
+    /// As for [`Distribution2D::new`].
+    pub fn with_sampler<W: Copy + Into<f64>>(
+        weights: &[W],
+        width: usize,
+        height: usize,
+    ) -> Result<Self, Error> {
+        Self::build(weights, width, height, |_| 1.0)
+    }
+
+    /// [`from_equirect`](Distribution2D::from_equirect) with sampler type `S`.
+    ///
+    /// # Errors
+    /// As for [`Distribution2D::new`].
+    pub fn from_equirect_with_sampler<W: Copy + Into<f64>>(
+        luminance: &[W],
+        width: usize,
+        height: usize,
+    ) -> Result<Self, Error> {
+        Self::build(luminance, width, height, |row| {
+            (PI * (row as f64 + 0.5) / height as f64).sin()
+        })
+    }
+
+    fn build<W: Copy + Into<f64>>(
+        weights: &[W],
+        width: usize,
+        height: usize,
+        row_scale: impl Fn(usize) -> f64,
+    ) -> Result<Self, Error> {
+        let expected = width.checked_mul(height);
+        if expected != Some(weights.len()) || width == 0 || height == 0 {
+            return Err(Error::DimensionMismatch {
+                width,
+                height,
+                expected: expected.unwrap_or(usize::MAX),
+                len: weights.len(),
+            });
+        }
+        // Validate everything first, so the error names the flat index.
+        checked_total(weights)?;
+        let mut row_mass = Vec::with_capacity(height);
+        let mut rows = Vec::with_capacity(height);
+        for (r, row) in weights.chunks_exact(width).enumerate() {
+            let sum: f64 = row.iter().map(|&w| w.into()).sum();
+            let mass = sum * row_scale(r);
+            row_mass.push(mass);
+            // A row of zero mass is never drawn; any valid sampler will do.
+            rows.push(if mass > 0.0 {
+                S::from_weights(row)?
+            } else {
+                S::from_weights(&[1.0f64])?
+            });
+        }
+        let marginal = S::from_weights(&row_mass)?;
+        Ok(Self {
+            width,
+            height,
+            marginal,
+            rows,
+        })
+    }
+
+    /// Columns of the grid.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Rows of the grid.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The marginal distribution over rows.
+    pub fn marginal(&self) -> &S {
+        &self.marginal
+    }
+
+    /// The conditional distribution of the columns of `row`.
+    ///
+    /// # Panics
+    /// If `row >= height()`.
+    pub fn row(&self, row: usize) -> &S {
+        &self.rows[row]
+    }
+
+    /// Probability of drawing the cell `[column, row]`.
+    pub fn cell_probability(&self, cell: [usize; 2]) -> f64 {
+        let [column, row] = cell;
+        match self.rows.get(row) {
+            Some(r) if column < self.width => self.marginal.pdf(row) * r.pdf(column),
+            _ => 0.0,
+        }
+    }
+
+    /// Density (w.r.t. area in `[0, 1)²`) at `point`; 0 outside the square.
+    pub fn pdf(&self, point: [f64; 2]) -> f64 {
+        let [x, y] = point;
+        if !((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y)) {
+            return 0.0;
+        }
+        let column = ((x * self.width as f64) as usize).min(self.width - 1);
+        let row = ((y * self.height as f64) as usize).min(self.height - 1);
+        let area = self.width as f64 * self.height as f64;
+        self.cell_probability([column, row]) * area
+    }
+
+    /// Draws a point for the variates `u = [u0, u1]` in `[0, 1)²` (clamped
+    /// otherwise): `u1` picks the row, `u0` the column.
+    pub fn sample_u(&self, u: [f64; 2]) -> Sample2D {
+        let (row, v) = self.marginal.sample_remapped(u[1]);
+        let conditional = &self.rows[row];
+        let (column, w) = conditional.sample_remapped(u[0]);
+        let (width, height) = (self.width as f64, self.height as f64);
+        Sample2D {
+            point: [
+                ((column as f64 + w) / width).min(ONE_MINUS_EPSILON),
+                ((row as f64 + v) / height).min(ONE_MINUS_EPSILON),
+            ],
+            cell: [column, row],
+            pdf: self.marginal.pdf(row) * conditional.pdf(column) * (width * height),
+        }
+    }
+
+    /// Fills `out` with independent samples, two `u64` of `rng` each.
+    pub fn sample_into<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [Sample2D]) {
+        for slot in out {
+            *slot = self.sample(rng);
+        }
+    }
+}
+
+impl<S: InvertibleSampler> Distribution2D<S> {
+    /// The variates that [`sample_u`](Self::sample_u) maps to `point`, or
+    /// `None` where the density is zero. `sample_u(invert(p)?).point ≈ p`.
+    pub fn invert(&self, point: [f64; 2]) -> Option<[f64; 2]> {
+        let [x, y] = point;
+        if !((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y)) {
+            return None;
+        }
+        let (xs, ys) = (x * self.width as f64, y * self.height as f64);
+        let column = (xs as usize).min(self.width - 1);
+        let row = (ys as usize).min(self.height - 1);
+        let conditional = &self.rows[row];
+        let u1 = self.marginal.invert(row)? + (ys - row as f64) * self.marginal.pdf(row);
+        let u0 = conditional.invert(column)? + (xs - column as f64) * conditional.pdf(column);
+        Some([u0.min(ONE_MINUS_EPSILON), u1.min(ONE_MINUS_EPSILON)])
+    }
+}
+
+impl<S: DiscreteSampler> Distribution<Sample2D> for Distribution2D<S> {
+    fn sample<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> Sample2D {
+        let u0 = unit_f64(rng);
+        let u1 = unit_f64(rng);
+        self.sample_u([u0, u1])
+    }
+}
+
+/// The direction of a point of an equirectangular map: `θ = π y` from the
+/// `+Z` pole (row 0 is the top), `φ = 2π x` from `+X` towards `+Y`; returns
+/// `[sin θ cos φ, sin θ sin φ, cos θ]`. Convert to your renderer's axes.
+pub fn equirect_direction(point: [f64; 2]) -> [f64; 3] {
+    let theta = PI * point[1];
+    let phi = 2.0 * PI * point[0];
+    let (sin_t, cos_t) = theta.sin_cos();
+    let (sin_p, cos_p) = phi.sin_cos();
+    [sin_t * cos_p, sin_t * sin_p, cos_t]
+}
+
+/// Converts a density over `[0, 1)²` of an equirectangular map to a density
+/// over solid angle: `p(ω) = p(x, y) / (2π² sin θ)`. Returns 0 at the poles,
+/// where the map is singular.
+pub fn pdf_solid_angle(pdf_area: f64, point: [f64; 2]) -> f64 {
+    let sin_t = (PI * point[1]).sin();
+    if sin_t <= 0.0 {
+        0.0
+    } else {
+        pdf_area / (2.0 * PI * PI * sin_t)
+    }
+}

@@ -1,0 +1,70 @@
+//! Real environment maps from `$TRILUX_DATA/hdr` (skipped with a notice when
+//! the variable is unset).
+
+use discrete_sampling::{CdfBisection, DiscreteSampler, Distribution2D, GuideTable};
+use rand::SeedableRng;
+use rand::distr::Distribution;
+use rand_pcg::Pcg64Mcg;
+
+use crate::hdr::{hdr_files, load_luminance};
+use crate::stats::chi_square;
+
+#[test]
+fn hdr_environment_maps() {
+    let Some(files) = hdr_files() else {
+        eprintln!("skipped: TRILUX_DATA is not set, so the real HDR images are not tested");
+        return;
+    };
+    assert!(
+        files.len() >= 2,
+        "expected the two HDR maps of the data README"
+    );
+    for path in files {
+        let lum = load_luminance(&path).unwrap();
+        let (w, h) = (lum.width, lum.height);
+        assert_eq!((w, h), (1024, 512), "{}", lum.name);
+
+        // 1D over all texels: the guide table is the same inversion as bisection.
+        let g = GuideTable::new(&lum.values).unwrap();
+        let b = CdfBisection::new(&lum.values).unwrap();
+        for j in 0..200_000 {
+            let u = (j as f64 + 0.37) / 200_000.0;
+            assert_eq!(g.sample_u(u), b.sample_u(u), "{} at u = {u}", lum.name);
+        }
+
+        // 2D lat-long: the brightest texel has the largest cell probability
+        // among its row, and 10⁶ samples binned into 32×16 blocks match the
+        // exact block masses.
+        let d = Distribution2D::from_equirect(&lum.values, w, h).unwrap();
+        let brightest = (0..w * h)
+            .max_by(|&a, &b| lum.values[a].total_cmp(&lum.values[b]))
+            .unwrap();
+        let (bx, by) = (brightest % w, brightest / w);
+        if lum.name.starts_with("spiaggia") {
+            assert_eq!((by, bx), (184, 615), "the sun of the data README");
+        }
+        let row = d.row(by);
+        assert!((0..w).all(|x| row.pdf(x) <= row.pdf(bx)));
+
+        let (bw, bh) = (32, 16);
+        let mut exact = vec![0.0f64; bw * bh];
+        for y in 0..h {
+            for x in 0..w {
+                exact[(y * bh / h) * bw + x * bw / w] += d.cell_probability([x, y]);
+            }
+        }
+        let mut counts = vec![0u64; bw * bh];
+        let mut rng = Pcg64Mcg::seed_from_u64(77);
+        for _ in 0..1_000_000 {
+            let s = d.sample(&mut rng);
+            counts[(s.cell[1] * bh / h) * bw + s.cell[0] * bw / w] += 1;
+        }
+        let test = chi_square(&counts, &exact, 20.0);
+        assert!(
+            test.p_value > 1e-3,
+            "{}: p = {:.2e}",
+            lum.name,
+            test.p_value
+        );
+    }
+}
