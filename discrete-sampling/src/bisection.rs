@@ -3,7 +3,8 @@
 
 use rand::distr::Distribution;
 
-use crate::weights::{normalized_cdf, remap, unit_f64};
+use crate::uniform::{bits_to_unit, clamp_unit, fill_batch, remap, unit_f64};
+use crate::weights::normalized_cdf;
 use crate::{DiscreteSampler, Error, InvertibleSampler};
 
 /// A discrete distribution sampled by binary search in its `f64` CDF.
@@ -77,18 +78,22 @@ impl DiscreteSampler for CdfBisection {
     }
 
     fn sample_remapped(&self, u: f64) -> (usize, f64) {
-        let u = crate::weights::clamp_unit(u);
+        let u = clamp_unit(u);
         let i = self.search(u);
         (i, remap(u, self.cdf[i], self.cdf[i + 1]))
     }
 
     fn sample_u(&self, u: f64) -> usize {
-        self.search(crate::weights::clamp_unit(u))
+        self.search(clamp_unit(u))
     }
 
     #[inline]
     fn sample_rng<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> usize {
         self.search(unit_f64(rng))
+    }
+
+    fn sample_into<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [usize]) {
+        fill_batch(rng, out, |bits| self.search(bits_to_unit(bits)));
     }
 }
 

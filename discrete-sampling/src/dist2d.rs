@@ -6,7 +6,8 @@ use std::f64::consts::PI;
 
 use rand::distr::Distribution;
 
-use crate::weights::{ONE_MINUS_EPSILON, checked_total, unit_f64};
+use crate::uniform::{ONE_MINUS_EPSILON, unit_f64};
+use crate::weights::checked_total;
 use crate::{DiscreteSampler, Error, GuideTable, InvertibleSampler};
 
 /// A point drawn from a [`Distribution2D`].

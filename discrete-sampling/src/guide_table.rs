@@ -7,14 +7,20 @@
 //! looks up the cell of `u` in constant time and bisects only inside
 //! `[C_k^begin, C_{k+1}^begin]`, which for `m ≈ 4 n` is one or two entries.
 //!
-//! The cell of a value is computed by one function, [`cell_of`], both when the
-//! table is built and when it is searched. Because that function is monotone
-//! in floating point, the answer always lies inside the stored range, with no
-//! exactness argument about `k / m` in binary needed.
+//! The cell of a value `x ∈ [0, 1]` is `(⌊x · 2⁶⁴⌋ · m) >> 64`, one integer
+//! function ([`cell_of_bits`]) used both when the table is built (on CDF
+//! values) and when it is searched (on the variate). Because it is monotone,
+//! the answer always lies inside the stored range, with no exactness
+//! argument about `k / m` in binary needed; and because it is integer
+//! arithmetic, a draw whose cell holds a single entry never converts to or
+//! compares floating point at all.
 
 use rand::distr::Distribution;
 
-use crate::weights::{clamp_unit, normalized_cdf, remap, unit_f64};
+use crate::uniform::{
+    bits_to_unit, clamp_unit, fill_batch, remap, scale_bits, unit_to_bits, variate_bits,
+};
+use crate::weights::normalized_cdf;
 use crate::{DiscreteSampler, Error, InvertibleSampler};
 
 /// Cells per CDF entry used by [`GuideTable::new`].
@@ -71,20 +77,24 @@ const CHUNK_CELLS: usize = 1 << 16;
 pub struct GuideTable {
     /// `cdf[0] = 0`, `cdf[i + 1]` = mass of `0..=i`, `cdf[n] = 1`.
     cdf: Vec<f64>,
-    /// `table[k]` = first entry `i` with `cell_of(cdf[i + 1]) >= k`;
+    /// `table[k]` = first entry `i` with `cell_of_value(cdf[i + 1]) >= k`;
     /// `table[m] = n - 1`.
     table: Vec<u32>,
-    /// Number of cells `m`, as `f64` for the lookup.
-    cells: f64,
-    /// `m - 1`.
-    last_cell: usize,
+    /// Number of cells `m`.
+    cells: u64,
 }
 
-/// The cell of a CDF value or variate. Monotone in `x`, which is all the
-/// search needs.
+/// The cell of a value from its bits `⌊x · 2⁶⁴⌋`. Monotone, which is all the
+/// search needs; always below `cells`.
 #[inline]
-fn cell_of(x: f64, cells: f64, last_cell: usize) -> usize {
-    ((x * cells) as usize).min(last_cell)
+fn cell_of_bits(bits: u64, cells: u64) -> usize {
+    scale_bits(bits, cells).0
+}
+
+/// The cell of a CDF value in `[0, 1]` (1 saturates into the last cell).
+#[inline]
+fn cell_of_value(x: f64, cells: u64) -> usize {
+    cell_of_bits((x * 18_446_744_073_709_551_616.0) as u64, cells)
 }
 
 impl GuideTable {
@@ -120,14 +130,13 @@ impl GuideTable {
         Self {
             cdf,
             table,
-            cells: cells as f64,
-            last_cell: cells - 1,
+            cells: cells as u64,
         }
     }
 
     /// Number of lookup-table cells.
     pub fn cells(&self) -> usize {
-        self.last_cell + 1
+        self.table.len() - 1
     }
 
     /// The normalised CDF, `len() + 1` values from 0 to 1.
@@ -140,25 +149,51 @@ impl GuideTable {
         self.cdf.len() * size_of::<f64>() + self.table.len() * size_of::<u32>()
     }
 
-    /// The index for a `u` already in `[0, 1)`: the first `i` with
-    /// `cdf[i + 1] > u`.
+    /// The index of a variate given by its bits (`u = bits · 2⁻⁶⁴`): the
+    /// first `i` with `cdf[i + 1] > u`.
+    #[inline]
+    fn search_bits(&self, bits: u64) -> usize {
+        let k = cell_of_bits(bits, self.cells);
+        // The answer lies in [lo, hi] (see the module docs). Most draws land
+        // in a cell inside one entry's interval (1 + 1/ratio candidates on
+        // average): answered from the table alone, without touching the CDF.
+        let lo = self.table[k] as usize;
+        let hi = self.table[k + 1] as usize;
+        if lo == hi {
+            return lo;
+        }
+        self.search_between(bits_to_unit(bits), lo, hi)
+    }
+
+    /// The index of a caller's variate `u`, already clamped to `[0, 1)`.
     #[inline]
     fn search(&self, u: f64) -> usize {
-        let k = cell_of(u, self.cells, self.last_cell);
-        // The answer lies in [lo, hi] (see the module docs), and
-        // cdf[hi + 1] > u.
-        let mut lo = self.table[k] as usize;
-        let mut hi = self.table[k + 1] as usize;
-        while hi - lo > 1 {
-            let mid = lo + (hi - lo) / 2;
-            if self.cdf[mid + 1] > u {
-                hi = mid;
-            } else {
-                lo = mid + 1;
-            }
+        let k = cell_of_bits(unit_to_bits(u), self.cells);
+        let lo = self.table[k] as usize;
+        let hi = self.table[k + 1] as usize;
+        if lo == hi {
+            return lo;
         }
-        // One or two candidates left; choose without a branch.
-        lo + usize::from(self.cdf[lo + 1] <= u)
+        self.search_between(u, lo, hi)
+    }
+
+    /// The answer among `lo..=hi` (`lo < hi`), knowing `cdf[hi + 1] > u`.
+    #[inline]
+    fn search_between(&self, u: f64, lo: usize, hi: usize) -> usize {
+        // Bisection with a branch-free step (the comparison is a coin flip
+        // the predictor cannot learn); its trip count depends on the range
+        // only. The candidates are base..base + size.
+        let mut base = lo;
+        let mut size = hi - lo + 1;
+        while size > 1 {
+            let half = size / 2;
+            // Entry base + half - 1 ends at cdf[base + half]; if that is <= u
+            // the answer is at or after base + half.
+            let step = usize::from(self.cdf[base + half] <= u).wrapping_neg() & half;
+            base += step;
+            size -= half;
+        }
+        base
     }
 }
 
@@ -180,21 +215,29 @@ fn fill_table(cdf: &[f64], table: &mut [u32]) {
 }
 
 /// Fills the cells `first_cell..first_cell + part.len()` of a table with
-/// `cells` cells by one sweep over the CDF.
+/// `cells` cells in one sweep over the CDF: entry `i` becomes the answer of
+/// every cell not yet filled up to and including its own cell.
 fn fill_cells(cdf: &[f64], cells: usize, first_cell: usize, part: &mut [u32]) {
     let n = cdf.len() - 1;
-    let steps = &cdf[1..];
-    let (cells_f, last_cell) = (cells as f64, cells - 1);
-    // The first entry whose cell is at least `first_cell` (entry n - 1 has
-    // cdf = 1, the last cell, so this never runs past the end).
-    let mut i = steps[..n - 1].partition_point(|&c| cell_of(c, cells_f, last_cell) < first_cell);
-    for (offset, slot) in part.iter_mut().enumerate() {
-        let k = first_cell + offset;
-        while i < n - 1 && cell_of(steps[i], cells_f, last_cell) < k {
-            i += 1;
+    let steps = &cdf[1..n];
+    let m = cells as u64;
+    let end_cell = first_cell + part.len();
+    // The first entry whose cell is at least `first_cell`.
+    let start = steps.partition_point(|&c| cell_of_value(c, m) < first_cell);
+    let mut k = first_cell;
+    for (i, &c) in steps.iter().enumerate().skip(start) {
+        let cell = cell_of_value(c, m).min(end_cell - 1);
+        while k <= cell {
+            part[k - first_cell] = i as u32;
+            k += 1;
         }
-        *slot = i as u32;
+        if k == end_cell {
+            return;
+        }
     }
+    // Cells after the last step belong to the last entry (cdf[n] = 1 lies
+    // in the last cell).
+    part[k - first_cell..].fill((n - 1) as u32);
 }
 
 impl DiscreteSampler for GuideTable {
@@ -226,7 +269,11 @@ impl DiscreteSampler for GuideTable {
 
     #[inline]
     fn sample_rng<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> usize {
-        self.search(unit_f64(rng))
+        self.search_bits(variate_bits(rng.next_u64()))
+    }
+
+    fn sample_into<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [usize]) {
+        fill_batch(rng, out, |bits| self.search_bits(bits));
     }
 }
 
@@ -264,10 +311,13 @@ mod tests {
             let g = GuideTable::with_ratio(&weights, ratio).unwrap();
             for j in 0..20_000 {
                 let u = j as f64 / 20_000.0;
-                let k = cell_of(u, g.cells, g.last_cell);
+                let k = cell_of_bits(unit_to_bits(u), g.cells);
                 let answer = g.cdf[1..].partition_point(|&c| c <= u);
                 assert!(g.table[k] as usize <= answer && answer <= g.table[k + 1] as usize);
                 assert_eq!(g.search(u), answer);
+                if bits_to_unit(unit_to_bits(u)) == u {
+                    assert_eq!(g.search_bits(unit_to_bits(u)), answer);
+                }
             }
         }
     }

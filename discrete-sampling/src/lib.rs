@@ -83,6 +83,7 @@ mod dist2d;
 mod error;
 mod guide_table;
 mod sampler;
+mod uniform;
 mod weights;
 
 pub use alias::AliasTable;

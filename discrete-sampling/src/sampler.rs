@@ -1,7 +1,7 @@
 //! The interface shared by the 1D samplers.
 
 use crate::Error;
-use crate::weights::{clamp_unit, unit_f64};
+use crate::uniform::{bits_to_unit, clamp_unit, fill_batch, unit_f64};
 
 /// A discrete distribution over `0..len()` that can be sampled by inversion
 /// of a uniform variate.
@@ -49,11 +49,12 @@ pub trait DiscreteSampler: Sized {
         self.sample_u(clamp_unit(unit_f64(rng)))
     }
 
-    /// Fills `out` with independent draws, one `u64` of `rng` each.
+    /// Fills `out` with independent draws, one `u64` of `rng` each, the
+    /// same draws as calling [`sample_rng`](Self::sample_rng) in a loop but
+    /// faster: the random numbers are generated ahead in small blocks and
+    /// the searches overlap.
     fn sample_into<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [usize]) {
-        for slot in out {
-            *slot = self.sample_rng(rng);
-        }
+        fill_batch(rng, out, |bits| self.sample_u(bits_to_unit(bits)));
     }
 }
 

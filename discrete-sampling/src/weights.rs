@@ -6,25 +6,6 @@ use crate::Error;
 /// Largest number of entries: tables store indices as `u32`.
 pub(crate) const MAX_ENTRIES: usize = u32::MAX as usize;
 
-/// The largest `f64` below one; uniform variates are clamped to it.
-pub(crate) const ONE_MINUS_EPSILON: f64 = 1.0 - f64::EPSILON / 2.0;
-
-/// Clamps a caller's variate into `[0, 1)`; NaN becomes 0.
-#[inline]
-#[expect(clippy::manual_clamp, reason = "max maps NaN to 0; clamp keeps NaN")]
-pub(crate) fn clamp_unit(u: f64) -> f64 {
-    u.max(0.0).min(ONE_MINUS_EPSILON)
-}
-
-/// A uniform `f64` in `[0, 1)` from the top 53 bits of one `u64`.
-///
-/// Defined here rather than taken from `rand` so that a fixed seed gives the
-/// same samples whatever `rand` version the caller links.
-#[inline]
-pub(crate) fn unit_f64<R: rand::Rng + ?Sized>(rng: &mut R) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-}
-
 /// Checks every weight and returns their sum, accumulated in `f64`.
 ///
 /// # Errors
@@ -74,21 +55,24 @@ pub(crate) fn normalized_cdf<W: Copy + Into<f64>>(weights: &[W]) -> Result<Vec<f
     let total = checked_total(weights)?;
     let mut cdf = Vec::with_capacity(weights.len() + 1);
     cdf.push(0.0);
+    let scale = 1.0 / total;
     let mut running = 0.0f64;
     for &w in weights {
         running += w.into();
-        // Division (not multiplication by 1/total) keeps the last value at
-        // exactly 1: x / x == 1 in IEEE arithmetic.
-        cdf.push(running / total);
+        cdf.push(running * scale);
     }
-    debug_assert_eq!(cdf[weights.len()], 1.0);
+    // `total * (1 / total)` may miss 1 by an ulp. Every value equal to the
+    // last one (the trailing zero weights and whatever rounds alike) becomes
+    // exactly 1; the values before it are at most the float below 1, so the
+    // CDF stays monotone.
+    let last = cdf[weights.len()];
+    for c in cdf.iter_mut().rev() {
+        if *c != last {
+            break;
+        }
+        *c = 1.0;
+    }
     Ok(cdf)
-}
-
-/// Position of `u` inside the interval `[lo, hi)`, kept in `[0, 1)`.
-#[inline]
-pub(crate) fn remap(u: f64, lo: f64, hi: f64) -> f64 {
-    ((u - lo) / (hi - lo)).min(ONE_MINUS_EPSILON)
 }
 
 #[cfg(test)]
@@ -135,13 +119,5 @@ mod tests {
         assert_eq!(cdf[1], cdf[2]);
         assert_eq!(cdf[3], 1.0);
         assert_eq!(cdf[5], 1.0);
-    }
-
-    #[test]
-    fn clamp_unit_keeps_variates_below_one() {
-        assert_eq!(clamp_unit(f64::NAN), 0.0);
-        assert_eq!(clamp_unit(-3.0), 0.0);
-        assert!(clamp_unit(1.0) < 1.0);
-        assert_eq!(clamp_unit(0.25), 0.25);
     }
 }
