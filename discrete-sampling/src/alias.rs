@@ -22,17 +22,33 @@ const NIL: u32 = u32::MAX;
 /// `2⁶⁴` as `f64`.
 const TWO_POW_64: f64 = 18_446_744_073_709_551_616.0;
 
-/// A column's share `t` in 64-bit fixed point (`t ≥ 1` saturates to a full
-/// column, `t ≤ 0` to an empty one).
+/// A column's share `t` in 64-bit fixed point, truncated to a multiple of
+/// `2⁻⁶³`; `t ≥ 1` gives a full column minus `2⁻⁶³`, `t ≤ 0` an empty one.
+///
+/// Through `i64`: one signed conversion, where `as u64` needs a branch on
+/// `2⁶³` that is a coin flip between small and large entries.
 #[inline]
 fn fixed_threshold(t: f64) -> u64 {
-    (t * TWO_POW_64) as u64
+    const TWO_POW_63: f64 = 9_223_372_036_854_775_808.0;
+    ((t.min(1.0) * TWO_POW_63) as i64 as u64) << 1
 }
 
-/// A fixed-point threshold as a fraction of the column.
+/// The index of the largest value (the first of equals).
+fn index_of_max(values: &[f64]) -> usize {
+    let mut best = 0;
+    for (i, &v) in values.iter().enumerate() {
+        if v > values[best] {
+            best = i;
+        }
+    }
+    best
+}
+
+/// A fixed-point threshold as a fraction of the column (exact for every
+/// value [`fixed_threshold`] makes, whose lowest bit is zero).
 #[inline]
 fn threshold_fraction(threshold: u64) -> f64 {
-    threshold as f64 / TWO_POW_64
+    (threshold >> 1) as i64 as f64 * (2.0 / TWO_POW_64)
 }
 
 /// A discrete distribution sampled in constant time by Walker's alias
@@ -95,35 +111,32 @@ impl AliasTable {
         let total = checked_total(weights)?;
         let n = weights.len();
         let (inv_total, n_f) = (1.0 / total, n as f64);
+        let probabilities: Vec<f64> = weights.iter().map(|&w| w.into() * inv_total).collect();
 
         // Shares scaled to mean 1: entries below 1 are "small" and give the
         // rest of their column to a "large" one. A small entry's threshold is
         // final when it is classified; both lists are threaded through the
-        // alias fields, which are free until an entry is settled.
-        let mut probabilities = Vec::with_capacity(n);
+        // alias fields, which are free until an entry is settled. The
+        // classification is a select, not a branch: small and large entries
+        // alternate unpredictably.
+        let (mut small_head, mut large_head) = (NIL, NIL);
         let mut columns = Vec::with_capacity(n);
-        let mut heads = [NIL, NIL]; // [large, small]
-        let (mut heaviest, mut heaviest_w) = (0usize, f64::NEG_INFINITY);
-        for (i, &w) in weights.iter().enumerate() {
-            let w: f64 = w.into();
-            let p = w * inv_total;
-            probabilities.push(p);
-            if w > heaviest_w {
-                (heaviest, heaviest_w) = (i, w);
-            }
+        columns.extend(probabilities.iter().enumerate().map(|(i, &p)| {
             let scaled = p * n_f;
-            let list = usize::from(scaled < 1.0); // indexing, not a branch
-            columns.push(Column {
+            let is_small = scaled < 1.0;
+            let next = if is_small { small_head } else { large_head };
+            small_head = if is_small { i as u32 } else { small_head };
+            large_head = if is_small { large_head } else { i as u32 };
+            Column {
                 threshold: fixed_threshold(scaled),
-                alias: heads[list],
-            });
-            heads[list] = i as u32;
-        }
+                alias: next,
+            }
+        }));
 
         // Vose's pairing. Only the large entry at the head of its list has a
         // changing remainder, kept here in f64; it is charged exactly the
         // rounded share each donor keeps, so rounding is not lost.
-        let [mut large, mut small] = heads;
+        let (mut large, mut small) = (large_head, small_head);
         let mut rest = if large == NIL {
             0.0
         } else {
@@ -152,14 +165,16 @@ impl AliasTable {
         // What is left is full columns up to rounding: threshold 1, alias
         // itself. A zero weight can only be left over through rounding; it
         // must still never be drawn, so it hands its column to the heaviest.
+        let mut heaviest = None;
         for mut i in [small, large] {
             while i != NIL {
                 let at = i as usize;
                 i = columns[at].alias;
                 columns[at] = if probabilities[at] == 0.0 {
+                    let to = *heaviest.get_or_insert_with(|| index_of_max(&probabilities));
                     Column {
                         threshold: 0,
-                        alias: heaviest as u32,
+                        alias: to as u32,
                     }
                 } else {
                     Column {

@@ -30,7 +30,9 @@ pub(crate) fn variate_bits(x: u64) -> u64 {
 /// The `f64` value of variate bits (exact: at most 53 significant bits).
 #[inline]
 pub(crate) fn bits_to_unit(bits: u64) -> f64 {
-    bits as f64 * TWO_POW_MINUS_64
+    // Through i64: one signed conversion, where `u64 as f64` needs several
+    // instructions on x86-64. Same value: the low 11 bits are zero.
+    (bits >> 11) as i64 as f64 * (TWO_POW_MINUS_64 * 2048.0)
 }
 
 /// The bits of a caller's variate: `⌊u · 2⁶⁴⌋` of `u` clamped to `[0, 1)`.

@@ -21,20 +21,18 @@ pub(crate) fn checked_total<W: Copy + Into<f64>>(weights: &[W]) -> Result<f64, E
             max: MAX_ENTRIES,
         });
     }
+    // Fast path without early exit: the checks fold into one flag, so the
+    // loop is the sum's dependency chain and nothing else. Only a bad input
+    // pays for the second pass that finds and names the first offender.
     let mut total = 0.0f64;
-    for (index, &w) in weights.iter().enumerate() {
+    let mut all_valid = true;
+    for &w in weights {
         let w: f64 = w.into();
-        // One comparison covers the common case; the slow path says why.
-        if !(0.0..f64::INFINITY).contains(&w) {
-            return Err(if w.is_nan() {
-                Error::NaN { index }
-            } else if w.is_infinite() {
-                Error::Infinite { index, value: w }
-            } else {
-                Error::Negative { index, value: w }
-            });
-        }
+        all_valid &= (0.0..f64::INFINITY).contains(&w);
         total += w;
+    }
+    if !all_valid {
+        return Err(first_invalid(weights));
     }
     if total == f64::INFINITY {
         return Err(Error::TotalOverflow);
@@ -43,6 +41,24 @@ pub(crate) fn checked_total<W: Copy + Into<f64>>(weights: &[W]) -> Result<f64, E
         return Err(Error::AllZero { len: weights.len() });
     }
     Ok(total)
+}
+
+/// The error for the first NaN, infinite or negative weight (there is one).
+#[cold]
+fn first_invalid<W: Copy + Into<f64>>(weights: &[W]) -> Error {
+    for (index, &w) in weights.iter().enumerate() {
+        let w: f64 = w.into();
+        if w.is_nan() {
+            return Error::NaN { index };
+        }
+        if w.is_infinite() {
+            return Error::Infinite { index, value: w };
+        }
+        if w < 0.0 {
+            return Error::Negative { index, value: w };
+        }
+    }
+    unreachable!("first_invalid is only called when a weight is invalid")
 }
 
 /// The normalised CDF with a leading zero: `cdf[0] = 0`, `cdf[i + 1]` is the
