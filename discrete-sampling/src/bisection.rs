@@ -77,6 +77,7 @@ impl DiscreteSampler for CdfBisection {
         }
     }
 
+    #[inline]
     fn sample_remapped(&self, u: f64) -> (usize, f64) {
         let u = clamp_unit(u);
         let i = self.search(u);

@@ -7,7 +7,8 @@
 //! looks up the cell of `u` in constant time and bisects only inside
 //! `[C_k^begin, C_{k+1}^begin]`, which for `m ≈ 4 n` is one or two entries.
 //!
-//! The cell of a value `x ∈ [0, 1]` is `(⌊x · 2⁶⁴⌋ · m) >> 64`, one integer
+//! The cell of a value `x ∈ [0, 1]` is `(bits(x) · m) >> 64` with
+//! `bits(x) = 2 ⌊x · 2⁶³⌋` (exactly the 53 bits of a variate), one integer
 //! function ([`cell_of_bits`]) used both when the table is built (on CDF
 //! values) and when it is searched (on the variate). Because it is monotone,
 //! the answer always lies inside the stored range, with no exactness
@@ -18,7 +19,7 @@
 use rand::distr::Distribution;
 
 use crate::uniform::{
-    bits_to_unit, clamp_unit, fill_batch, remap, scale_bits, unit_to_bits, variate_bits,
+    bits_to_unit, clamp_unit, fill_batch, remap, scale_bits, value_bits, variate_bits,
 };
 use crate::weights::normalized_cdf;
 use crate::{DiscreteSampler, Error, InvertibleSampler};
@@ -98,10 +99,10 @@ fn cell_of_bits(bits: u64, cells: u64) -> usize {
     scale_bits(bits, cells).0
 }
 
-/// The cell of a CDF value in `[0, 1]` (1 saturates into the last cell).
+/// The cell of a CDF value in `[0, 1]` (1 falls into the last cell).
 #[inline]
 fn cell_of_value(x: f64, cells: u64) -> usize {
-    cell_of_bits((x * 18_446_744_073_709_551_616.0) as u64, cells)
+    cell_of_bits(value_bits(x), cells)
 }
 
 impl GuideTable {
@@ -158,9 +159,11 @@ impl GuideTable {
     }
 
     /// The index of a variate given by its bits (`u = bits · 2⁻⁶⁴`): the
-    /// first `i` with `cdf[i + 1] > u`.
+    /// first `i` with `cdf[i + 1] > u`. `unit` gives `u` itself; it is only
+    /// called when the CDF must be compared, so the random-number path never
+    /// converts a draw answered by the table alone.
     #[inline]
-    fn search_bits(&self, bits: u64) -> usize {
+    fn search_with(&self, bits: u64, unit: impl Fn() -> f64) -> usize {
         let k = cell_of_bits(bits, self.cells);
         // The answer lies in [lo, hi] (see the module docs); there are
         // 1 + 1/ratio candidates on average.
@@ -172,26 +175,26 @@ impl GuideTable {
             // mispredicting which case this is. With one candidate,
             // cdf[lo + 1] > u holds and nothing is added.
             if hi - lo <= 1 {
-                return lo + usize::from(self.cdf[lo + 1] <= bits_to_unit(bits));
+                return lo + usize::from(self.cdf[lo + 1] <= unit());
             }
         } else if lo == hi {
             // A cell inside one entry's interval: answered from the table
             // alone, without a second cache miss on the CDF.
             return lo;
         }
-        self.search_between(bits_to_unit(bits), lo, hi)
+        self.search_between(unit(), lo, hi)
+    }
+
+    /// The index of variate bits from the random-number path.
+    #[inline]
+    fn search_bits(&self, bits: u64) -> usize {
+        self.search_with(bits, || bits_to_unit(bits))
     }
 
     /// The index of a caller's variate `u`, already clamped to `[0, 1)`.
     #[inline]
     fn search(&self, u: f64) -> usize {
-        let k = cell_of_bits(unit_to_bits(u), self.cells);
-        let lo = self.table[k] as usize;
-        let hi = self.table[k + 1] as usize;
-        if lo == hi {
-            return lo;
-        }
-        self.search_between(u, lo, hi)
+        self.search_with(value_bits(u), || u)
     }
 
     /// The answer among `lo..=hi` (`lo < hi`), knowing `cdf[hi + 1] > u`.
@@ -232,29 +235,32 @@ fn fill_table(cdf: &[f64], table: &mut [u32]) {
 }
 
 /// Fills the cells `first_cell..first_cell + part.len()` of a table with
-/// `cells` cells in one sweep over the CDF: entry `i` becomes the answer of
-/// every cell not yet filled up to and including its own cell.
+/// `cells` cells.
+///
+/// `table[k]`, the first entry whose cell is at least `k`, is also the number
+/// of entries whose cell is below `k`, because cells grow with the index. So
+/// the fill is a histogram of the entries' cells and a prefix sum, both
+/// sequential passes.
 fn fill_cells(cdf: &[f64], cells: usize, first_cell: usize, part: &mut [u32]) {
     let n = cdf.len() - 1;
+    // The last entry ends at 1 and bounds every cell; it is never counted.
     let steps = &cdf[1..n];
     let m = cells as u64;
     let end_cell = first_cell + part.len();
-    // The first entry whose cell is at least `first_cell`.
     let start = steps.partition_point(|&c| cell_of_value(c, m) < first_cell);
-    let mut k = first_cell;
-    for (i, &c) in steps.iter().enumerate().skip(start) {
-        let cell = cell_of_value(c, m).min(end_cell - 1);
-        if cell >= k {
-            part[k - first_cell..=cell - first_cell].fill(i as u32);
-            k = cell + 1;
-            if k == end_cell {
-                return;
-            }
+    part.fill(0);
+    for &c in &steps[start..] {
+        let cell = cell_of_value(c, m);
+        if cell + 1 >= end_cell {
+            break;
         }
+        part[cell + 1 - first_cell] += 1;
     }
-    // Cells after the last step belong to the last entry (cdf[n] = 1 lies
-    // in the last cell).
-    part[k - first_cell..].fill((n - 1) as u32);
+    let mut below = start as u32;
+    for slot in part.iter_mut() {
+        below += *slot;
+        *slot = below;
+    }
 }
 
 impl DiscreteSampler for GuideTable {
@@ -274,6 +280,7 @@ impl DiscreteSampler for GuideTable {
         }
     }
 
+    #[inline]
     fn sample_remapped(&self, u: f64) -> (usize, f64) {
         let u = clamp_unit(u);
         let i = self.search(u);
@@ -310,6 +317,7 @@ impl Distribution<usize> for GuideTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::uniform::unit_to_bits;
 
     /// The table invariant, checked directly: every `u` in cell `k` has its
     /// answer inside `[table[k], table[k + 1]]`.
