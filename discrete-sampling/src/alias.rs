@@ -45,10 +45,10 @@ fn index_of_max(values: &[f64]) -> usize {
 }
 
 /// A fixed-point threshold as a fraction of the column (exact for every
-/// value [`fixed_threshold`] makes, whose lowest bit is zero).
+/// value [`fixed_threshold`] makes: it has at most 53 significant bits).
 #[inline]
 fn threshold_fraction(threshold: u64) -> f64 {
-    (threshold >> 1) as i64 as f64 * (2.0 / TWO_POW_64)
+    threshold as f64 / TWO_POW_64
 }
 
 /// A discrete distribution sampled in constant time by Walker's alias
