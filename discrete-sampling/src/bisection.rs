@@ -3,8 +3,8 @@
 
 use rand::distr::Distribution;
 
-use crate::uniform::{bits_to_unit, clamp_unit, fill_batch, remap, unit_f64};
-use crate::weights::normalized_cdf;
+use crate::cdf::Cdf;
+use crate::uniform::{bits_to_unit, clamp_unit, fill_batch, unit_f64};
 use crate::{DiscreteSampler, Error, InvertibleSampler};
 
 /// A discrete distribution sampled by binary search in its `f64` CDF.
@@ -28,7 +28,7 @@ use crate::{DiscreteSampler, Error, InvertibleSampler};
 #[derive(Debug, Clone, PartialEq)]
 pub struct CdfBisection {
     /// `cdf[0] = 0`, `cdf[i + 1]` = mass of `0..=i`, `cdf[n] = 1`.
-    cdf: Vec<f64>,
+    cdf: Cdf,
 }
 
 impl CdfBisection {
@@ -38,7 +38,7 @@ impl CdfBisection {
     /// See [`Error`]: empty, NaN, infinite, negative or all-zero weights.
     pub fn new<W: Copy + Into<f64>>(weights: &[W]) -> Result<Self, Error> {
         Ok(Self {
-            cdf: normalized_cdf(weights)?,
+            cdf: Cdf::new(weights)?,
         })
     }
 
@@ -66,22 +66,17 @@ impl DiscreteSampler for CdfBisection {
     }
 
     fn len(&self) -> usize {
-        self.cdf.len() - 1
+        self.cdf.entries()
     }
 
     fn pdf(&self, index: usize) -> f64 {
-        if index < self.len() {
-            self.cdf[index + 1] - self.cdf[index]
-        } else {
-            0.0
-        }
+        self.cdf.pdf(index)
     }
 
     #[inline]
     fn sample_remapped(&self, u: f64) -> (usize, f64) {
         let u = clamp_unit(u);
-        let i = self.search(u);
-        (i, remap(u, self.cdf[i], self.cdf[i + 1]))
+        self.cdf.remapped(self.search(u), u)
     }
 
     fn sample_u(&self, u: f64) -> usize {
@@ -100,7 +95,7 @@ impl DiscreteSampler for CdfBisection {
 
 impl InvertibleSampler for CdfBisection {
     fn invert(&self, index: usize) -> Option<f64> {
-        (self.pdf(index) > 0.0).then(|| self.cdf[index])
+        self.cdf.invert(index)
     }
 }
 

@@ -18,10 +18,8 @@
 
 use rand::distr::Distribution;
 
-use crate::uniform::{
-    bits_to_unit, clamp_unit, fill_batch, remap, scale_bits, value_bits, variate_bits,
-};
-use crate::weights::normalized_cdf;
+use crate::cdf::Cdf;
+use crate::uniform::{bits_to_unit, clamp_unit, fill_batch, scale_bits, value_bits, variate_bits};
 use crate::{DiscreteSampler, Error, InvertibleSampler};
 
 /// Cells per CDF entry used by [`GuideTable::new`].
@@ -79,7 +77,7 @@ const CHUNK_CELLS: usize = 1 << 16;
 #[derive(Debug, Clone, PartialEq)]
 pub struct GuideTable {
     /// `cdf[0] = 0`, `cdf[i + 1]` = mass of `0..=i`, `cdf[n] = 1`.
-    cdf: Vec<f64>,
+    cdf: Cdf,
     /// `table[k]` = first entry `i` with `cell_of_value(cdf[i + 1]) >= k`;
     /// `table[m] = n - 1`.
     table: Vec<u32>,
@@ -126,12 +124,11 @@ impl GuideTable {
         if !(ratio > 0.0 && ratio.is_finite()) {
             return Err(Error::InvalidRatio { ratio });
         }
-        let cdf = normalized_cdf(weights)?;
-        Ok(Self::from_cdf(cdf, ratio))
+        Ok(Self::from_cdf(Cdf::new(weights)?, ratio))
     }
 
     /// Builds the table over an already validated, normalised CDF.
-    pub(crate) fn from_cdf(cdf: Vec<f64>, ratio: f64) -> Self {
+    fn from_cdf(cdf: Cdf, ratio: f64) -> Self {
         let n = cdf.len() - 1;
         let cells = ((n as f64 * ratio).round() as usize).clamp(1, MAX_CELLS);
         let mut table = vec![0u32; cells + 1];
@@ -271,22 +268,17 @@ impl DiscreteSampler for GuideTable {
     }
 
     fn len(&self) -> usize {
-        self.cdf.len() - 1
+        self.cdf.entries()
     }
 
     fn pdf(&self, index: usize) -> f64 {
-        if index < self.len() {
-            self.cdf[index + 1] - self.cdf[index]
-        } else {
-            0.0
-        }
+        self.cdf.pdf(index)
     }
 
     #[inline]
     fn sample_remapped(&self, u: f64) -> (usize, f64) {
         let u = clamp_unit(u);
-        let i = self.search(u);
-        (i, remap(u, self.cdf[i], self.cdf[i + 1]))
+        self.cdf.remapped(self.search(u), u)
     }
 
     fn sample_u(&self, u: f64) -> usize {
@@ -305,7 +297,7 @@ impl DiscreteSampler for GuideTable {
 
 impl InvertibleSampler for GuideTable {
     fn invert(&self, index: usize) -> Option<f64> {
-        (self.pdf(index) > 0.0).then(|| self.cdf[index])
+        self.cdf.invert(index)
     }
 }
 
@@ -370,7 +362,7 @@ mod tests {
     #[test]
     fn parallel_fill_equals_serial() {
         let weights: Vec<f64> = (0..400_000).map(|i| ((i % 1000) as f64).powi(2)).collect();
-        let cdf = normalized_cdf(&weights).unwrap();
+        let cdf = Cdf::new(&weights).unwrap();
         let cells = 3 * PARALLEL_CELLS / 2;
         let mut parallel = vec![0u32; cells];
         fill_table(&cdf, &mut parallel);

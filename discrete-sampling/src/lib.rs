@@ -79,6 +79,7 @@
 
 mod alias;
 mod bisection;
+mod cdf;
 mod dist2d;
 mod error;
 mod guide_table;

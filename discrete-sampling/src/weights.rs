@@ -1,5 +1,4 @@
-//! Validation of weights and the normalised cumulative distribution every
-//! sampler starts from.
+//! Validation of weights: the first pass of every constructor.
 
 use crate::Error;
 
@@ -61,36 +60,6 @@ fn first_invalid<W: Copy + Into<f64>>(weights: &[W]) -> Error {
     unreachable!("first_invalid is only called when a weight is invalid")
 }
 
-/// The normalised CDF with a leading zero: `cdf[0] = 0`, `cdf[i + 1]` is the
-/// mass of entries `0..=i`, and `cdf[n] = 1` exactly.
-///
-/// Sums are accumulated and stored in `f64`: in `f32` a dim entry added to a
-/// large running sum is rounded away and becomes unreachable. A zero weight
-/// gives two equal neighbours, an empty interval that no variate falls into.
-pub(crate) fn normalized_cdf<W: Copy + Into<f64>>(weights: &[W]) -> Result<Vec<f64>, Error> {
-    let total = checked_total(weights)?;
-    let mut cdf = Vec::with_capacity(weights.len() + 1);
-    cdf.push(0.0);
-    let scale = 1.0 / total;
-    let mut running = 0.0f64;
-    for &w in weights {
-        running += w.into();
-        cdf.push(running * scale);
-    }
-    // `total * (1 / total)` may miss 1 by an ulp. Every value equal to the
-    // last one (the trailing zero weights and whatever rounds alike) becomes
-    // exactly 1; the values before it are at most the float below 1, so the
-    // CDF stays monotone.
-    let last = cdf[weights.len()];
-    for c in cdf.iter_mut().rev() {
-        if *c != last {
-            break;
-        }
-        *c = 1.0;
-    }
-    Ok(cdf)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -125,15 +94,5 @@ mod tests {
             Err(Error::TotalOverflow)
         );
         assert_eq!(checked_total(&[1u32, 2, 3]), Ok(6.0));
-    }
-
-    #[test]
-    fn cdf_is_exactly_one_at_the_end_and_flat_over_zeros() {
-        let cdf = normalized_cdf(&[0.1f32, 0.0, 0.7, 0.0, 0.0]).unwrap();
-        assert_eq!(cdf.len(), 6);
-        assert_eq!(cdf[0], 0.0);
-        assert_eq!(cdf[1], cdf[2]);
-        assert_eq!(cdf[3], 1.0);
-        assert_eq!(cdf[5], 1.0);
     }
 }
