@@ -141,3 +141,30 @@ fn equirect_map_of_constant_radiance_is_uniform_over_the_sphere() {
     assert!((equirect_direction([0.0, 0.0])[2] - 1.0).abs() < 1e-12);
     assert_eq!(pdf_solid_angle(1.0, [0.5, 0.0]), 0.0);
 }
+
+#[test]
+fn alias_rows_give_the_same_distribution() {
+    // The alias method scrambles the order of u, so points differ from the
+    // guide table's, but cells must still follow the image.
+    let img = image();
+    let d = Distribution2D::<discrete_sampling::AliasTable>::with_sampler(&img, W, H).unwrap();
+    let mut rng = Pcg64Mcg::seed_from_u64(5);
+    let mut counts = vec![0u64; W * H];
+    let mut batch = vec![
+        Sample2D {
+            point: [0.0; 2],
+            cell: [0; 2],
+            pdf: 0.0
+        };
+        1000
+    ];
+    for _ in 0..500 {
+        d.sample_into(&mut rng, &mut batch);
+        for s in &batch {
+            counts[s.cell[1] * W + s.cell[0]] += 1;
+            assert_eq!(d.pdf(s.point), s.pdf);
+        }
+    }
+    let test = chi_square(&counts, &probabilities(&img), 20.0);
+    assert!(test.p_value > 1e-3, "alias rows: p = {:.2e}", test.p_value);
+}
