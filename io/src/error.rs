@@ -1,0 +1,132 @@
+//! The one error type of this crate: what went wrong, in which file, where.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Where in a file an error was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Location {
+    /// A 1-based line of a text file.
+    Line(usize),
+    /// A byte offset into a binary file or section.
+    Byte(usize),
+}
+
+impl fmt::Display for Location {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Location::Line(line) => write!(f, "line {line}"),
+            Location::Byte(offset) => write!(f, "byte {offset}"),
+        }
+    }
+}
+
+/// What was wrong.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ErrorKind {
+    /// The file could not be opened, read or written.
+    #[error("{0}")]
+    Io(#[source] std::io::Error),
+    /// The extension names no format this crate reads or writes.
+    #[error("unknown extension {0:?} (expected one of {1})")]
+    UnknownExtension(String, &'static str),
+    /// The data ends before a declared record or section does.
+    #[error("the file ends early: expected {0}")]
+    Truncated(String),
+    /// A token or record is not what the format allows here.
+    #[error("expected {expected}, found {found:?}")]
+    Syntax {
+        /// What the format requires at this point.
+        expected: String,
+        /// What the file has (shortened).
+        found: String,
+    },
+    /// A header declares more records than the rest of the file can hold;
+    /// refused before anything is allocated.
+    #[error(
+        "the header declares {declared} {what}, but the {bytes_left} bytes left can hold at most {fit}"
+    )]
+    CountTooLarge {
+        /// What is counted ("nodes", "tetrahedra", …).
+        what: &'static str,
+        /// The count the header declares.
+        declared: u64,
+        /// Bytes after the header.
+        bytes_left: usize,
+        /// How many records of the smallest legal size would fit.
+        fit: u64,
+    },
+    /// An element references a node that does not exist.
+    #[error("{element} {index} references node {node}, but there are only {count} nodes")]
+    IndexOutOfRange {
+        /// The kind of element ("tetrahedron", "face").
+        element: &'static str,
+        /// The element's position in the file (0-based).
+        index: usize,
+        /// The node reference as written in the file.
+        node: i64,
+        /// The number of nodes.
+        count: usize,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error("node {index} has a non-finite coordinate ({value})")]
+    NonFinite {
+        /// The node's position in the file (0-based).
+        index: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// A valid file that uses a feature this crate does not read.
+    #[error("unsupported: {0}")]
+    Unsupported(String),
+}
+
+/// A failure to read or write a file: the file, the line or byte offset
+/// where it was found, and what was wrong. Nothing half-read is returned.
+#[derive(Debug)]
+pub struct Error {
+    /// The file.
+    pub path: PathBuf,
+    /// Where in the file, when known.
+    pub location: Option<Location>,
+    /// What was wrong.
+    pub kind: ErrorKind,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.location {
+            Some(location) => write!(f, "{}: {location}: {}", self.path.display(), self.kind),
+            None => write!(f, "{}: {}", self.path.display(), self.kind),
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &self.kind {
+            ErrorKind::Io(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl Error {
+    /// An error at no particular place in `path`.
+    pub(crate) fn new(path: &Path, kind: ErrorKind) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            location: None,
+            kind,
+        }
+    }
+
+    /// An I/O error on `path`.
+    pub(crate) fn io(path: &Path, error: std::io::Error) -> Self {
+        Self::new(path, ErrorKind::Io(error))
+    }
+}
+
+/// Short for `Result<T, Error>`.
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,177 @@
+//! Tetrahedral meshes: the plain data every tet reader returns, and the
+//! boundary surface derived from the tetrahedra themselves.
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::error::{Error, ErrorKind, Result};
+
+pub mod gmsh;
+pub mod tetgen;
+
+/// A tetrahedral mesh as plain data.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TetMesh {
+    /// Node positions (f64, as TetGen and Gmsh write them).
+    pub positions: Vec<DVec3>,
+    /// Four 0-based node indices per tetrahedron, as the file orders them.
+    pub tets: Vec<[u32; 4]>,
+    /// One region tag per tetrahedron (TetGen's region attribute, Gmsh's
+    /// physical tag), or empty when the file has none.
+    pub regions: Vec<i32>,
+}
+
+/// The faces of tetrahedron `(0, 1, 2, 3)` with outward normals (right-hand
+/// rule) when it is positively oriented, `det[p1-p0, p2-p0, p3-p0] > 0`.
+const OUTWARD_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+
+impl TetMesh {
+    /// Reads a tetrahedral mesh, choosing the format by extension: `.node`
+    /// or `.ele` (TetGen; the other file is found beside it) and `.msh`
+    /// (Gmsh 2.2 ASCII or binary, or 4.1 ASCII).
+    ///
+    /// # Errors
+    /// [`Error`] naming the file, the line or byte, and what was wrong.
+    pub fn read(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("node" | "ele") => tetgen::read(path),
+            Some("msh") => gmsh::read(path),
+            other => Err(Error::new(
+                path,
+                ErrorKind::UnknownExtension(other.unwrap_or("").to_string(), ".node, .ele, .msh"),
+            )),
+        }
+    }
+
+    /// Six times the signed volume of tetrahedron `t`: positive when its
+    /// nodes are ordered as TetGen and Gmsh order them.
+    pub fn signed_volume6(&self, t: usize) -> f64 {
+        let [a, b, c, d] = self.tets[t].map(|i| self.positions[i as usize]);
+        (b - a).dot((c - a).cross(d - a))
+    }
+
+    /// The total volume of the tetrahedra.
+    pub fn volume(&self) -> f64 {
+        (0..self.tets.len())
+            .map(|t| self.signed_volume6(t).abs())
+            .sum::<f64>()
+            / 6.0
+    }
+
+    /// The boundary surface: every triangle that belongs to exactly one
+    /// tetrahedron, oriented with its normal pointing out of that
+    /// tetrahedron (whatever the file's node order). Derived from the
+    /// tetrahedra, never taken from a file's face list. Sorted, so the
+    /// result does not depend on hashing.
+    pub fn boundary(&self) -> Vec<[u32; 3]> {
+        // Each face as (sorted nodes packed in a u128, oriented face).
+        let mut faces: Vec<(u128, [u32; 3])> = Vec::with_capacity(4 * self.tets.len());
+        for (t, tet) in self.tets.iter().enumerate() {
+            let flip = self.signed_volume6(t) < 0.0;
+            for local in OUTWARD_FACES {
+                let mut face = local.map(|i| tet[i]);
+                if flip {
+                    face.swap(1, 2);
+                }
+                let mut key = face;
+                key.sort_unstable();
+                let packed =
+                    (u128::from(key[0]) << 64) | (u128::from(key[1]) << 32) | u128::from(key[2]);
+                faces.push((packed, face));
+            }
+        }
+        faces.sort_unstable_by_key(|&(key, _)| key);
+        let mut boundary = Vec::new();
+        let mut i = 0;
+        while i < faces.len() {
+            let mut j = i + 1;
+            while j < faces.len() && faces[j].0 == faces[i].0 {
+                j += 1;
+            }
+            if j - i == 1 {
+                boundary.push(faces[i].1);
+            }
+            i = j;
+        }
+        boundary
+    }
+
+    /// Checks that every tetrahedron references existing nodes; the readers
+    /// guarantee it, this is for meshes built by hand.
+    pub(crate) fn check_indices(&self, path: &Path) -> Result<()> {
+        let count = self.positions.len();
+        for (index, tet) in self.tets.iter().enumerate() {
+            if let Some(&node) = tet.iter().find(|&&n| n as usize >= count) {
+                return Err(Error::new(
+                    path,
+                    ErrorKind::IndexOutOfRange {
+                        element: "tetrahedron",
+                        index,
+                        node: i64::from(node),
+                        count,
+                    },
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The volume enclosed by a closed, outward-oriented triangle surface
+/// (divergence theorem); used to check boundary orientation.
+pub fn enclosed_volume(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            a.dot(b.cross(c))
+        })
+        .sum::<f64>()
+        / 6.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_tet() -> TetMesh {
+        TetMesh {
+            positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
+            tets: vec![[0, 1, 2, 3]],
+            regions: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn boundary_of_one_tet_is_outward() {
+        let mesh = unit_tet();
+        assert!(mesh.signed_volume6(0) > 0.0);
+        let b = mesh.boundary();
+        assert_eq!(b.len(), 4);
+        assert!((enclosed_volume(&mesh.positions, &b) - 1.0 / 6.0).abs() < 1e-15);
+        // An inverted tet still gets an outward boundary.
+        let mut inverted = mesh.clone();
+        inverted.tets[0].swap(2, 3);
+        assert!(inverted.signed_volume6(0) < 0.0);
+        let b = inverted.boundary();
+        assert!((enclosed_volume(&inverted.positions, &b) - 1.0 / 6.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn shared_faces_are_interior() {
+        // Two tets sharing face (1, 2, 3).
+        let mut mesh = unit_tet();
+        mesh.positions.push(DVec3::ONE);
+        mesh.tets.push([4, 1, 3, 2]);
+        assert!(mesh.signed_volume6(1) > 0.0);
+        let b = mesh.boundary();
+        assert_eq!(b.len(), 6);
+        assert!((enclosed_volume(&mesh.positions, &b) - mesh.volume()).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,370 @@
+//! TetGen's `.node` / `.ele` / `.face` files (TetGen manual, Sec. 5.2):
+//! ASCII, `#` comments, 0- or 1-based numbering (the first node decides),
+//! optional attributes and boundary markers.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+
+use super::TetMesh;
+use crate::error::{Error, ErrorKind, Result};
+use crate::text::Cursor;
+
+/// A TetGen mesh with what the files say beyond the tetrahedra.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TetGenFiles {
+    /// Nodes, tetrahedra and region attributes.
+    pub mesh: TetMesh,
+    /// The index of the first node as written (0 or 1).
+    pub first_index: i64,
+    /// The `.face` file's triangles (0-based), when the file exists. Kept
+    /// for reference only: [`TetMesh::boundary`] derives the boundary from
+    /// the tetrahedra.
+    pub faces: Option<Vec<[u32; 3]>>,
+}
+
+/// The `.node`, `.ele` and `.face` paths beside `path` (either of the first
+/// two may be given).
+fn sibling(path: &Path, ext: &str) -> PathBuf {
+    path.with_extension(ext)
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>> {
+    std::fs::read(path).map_err(|e| Error::io(path, e))
+}
+
+/// Reads `<name>.node` and `<name>.ele` given either path.
+///
+/// # Errors
+/// [`Error`] with the file and line: a missing file, a malformed or
+/// truncated record, a non-finite coordinate, a tetrahedron referencing a
+/// missing node, numbering that is not consecutive, or a header count the
+/// file cannot hold.
+pub fn read(path: &Path) -> Result<TetMesh> {
+    let node_path = sibling(path, "node");
+    let ele_path = sibling(path, "ele");
+    let (positions, first_index) = parse_nodes(&read_bytes(&node_path)?, &node_path)?;
+    let (tets, regions) = parse_elements(
+        &read_bytes(&ele_path)?,
+        &ele_path,
+        first_index,
+        positions.len(),
+    )?;
+    Ok(TetMesh {
+        positions,
+        tets,
+        regions,
+    })
+}
+
+/// Reads the mesh and, if it exists, the `.face` file beside it.
+///
+/// # Errors
+/// As for [`read`], and for the `.face` file.
+pub fn read_all(path: &Path) -> Result<TetGenFiles> {
+    let node_path = sibling(path, "node");
+    let ele_path = sibling(path, "ele");
+    let face_path = sibling(path, "face");
+    let (positions, first_index) = parse_nodes(&read_bytes(&node_path)?, &node_path)?;
+    let (tets, regions) = parse_elements(
+        &read_bytes(&ele_path)?,
+        &ele_path,
+        first_index,
+        positions.len(),
+    )?;
+    let faces = match std::fs::read(&face_path) {
+        Ok(data) => Some(parse_faces(
+            &data,
+            &face_path,
+            first_index,
+            positions.len(),
+        )?),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
+        Err(e) => return Err(Error::io(&face_path, e)),
+    };
+    Ok(TetGenFiles {
+        mesh: TetMesh {
+            positions,
+            tets,
+            regions,
+        },
+        first_index,
+        faces,
+    })
+}
+
+/// Reads the record index, which must continue the numbering.
+fn record_index(c: &mut Cursor<'_>, expected: i64, what: &str) -> Result<()> {
+    let (at, tok) = c.expect_token(what)?;
+    match std::str::from_utf8(tok)
+        .ok()
+        .and_then(|s| s.parse::<i64>().ok())
+    {
+        Some(i) if i == expected => Ok(()),
+        _ => Err(c.syntax(
+            at,
+            &format!("{what} {expected} (consecutive numbering)"),
+            tok,
+        )),
+    }
+}
+
+/// A node reference converted to a 0-based index, checked against the
+/// node count.
+#[inline]
+fn node_ref(
+    c: &mut Cursor<'_>,
+    first_index: i64,
+    count: usize,
+    element: &'static str,
+    index: usize,
+) -> Result<u32> {
+    let at = {
+        c.skip_space();
+        c.offset()
+    };
+    let raw = c.i64("a node index")?;
+    let zero_based = raw - first_index;
+    if zero_based < 0 || zero_based as u64 >= count as u64 {
+        return Err(c.error_at(
+            at,
+            ErrorKind::IndexOutOfRange {
+                element,
+                index,
+                node: raw,
+                count,
+            },
+        ));
+    }
+    Ok(zero_based as u32)
+}
+
+/// Skips `n` tokens (attributes, markers, extra nodes).
+fn skip_tokens(c: &mut Cursor<'_>, n: u64, what: &str) -> Result<()> {
+    for _ in 0..n {
+        c.expect_token(what)?;
+    }
+    Ok(())
+}
+
+/// Fails if anything but comments follows the last declared record.
+fn expect_end(c: &mut Cursor<'_>, what: &str) -> Result<()> {
+    if c.at_end() {
+        return Ok(());
+    }
+    let (at, tok) = c.expect_token("the end of the file")?;
+    Err(c.syntax(
+        at,
+        &format!("the end of the file after the last {what}"),
+        tok,
+    ))
+}
+
+/// Parses a `.node` file: positions and the first index (0 or 1).
+pub(crate) fn parse_nodes(data: &[u8], path: &Path) -> Result<(Vec<DVec3>, i64)> {
+    let mut c = Cursor::new(data, path, Some(b'#'));
+    let declared = c.u64("the number of nodes")?;
+    let (at, dim_tok) = c.expect_token("the dimension")?;
+    if dim_tok != b"3" {
+        return Err(c.syntax(at, "dimension 3", dim_tok));
+    }
+    let attributes = c.u64("the number of node attributes")?;
+    let (at, marker_tok) = c.expect_token("the number of boundary markers")?;
+    let markers = match marker_tok {
+        b"0" => 0,
+        b"1" => 1,
+        _ => return Err(c.syntax(at, "0 or 1 boundary markers", marker_tok)),
+    };
+    if declared == 0 {
+        return Err(c.error_at(
+            at,
+            ErrorKind::Unsupported("a .node file with 0 points (points in a .poly file)".into()),
+        ));
+    }
+    // Smallest record: "i x y z" plus attributes and markers, one byte and
+    // one separator each.
+    let count = c.check_count("nodes", declared, 2 * (4 + attributes as usize + markers))?;
+    let mut positions = Vec::with_capacity(count);
+    let mut first_index = 0;
+    for k in 0..count {
+        if k == 0 {
+            let (at, tok) = c.expect_token("the first node's index")?;
+            first_index = match tok {
+                b"0" => 0,
+                b"1" => 1,
+                _ => return Err(c.syntax(at, "first node index 0 or 1", tok)),
+            };
+        } else {
+            record_index(&mut c, first_index + k as i64, "node")?;
+        }
+        let at = {
+            c.skip_space();
+            c.offset()
+        };
+        let p = DVec3::new(
+            c.f64("an x coordinate")?,
+            c.f64("a y coordinate")?,
+            c.f64("a z coordinate")?,
+        );
+        if !p.is_finite() {
+            let value = p
+                .to_array()
+                .into_iter()
+                .find(|v| !v.is_finite())
+                .unwrap_or(f64::NAN);
+            return Err(c.error_at(at, ErrorKind::NonFinite { index: k, value }));
+        }
+        positions.push(p);
+        skip_tokens(
+            &mut c,
+            attributes + markers as u64,
+            "a node attribute or marker",
+        )?;
+    }
+    expect_end(&mut c, "node")?;
+    Ok((positions, first_index))
+}
+
+/// Parses a `.ele` file: tetrahedra (0-based) and region tags.
+pub(crate) fn parse_elements(
+    data: &[u8],
+    path: &Path,
+    first_index: i64,
+    node_count: usize,
+) -> Result<(Vec<[u32; 4]>, Vec<i32>)> {
+    let mut c = Cursor::new(data, path, Some(b'#'));
+    let declared = c.u64("the number of tetrahedra")?;
+    let (at, per_tok) = c.expect_token("the number of nodes per tetrahedron")?;
+    let per_tet = match per_tok {
+        b"4" => 4,
+        b"10" => 10,
+        _ => return Err(c.syntax(at, "4 or 10 nodes per tetrahedron", per_tok)),
+    };
+    let attributes = c.u64("the number of tetrahedron attributes")?;
+    let count = c.check_count(
+        "tetrahedra",
+        declared,
+        2 * (1 + per_tet as usize + attributes as usize),
+    )?;
+    let mut tets = Vec::with_capacity(count);
+    let mut regions = Vec::with_capacity(if attributes > 0 { count } else { 0 });
+    for k in 0..count {
+        record_index(&mut c, first_index + k as i64, "tetrahedron")?;
+        let mut tet = [0u32; 4];
+        for slot in &mut tet {
+            *slot = node_ref(&mut c, first_index, node_count, "tetrahedron", k)?;
+        }
+        // Quadratic tetrahedra: the six edge nodes follow the corners.
+        skip_tokens(&mut c, per_tet - 4, "an edge node")?;
+        tets.push(tet);
+        if attributes > 0 {
+            let at = {
+                c.skip_space();
+                c.offset()
+            };
+            let value = c.f64("a region attribute")?;
+            if value.fract() != 0.0 || !(f64::from(i32::MIN)..=f64::from(i32::MAX)).contains(&value)
+            {
+                return Err(c.syntax(
+                    at,
+                    "an integer region attribute",
+                    value.to_string().as_bytes(),
+                ));
+            }
+            regions.push(value as i32);
+            skip_tokens(&mut c, attributes - 1, "a tetrahedron attribute")?;
+        }
+    }
+    expect_end(&mut c, "tetrahedron")?;
+    Ok((tets, regions))
+}
+
+/// Parses a `.face` file: triangles (0-based).
+pub(crate) fn parse_faces(
+    data: &[u8],
+    path: &Path,
+    first_index: i64,
+    node_count: usize,
+) -> Result<Vec<[u32; 3]>> {
+    let mut c = Cursor::new(data, path, Some(b'#'));
+    let declared = c.u64("the number of faces")?;
+    let (at, marker_tok) = c.expect_token("the boundary marker flag")?;
+    let markers = match marker_tok {
+        b"0" => 0,
+        b"1" => 1,
+        _ => return Err(c.syntax(at, "a boundary marker flag of 0 or 1", marker_tok)),
+    };
+    let count = c.check_count("faces", declared, 2 * (4 + markers as usize))?;
+    let mut faces = Vec::with_capacity(count);
+    for k in 0..count {
+        record_index(&mut c, first_index + k as i64, "face")?;
+        let mut face = [0u32; 3];
+        for slot in &mut face {
+            *slot = node_ref(&mut c, first_index, node_count, "face", k)?;
+        }
+        faces.push(face);
+        skip_tokens(&mut c, markers, "a boundary marker")?;
+    }
+    expect_end(&mut c, "face")?;
+    Ok(faces)
+}
+
+/// Writes `<name>.node` and `<name>.ele` (1-based, TetGen's default; one
+/// region attribute per tetrahedron when the mesh has regions).
+/// Coordinates are written in Rust's shortest round-trip form, so reading
+/// them back gives the same bits.
+///
+/// # Errors
+/// [`Error`] for a tetrahedron referencing a missing node, or an I/O error.
+pub fn write(path: &Path, mesh: &TetMesh) -> Result<()> {
+    let node_path = sibling(path, "node");
+    let ele_path = sibling(path, "ele");
+    mesh.check_indices(&ele_path)?;
+    if !mesh.regions.is_empty() && mesh.regions.len() != mesh.tets.len() {
+        return Err(Error::new(
+            &ele_path,
+            ErrorKind::Unsupported(format!(
+                "{} region tags for {} tetrahedra",
+                mesh.regions.len(),
+                mesh.tets.len()
+            )),
+        ));
+    }
+    let mut text = String::with_capacity(mesh.positions.len() * 64);
+    text.push_str("# written by trilux-io; 1-based\n");
+    let _ = writeln!(text, "{} 3 0 0", mesh.positions.len());
+    for (i, p) in mesh.positions.iter().enumerate() {
+        let _ = writeln!(text, "{} {} {} {}", i + 1, p.x, p.y, p.z);
+    }
+    write_text(&node_path, &text)?;
+
+    text.clear();
+    let attributes = usize::from(!mesh.regions.is_empty());
+    text.push_str("# written by trilux-io; 1-based\n");
+    let _ = writeln!(text, "{} 4 {attributes}", mesh.tets.len());
+    for (i, t) in mesh.tets.iter().enumerate() {
+        let _ = write!(
+            text,
+            "{} {} {} {} {}",
+            i + 1,
+            t[0] + 1,
+            t[1] + 1,
+            t[2] + 1,
+            t[3] + 1
+        );
+        if let Some(r) = mesh.regions.get(i) {
+            let _ = write!(text, " {r}");
+        }
+        text.push('\n');
+    }
+    write_text(&ele_path, &text)
+}
+
+fn write_text(path: &Path, text: &str) -> Result<()> {
+    let mut file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    file.write_all(text.as_bytes())
+        .and_then(|()| file.flush())
+        .map_err(|e| Error::io(path, e))
+}
