@@ -78,11 +78,15 @@ struct Parts {
 /// non-finite coordinate, or a tetrahedron that references a missing node.
 pub fn read(path: &Path) -> Result<TetMesh> {
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    parse(&data, path)
+    from_bytes(&data, path)
 }
 
-/// Parses the bytes of a `.msh` file.
-pub(crate) fn parse(data: &[u8], path: &Path) -> Result<TetMesh> {
+/// Parses the contents of a `.msh` file, for data that is not in a file
+/// (archives, network, fuzzing). `path` names it in errors.
+///
+/// # Errors
+/// As for [`read`].
+pub fn from_bytes(data: &[u8], path: &Path) -> Result<TetMesh> {
     let mut c = Cursor::new(data, path, None);
     c.keyword("$MeshFormat")?;
     let (at, version) = c.expect_token("the format version")?;

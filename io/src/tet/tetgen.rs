@@ -43,15 +43,22 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>> {
 /// missing node, numbering that is not consecutive, or a header count the
 /// file cannot hold.
 pub fn read(path: &Path) -> Result<TetMesh> {
+    let node = read_bytes(&sibling(path, "node"))?;
+    let ele = read_bytes(&sibling(path, "ele"))?;
+    from_bytes(&node, &ele, path)
+}
+
+/// Parses the contents of a `.node` and an `.ele` file, for data that is
+/// not in files (archives, network, fuzzing). `path` names them in errors:
+/// its `.node` and `.ele` siblings.
+///
+/// # Errors
+/// As for [`read`].
+pub fn from_bytes(node: &[u8], ele: &[u8], path: &Path) -> Result<TetMesh> {
     let node_path = sibling(path, "node");
     let ele_path = sibling(path, "ele");
-    let (positions, first_index) = parse_nodes(&read_bytes(&node_path)?, &node_path)?;
-    let (tets, regions) = parse_elements(
-        &read_bytes(&ele_path)?,
-        &ele_path,
-        first_index,
-        positions.len(),
-    )?;
+    let (positions, first_index) = parse_nodes(node, &node_path)?;
+    let (tets, regions) = parse_elements(ele, &ele_path, first_index, positions.len())?;
     Ok(TetMesh {
         positions,
         tets,

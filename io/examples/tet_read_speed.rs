@@ -1,0 +1,115 @@
+//! Parsing speed of the ASCII tetrahedral mesh readers on the largest tet
+//! mesh of `$TRILUX_DATA/tets` (bunny_500k), in MB of input per second on
+//! one core: parsing from memory (the reader's own cost) and end to end
+//! from the file. Medians of 7 runs. Markdown on stdout.
+//!
+//! ```text
+//! TRILUX_DATA=../shared/data cargo run --release -p trilux-io --example tet_read_speed
+//! ```
+
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use trilux_io::tet::{TetMesh, gmsh, tetgen};
+
+const RUNS: usize = 7;
+
+fn median_seconds(mut f: impl FnMut()) -> f64 {
+    let mut times: Vec<f64> = (0..RUNS)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[RUNS / 2]
+}
+
+fn data_dir() -> Option<PathBuf> {
+    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    [given.clone(), workspace.join(&given)]
+        .into_iter()
+        .find(|p| p.is_dir())
+}
+
+fn main() -> ExitCode {
+    let Some(data) = data_dir() else {
+        eprintln!(
+            "tet_read_speed: set TRILUX_DATA to the data folder (it holds tets/bunny_500k.*)"
+        );
+        return ExitCode::from(2);
+    };
+    let tets = data.join("tets");
+    let read = |name: &str| match std::fs::read(tets.join(name)) {
+        Ok(bytes) => Ok(bytes),
+        Err(e) => Err(format!("{}: {e}", tets.join(name).display())),
+    };
+    let (node, ele, msh) = match (
+        read("bunny_500k.node"),
+        read("bunny_500k.ele"),
+        read("bunny_500k.msh"),
+    ) {
+        (Ok(n), Ok(e), Ok(m)) => (n, e, m),
+        (Err(e), _, _) | (_, Err(e), _) | (_, _, Err(e)) => {
+            eprintln!("tet_read_speed: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let base = tets.join("bunny_500k.node");
+    let msh_path = tets.join("bunny_500k.msh");
+
+    let rows: Vec<(&str, usize, f64, f64)> = vec![
+        (
+            "TetGen .node + .ele",
+            node.len() + ele.len(),
+            median_seconds(|| {
+                black_box(tetgen::from_bytes(&node, &ele, &base).expect("valid"));
+            }),
+            median_seconds(|| {
+                black_box(TetMesh::read(&base).expect("valid"));
+            }),
+        ),
+        (
+            "Gmsh 4.1 ASCII .msh",
+            msh.len(),
+            median_seconds(|| {
+                black_box(gmsh::from_bytes(&msh, &msh_path).expect("valid"));
+            }),
+            median_seconds(|| {
+                black_box(TetMesh::read(&msh_path).expect("valid"));
+            }),
+        ),
+    ];
+    let mesh = TetMesh::read(&base).expect("valid");
+    let boundary_s = median_seconds(|| {
+        black_box(mesh.boundary());
+    });
+
+    println!(
+        "## trilux-io: ASCII tet readers on bunny_500k (93,375 nodes, 507,125 tets), one core\n"
+    );
+    println!(
+        "| reader | input MB | parse ms | parse MB/s | file→mesh ms | file→mesh MB/s | bar 100 MB/s |"
+    );
+    println!("|---|---:|---:|---:|---:|---:|---|");
+    for (name, bytes, parse, whole) in rows {
+        let mb = bytes as f64 / 1e6;
+        let verdict = if mb / parse >= 100.0 { "met" } else { "MISSED" };
+        println!(
+            "| {name} | {mb:.1} | {:.1} | {:.0} | {:.1} | {:.0} | {verdict} |",
+            parse * 1e3,
+            mb / parse,
+            whole * 1e3,
+            mb / whole
+        );
+    }
+    println!(
+        "\nBoundary derivation (43,188 triangles from 507,125 tets): {:.1} ms",
+        boundary_s * 1e3
+    );
+    ExitCode::SUCCESS
+}
