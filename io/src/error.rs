@@ -80,6 +80,10 @@ pub enum ErrorKind {
     /// A valid file that uses a feature this crate does not read.
     #[error("unsupported: {0}")]
     Unsupported(String),
+    /// What the caller asked to write is inconsistent (a field of the wrong
+    /// length, a tetrahedron referencing a missing node).
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
 }
 
 /// A failure to read or write a file: the file, the line or byte offset

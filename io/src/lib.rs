@@ -1,8 +1,9 @@
 //! `trilux-io`: the files trilux users already have, in and out.
 //!
 //! This first part reads and writes **tetrahedral meshes**: TetGen
-//! `.node`/`.ele` (+ `.face`), and Gmsh `.msh` 2.2 (ASCII and binary) and
-//! 4.1 (ASCII). Readers return plain data ([`tet::TetMesh`]: `glam`
+//! `.node`/`.ele` (+ `.face`), Gmsh `.msh` 2.2 (ASCII and binary) and 4.1
+//! (ASCII), MEDIT `.mesh`, and VTK `.vtu` output with scalar fields for
+//! ParaView. Readers return plain data ([`tet::TetMesh`]: `glam`
 //! positions and `[u32; 4]` tetrahedra) and never a half-read mesh. Every
 //! failure is an [`Error`] that names the file, the line (or byte offset)
 //! and what was wrong: a truncated record, a non-finite coordinate, a

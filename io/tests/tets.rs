@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use trilux_io::tet::{TetMesh, enclosed_volume, gmsh, tetgen};
+use trilux_io::tet::{TetMesh, enclosed_volume, gmsh, medit, tetgen, vtu};
 use trilux_io::{ErrorKind, Location};
 
 /// The data folder named by `TRILUX_DATA` (relative paths from the
@@ -432,4 +432,157 @@ fn missing_files_and_unknown_extensions() {
     assert!(std::error::Error::source(&err).is_some());
     let err = TetMesh::read("mesh.stl").unwrap_err();
     assert!(matches!(err.kind, ErrorKind::UnknownExtension(..)), "{err}");
+}
+
+const MEDIT: &[u8] = b"# a comment\nMeshVersionFormatted 2\n\nDimension\n3\n\
+Vertices\n5\n0 0 0 1\n1 0 0 1\n0 1 0 1\n0 0 1 1\n1 1 1 2\n\
+Edges\n1\n1 2 0\nCorners\n2\n1\n2\n\
+Tetrahedra\n2\n1 2 3 4 3\n5 2 4 3 4\n\
+Triangles\n1\n1 2 3 0\nNormals\n1\n0.0 0.0 1.0\nEnd\n";
+
+#[test]
+fn medit_reads_blocks_in_any_order_and_round_trips() {
+    let dir = scratch("medit");
+    let mesh = TetMesh::read(write(&dir, "m.mesh", MEDIT)).unwrap();
+    assert_eq!(mesh.positions.len(), 5);
+    assert_eq!(mesh.tets, vec![[0, 1, 2, 3], [4, 1, 3, 2]]);
+    assert_eq!(mesh.regions, vec![3, 4]);
+    let copy = dir.join("copy.mesh");
+    medit::write(&copy, &mesh).unwrap();
+    assert_eq!(TetMesh::read(&copy).unwrap(), mesh);
+}
+
+#[test]
+fn real_mesh_through_medit_and_back() {
+    let Some(data) = data_dir() else {
+        eprintln!("skipped: TRILUX_DATA is not set, so no real mesh goes through MEDIT");
+        return;
+    };
+    let mesh = TetMesh::read(data.join("tets/bunny_50k.node")).unwrap();
+    let dir = scratch("medit-real");
+    let path = dir.join("bunny.mesh");
+    medit::write(&path, &mesh).unwrap();
+    assert_eq!(TetMesh::read(&path).unwrap(), mesh);
+}
+
+#[test]
+fn medit_errors() {
+    let dir = scratch("medit-errors");
+    let cases: Vec<GmshCase> = vec![
+        ("dim2", b"MeshVersionFormatted 1\nDimension 2\nEnd\n", |k| matches!(k, ErrorKind::Syntax { .. })),
+        ("no-vertices", b"MeshVersionFormatted 1\nDimension 3\nEnd\n", |k| matches!(k, ErrorKind::Truncated(_))),
+        ("unknown", b"MeshVersionFormatted 1\nDimension 3\nSolAtVertices\n1\n", |k| matches!(k, ErrorKind::Unsupported(_))),
+        (
+            "zero-index",
+            b"MeshVersionFormatted 1\nDimension 3\nVertices\n1\n0 0 0 0\nTetrahedra\n1\n0 1 1 1 0\nEnd\n",
+            |k| matches!(k, ErrorKind::IndexOutOfRange { node: 0, count: 1, .. }),
+        ),
+        ("nan", b"MeshVersionFormatted 1\nDimension 3\nVertices\n1\n0 NaN 0 0\nEnd\n", |k| matches!(k, ErrorKind::NonFinite { .. })),
+        ("no-end", b"MeshVersionFormatted 1\nDimension 3\nVertices\n1\n0 0 0 0\n", |k| matches!(k, ErrorKind::Truncated(_))),
+        ("huge", b"MeshVersionFormatted 1\nDimension 3\nVertices\n4000000000\n0 0 0 0\n", |k| matches!(k, ErrorKind::CountTooLarge { .. })),
+    ];
+    for (name, bytes, kind_ok) in cases {
+        let err = medit::read(&write(&dir, &format!("{name}.mesh"), bytes)).unwrap_err();
+        assert!(kind_ok(&err.kind), "{name}: {err}");
+    }
+}
+
+/// Decodes standard base64, independently of the writer's encoder.
+fn decode_base64(text: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => c - b'A',
+        b'a'..=b'z' => c - b'a' + 26,
+        b'0'..=b'9' => c - b'0' + 52,
+        b'+' => 62,
+        b'/' => 63,
+        _ => panic!("not base64: {c}"),
+    };
+    let mut out = Vec::new();
+    for quad in text.trim().as_bytes().chunks(4) {
+        let pad = quad.iter().filter(|&&c| c == b'=').count();
+        let n = quad
+            .iter()
+            .take(4 - pad)
+            .fold(0u32, |acc, &c| (acc << 6) | u32::from(value(c)))
+            << (6 * pad);
+        let bytes = [(n >> 16) as u8, (n >> 8) as u8, n as u8];
+        out.extend_from_slice(&bytes[..3 - pad]);
+    }
+    out
+}
+
+/// The text content of each `<DataArray …>` in document order.
+fn data_arrays(doc: &str) -> Vec<(String, String)> {
+    doc.split("<DataArray ")
+        .skip(1)
+        .map(|part| {
+            let (attrs, rest) = part.split_once('>').unwrap();
+            let content = rest.split("</DataArray>").next().unwrap();
+            (attrs.to_string(), content.trim().to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn vtu_arrays_decode_to_the_mesh_and_fields() {
+    let mesh = gmsh_from(GMSH_22);
+    let temperature = [0.5, 1.0 / 3.0, -2.0, 1e-300, 7.0];
+    let volume: Vec<f64> = (0..2).map(|t| mesh.signed_volume6(t) / 6.0).collect();
+    let points = [vtu::Field {
+        name: "T<K>",
+        values: &temperature,
+    }];
+    let cells = [vtu::Field {
+        name: "volume",
+        values: &volume,
+    }];
+    let path = Path::new("out.vtu");
+    let binary = vtu::to_string(path, &mesh, &points, &cells, vtu::Encoding::Base64).unwrap();
+    assert!(binary.contains("NumberOfPoints=\"5\" NumberOfCells=\"2\""));
+    assert!(binary.contains("Name=\"T&lt;K&gt;\""));
+    let arrays = data_arrays(&binary);
+    assert_eq!(arrays.len(), 6);
+    let f64s = |content: &str| {
+        let bytes = decode_base64(content);
+        let len = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+        assert_eq!(len, bytes.len() - 8);
+        bytes[8..]
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(f64s(&arrays[0].1), temperature);
+    assert_eq!(f64s(&arrays[1].1), volume);
+    let coords: Vec<f64> = mesh.positions.iter().flat_map(|p| p.to_array()).collect();
+    assert_eq!(f64s(&arrays[2].1), coords);
+    let connectivity: Vec<i64> = decode_base64(&arrays[3].1)[8..]
+        .chunks_exact(8)
+        .map(|c| i64::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    let expected: Vec<i64> = mesh.tets.iter().flatten().map(|&i| i64::from(i)).collect();
+    assert_eq!(connectivity, expected);
+    assert_eq!(decode_base64(&arrays[5].1)[8..], [10, 10]);
+
+    let ascii = vtu::to_string(path, &mesh, &points, &cells, vtu::Encoding::Ascii).unwrap();
+    let arrays = data_arrays(&ascii);
+    let parsed: Vec<f64> = arrays[0]
+        .1
+        .split_whitespace()
+        .map(|t| t.parse().unwrap())
+        .collect();
+    assert_eq!(parsed, temperature);
+    assert_eq!(arrays[4].1, "4 8");
+    assert_eq!(arrays[5].1, "10 10");
+
+    let wrong = [vtu::Field {
+        name: "short",
+        values: &temperature[..3],
+    }];
+    let err = vtu::to_string(path, &mesh, &wrong, &[], vtu::Encoding::Ascii).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::InvalidInput(_)), "{err}");
+    assert!(
+        err.to_string()
+            .contains("\"short\" has 3 values for 5 nodes"),
+        "{err}"
+    );
 }

@@ -8,7 +8,9 @@ use glam::DVec3;
 use crate::error::{Error, ErrorKind, Result};
 
 pub mod gmsh;
+pub mod medit;
 pub mod tetgen;
+pub mod vtu;
 
 /// A tetrahedral mesh as plain data.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -28,8 +30,8 @@ const OUTWARD_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 
 
 impl TetMesh {
     /// Reads a tetrahedral mesh, choosing the format by extension: `.node`
-    /// or `.ele` (TetGen; the other file is found beside it) and `.msh`
-    /// (Gmsh 2.2 ASCII or binary, or 4.1 ASCII).
+    /// or `.ele` (TetGen; the other file is found beside it), `.msh` (Gmsh
+    /// 2.2 ASCII or binary, or 4.1 ASCII) and `.mesh` (MEDIT).
     ///
     /// # Errors
     /// [`Error`] naming the file, the line or byte, and what was wrong.
@@ -42,6 +44,7 @@ impl TetMesh {
         match ext.as_deref() {
             Some("node" | "ele") => tetgen::read(path),
             Some("msh") => gmsh::read(path),
+            Some("mesh") => medit::read(path),
             other => Err(Error::new(
                 path,
                 ErrorKind::UnknownExtension(other.unwrap_or("").to_string(), ".node, .ele, .msh"),
