@@ -1,0 +1,85 @@
+//! Triangle meshes: the plain data every triangle-mesh reader returns.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+
+use crate::error::{Error, ErrorKind, Result};
+
+pub mod obj;
+
+/// A triangle mesh as plain data, with one index stream: attributes are
+/// per vertex, and a vertex that has several UVs or normals in the file
+/// (a seam) is split into several vertices.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Three 0-based vertex indices per triangle, counter-clockwise as the
+    /// file orders them.
+    pub indices: Vec<[u32; 3]>,
+    /// Per-vertex normals, when the file has them.
+    pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates, when the file has them.
+    pub uvs: Option<Vec<Vec2>>,
+    /// Consecutive triangle ranges per object, group or material.
+    pub objects: Vec<Object>,
+    /// Materials, indexed by [`Object::material`].
+    pub materials: Vec<Material>,
+}
+
+/// A named run of triangles with one material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Object {
+    /// The object or group name (empty when the file gives none).
+    pub name: String,
+    /// The triangles, as a range of [`TriMesh::indices`].
+    pub triangles: Range<usize>,
+    /// Index into [`TriMesh::materials`], if the triangles have one.
+    pub material: Option<usize>,
+}
+
+/// What a renderer or sampler needs of a material.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    /// The material name.
+    pub name: String,
+    /// Diffuse (base) colour, linear RGB.
+    pub diffuse: [f32; 3],
+    /// The diffuse (base colour) texture, resolved against the mesh file's
+    /// folder. Not opened: images are read separately.
+    pub diffuse_texture: Option<PathBuf>,
+}
+
+impl TriMesh {
+    /// Reads a triangle mesh, choosing the format by extension: `.obj`.
+    ///
+    /// # Errors
+    /// [`Error`] naming the file, the line, and what was wrong.
+    pub fn read(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        match ext.as_deref() {
+            Some("obj") => obj::read(path),
+            other => Err(Error::new(
+                path,
+                ErrorKind::UnknownExtension(other.unwrap_or("").to_string(), ".obj"),
+            )),
+        }
+    }
+
+    /// The total surface area.
+    pub fn area(&self) -> f64 {
+        self.indices
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| self.positions[i as usize].as_dvec3());
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+}

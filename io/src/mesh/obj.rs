@@ -1,0 +1,425 @@
+//! Wavefront OBJ: `v`, `vt`, `vn`, `f` (all four index forms, negative
+//! indices, polygons fan-triangulated), `o`, `g`, `usemtl`, `mtllib` (with
+//! `newmtl`, `Kd`, `map_Kd`). Lines, points, smoothing groups and
+//! free-form geometry are skipped.
+//!
+//! Our own reader rather than `tobj`: errors must name the line, NaN and
+//! infinite coordinates must be refused, and unused vertices must not
+//! reach the samplers. A vertex is one distinct `v/vt/vn` triple, so UV
+//! seams split vertices and unused `v` lines disappear.
+
+use std::collections::HashMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+use super::{Material, Object, TriMesh};
+use crate::error::{Error, ErrorKind, Location, Result};
+
+/// "No UV / no normal" in a vertex key.
+const NONE: u32 = u32::MAX;
+
+/// Kd of a material that no library defines (the MTL default).
+const DEFAULT_DIFFUSE: [f32; 3] = [0.8, 0.8, 0.8];
+
+/// Reads an `.obj` file and the material libraries it names (resolved
+/// against its folder).
+///
+/// # Errors
+/// [`Error`] with the file and line: a malformed number, a NaN or infinite
+/// coordinate, a face with fewer than 3 vertices, a face index out of
+/// range, or an unreadable file (a missing material library included).
+pub fn read(path: &Path) -> Result<TriMesh> {
+    let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let (mut mesh, libraries) = parse(&data, path)?;
+    let folder = path.parent().unwrap_or(Path::new("."));
+    for library in libraries {
+        let lib_path = folder.join(&library);
+        let text = std::fs::read(&lib_path).map_err(|e| Error::io(&lib_path, e))?;
+        for found in parse_mtl(&text, &lib_path, folder)? {
+            if let Some(m) = mesh.materials.iter_mut().find(|m| m.name == found.name) {
+                *m = found;
+            }
+        }
+    }
+    Ok(mesh)
+}
+
+/// Parses the contents of an `.obj` file; `path` names it in errors.
+/// Material libraries are not opened: materials carry only their names
+/// (and the MTL defaults).
+///
+/// # Errors
+/// As for [`read`], without the files.
+pub fn from_bytes(data: &[u8], path: &Path) -> Result<TriMesh> {
+    parse(data, path).map(|(mesh, _)| mesh)
+}
+
+/// One line's location for errors.
+struct At<'a> {
+    path: &'a Path,
+    line: usize,
+}
+
+impl At<'_> {
+    fn error(&self, kind: ErrorKind) -> Error {
+        Error {
+            path: self.path.to_path_buf(),
+            location: Some(Location::Line(self.line)),
+            kind,
+        }
+    }
+
+    fn syntax(&self, expected: &str, found: &str) -> Error {
+        self.error(ErrorKind::Syntax {
+            expected: expected.to_string(),
+            found: found.chars().take(40).collect(),
+        })
+    }
+}
+
+/// Splits the data into lines (joining `\` continuations) with their
+/// 1-based numbers.
+fn lines(data: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
+    let mut number = 0;
+    let mut pending: Option<(usize, String)> = None;
+    let mut raw = data.split(|&b| b == b'\n');
+    std::iter::from_fn(move || {
+        loop {
+            let Some(bytes) = raw.next() else {
+                return pending.take();
+            };
+            number += 1;
+            let text = String::from_utf8_lossy(bytes);
+            let text = text.trim_end_matches('\r');
+            let (first, mut joined) = pending.take().unwrap_or((number, String::new()));
+            if let Some(head) = text.strip_suffix('\\') {
+                joined.push_str(head);
+                joined.push(' ');
+                pending = Some((first, joined));
+                continue;
+            }
+            joined.push_str(text);
+            return Some((first, joined));
+        }
+    })
+}
+
+fn number(at: &At<'_>, token: Option<&str>, what: &str) -> Result<f32> {
+    let token = token.ok_or_else(|| at.error(ErrorKind::Truncated(what.to_string())))?;
+    token.parse::<f32>().map_err(|_| at.syntax(what, token))
+}
+
+fn vec3(at: &At<'_>, tokens: &mut std::str::SplitWhitespace<'_>, what: &str) -> Result<Vec3> {
+    let v = Vec3::new(
+        number(at, tokens.next(), what)?,
+        number(at, tokens.next(), what)?,
+        number(at, tokens.next(), what)?,
+    );
+    Ok(v)
+}
+
+/// A 1-based or negative (relative) OBJ index into a list of `len`.
+fn resolve(
+    at: &At<'_>,
+    token: &str,
+    len: usize,
+    element: &'static str,
+    face: usize,
+) -> Result<u32> {
+    let raw: i64 = token
+        .parse()
+        .map_err(|_| at.syntax(&format!("a {element} index"), token))?;
+    let index = if raw > 0 { raw - 1 } else { len as i64 + raw };
+    if raw == 0 || index < 0 || index >= len as i64 {
+        return Err(at.error(ErrorKind::IndexOutOfRange {
+            element,
+            index: face,
+            node: raw,
+            count: len,
+        }));
+    }
+    Ok(index as u32)
+}
+
+/// The mesh and the material libraries named by `mtllib`.
+fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
+    let mut v: Vec<Vec3> = Vec::new();
+    let mut vt: Vec<Vec2> = Vec::new();
+    let mut vn: Vec<Vec3> = Vec::new();
+    let mut keys: HashMap<(u32, u32, u32), u32> = HashMap::new();
+    let mut vertices: Vec<(u32, u32, u32)> = Vec::new();
+    let mut indices: Vec<[u32; 3]> = Vec::new();
+    let mut objects: Vec<Object> = Vec::new();
+    let mut materials: Vec<Material> = Vec::new();
+    let mut libraries = Vec::new();
+    let mut faces = 0usize;
+    let mut name = String::new();
+    let mut material: Option<usize> = None;
+    let mut polygon: Vec<u32> = Vec::new();
+
+    // Closes the current run of triangles into an object range.
+    let close = |objects: &mut Vec<Object>, name: &str, material, end: usize| {
+        let start = objects.last().map_or(0, |o: &Object| o.triangles.end);
+        if end > start {
+            objects.push(Object {
+                name: name.to_string(),
+                triangles: start..end,
+                material,
+            });
+        }
+    };
+
+    for (line, text) in lines(data) {
+        let at = At { path, line };
+        let mut tokens = text.split_whitespace();
+        let Some(keyword) = tokens.next() else {
+            continue;
+        };
+        match keyword {
+            "v" => {
+                let p = vec3(&at, &mut tokens, "a vertex coordinate")?;
+                if !p.is_finite() {
+                    let value = p
+                        .to_array()
+                        .into_iter()
+                        .find(|x| !x.is_finite())
+                        .unwrap_or(f32::NAN);
+                    return Err(at.error(ErrorKind::NonFinite {
+                        index: v.len(),
+                        value: f64::from(value),
+                    }));
+                }
+                v.push(p);
+            }
+            "vt" => {
+                let u = number(&at, tokens.next(), "a texture coordinate")?;
+                let w = match tokens.next() {
+                    Some(t) => t
+                        .parse::<f32>()
+                        .map_err(|_| at.syntax("a texture coordinate", t))?,
+                    None => 0.0,
+                };
+                if !(u.is_finite() && w.is_finite()) {
+                    return Err(at.syntax("a finite texture coordinate", &text));
+                }
+                vt.push(Vec2::new(u, w));
+            }
+            "vn" => {
+                let n = vec3(&at, &mut tokens, "a normal coordinate")?;
+                if !n.is_finite() {
+                    return Err(at.syntax("a finite normal", &text));
+                }
+                vn.push(n);
+            }
+            "f" => {
+                polygon.clear();
+                for corner in tokens {
+                    let mut parts = corner.split('/');
+                    let pv = resolve(&at, parts.next().unwrap_or(""), v.len(), "face", faces)?;
+                    let pt = match parts.next() {
+                        None | Some("") => NONE,
+                        Some(t) => resolve(&at, t, vt.len(), "face", faces)?,
+                    };
+                    let pn = match parts.next() {
+                        None | Some("") => NONE,
+                        Some(t) => resolve(&at, t, vn.len(), "face", faces)?,
+                    };
+                    let key = (pv, pt, pn);
+                    let next = vertices.len() as u32;
+                    let id = *keys.entry(key).or_insert_with(|| {
+                        vertices.push(key);
+                        next
+                    });
+                    polygon.push(id);
+                }
+                if polygon.len() < 3 {
+                    return Err(at.syntax("a face with at least 3 vertices", &text));
+                }
+                for k in 1..polygon.len() - 1 {
+                    indices.push([polygon[0], polygon[k], polygon[k + 1]]);
+                }
+                faces += 1;
+            }
+            "o" | "g" => {
+                close(&mut objects, &name, material, indices.len());
+                name = tokens.collect::<Vec<_>>().join(" ");
+            }
+            "usemtl" => {
+                close(&mut objects, &name, material, indices.len());
+                let wanted = tokens.collect::<Vec<_>>().join(" ");
+                material = Some(match materials.iter().position(|m| m.name == wanted) {
+                    Some(i) => i,
+                    None => {
+                        materials.push(Material {
+                            name: wanted,
+                            diffuse: DEFAULT_DIFFUSE,
+                            diffuse_texture: None,
+                        });
+                        materials.len() - 1
+                    }
+                });
+            }
+            "mtllib" => libraries.extend(tokens.map(str::to_string)),
+            // Smoothing groups, lines, points, free-form geometry: skipped.
+            "s" | "l" | "p" | "vp" | "cstype" | "deg" | "curv" | "curv2" | "surf" | "parm"
+            | "trim" | "hole" | "end" | "bmat" | "step" | "con" | "mg" | "lod" | "shadow_obj"
+            | "trace_obj" | "ctech" | "stech" | "bevel" | "c_interp" | "d_interp" => {}
+            k if k.starts_with('#') => {}
+            other => return Err(at.syntax("an OBJ keyword", other)),
+        }
+    }
+    close(&mut objects, &name, material, indices.len());
+
+    let has_uv = vertices.iter().any(|k| k.1 != NONE);
+    let has_normal = vertices.iter().any(|k| k.2 != NONE);
+    let mesh = TriMesh {
+        positions: vertices.iter().map(|k| v[k.0 as usize]).collect(),
+        uvs: has_uv.then(|| {
+            vertices
+                .iter()
+                .map(|k| vt.get(k.1 as usize).copied().unwrap_or(Vec2::ZERO))
+                .collect()
+        }),
+        normals: has_normal.then(|| {
+            vertices
+                .iter()
+                .map(|k| vn.get(k.2 as usize).copied().unwrap_or(Vec3::ZERO))
+                .collect()
+        }),
+        indices,
+        objects,
+        materials,
+    };
+    Ok((mesh, libraries))
+}
+
+/// Parses an MTL library: `newmtl`, `Kd`, `map_Kd` (the last token is the
+/// file; options before it are skipped).
+fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<Vec<Material>> {
+    let mut materials: Vec<Material> = Vec::new();
+    for (line, text) in lines(data) {
+        let at = At { path, line };
+        let mut tokens = text.split_whitespace();
+        match tokens.next() {
+            Some("newmtl") => materials.push(Material {
+                name: tokens.collect::<Vec<_>>().join(" "),
+                diffuse: DEFAULT_DIFFUSE,
+                diffuse_texture: None,
+            }),
+            Some("Kd") => {
+                let kd = vec3(&at, &mut tokens, "a diffuse colour")?;
+                let current = materials
+                    .last_mut()
+                    .ok_or_else(|| at.syntax("newmtl before Kd", &text))?;
+                current.diffuse = kd.to_array();
+            }
+            Some("map_Kd") => {
+                let file = tokens
+                    .last()
+                    .ok_or_else(|| at.error(ErrorKind::Truncated("a texture file".into())))?;
+                let current = materials
+                    .last_mut()
+                    .ok_or_else(|| at.syntax("newmtl before map_Kd", &text))?;
+                current.diffuse_texture = Some(folder.join(file));
+            }
+            _ => {}
+        }
+    }
+    Ok(materials)
+}
+
+/// Writes an `.obj` file: positions, UVs and normals when present, one
+/// `o` line per object, faces in the matching `v/vt/vn` form. Floats are
+/// written in shortest round-trip form.
+///
+/// # Errors
+/// [`ErrorKind::InvalidInput`] for an index out of range or attribute
+/// arrays of the wrong length; an I/O error.
+pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
+    let n = mesh.positions.len();
+    let bad_len = |len: Option<usize>| len.is_some_and(|l| l != n);
+    if bad_len(mesh.uvs.as_ref().map(Vec::len)) || bad_len(mesh.normals.as_ref().map(Vec::len)) {
+        return Err(Error::new(
+            path,
+            ErrorKind::InvalidInput("UVs or normals do not match the positions".into()),
+        ));
+    }
+    if let Some((t, _)) = mesh
+        .indices
+        .iter()
+        .enumerate()
+        .find(|(_, tri)| tri.iter().any(|&i| i as usize >= n))
+    {
+        return Err(Error::new(
+            path,
+            ErrorKind::InvalidInput(format!("triangle {t} references a missing vertex")),
+        ));
+    }
+    let mut end = 0;
+    for o in &mesh.objects {
+        if o.triangles.start != end || o.triangles.end < o.triangles.start {
+            return Err(Error::new(
+                path,
+                ErrorKind::InvalidInput(format!(
+                    "object {:?} does not continue at triangle {end}",
+                    o.name
+                )),
+            ));
+        }
+        end = o.triangles.end;
+    }
+    if !mesh.objects.is_empty() && end != mesh.indices.len() {
+        return Err(Error::new(
+            path,
+            ErrorKind::InvalidInput(format!(
+                "the objects cover {end} of {} triangles",
+                mesh.indices.len()
+            )),
+        ));
+    }
+    let mut out = String::with_capacity(40 * n + 30 * mesh.indices.len());
+    out.push_str("# written by trilux-io\n");
+    for p in &mesh.positions {
+        let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
+    }
+    for t in mesh.uvs.iter().flatten() {
+        let _ = writeln!(out, "vt {} {}", t.x, t.y);
+    }
+    for q in mesh.normals.iter().flatten() {
+        let _ = writeln!(out, "vn {} {} {}", q.x, q.y, q.z);
+    }
+    let corner = |out: &mut String, i: u32| {
+        let i = i + 1;
+        let _ = match (mesh.uvs.is_some(), mesh.normals.is_some()) {
+            (false, false) => write!(out, " {i}"),
+            (true, false) => write!(out, " {i}/{i}"),
+            (false, true) => write!(out, " {i}//{i}"),
+            (true, true) => write!(out, " {i}/{i}/{i}"),
+        };
+    };
+    let whole = [Object {
+        name: String::new(),
+        triangles: 0..mesh.indices.len(),
+        material: None,
+    }];
+    let objects = if mesh.objects.is_empty() {
+        &whole[..]
+    } else {
+        &mesh.objects[..]
+    };
+    for object in objects {
+        if !object.name.is_empty() {
+            let _ = writeln!(out, "o {}", object.name);
+        }
+        for tri in &mesh.indices[object.triangles.clone()] {
+            out.push('f');
+            for &i in tri {
+                corner(&mut out, i);
+            }
+            out.push('\n');
+        }
+    }
+    std::fs::write(path, out).map_err(|e| Error::io(path, e))
+}

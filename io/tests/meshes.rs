@@ -1,0 +1,249 @@
+//! Triangle meshes: the real OBJ files of `$TRILUX_DATA/meshes` with the
+//! counts of the data README, hand-written files for every OBJ feature,
+//! malformed files, and round trips.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+use trilux_io::mesh::{TriMesh, obj};
+use trilux_io::{ErrorKind, Location};
+
+fn data_dir() -> Option<PathBuf> {
+    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let found = [given.clone(), workspace.join(&given)]
+        .into_iter()
+        .find(|p| p.is_dir());
+    assert!(
+        found.is_some(),
+        "TRILUX_DATA={} names no folder",
+        given.display()
+    );
+    found
+}
+
+fn scratch(name: &str) -> PathBuf {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    let dir =
+        std::env::temp_dir().join(format!("trilux-io-mesh-{}-{n}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+/// file, triangles, vertices after splitting (None: only the upper bound
+/// given by the `v` lines), that upper bound, has UVs, has normals.
+type RealObj = (&'static str, usize, Option<usize>, usize, bool, bool);
+
+/// A malformed file: name, bytes, the error kind it must give, the line.
+type BadObj = (&'static str, &'static [u8], fn(&ErrorKind) -> bool, usize);
+
+#[test]
+fn real_obj_files_match_the_data_readme() {
+    let Some(data) = data_dir() else {
+        eprintln!("skipped: TRILUX_DATA is not set, so the real OBJ meshes are not tested");
+        return;
+    };
+    let expected: [RealObj; 6] = [
+        (
+            "stanford-bunny.obj",
+            69_451,
+            Some(34_834),
+            35_947,
+            false,
+            false,
+        ),
+        ("spot.obj", 5_856, Some(3_225), 3_225, true, false),
+        ("teapot.obj", 6_320, None, 3_644, false, false),
+        ("fandisk.obj", 12_946, Some(6_475), 6_475, false, false),
+        ("suzanne.obj", 968, None, 507, false, true),
+        ("nefertiti.obj", 99_938, Some(49_971), 49_971, false, false),
+    ];
+    for (file, tris, verts, max_verts, uv, normal) in expected {
+        let mesh = TriMesh::read(data.join("meshes").join(file)).unwrap();
+        assert_eq!(mesh.indices.len(), tris, "{file}");
+        if let Some(v) = verts {
+            assert_eq!(mesh.positions.len(), v, "{file}");
+        }
+        assert!(mesh.positions.len() <= max_verts, "{file}");
+        assert_eq!(mesh.uvs.is_some(), uv, "{file}");
+        assert_eq!(mesh.normals.is_some(), normal, "{file}");
+        assert!(mesh.area() > 0.0, "{file}");
+        // Every vertex is used (unused `v` lines are dropped).
+        let mut used = vec![false; mesh.positions.len()];
+        mesh.indices
+            .iter()
+            .flatten()
+            .for_each(|&i| used[i as usize] = true);
+        assert!(used.iter().all(|&u| u), "{file}");
+        if file == "spot.obj" {
+            let uvs = mesh.uvs.as_ref().unwrap();
+            let min_u = uvs.iter().map(|t| t.x).fold(f32::INFINITY, f32::min);
+            assert!(
+                (min_u + 0.052).abs() < 1e-3,
+                "spot keeps its UVs outside [0, 1]: {min_u}"
+            );
+        }
+    }
+}
+
+const FEATURES: &[u8] = b"# every feature\nmtllib parts.mtl\n\
+v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 9 9 9\n\
+vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n\
+o quad\nusemtl red\nf 1/1/1 2/2/1 3/3/1 4/4/1\n\
+g tri \\\n  continued\nusemtl blue\nf -5/-4/-1 -3/-2/-1 -2/-1/-1\ns off\nl 1 2\n";
+
+const MTL: &[u8] =
+    b"newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\nmap_Kd -s 1 1 1 textures/blue.png\n";
+
+#[test]
+fn every_obj_feature() {
+    let dir = scratch("features");
+    write(&dir, "parts.mtl", MTL);
+    let mesh = obj::read(&write(&dir, "m.obj", FEATURES)).unwrap();
+    // The quad fans into two triangles; the last face reuses corners with
+    // the same v/vt/vn, so only 4 vertices exist and v 9 9 9 is unused.
+    assert_eq!(mesh.indices, vec![[0, 1, 2], [0, 2, 3], [0, 2, 3]]);
+    assert_eq!(mesh.positions.len(), 4);
+    assert_eq!(mesh.uvs.as_ref().unwrap()[2], Vec2::new(1.0, 1.0));
+    assert_eq!(mesh.normals.as_ref().unwrap()[0], Vec3::Z);
+    let names: Vec<_> = mesh
+        .objects
+        .iter()
+        .map(|o| (o.name.as_str(), o.triangles.clone(), o.material))
+        .collect();
+    assert_eq!(
+        names,
+        vec![("quad", 0..2, Some(0)), ("tri continued", 2..3, Some(1))]
+    );
+    assert_eq!(mesh.materials[0].diffuse, [1.0, 0.0, 0.0]);
+    assert_eq!(mesh.materials[1].name, "blue");
+    assert_eq!(
+        mesh.materials[1].diffuse_texture.as_deref(),
+        Some(dir.join("textures/blue.png").as_path())
+    );
+    // Without the files, materials are names with the MTL defaults.
+    let bare = obj::from_bytes(FEATURES, Path::new("m.obj")).unwrap();
+    assert_eq!(bare.materials[0].diffuse, [0.8, 0.8, 0.8]);
+}
+
+#[test]
+fn obj_round_trip() {
+    let dir = scratch("roundtrip");
+    let mesh = obj::read(&{
+        write(&dir, "parts.mtl", MTL);
+        write(&dir, "m.obj", FEATURES)
+    })
+    .unwrap();
+    let copy = dir.join("copy.obj");
+    obj::write(&copy, &mesh).unwrap();
+    let back = obj::read(&copy).unwrap();
+    assert_eq!(back.positions, mesh.positions);
+    assert_eq!(back.uvs, mesh.uvs);
+    assert_eq!(back.normals, mesh.normals);
+    assert_eq!(back.indices, mesh.indices);
+    assert_eq!(
+        back.objects
+            .iter()
+            .map(|o| o.triangles.clone())
+            .collect::<Vec<_>>(),
+        vec![0..2, 2..3]
+    );
+}
+
+#[test]
+fn malformed_obj_files_name_the_line() {
+    let dir = scratch("malformed");
+    let cases: [BadObj; 8] = [
+        (
+            "nan",
+            b"v 0 0 0\nv nan 0 0\n",
+            |k| matches!(k, ErrorKind::NonFinite { index: 1, .. }),
+            2,
+        ),
+        (
+            "inf",
+            b"v 0 0 inf\n",
+            |k| matches!(k, ErrorKind::NonFinite { index: 0, .. }),
+            1,
+        ),
+        (
+            "two-corners",
+            b"v 0 0 0\nv 1 0 0\nf 1 2\n",
+            |k| matches!(k, ErrorKind::Syntax { .. }),
+            3,
+        ),
+        (
+            "out-of-range",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+            |k| {
+                matches!(
+                    k,
+                    ErrorKind::IndexOutOfRange {
+                        node: 4,
+                        count: 3,
+                        ..
+                    }
+                )
+            },
+            4,
+        ),
+        (
+            "zero-index",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
+            |k| matches!(k, ErrorKind::IndexOutOfRange { node: 0, .. }),
+            4,
+        ),
+        (
+            "bad-number",
+            b"v 0 0 0,5\n",
+            |k| matches!(k, ErrorKind::Syntax { .. }),
+            1,
+        ),
+        (
+            "short-vertex",
+            b"# c\nv 0 0\n",
+            |k| matches!(k, ErrorKind::Truncated(_)),
+            2,
+        ),
+        (
+            "keyword",
+            b"v 0 0 0\nvertex 1 2 3\n",
+            |k| matches!(k, ErrorKind::Syntax { .. }),
+            2,
+        ),
+    ];
+    for (name, bytes, kind_ok, line) in cases {
+        let err = obj::read(&write(&dir, &format!("{name}.obj"), bytes)).unwrap_err();
+        assert!(kind_ok(&err.kind), "{name}: {err}");
+        assert_eq!(err.location, Some(Location::Line(line)), "{name}: {err}");
+    }
+    let err = obj::read(&write(&dir, "lib.obj", b"mtllib gone.mtl\nv 0 0 0\n")).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::Io(_)));
+    assert!(err.path.ends_with("gone.mtl"), "{err}");
+    let err = TriMesh::read("mesh.stl").unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::UnknownExtension(..)));
+}
+
+#[test]
+fn obj_writer_refuses_inconsistent_meshes() {
+    let dir = scratch("write-errors");
+    let mut mesh = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices: vec![[0, 1, 3]],
+        ..TriMesh::default()
+    };
+    let err = obj::write(&dir.join("a.obj"), &mesh).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::InvalidInput(_)), "{err}");
+    mesh.indices = vec![[0, 1, 2]];
+    mesh.uvs = Some(vec![Vec2::ZERO]);
+    assert!(obj::write(&dir.join("b.obj"), &mesh).is_err());
+}
