@@ -148,6 +148,13 @@ fn node_ref(
     Ok(zero_based as u32)
 }
 
+/// The smallest size of a record of `fields + extra` tokens (one byte and
+/// one separator each), saturating: a header may declare absurd numbers
+/// of attributes (found by fuzzing).
+fn min_record_bytes(fields: u64, extra: u64) -> usize {
+    usize::try_from(fields.saturating_add(extra).saturating_mul(2)).unwrap_or(usize::MAX)
+}
+
 /// Skips `n` tokens (attributes, markers, extra nodes).
 fn skip_tokens(c: &mut Cursor<'_>, n: u64, what: &str) -> Result<()> {
     for _ in 0..n {
@@ -192,7 +199,11 @@ pub(crate) fn parse_nodes(data: &[u8], path: &Path) -> Result<(Vec<DVec3>, i64)>
     }
     // Smallest record: "i x y z" plus attributes and markers, one byte and
     // one separator each.
-    let count = c.check_count("nodes", declared, 2 * (4 + attributes as usize + markers))?;
+    let count = c.check_count(
+        "nodes",
+        declared,
+        min_record_bytes(4 + markers as u64, attributes),
+    )?;
     let mut positions = Vec::with_capacity(count);
     let mut first_index = 0;
     for k in 0..count {
@@ -253,7 +264,7 @@ pub(crate) fn parse_elements(
     let count = c.check_count(
         "tetrahedra",
         declared,
-        2 * (1 + per_tet as usize + attributes as usize),
+        min_record_bytes(1 + per_tet, attributes),
     )?;
     let mut tets = Vec::with_capacity(count);
     let mut regions = Vec::with_capacity(if attributes > 0 { count } else { 0 });
