@@ -30,6 +30,11 @@ impl<'a> Cursor<'a> {
         }
     }
 
+    /// The file the data comes from.
+    pub(crate) fn path(&self) -> &'a Path {
+        self.path
+    }
+
     /// The current byte offset.
     pub(crate) fn offset(&self) -> usize {
         self.pos

@@ -247,3 +247,171 @@ fn obj_writer_refuses_inconsistent_meshes() {
     mesh.uvs = Some(vec![Vec2::ZERO]);
     assert!(obj::write(&dir.join("b.obj"), &mesh).is_err());
 }
+
+use trilux_io::mesh::ply::{self, Format, PlyData};
+
+fn sample_ply() -> PlyData {
+    PlyData {
+        positions: vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.5, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, -2.0),
+        ],
+        triangles: vec![[0, 1, 2]],
+        normals: Some(vec![Vec3::Z; 3]),
+        colors: Some(vec![[255, 0, 0, 255], [0, 255, 0, 128], [0, 0, 255, 0]]),
+        uvs: Some(vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(0.25, 1.0),
+        ]),
+        scalars: vec![("quality".to_string(), vec![0.5, 1.0, -3.0])],
+    }
+}
+
+#[test]
+fn ply_binary_header_and_layout_follow_the_spec() {
+    let bytes = ply::to_bytes(
+        Path::new("t.ply"),
+        &sample_ply(),
+        Format::BinaryLittleEndian,
+    )
+    .unwrap();
+    let header = "ply\nformat binary_little_endian 1.0\ncomment written by trilux-io\n\
+element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+property float nx\nproperty float ny\nproperty float nz\n\
+property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n\
+property float s\nproperty float t\nproperty float quality\n\
+element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    assert!(bytes.starts_with(header.as_bytes()));
+    let body = &bytes[header.len()..];
+    // Vertex: 3 + 3 floats, 4 uchar, 2 + 1 floats = 40 bytes; face: 1 + 3·4.
+    assert_eq!(body.len(), 3 * 40 + 13);
+    let f32_at = |o: usize| f32::from_le_bytes(body[o..o + 4].try_into().unwrap());
+    assert_eq!(f32_at(40), 1.5); // x of vertex 1
+    assert_eq!(f32_at(2 * 40 + 8), -2.0); // z of vertex 2
+    assert_eq!(&body[40 + 24..40 + 28], &[0, 255, 0, 128]); // rgba of vertex 1
+    assert_eq!(f32_at(2 * 40 + 28), 0.25); // s of vertex 2
+    assert_eq!(f32_at(2 * 40 + 36), -3.0); // quality of vertex 2
+    assert_eq!(body[120], 3);
+    assert_eq!(i32::from_le_bytes(body[129..133].try_into().unwrap()), 2);
+}
+
+#[test]
+fn ply_round_trips_in_both_formats() {
+    let dir = scratch("ply");
+    for format in [Format::Ascii, Format::BinaryLittleEndian] {
+        let path = dir.join(format!("{format:?}.ply"));
+        ply::write(&path, &sample_ply(), format).unwrap();
+        assert_eq!(ply::read(&path).unwrap(), sample_ply(), "{format:?}");
+    }
+    let cloud = PlyData {
+        positions: vec![Vec3::ONE, Vec3::NEG_ONE],
+        ..PlyData::default()
+    };
+    let path = dir.join("cloud.ply");
+    ply::write(&path, &cloud, Format::Ascii).unwrap();
+    assert_eq!(ply::read(&path).unwrap(), cloud);
+}
+
+#[test]
+fn ply_reads_other_writers_layouts() {
+    // Big-endian doubles, float colours, a quad, a skipped element.
+    let mut bytes = b"ply\nformat binary_big_endian 1.0\nobj_info made by hand\n\
+element vertex 4\nproperty double x\nproperty double y\nproperty double z\n\
+property float red\nproperty float green\nproperty float blue\nproperty ushort flags\n\
+element material 1\nproperty list uint uchar name\n\
+element face 1\nproperty uchar tag\nproperty list uchar uint vertex_index\nend_header\n"
+        .to_vec();
+    for (i, p) in [
+        [0.0f64, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+    ]
+    .iter()
+    .enumerate()
+    {
+        for x in p {
+            bytes.extend_from_slice(&x.to_be_bytes());
+        }
+        for c in [1.0f32, 0.5, 0.0] {
+            bytes.extend_from_slice(&c.to_be_bytes());
+        }
+        bytes.extend_from_slice(&(i as u16).to_be_bytes());
+    }
+    bytes.extend_from_slice(&2u32.to_be_bytes());
+    bytes.extend_from_slice(b"ab");
+    bytes.push(7);
+    bytes.push(4);
+    for i in [0u32, 1, 2, 3] {
+        bytes.extend_from_slice(&i.to_be_bytes());
+    }
+    let data = ply::from_bytes(&bytes, Path::new("be.ply")).unwrap();
+    assert_eq!(data.positions[2], Vec3::new(1.0, 1.0, 0.0));
+    assert_eq!(data.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    assert_eq!(data.colors.as_ref().unwrap()[0], [255, 128, 0, 255]);
+    assert_eq!(
+        data.scalars,
+        vec![("flags".to_string(), vec![0.0, 1.0, 2.0, 3.0])]
+    );
+
+    let ascii = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+property float z\nelement edge 1\nproperty int vertex1\nproperty int vertex2\n\
+element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+0 0 0\n1 0 0\n0 1 0\n0 1\n3 0 1 2\n";
+    let data = ply::from_bytes(ascii, Path::new("a.ply")).unwrap();
+    assert_eq!(data.triangles, vec![[0, 1, 2]]);
+}
+
+#[test]
+fn malformed_ply_files() {
+    type KindCheck = fn(&ErrorKind) -> bool;
+    let head = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
+    let cases: Vec<(String, KindCheck)> = vec![
+        ("plx\n".into(), |k| matches!(k, ErrorKind::Syntax { .. })),
+        (format!("{head}end_header\n0.0 0.0 0.0\n1.0 1.0"), |k| {
+            matches!(k, ErrorKind::Truncated(_))
+        }),
+        (format!("{head}end_header\n0 0 0\nnan 1 1\n"), |k| {
+            matches!(k, ErrorKind::NonFinite { index: 1, .. })
+        }),
+        (
+            format!(
+                "{head}element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 1 1\n3 0 1 5\n"
+            ),
+            |k| matches!(k, ErrorKind::IndexOutOfRange { node: 5, .. }),
+        ),
+        (
+            format!(
+                "{head}element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 1 1\n2 0 1\n"
+            ),
+            |k| matches!(k, ErrorKind::Syntax { .. }),
+        ),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float y\nend_header\n1\n".into(),
+            |k| matches!(k, ErrorKind::Truncated(_)),
+        ),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 99999999999\nproperty float x\nend_header\n1\n"
+                .into(),
+            |k| matches!(k, ErrorKind::CountTooLarge { .. }),
+        ),
+        (
+            "ply\nformat ascii 1.0\nproperty float x\nend_header\n".into(),
+            |k| matches!(k, ErrorKind::Syntax { .. }),
+        ),
+        ("ply\nformat ascii 2.0\n".into(), |k| {
+            matches!(k, ErrorKind::Syntax { .. })
+        }),
+    ];
+    for (text, kind_ok) in cases {
+        let err = ply::from_bytes(text.as_bytes(), Path::new("bad.ply")).unwrap_err();
+        assert!(kind_ok(&err.kind), "{text:?}: {err}");
+        assert!(err.to_string().starts_with("bad.ply"), "{err}");
+    }
+    let mut wrong = sample_ply();
+    wrong.uvs = Some(vec![Vec2::ZERO]);
+    let err = ply::to_bytes(Path::new("w.ply"), &wrong, Format::Ascii).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::InvalidInput(_)), "{err}");
+}

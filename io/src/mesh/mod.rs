@@ -8,6 +8,7 @@ use glam::{Vec2, Vec3};
 use crate::error::{Error, ErrorKind, Result};
 
 pub mod obj;
+pub mod ply;
 
 /// A triangle mesh as plain data, with one index stream: attributes are
 /// per vertex, and a vertex that has several UVs or normals in the file
