@@ -80,6 +80,20 @@ pub enum ErrorKind {
     /// A valid file that uses a feature this crate does not read.
     #[error("unsupported: {0}")]
     Unsupported(String),
+    /// A codec (PNG, JPEG, HDR, EXR) could not decode or encode the data;
+    /// its own error is the source.
+    #[error("{format}: {source}")]
+    Codec {
+        /// The format.
+        format: &'static str,
+        /// The codec's error.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// The file asks for more than the reader allows (image dimensions or
+    /// memory), refused before decoding.
+    #[error("limit exceeded: {0}")]
+    LimitExceeded(String),
     /// What the caller asked to write is inconsistent (a field of the wrong
     /// length, a tetrahedron referencing a missing node).
     #[error("invalid input: {0}")]

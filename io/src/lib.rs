@@ -29,6 +29,7 @@
 #![forbid(unsafe_code)]
 
 mod error;
+pub mod image;
 pub mod mesh;
 pub mod tet;
 mod text;

@@ -1,0 +1,298 @@
+//! Images in and out: PNG, JPEG, Radiance HDR and OpenEXR in; PNG (8 or
+//! 16 bit, sRGB-encoded) and OpenEXR (f32 or f16, linear) out. Pixels are
+//! always linear `f32` RGBA, so samplers and colour conversion see the same
+//! numbers whatever the file.
+
+use std::io::Cursor as IoCursor;
+use std::path::Path;
+
+use image::{DynamicImage, ImageError, ImageFormat, ImageReader, Limits};
+
+use crate::error::{Error, ErrorKind, Result};
+
+/// A linear RGBA image, row-major, row 0 at the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// `width · height` pixels, linear RGBA (alpha straight, not
+    /// premultiplied).
+    pub pixels: Vec<[f32; 4]>,
+}
+
+/// How to read an image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// Keep 8- and 16-bit values as stored (scaled to `[0, 1]`) instead of
+    /// decoding sRGB: for data textures such as densities, masks or normal
+    /// maps. Float formats are always linear.
+    pub raw: bool,
+    /// The largest width and height accepted.
+    pub max_dimension: u32,
+    /// The most memory a decoder may allocate, in bytes.
+    pub max_bytes: u64,
+}
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        Self {
+            raw: false,
+            max_dimension: 32_768,
+            max_bytes: 4 << 30,
+        }
+    }
+}
+
+/// PNG sample depth.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PngDepth {
+    /// 8 bits per channel.
+    Eight,
+    /// 16 bits per channel.
+    Sixteen,
+}
+
+/// EXR sample precision.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExrPrecision {
+    /// 16-bit half floats.
+    F16,
+    /// 32-bit floats.
+    F32,
+}
+
+/// The format for an extension, or the error naming the extensions known.
+fn format_of(path: &Path) -> Result<ImageFormat> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    match ext.as_str() {
+        "png" => Ok(ImageFormat::Png),
+        "jpg" | "jpeg" => Ok(ImageFormat::Jpeg),
+        "hdr" => Ok(ImageFormat::Hdr),
+        "exr" => Ok(ImageFormat::OpenExr),
+        _ => Err(Error::new(
+            path,
+            ErrorKind::UnknownExtension(ext, ".png, .jpg, .jpeg, .hdr, .exr"),
+        )),
+    }
+}
+
+fn format_name(format: ImageFormat) -> &'static str {
+    match format {
+        ImageFormat::Png => "PNG",
+        ImageFormat::Jpeg => "JPEG",
+        ImageFormat::Hdr => "Radiance HDR",
+        ImageFormat::OpenExr => "OpenEXR",
+        _ => "image",
+    }
+}
+
+/// Reads an image as linear RGBA with the default options (sRGB decoded,
+/// at most 32768 pixels a side).
+///
+/// # Errors
+/// [`Error`]: a missing file, an unknown extension, data the codec cannot
+/// decode, or dimensions beyond the limits.
+pub fn read(path: impl AsRef<Path>) -> Result<Image> {
+    read_with(path.as_ref(), ReadOptions::default())
+}
+
+/// Reads an image with explicit options.
+///
+/// # Errors
+/// As for [`read`].
+pub fn read_with(path: &Path, options: ReadOptions) -> Result<Image> {
+    format_of(path)?;
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    decode(&bytes, path, options)
+}
+
+/// Decodes image data (embedded textures, archives); the extension of
+/// `name` gives the format, and `name` labels errors.
+///
+/// # Errors
+/// As for [`read`].
+pub fn decode(bytes: &[u8], name: &Path, options: ReadOptions) -> Result<Image> {
+    let path = name;
+    let format = format_of(path)?;
+    let mut limits = Limits::default();
+    limits.max_image_width = Some(options.max_dimension);
+    limits.max_image_height = Some(options.max_dimension);
+    limits.max_alloc = Some(options.max_bytes);
+    let mut reader = ImageReader::with_format(IoCursor::new(bytes), format);
+    reader.limits(limits);
+    let image = reader.decode().map_err(|e| codec_error(path, format, e))?;
+    Ok(to_linear(image, options.raw))
+}
+
+fn codec_error(path: &Path, format: ImageFormat, e: ImageError) -> Error {
+    let kind = match e {
+        ImageError::Limits(l) => ErrorKind::LimitExceeded(l.to_string()),
+        ImageError::IoError(io) => ErrorKind::Io(io),
+        other => ErrorKind::Codec {
+            format: format_name(format),
+            source: Box::new(other),
+        },
+    };
+    Error::new(path, kind)
+}
+
+/// sRGB-encoded value in `[0, 1]` to linear (IEC 61966-2-1).
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// Linear value to sRGB-encoded, clamped to `[0, 1]`.
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+fn to_linear(image: DynamicImage, raw: bool) -> Image {
+    let float_source = matches!(
+        image,
+        DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+    );
+    let rgba = image.to_rgba32f();
+    let (width, height) = rgba.dimensions();
+    let decode = !raw && !float_source;
+    let pixels = rgba
+        .pixels()
+        .map(|p| {
+            let mut px = p.0;
+            if decode {
+                for c in &mut px[..3] {
+                    *c = srgb_to_linear(*c);
+                }
+            }
+            px
+        })
+        .collect();
+    Image {
+        width,
+        height,
+        pixels,
+    }
+}
+
+impl Image {
+    /// Rec. 709 luminance of each pixel (for density textures and maps).
+    pub fn luminance(&self) -> Vec<f32> {
+        self.pixels
+            .iter()
+            .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+            .collect()
+    }
+
+    fn check(&self, path: &Path) -> Result<()> {
+        let expected = u64::from(self.width) * u64::from(self.height);
+        if self.pixels.len() as u64 != expected || self.width == 0 || self.height == 0 {
+            return Err(Error::new(
+                path,
+                ErrorKind::InvalidInput(format!(
+                    "{} pixels for a {}×{} image",
+                    self.pixels.len(),
+                    self.width,
+                    self.height
+                )),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Writes a PNG: colour sRGB-encoded (values above 1 are clipped; tone map
+/// first), alpha linear.
+///
+/// # Errors
+/// [`ErrorKind::InvalidInput`] for a pixel count that does not match the
+/// size; codec and I/O errors.
+pub fn write_png(path: &Path, image: &Image, depth: PngDepth) -> Result<()> {
+    image.check(path)?;
+    let encode = |p: &[f32; 4], k: usize| {
+        if k < 3 {
+            linear_to_srgb(p[k])
+        } else {
+            p[k].clamp(0.0, 1.0)
+        }
+    };
+    let dynamic = match depth {
+        PngDepth::Eight => {
+            let data: Vec<u8> = image
+                .pixels
+                .iter()
+                .flat_map(|p| (0..4).map(move |k| (encode(p, k) * 255.0).round() as u8))
+                .collect();
+            DynamicImage::ImageRgba8(
+                image::RgbaImage::from_raw(image.width, image.height, data).ok_or_else(|| {
+                    Error::new(path, ErrorKind::InvalidInput("pixel buffer size".into()))
+                })?,
+            )
+        }
+        PngDepth::Sixteen => {
+            let data: Vec<u16> = image
+                .pixels
+                .iter()
+                .flat_map(|p| (0..4).map(move |k| (encode(p, k) * 65535.0).round() as u16))
+                .collect();
+            DynamicImage::ImageRgba16(
+                image::ImageBuffer::from_raw(image.width, image.height, data).ok_or_else(|| {
+                    Error::new(path, ErrorKind::InvalidInput("pixel buffer size".into()))
+                })?,
+            )
+        }
+    };
+    dynamic
+        .save_with_format(path, ImageFormat::Png)
+        .map_err(|e| codec_error(path, ImageFormat::Png, e))
+}
+
+/// Writes an OpenEXR file: linear RGBA, f32 or f16 samples.
+///
+/// # Errors
+/// [`ErrorKind::InvalidInput`] for a pixel count that does not match the
+/// size; codec and I/O errors.
+pub fn write_exr(path: &Path, image: &Image, precision: ExrPrecision) -> Result<()> {
+    use exr::prelude::f16;
+    image.check(path)?;
+    let (w, h) = (image.width as usize, image.height as usize);
+    let pixel = |x: usize, y: usize| image.pixels[y * w + x];
+    let result = match precision {
+        ExrPrecision::F32 => exr::prelude::write_rgba_file(path, w, h, |x, y| {
+            let p = pixel(x, y);
+            (p[0], p[1], p[2], p[3])
+        }),
+        ExrPrecision::F16 => exr::prelude::write_rgba_file(path, w, h, |x, y| {
+            let p = pixel(x, y);
+            (
+                f16::from_f32(p[0]),
+                f16::from_f32(p[1]),
+                f16::from_f32(p[2]),
+                f16::from_f32(p[3]),
+            )
+        }),
+    };
+    result.map_err(|e| match e {
+        exr::error::Error::Io(io) => Error::io(path, io),
+        other => Error::new(
+            path,
+            ErrorKind::Codec {
+                format: "OpenEXR",
+                source: Box::new(other),
+            },
+        ),
+    })
+}

@@ -1,0 +1,223 @@
+//! Images: the real PNG and HDR files of `$TRILUX_DATA`, sRGB handling,
+//! round trips through PNG (8/16 bit) and EXR (f32/f16), and hostile or
+//! broken files.
+
+use std::path::{Path, PathBuf};
+
+use trilux_io::ErrorKind;
+use trilux_io::image::{self, ExrPrecision, Image, PngDepth, ReadOptions};
+
+fn data_dir() -> Option<PathBuf> {
+    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let found = [given.clone(), workspace.join(&given)]
+        .into_iter()
+        .find(|p| p.is_dir());
+    assert!(
+        found.is_some(),
+        "TRILUX_DATA={} names no folder",
+        given.display()
+    );
+    found
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("trilux-io-img-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn real_images_match_the_data_readme() {
+    let Some(data) = data_dir() else {
+        eprintln!("skipped: TRILUX_DATA is not set, so the real images are not tested");
+        return;
+    };
+    let spot = image::read(data.join("textures/spot_texture.png")).unwrap();
+    assert_eq!((spot.width, spot.height), (1024, 1024));
+    assert!(
+        spot.pixels
+            .iter()
+            .all(|p| p[3] == 1.0 && p.iter().all(|c| (0.0..=1.0).contains(c)))
+    );
+    // HDR maps: size and luminance extremes from the data README.
+    for (file, max_l, min_l) in [
+        ("hdr/spiaggia_di_mondello_1k.hdr", 70_948.0, 0.00869),
+        ("hdr/kloppenheim_06_1k.hdr", 19.87, 0.293),
+    ] {
+        let hdr = image::read(data.join(file)).unwrap();
+        assert_eq!((hdr.width, hdr.height), (1024, 512), "{file}");
+        let l = hdr.luminance();
+        let max = l.iter().copied().fold(0.0f32, f32::max);
+        let min = l.iter().copied().fold(f32::INFINITY, f32::min);
+        assert!((max / max_l - 1.0).abs() < 0.01, "{file}: max {max}");
+        assert!((min / min_l - 1.0).abs() < 0.01, "{file}: min {min}");
+    }
+    let helmet = data.join("gltf/FlightHelmet");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&helmet).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "png") {
+            let img = image::read(&path).unwrap();
+            assert!(img.width == 512 || img.width == 32, "{}", path.display());
+            count += 1;
+        }
+    }
+    assert_eq!(count, 15);
+}
+
+fn gradient(width: u32, height: u32) -> Image {
+    let pixels = (0..width * height)
+        .map(|i| {
+            let t = i as f32 / (width * height - 1) as f32;
+            [t, 1.0 - t, t * t, 0.5 + 0.5 * t]
+        })
+        .collect();
+    Image {
+        width,
+        height,
+        pixels,
+    }
+}
+
+#[test]
+fn srgb_is_decoded_unless_raw() {
+    let dir = scratch("srgb");
+    let g = image::srgb_to_linear(128.0 / 255.0);
+    let grey = Image {
+        width: 1,
+        height: 1,
+        pixels: vec![[g, g, g, 1.0]],
+    };
+    let path = dir.join("grey.png");
+    image::write_png(&path, &grey, PngDepth::Eight).unwrap();
+    let decoded = image::read(&path).unwrap();
+    assert!(
+        (decoded.pixels[0][0] - 0.215_860_5).abs() < 1e-6,
+        "{:?}",
+        decoded.pixels[0]
+    );
+    let raw = image::read_with(
+        &path,
+        ReadOptions {
+            raw: true,
+            ..ReadOptions::default()
+        },
+    )
+    .unwrap();
+    assert!((raw.pixels[0][0] - 128.0 / 255.0).abs() < 1e-6);
+    for c in [0.0f32, 0.001, 0.04, 0.2, 0.5, 0.9, 1.0] {
+        assert!((image::srgb_to_linear(image::linear_to_srgb(c)) - c).abs() < 1e-6);
+    }
+}
+
+#[test]
+fn png_and_exr_round_trips() {
+    let dir = scratch("roundtrip");
+    let img = gradient(37, 23);
+    let cases: [(&str, f32); 4] = [
+        ("a8.png", 0.01),
+        ("a16.png", 1e-4),
+        ("f32.exr", 0.0),
+        ("f16.exr", 1e-3),
+    ];
+    for (name, tolerance) in cases {
+        let path = dir.join(name);
+        match name {
+            "a8.png" => image::write_png(&path, &img, PngDepth::Eight).unwrap(),
+            "a16.png" => image::write_png(&path, &img, PngDepth::Sixteen).unwrap(),
+            "f32.exr" => image::write_exr(&path, &img, ExrPrecision::F32).unwrap(),
+            _ => image::write_exr(&path, &img, ExrPrecision::F16).unwrap(),
+        }
+        let back = image::read(&path).unwrap();
+        assert_eq!((back.width, back.height), (37, 23), "{name}");
+        let worst = back
+            .pixels
+            .iter()
+            .zip(&img.pixels)
+            .flat_map(|(a, b)| (0..4).map(move |k| (a[k] - b[k]).abs()))
+            .fold(0.0f32, f32::max);
+        assert!(worst <= tolerance, "{name}: worst error {worst}");
+    }
+    // HDR values survive EXR.
+    let bright = Image {
+        width: 1,
+        height: 1,
+        pixels: vec![[70_948.0, 1e-4, 3.5, 1.0]],
+    };
+    let path = dir.join("bright.exr");
+    image::write_exr(&path, &bright, ExrPrecision::F32).unwrap();
+    assert_eq!(image::read(&path).unwrap(), bright);
+}
+
+/// CRC-32 (PNG's polynomial), to forge a valid header in the test.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+#[test]
+fn hostile_and_broken_images_are_refused() {
+    let dir = scratch("hostile");
+    // A 60-byte PNG whose header claims 100000 × 100000 RGBA pixels (40 GB).
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend_from_slice(&100_000u32.to_be_bytes());
+    ihdr.extend_from_slice(&100_000u32.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 6, 0, 0, 0]);
+    png.extend_from_slice(&13u32.to_be_bytes());
+    png.extend_from_slice(&ihdr);
+    png.extend_from_slice(&crc32(&ihdr).to_be_bytes());
+    let path = dir.join("huge.png");
+    std::fs::write(&path, &png).unwrap();
+    let err = image::read(&path).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::LimitExceeded(_)), "{err}");
+
+    // A real image beyond a caller's smaller limit.
+    let small = gradient(64, 64);
+    let path = dir.join("ok.png");
+    image::write_png(&path, &small, PngDepth::Eight).unwrap();
+    let limited = ReadOptions {
+        max_dimension: 32,
+        ..ReadOptions::default()
+    };
+    let err = image::read_with(&path, limited).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::LimitExceeded(_)), "{err}");
+
+    // Truncated data is a codec error with the codec's message behind it.
+    let bytes = std::fs::read(&path).unwrap();
+    let cut = dir.join("cut.png");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let err = image::read(&cut).unwrap_err();
+    assert!(
+        matches!(
+            err.kind,
+            ErrorKind::Codec { format: "PNG", .. } | ErrorKind::Io(_)
+        ),
+        "{err}"
+    );
+    assert!(std::error::Error::source(&err).is_some());
+
+    let err = image::read(dir.join("picture.gif")).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::UnknownExtension(..)), "{err}");
+    let err = image::read(dir.join("missing.png")).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::Io(_)), "{err}");
+    let wrong = Image {
+        width: 2,
+        height: 2,
+        pixels: vec![[0.0; 4]; 3],
+    };
+    let err = image::write_png(&dir.join("w.png"), &wrong, PngDepth::Eight).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::InvalidInput(_)), "{err}");
+}
