@@ -94,6 +94,10 @@ pub enum ErrorKind {
     /// memory), refused before decoding.
     #[error("limit exceeded: {0}")]
     LimitExceeded(String),
+    /// A URI in the file points outside its folder (absolute, `..`, or a
+    /// remote scheme), refused unless the caller allows it.
+    #[error("URI {0:?} points outside the file's folder; allow it explicitly to read it")]
+    OutsideFolder(String),
     /// What the caller asked to write is inconsistent (a field of the wrong
     /// length, a tetrahedron referencing a missing node).
     #[error("invalid input: {0}")]

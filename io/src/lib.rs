@@ -1,10 +1,15 @@
 //! `trilux-io`: the files trilux users already have, in and out.
 //!
-//! This first part reads and writes **tetrahedral meshes**: TetGen
-//! `.node`/`.ele` (+ `.face`), Gmsh `.msh` 2.2 (ASCII and binary) and 4.1
-//! (ASCII), MEDIT `.mesh`, and VTK `.vtu` output with scalar fields for
-//! ParaView. Readers return plain data ([`tet::TetMesh`]: `glam`
-//! positions and `[u32; 4]` tetrahedra) and never a half-read mesh. Every
+//! - **Triangle meshes** ([`mesh`]): OBJ and glTF/GLB in, PLY in and out,
+//!   OBJ out; one index stream, materials with decoded glTF textures.
+//! - **Images** ([`image`]): PNG, JPEG, Radiance HDR, OpenEXR in as linear
+//!   `f32` RGBA; PNG (8/16 bit) and EXR (f32/f16) out.
+//! - **Tetrahedral meshes** ([`tet`]): TetGen `.node`/`.ele` (+ `.face`),
+//!   Gmsh `.msh` 2.2 (ASCII and binary) and 4.1 (ASCII), MEDIT `.mesh` in;
+//!   TetGen, MEDIT and VTK `.vtu` (with scalar fields, for ParaView) out.
+//!
+//! Readers return plain data (`glam` vectors, `[u32; N]` indices) and
+//! never a half-read mesh. Every
 //! failure is an [`Error`] that names the file, the line (or byte offset)
 //! and what was wrong: a truncated record, a non-finite coordinate, a
 //! tetrahedron that references a missing node, or a header that declares
@@ -12,7 +17,9 @@
 //! boundary surface is derived from the tetrahedra
 //! ([`tet::TetMesh::boundary`]), not trusted from a file's face list.
 //!
-//! Triangle meshes (OBJ, glTF, PLY) and images are still to come (issue 3).
+//! A glTF's URIs are confined to its folder, and image dimensions and
+//! header counts are checked before anything is allocated, so hostile files
+//! fail cleanly.
 //!
 //! # Example
 //!
@@ -28,6 +35,7 @@
 
 #![forbid(unsafe_code)]
 
+mod base64;
 mod error;
 pub mod image;
 pub mod mesh;

@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 
 use crate::error::{Error, ErrorKind, Result};
+use crate::image::Image;
 
+pub mod gltf;
 pub mod obj;
 pub mod ply;
 
@@ -48,13 +50,31 @@ pub struct Material {
     pub name: String,
     /// Diffuse (base) colour, linear RGB.
     pub diffuse: [f32; 3],
-    /// The diffuse (base colour) texture, resolved against the mesh file's
-    /// folder. Not opened: images are read separately.
+    /// The diffuse (base colour) texture file, resolved against the mesh
+    /// file's folder, when it is a file.
     pub diffuse_texture: Option<PathBuf>,
+    /// The decoded base colour texture, when the reader decodes it (glTF:
+    /// embedded or external). OBJ leaves it to the caller
+    /// ([`crate::image::read`] of `diffuse_texture`).
+    pub diffuse_image: Option<Image>,
+    /// How the texture repeats outside `[0, 1]` along u and v.
+    pub wrap: [Wrap; 2],
+}
+
+/// Texture wrap mode (glTF sampler modes; OBJ/MTL textures repeat).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wrap {
+    /// Tile the texture.
+    Repeat,
+    /// Tile, mirroring every other copy.
+    MirroredRepeat,
+    /// Extend the edge texels.
+    ClampToEdge,
 }
 
 impl TriMesh {
-    /// Reads a triangle mesh, choosing the format by extension: `.obj`.
+    /// Reads a triangle mesh, choosing the format by extension: `.obj`,
+    /// `.gltf`, `.glb` (URIs confined to the file's folder), `.ply`.
     ///
     /// # Errors
     /// [`Error`] naming the file, the line, and what was wrong.
@@ -66,9 +86,28 @@ impl TriMesh {
             .map(str::to_ascii_lowercase);
         match ext.as_deref() {
             Some("obj") => obj::read(path),
+            Some("gltf" | "glb") => gltf::read(path),
+            Some("ply") => {
+                let ply = ply::read(path)?;
+                Ok(TriMesh {
+                    objects: vec![Object {
+                        name: String::new(),
+                        triangles: 0..ply.triangles.len(),
+                        material: None,
+                    }],
+                    positions: ply.positions,
+                    indices: ply.triangles,
+                    normals: ply.normals,
+                    uvs: ply.uvs,
+                    materials: Vec::new(),
+                })
+            }
             other => Err(Error::new(
                 path,
-                ErrorKind::UnknownExtension(other.unwrap_or("").to_string(), ".obj"),
+                ErrorKind::UnknownExtension(
+                    other.unwrap_or("").to_string(),
+                    ".obj, .gltf, .glb, .ply",
+                ),
             )),
         }
     }

@@ -14,7 +14,7 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use super::{Material, Object, TriMesh};
+use super::{Material, Object, TriMesh, Wrap};
 use crate::error::{Error, ErrorKind, Location, Result};
 
 /// "No UV / no normal" in a vertex key.
@@ -256,6 +256,8 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
                             name: wanted,
                             diffuse: DEFAULT_DIFFUSE,
                             diffuse_texture: None,
+                            diffuse_image: None,
+                            wrap: [Wrap::Repeat; 2],
                         });
                         materials.len() - 1
                     }
@@ -307,6 +309,8 @@ fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<Vec<Material>> {
                 name: tokens.collect::<Vec<_>>().join(" "),
                 diffuse: DEFAULT_DIFFUSE,
                 diffuse_texture: None,
+                diffuse_image: None,
+                wrap: [Wrap::Repeat; 2],
             }),
             Some("Kd") => {
                 let kd = vec3(&at, &mut tokens, "a diffuse colour")?;
