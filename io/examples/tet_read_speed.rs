@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
-use trilux_io::tet::{TetMesh, gmsh, tetgen};
+use trilux_io::tet::{TetMesh, gmsh, medit, tetgen};
 
 const RUNS: usize = 7;
 
@@ -61,6 +61,14 @@ fn main() -> ExitCode {
     };
     let base = tets.join("bunny_500k.node");
     let msh_path = tets.join("bunny_500k.msh");
+    // No MEDIT file in the data set: write the same mesh as one.
+    let medit_path = std::env::temp_dir().join(format!("trilux-bunny-{}.mesh", std::process::id()));
+    let bunny = TetMesh::read(&base).expect("valid");
+    if let Err(e) = medit::write(&medit_path, &bunny) {
+        eprintln!("tet_read_speed: {e}");
+        return ExitCode::FAILURE;
+    }
+    let mesh_bytes = std::fs::read(&medit_path).unwrap_or_default();
 
     let rows: Vec<(&str, usize, f64, f64)> = vec![
         (
@@ -74,6 +82,16 @@ fn main() -> ExitCode {
             }),
         ),
         (
+            "MEDIT .mesh (written from the same mesh)",
+            mesh_bytes.len(),
+            median_seconds(|| {
+                black_box(medit::from_bytes(&mesh_bytes, &medit_path).expect("valid"));
+            }),
+            median_seconds(|| {
+                black_box(TetMesh::read(&medit_path).expect("valid"));
+            }),
+        ),
+        (
             "Gmsh 4.1 ASCII .msh",
             msh.len(),
             median_seconds(|| {
@@ -84,10 +102,10 @@ fn main() -> ExitCode {
             }),
         ),
     ];
-    let mesh = TetMesh::read(&base).expect("valid");
     let boundary_s = median_seconds(|| {
-        black_box(mesh.boundary());
+        black_box(bunny.boundary());
     });
+    let _ = std::fs::remove_file(&medit_path);
 
     println!(
         "## trilux-io: ASCII tet readers on bunny_500k (93,375 nodes, 507,125 tets), one core\n"

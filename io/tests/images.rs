@@ -151,6 +151,24 @@ fn png_and_exr_round_trips() {
     assert_eq!(image::read(&path).unwrap(), bright);
 }
 
+#[test]
+fn jpeg_is_read_and_srgb_decoded() {
+    // The data set has no JPEG: encode one with the image crate.
+    let dir = scratch("jpeg");
+    let path = dir.join("flat.jpg");
+    let rgb = ::image::RgbImage::from_pixel(16, 8, ::image::Rgb([200, 100, 50]));
+    rgb.save(&path).unwrap();
+    let img = image::read(&path).unwrap();
+    assert_eq!((img.width, img.height), (16, 8));
+    let expected = [200.0f32, 100.0, 50.0].map(|c| image::srgb_to_linear(c / 255.0));
+    for p in &img.pixels {
+        for k in 0..3 {
+            assert!((p[k] - expected[k]).abs() < 0.02, "{p:?} vs {expected:?}");
+        }
+        assert_eq!(p[3], 1.0);
+    }
+}
+
 /// CRC-32 (PNG's polynomial), to forge a valid header in the test.
 fn crc32(bytes: &[u8]) -> u32 {
     let mut crc = !0u32;
