@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use trilux_io::mesh::obj;
+use trilux_io::mesh::{gltf, obj};
 use trilux_io::tet::{gmsh, medit, tetgen};
 
 fn replay(target: &str, run: impl Fn(&[u8])) -> usize {
@@ -35,6 +35,9 @@ fn saved_fuzz_crashes_stay_fixed() {
         let _ = medit::from_bytes(data, Path::new("fuzz.mesh"));
     }) + replay("obj", |data| {
         let _ = obj::from_bytes(data, Path::new("fuzz.obj"));
+    }) + replay("gltf", |data| {
+        let path = Path::new("/nonexistent-trilux-fuzz/asset.gltf");
+        let _ = gltf::from_bytes(data, path, gltf::Options::default());
     });
-    assert!(total >= 1, "the saved crash inputs are missing");
+    assert!(total >= 2, "the saved crash inputs are missing");
 }

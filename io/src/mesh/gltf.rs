@@ -129,12 +129,22 @@ impl Reader<'_> {
     }
 
     fn read(&self, bytes: &[u8]) -> Result<TriMesh> {
-        let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(bytes).map_err(|e| {
+        let codec = |e: gltf::Error| {
             self.error(ErrorKind::Codec {
                 format: "glTF",
                 source: Box::new(e),
             })
-        })?;
+        };
+        // The gltf crate's validation indexes the arrays a file references
+        // without bounds checks (found by fuzzing: a primitive naming an
+        // accessor that does not exist panics inside it), so every
+        // reference is checked here first.
+        let gltf::Gltf { document, blob } =
+            gltf::Gltf::from_slice_without_validation(bytes).map_err(codec)?;
+        if let Some(broken) = first_dangling_reference(document.as_json()) {
+            return Err(self.invalid(broken));
+        }
+        let document = gltf::Document::from_json(document.into_json()).map_err(codec)?;
         let mut buffers = Vec::new();
         for buffer in document.buffers() {
             let mut data = match buffer.source() {
@@ -404,6 +414,140 @@ impl Reader<'_> {
         out.diffuse_image = Some(decoded);
         Ok(out)
     }
+}
+
+/// The first reference of the JSON to an array element that does not
+/// exist, described, or `None` when every reference resolves.
+fn first_dangling_reference(root: &gltf::json::Root) -> Option<String> {
+    let mut problems = Vec::new();
+    let mut check = |what: &str, index: usize, len: usize| {
+        if index >= len && problems.is_empty() {
+            problems.push(format!("{what} {index} of {len}"));
+        }
+    };
+    let (accessors, views, buffers) = (
+        root.accessors.len(),
+        root.buffer_views.len(),
+        root.buffers.len(),
+    );
+    let (nodes, meshes, materials) = (root.nodes.len(), root.meshes.len(), root.materials.len());
+    let (textures, images, samplers) =
+        (root.textures.len(), root.images.len(), root.samplers.len());
+    if let Some(scene) = root.scene {
+        check("scene", scene.value(), root.scenes.len());
+    }
+    for scene in &root.scenes {
+        scene
+            .nodes
+            .iter()
+            .for_each(|n| check("node", n.value(), nodes));
+    }
+    for node in &root.nodes {
+        node.children
+            .iter()
+            .flatten()
+            .for_each(|n| check("node", n.value(), nodes));
+        node.mesh
+            .iter()
+            .for_each(|m| check("mesh", m.value(), meshes));
+        node.skin
+            .iter()
+            .for_each(|s| check("skin", s.value(), root.skins.len()));
+        node.camera
+            .iter()
+            .for_each(|c| check("camera", c.value(), root.cameras.len()));
+    }
+    for mesh in &root.meshes {
+        for primitive in &mesh.primitives {
+            primitive
+                .attributes
+                .values()
+                .for_each(|a| check("accessor", a.value(), accessors));
+            primitive
+                .indices
+                .iter()
+                .for_each(|a| check("accessor", a.value(), accessors));
+            primitive
+                .material
+                .iter()
+                .for_each(|m| check("material", m.value(), materials));
+            for target in primitive.targets.iter().flatten() {
+                [target.positions, target.normals, target.tangents]
+                    .into_iter()
+                    .flatten()
+                    .for_each(|a| check("accessor", a.value(), accessors));
+            }
+        }
+    }
+    for accessor in &root.accessors {
+        accessor
+            .buffer_view
+            .iter()
+            .for_each(|v| check("buffer view", v.value(), views));
+        if let Some(sparse) = &accessor.sparse {
+            check("buffer view", sparse.indices.buffer_view.value(), views);
+            check("buffer view", sparse.values.buffer_view.value(), views);
+        }
+    }
+    root.buffer_views
+        .iter()
+        .for_each(|v| check("buffer", v.buffer.value(), buffers));
+    for material in &root.materials {
+        let pbr = &material.pbr_metallic_roughness;
+        [
+            &pbr.base_color_texture,
+            &pbr.metallic_roughness_texture,
+            &material.emissive_texture,
+        ]
+        .into_iter()
+        .flatten()
+        .for_each(|t| check("texture", t.index.value(), textures));
+        material
+            .normal_texture
+            .iter()
+            .for_each(|t| check("texture", t.index.value(), textures));
+        material
+            .occlusion_texture
+            .iter()
+            .for_each(|t| check("texture", t.index.value(), textures));
+    }
+    for texture in &root.textures {
+        check("image", texture.source.value(), images);
+        texture
+            .sampler
+            .iter()
+            .for_each(|s| check("sampler", s.value(), samplers));
+    }
+    root.images
+        .iter()
+        .flat_map(|i| i.buffer_view)
+        .for_each(|v| check("buffer view", v.value(), views));
+    for skin in &root.skins {
+        skin.joints
+            .iter()
+            .for_each(|n| check("node", n.value(), nodes));
+        skin.skeleton
+            .iter()
+            .for_each(|n| check("node", n.value(), nodes));
+        skin.inverse_bind_matrices
+            .iter()
+            .for_each(|a| check("accessor", a.value(), accessors));
+    }
+    for animation in &root.animations {
+        for channel in &animation.channels {
+            check(
+                "animation sampler",
+                channel.sampler.value(),
+                animation.samplers.len(),
+            );
+            check("node", channel.target.node.value(), nodes);
+        }
+        for sampler in &animation.samplers {
+            check("accessor", sampler.input.value(), accessors);
+            check("accessor", sampler.output.value(), accessors);
+        }
+    }
+    problems.pop().map(|p| format!("a reference to {p}"))
 }
 
 /// Decodes `%XX` escapes; `None` for a malformed escape or non-UTF-8.
