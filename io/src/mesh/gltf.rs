@@ -12,7 +12,7 @@
 use std::path::{Component, Path, PathBuf};
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
-use gltf::accessor::Accessor;
+use gltf::accessor::{Accessor, DataType, Dimensions};
 use gltf::mesh::Mode;
 use gltf::texture::WrappingMode;
 
@@ -208,8 +208,24 @@ impl Reader<'_> {
         Ok(mesh)
     }
 
-    /// Checks that `accessor` lies inside its buffer view and buffer.
-    fn check(&self, accessor: &Accessor<'_>, buffers: &[Vec<u8>]) -> Result<()> {
+    /// Checks that `accessor` has the layout its use requires (the gltf
+    /// reader only debug-asserts it; found by fuzzing) and lies inside its
+    /// buffer view and buffer.
+    fn check(
+        &self,
+        accessor: &Accessor<'_>,
+        buffers: &[Vec<u8>],
+        dimensions: Dimensions,
+        types: &[DataType],
+    ) -> Result<()> {
+        if accessor.dimensions() != dimensions || !types.contains(&accessor.data_type()) {
+            return Err(self.invalid(format!(
+                "accessor {} of type {:?} {:?} where {dimensions:?} of {types:?} is required",
+                accessor.index(),
+                accessor.dimensions(),
+                accessor.data_type()
+            )));
+        }
         if accessor.sparse().is_some() {
             return Err(self.error(ErrorKind::Unsupported("sparse accessors".into())));
         }
@@ -260,17 +276,21 @@ impl Reader<'_> {
         ) {
             return Ok(()); // points and lines have no surface
         }
-        for semantic in [
-            gltf::Semantic::Positions,
-            gltf::Semantic::Normals,
-            gltf::Semantic::TexCoords(0),
-        ] {
+        let float = &[DataType::F32][..];
+        let uv_types = &[DataType::F32, DataType::U8, DataType::U16][..];
+        let layouts = [
+            (gltf::Semantic::Positions, Dimensions::Vec3, float),
+            (gltf::Semantic::Normals, Dimensions::Vec3, float),
+            (gltf::Semantic::TexCoords(0), Dimensions::Vec2, uv_types),
+        ];
+        for (semantic, dimensions, types) in layouts {
             if let Some(accessor) = primitive.get(&semantic) {
-                self.check(&accessor, buffers)?;
+                self.check(&accessor, buffers, dimensions, types)?;
             }
         }
         if let Some(accessor) = primitive.indices() {
-            self.check(&accessor, buffers)?;
+            let index_types = [DataType::U8, DataType::U16, DataType::U32];
+            self.check(&accessor, buffers, Dimensions::Scalar, &index_types)?;
         }
         let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
         let positions: Vec<Vec3> = reader
