@@ -83,12 +83,7 @@ fn draw<D: Distribution<usize>>(d: &D, rng: &mut Pcg64Mcg, samples: usize) -> us
 
 /// Draws `samples` 2D points through `sample_into` and folds their cells.
 fn draw_2d<S: DiscreteSampler>(d: &Distribution2D<S>, rng: &mut Pcg64Mcg, samples: usize) -> usize {
-    let blank = discrete_sampling::Sample2D {
-        point: [0.0; 2],
-        cell: [0; 2],
-        pdf: 0.0,
-    };
-    let mut buf = vec![blank; 4096];
+    let mut buf = vec![discrete_sampling::Sample2D::default(); 4096];
     let mut acc = 0usize;
     let mut left = samples;
     while left > 0 {

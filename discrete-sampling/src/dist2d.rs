@@ -10,8 +10,10 @@ use crate::uniform::{ONE_MINUS_EPSILON, bits_to_unit, fill_batch_pairs, unit_f64
 use crate::weights::checked_total;
 use crate::{DiscreteSampler, Error, GuideTable, InvertibleSampler};
 
-/// A point drawn from a [`Distribution2D`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A point drawn from a [`Distribution2D`]. `Default` (the origin, cell
+/// `[0, 0]`, density 0) is for allocating buffers for
+/// [`sample_into`](Distribution2D::sample_into).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Sample2D {
     /// `[x, y]` in `[0, 1)²`: `x` runs along a row (columns), `y` down the
     /// rows, as in an image.

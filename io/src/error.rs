@@ -150,5 +150,14 @@ impl Error {
     }
 }
 
+/// The lowercased extension of `path` ("" when it has none), which picks
+/// the format in every `read`.
+pub(crate) fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default()
+}
+
 /// Short for `Result<T, Error>`.
 pub type Result<T> = std::result::Result<T, Error>;

@@ -65,11 +65,7 @@ pub enum ExrPrecision {
 
 /// The format for an extension, or the error naming the extensions known.
 fn format_of(path: &Path) -> Result<ImageFormat> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .unwrap_or_default();
+    let ext = crate::error::extension(path);
     match ext.as_str() {
         "png" => Ok(ImageFormat::Png),
         "jpg" | "jpeg" => Ok(ImageFormat::Jpeg),

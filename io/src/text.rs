@@ -157,6 +157,21 @@ impl<'a> Cursor<'a> {
             .ok_or_else(|| self.syntax(at, what, tok))
     }
 
+    /// Three coordinates of node `index`, which must be finite.
+    pub(crate) fn point(&mut self, index: usize) -> Result<glam::DVec3, Error> {
+        self.skip_space();
+        let at = self.pos;
+        let p = glam::DVec3::new(
+            self.f64("an x coordinate")?,
+            self.f64("a y coordinate")?,
+            self.f64("a z coordinate")?,
+        );
+        match p.to_array().into_iter().find(|v| !v.is_finite()) {
+            None => Ok(p),
+            Some(value) => Err(self.error_at(at, ErrorKind::NonFinite { index, value })),
+        }
+    }
+
     /// Checks that `declared` records of at least `min_bytes` each can fit in
     /// what is left, before the caller allocates for them.
     pub(crate) fn check_count(

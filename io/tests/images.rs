@@ -2,31 +2,12 @@
 //! round trips through PNG (8/16 bit) and EXR (f32/f16), and hostile or
 //! broken files.
 
-use std::path::{Path, PathBuf};
+mod support;
+
+use support::{data_dir, scratch};
 
 use trilux_io::ErrorKind;
 use trilux_io::image::{self, ExrPrecision, Image, PngDepth, ReadOptions};
-
-fn data_dir() -> Option<PathBuf> {
-    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let found = [given.clone(), workspace.join(&given)]
-        .into_iter()
-        .find(|p| p.is_dir());
-    assert!(
-        found.is_some(),
-        "TRILUX_DATA={} names no folder",
-        given.display()
-    );
-    found
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("trilux-io-img-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 #[test]
 fn real_images_match_the_data_readme() {

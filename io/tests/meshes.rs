@@ -2,42 +2,15 @@
 //! counts of the data README, hand-written files for every OBJ feature,
 //! malformed files, and round trips.
 
-use std::path::{Path, PathBuf};
+mod support;
+
+use std::path::Path;
+
+use support::{data_dir, scratch, write};
 
 use glam::{Vec2, Vec3};
 use trilux_io::mesh::{TriMesh, obj};
 use trilux_io::{ErrorKind, Location};
-
-fn data_dir() -> Option<PathBuf> {
-    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let found = [given.clone(), workspace.join(&given)]
-        .into_iter()
-        .find(|p| p.is_dir());
-    assert!(
-        found.is_some(),
-        "TRILUX_DATA={} names no folder",
-        given.display()
-    );
-    found
-}
-
-fn scratch(name: &str) -> PathBuf {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    static NEXT: AtomicUsize = AtomicUsize::new(0);
-    let n = NEXT.fetch_add(1, Ordering::Relaxed);
-    let dir =
-        std::env::temp_dir().join(format!("trilux-io-mesh-{}-{n}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
-    let path = dir.join(name);
-    std::fs::write(&path, bytes).unwrap();
-    path
-}
 
 /// file, triangles, vertices after splitting (None: only the upper bound
 /// given by the `v` lines), that upper bound, has UVs, has normals.

@@ -2,43 +2,14 @@
 //! `$TRILUX_DATA/tets` with the counts of the data README, round trips,
 //! hand-written files for each format variant, and malformed files.
 
-use std::path::{Path, PathBuf};
+mod support;
+
+use std::path::Path;
+
+use support::{data_dir, scratch, write};
 
 use trilux_io::tet::{TetMesh, enclosed_volume, gmsh, medit, tetgen, vtu};
 use trilux_io::{ErrorKind, Location};
-
-/// The data folder named by `TRILUX_DATA` (relative paths from the
-/// workspace root), or `None` when unset.
-fn data_dir() -> Option<PathBuf> {
-    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let found = [given.clone(), workspace.join(&given)]
-        .into_iter()
-        .find(|p| p.is_dir());
-    assert!(
-        found.is_some(),
-        "TRILUX_DATA={} names no folder",
-        given.display()
-    );
-    found
-}
-
-/// A fresh scratch folder, unique even for tests running in parallel.
-fn scratch(name: &str) -> PathBuf {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    static NEXT: AtomicUsize = AtomicUsize::new(0);
-    let n = NEXT.fetch_add(1, Ordering::Relaxed);
-    let dir = std::env::temp_dir().join(format!("trilux-io-{}-{n}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
-    let path = dir.join(name);
-    std::fs::write(&path, bytes).unwrap();
-    path
-}
 
 /// A face up to rotation (orientation kept).
 fn canonical(f: [u32; 3]) -> [u32; 3] {

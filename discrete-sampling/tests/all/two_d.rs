@@ -36,14 +36,7 @@ fn cells_are_drawn_with_their_probabilities() {
     let mut rng = Pcg64Mcg::seed_from_u64(21);
     let mut counts = vec![0u64; W * H];
     let mut within = [0u64; 16]; // position inside the cell, 4×4 sub-bins
-    let mut batch = vec![
-        Sample2D {
-            point: [0.0; 2],
-            cell: [0; 2],
-            pdf: 0.0
-        };
-        1000
-    ];
+    let mut batch = vec![Sample2D::default(); 1000];
     for _ in 0..1000 {
         d.sample_into(&mut rng, &mut batch);
         for s in &batch {
@@ -150,14 +143,7 @@ fn alias_rows_give_the_same_distribution() {
     let d = Distribution2D::<discrete_sampling::AliasTable>::with_sampler(&img, W, H).unwrap();
     let mut rng = Pcg64Mcg::seed_from_u64(5);
     let mut counts = vec![0u64; W * H];
-    let mut batch = vec![
-        Sample2D {
-            point: [0.0; 2],
-            cell: [0; 2],
-            pdf: 0.0
-        };
-        1000
-    ];
+    let mut batch = vec![Sample2D::default(); 1000];
     for _ in 0..500 {
         d.sample_into(&mut rng, &mut batch);
         for s in &batch {

@@ -80,14 +80,10 @@ impl TriMesh {
     /// [`Error`] naming the file, the line, and what was wrong.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
-            Some("obj") => obj::read(path),
-            Some("gltf" | "glb") => gltf::read(path),
-            Some("ply") => {
+        match crate::error::extension(path).as_str() {
+            "obj" => obj::read(path),
+            "gltf" | "glb" => gltf::read(path),
+            "ply" => {
                 let ply = ply::read(path)?;
                 Ok(TriMesh {
                     objects: vec![Object {
@@ -104,10 +100,7 @@ impl TriMesh {
             }
             other => Err(Error::new(
                 path,
-                ErrorKind::UnknownExtension(
-                    other.unwrap_or("").to_string(),
-                    ".obj, .gltf, .glb, .ply",
-                ),
+                ErrorKind::UnknownExtension(other.to_string(), ".obj, .gltf, .glb, .ply"),
             )),
         }
     }

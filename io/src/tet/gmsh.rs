@@ -199,28 +199,15 @@ fn finish(parts: Parts, c: &Cursor<'_>) -> Result<TetMesh> {
     })
 }
 
-/// A position, checked finite.
-fn point(c: &mut Cursor<'_>, index: usize) -> Result<DVec3> {
-    c.skip_space();
-    let at = c.offset();
-    let p = DVec3::new(
-        c.f64("an x coordinate")?,
-        c.f64("a y coordinate")?,
-        c.f64("a z coordinate")?,
-    );
-    finite(c, p, index, at)
-}
-
-fn finite(c: &Cursor<'_>, p: DVec3, index: usize, at: usize) -> Result<DVec3> {
-    if p.is_finite() {
-        return Ok(p);
-    }
-    let value = p
-        .to_array()
-        .into_iter()
-        .find(|v| !v.is_finite())
-        .unwrap_or(f64::NAN);
-    Err(c.error_at(at, ErrorKind::NonFinite { index, value }))
+/// A physical tag, which must fit 32 bits.
+fn physical_tag(c: &Cursor<'_>, at: usize, value: i64) -> Result<i32> {
+    i32::try_from(value).map_err(|_| {
+        c.syntax(
+            at,
+            "a physical tag that fits 32 bits",
+            value.to_string().as_bytes(),
+        )
+    })
 }
 
 fn nodes_22(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
@@ -231,7 +218,7 @@ fn nodes_22(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
     for _ in 0..n {
         parts.tags.push(c.u64("a node tag")?);
         let index = parts.positions.len();
-        let p = point(c, index)?;
+        let p = c.point(index)?;
         parts.positions.push(p);
     }
     parts.nodes_seen = true;
@@ -255,13 +242,7 @@ fn elements_22(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
         for t in 0..ntags {
             let tag = c.i64("an element tag")?;
             if t == 0 {
-                region = i32::try_from(tag).map_err(|_| {
-                    c.syntax(
-                        at,
-                        "a physical tag that fits 32 bits",
-                        tag.to_string().as_bytes(),
-                    )
-                })?;
+                region = physical_tag(c, at, tag)?;
             }
         }
         let mut tags = [0i64; 4];
@@ -396,14 +377,9 @@ fn entities_41(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
                 };
                 let value = c.i64("a physical tag")?;
                 if dim == 3 && p == 0 {
-                    let value = i32::try_from(value).map_err(|_| {
-                        c.syntax(
-                            at,
-                            "a physical tag that fits 32 bits",
-                            value.to_string().as_bytes(),
-                        )
-                    })?;
-                    parts.volume_physical.insert(tag, value);
+                    parts
+                        .volume_physical
+                        .insert(tag, physical_tag(c, at, value)?);
                 }
             }
             if dim > 0 {
@@ -442,7 +418,7 @@ fn nodes_41(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
         }
         for _ in 0..n {
             let index = parts.positions.len();
-            let p = point(c, index)?;
+            let p = c.point(index)?;
             parts.positions.push(p);
         }
     }

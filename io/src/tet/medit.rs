@@ -73,21 +73,7 @@ pub fn from_bytes(data: &[u8], path: &Path) -> Result<TetMesh> {
             let n = c.check_count("vertices", declared, 8)?;
             let mut list = Vec::with_capacity(n);
             for index in 0..n {
-                c.skip_space();
-                let at = c.offset();
-                let p = DVec3::new(
-                    c.f64("an x coordinate")?,
-                    c.f64("a y coordinate")?,
-                    c.f64("a z coordinate")?,
-                );
-                if !p.is_finite() {
-                    let value = p
-                        .to_array()
-                        .into_iter()
-                        .find(|v| !v.is_finite())
-                        .unwrap_or(f64::NAN);
-                    return Err(c.error_at(at, ErrorKind::NonFinite { index, value }));
-                }
+                let p = c.point(index)?;
                 c.i64("a vertex reference")?;
                 list.push(p);
             }

@@ -37,17 +37,13 @@ impl TetMesh {
     /// [`Error`] naming the file, the line or byte, and what was wrong.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let ext = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase);
-        match ext.as_deref() {
-            Some("node" | "ele") => tetgen::read(path),
-            Some("msh") => gmsh::read(path),
-            Some("mesh") => medit::read(path),
+        match crate::error::extension(path).as_str() {
+            "node" | "ele" => tetgen::read(path),
+            "msh" => gmsh::read(path),
+            "mesh" => medit::read(path),
             other => Err(Error::new(
                 path,
-                ErrorKind::UnknownExtension(other.unwrap_or("").to_string(), ".node, .ele, .msh"),
+                ErrorKind::UnknownExtension(other.to_string(), ".node, .ele, .msh"),
             )),
         }
     }

@@ -217,23 +217,7 @@ pub(crate) fn parse_nodes(data: &[u8], path: &Path) -> Result<(Vec<DVec3>, i64)>
         } else {
             record_index(&mut c, first_index + k as i64, "node")?;
         }
-        let at = {
-            c.skip_space();
-            c.offset()
-        };
-        let p = DVec3::new(
-            c.f64("an x coordinate")?,
-            c.f64("a y coordinate")?,
-            c.f64("a z coordinate")?,
-        );
-        if !p.is_finite() {
-            let value = p
-                .to_array()
-                .into_iter()
-                .find(|v| !v.is_finite())
-                .unwrap_or(f64::NAN);
-            return Err(c.error_at(at, ErrorKind::NonFinite { index: k, value }));
-        }
+        let p = c.point(k)?;
         positions.push(p);
         skip_tokens(
             &mut c,

@@ -1,0 +1,40 @@
+//! Helpers shared by the integration tests of `trilux-io`.
+
+#![allow(dead_code, reason = "each test binary uses a subset")]
+
+use std::path::{Path, PathBuf};
+
+/// The data folder named by `TRILUX_DATA` (a relative path is taken from
+/// the workspace root), or `None` when unset. A value that names no folder
+/// fails the test instead of skipping it.
+pub(crate) fn data_dir() -> Option<PathBuf> {
+    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let found = [given.clone(), workspace.join(&given)]
+        .into_iter()
+        .find(|p| p.is_dir());
+    assert!(
+        found.is_some(),
+        "TRILUX_DATA={} names no folder",
+        given.display()
+    );
+    found
+}
+
+/// A fresh scratch folder, unique even for tests running in parallel.
+pub(crate) fn scratch(name: &str) -> PathBuf {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("trilux-io-{}-{n}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Writes `bytes` to `dir/name` and returns the path.
+pub(crate) fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
