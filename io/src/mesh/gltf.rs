@@ -218,6 +218,11 @@ impl Reader<'_> {
         dimensions: Dimensions,
         types: &[DataType],
     ) -> Result<()> {
+        // The spec requires count >= 1; the gltf reader computes count - 1
+        // (found by fuzzing).
+        if accessor.count() == 0 {
+            return Err(self.invalid(format!("accessor {} with count 0", accessor.index())));
+        }
         if accessor.dimensions() != dimensions || !types.contains(&accessor.data_type()) {
             return Err(self.invalid(format!(
                 "accessor {} of type {:?} {:?} where {dimensions:?} of {types:?} is required",
@@ -238,13 +243,10 @@ impl Reader<'_> {
         let view_end = view.offset().checked_add(view.length());
         let size = accessor.size();
         let stride = view.stride().unwrap_or(size);
-        let used = match accessor.count() {
-            0 => Some(0),
-            n => stride
-                .checked_mul(n - 1)
-                .and_then(|s| s.checked_add(size))
-                .and_then(|s| s.checked_add(accessor.offset())),
-        };
+        let used = stride
+            .checked_mul(accessor.count() - 1)
+            .and_then(|s| s.checked_add(size))
+            .and_then(|s| s.checked_add(accessor.offset()));
         match (view_end, used) {
             (Some(end), Some(used)) if end <= buffer.len() && used <= view.length() => Ok(()),
             _ => Err(self.error(ErrorKind::Truncated(format!(
