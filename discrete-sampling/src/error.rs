@@ -61,8 +61,8 @@ pub enum Error {
         /// Number of weights given.
         len: usize,
     },
-    /// The lookup-table ratio is not a finite number above zero.
-    #[error("table ratio {ratio} is invalid: it must be finite and > 0")]
+    /// The lookup-table ratio is not in `(0, 1024]`.
+    #[error("table ratio {ratio} is invalid: it must be above 0 and at most 1024")]
     InvalidRatio {
         /// The ratio given.
         ratio: f64,

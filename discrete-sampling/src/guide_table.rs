@@ -32,6 +32,9 @@ use crate::{DiscreteSampler, Error, InvertibleSampler};
 /// [`GuideTable::with_ratio`] for small, hot distributions.
 pub const DEFAULT_RATIO: f64 = 4.0;
 
+/// The largest table ratio [`GuideTable::with_ratio`] accepts.
+pub const MAX_RATIO: f64 = 1024.0;
+
 /// Largest table: cells are addressed with `usize` but the table must fit in
 /// memory; 2³¹ cells are 8 GiB.
 const MAX_CELLS: usize = 1 << 31;
@@ -118,10 +121,11 @@ impl GuideTable {
     /// The paper's Fig. 7 varies this ratio from 1/4 to 16.
     ///
     /// # Errors
-    /// [`Error::InvalidRatio`] unless `ratio` is finite and above zero, and
-    /// the weight errors of [`new`](Self::new).
+    /// [`Error::InvalidRatio`] unless `0 < ratio ≤ `[`MAX_RATIO`] (a larger
+    /// table only costs memory: 4 bytes a cell), and the weight errors of
+    /// [`new`](Self::new).
     pub fn with_ratio<W: Copy + Into<f64>>(weights: &[W], ratio: f64) -> Result<Self, Error> {
-        if !(ratio > 0.0 && ratio.is_finite()) {
+        if !(ratio > 0.0 && ratio <= MAX_RATIO) {
             return Err(Error::InvalidRatio { ratio });
         }
         Ok(Self::from_cdf(Cdf::new(weights)?, ratio))
@@ -351,7 +355,7 @@ mod tests {
 
     #[test]
     fn rejects_bad_ratios() {
-        for ratio in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        for ratio in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e9] {
             let err = GuideTable::with_ratio(&[1.0], ratio).unwrap_err();
             assert!(matches!(err, Error::InvalidRatio { .. }));
         }

@@ -91,5 +91,5 @@ pub use alias::AliasTable;
 pub use bisection::CdfBisection;
 pub use dist2d::{Distribution2D, Sample2D, equirect_direction, pdf_solid_angle};
 pub use error::Error;
-pub use guide_table::{DEFAULT_RATIO, GuideTable};
+pub use guide_table::{DEFAULT_RATIO, GuideTable, MAX_RATIO};
 pub use sampler::{DiscreteSampler, InvertibleSampler};
