@@ -1,0 +1,90 @@
+//! The mesh a sampler reads: borrowed plain data, validated once.
+
+use glam::{Vec2, Vec3};
+
+use crate::Error;
+
+/// A triangle mesh as slices, the way `trilux-io` and most renderers hold
+/// it: positions, three vertex indices per triangle, and optional
+/// per-vertex shading normals and texture coordinates.
+#[derive(Debug, Clone, Copy)]
+pub struct MeshRef<'a> {
+    /// Vertex positions.
+    pub positions: &'a [Vec3],
+    /// Triangles as vertex indices (counter-clockwise when seen from the
+    /// side the geometric normal points to).
+    pub indices: &'a [[u32; 3]],
+    /// Per-vertex shading normals.
+    pub normals: Option<&'a [Vec3]>,
+    /// Per-vertex texture coordinates.
+    pub uvs: Option<&'a [Vec2]>,
+}
+
+impl<'a> MeshRef<'a> {
+    /// A mesh of positions and triangles only.
+    pub fn new(positions: &'a [Vec3], indices: &'a [[u32; 3]]) -> Self {
+        Self {
+            positions,
+            indices,
+            normals: None,
+            uvs: None,
+        }
+    }
+
+    /// Checks what a sampler relies on: at least one triangle, indices in
+    /// range, finite positions of the referenced vertices, attribute
+    /// arrays as long as the positions.
+    ///
+    /// # Errors
+    /// The first problem found, with the triangle or vertex it concerns.
+    pub fn validate(&self) -> Result<(), Error> {
+        if self.indices.is_empty() {
+            return Err(Error::Empty);
+        }
+        if self.indices.len() > u32::MAX as usize {
+            return Err(Error::TooLarge(self.indices.len()));
+        }
+        let count = self.positions.len();
+        for (attribute, len) in [
+            ("normals", self.normals.map(<[Vec3]>::len)),
+            ("uvs", self.uvs.map(<[Vec2]>::len)),
+        ] {
+            if let Some(len) = len.filter(|&l| l != count) {
+                return Err(Error::AttributeLength {
+                    attribute,
+                    len,
+                    count,
+                });
+            }
+        }
+        for (triangle, tri) in self.indices.iter().enumerate() {
+            for &vertex in tri {
+                let Some(p) = self.positions.get(vertex as usize) else {
+                    return Err(Error::IndexOutOfRange {
+                        triangle,
+                        vertex,
+                        count,
+                    });
+                };
+                if !p.is_finite() {
+                    return Err(Error::NonFinitePosition {
+                        vertex: vertex as usize,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The corners of triangle `face`.
+    #[inline]
+    pub fn corners(&self, face: usize) -> [Vec3; 3] {
+        self.indices[face].map(|i| self.positions[i as usize])
+    }
+
+    /// The area of triangle `face`, computed in `f64`.
+    pub fn area(&self, face: usize) -> f64 {
+        let [a, b, c] = self.corners(face).map(Vec3::as_dvec3);
+        0.5 * (b - a).cross(c - a).length()
+    }
+}

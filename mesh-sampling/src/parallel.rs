@@ -1,0 +1,44 @@
+//! Deterministic batches: fixed-size chunks, each with its own random
+//! stream seeded from `(seed, chunk)`, so the output never depends on the
+//! number of threads.
+
+use rand::SeedableRng;
+use rand_pcg::Pcg64Mcg;
+
+/// Points per chunk (and per random stream).
+pub(crate) const CHUNK: usize = 1 << 14;
+
+/// A uniform `f64` in `[0, 1)` from the top 53 bits of a `u64`.
+#[inline]
+pub(crate) fn unit(x: u64) -> f64 {
+    (x >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+}
+
+/// The random stream of chunk `k`: SplitMix64 of `(seed, k)` as the seed,
+/// so neighbouring chunks get unrelated streams.
+pub(crate) fn chunk_rng(seed: u64, k: usize) -> Pcg64Mcg {
+    let mut z = seed ^ (k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    Pcg64Mcg::seed_from_u64(z ^ (z >> 31))
+}
+
+/// Runs `fill(rng_k, chunk_k)` over `out` in chunks of [`CHUNK`], on all
+/// threads with the `rayon` feature.
+pub(crate) fn for_each_chunk<T: Send>(
+    seed: u64,
+    out: &mut [T],
+    fill: impl Fn(&mut Pcg64Mcg, &mut [T]) + Sync,
+) {
+    #[cfg(feature = "rayon")]
+    {
+        use rayon::prelude::*;
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each(|(k, chunk)| fill(&mut chunk_rng(seed, k), chunk));
+    }
+    #[cfg(not(feature = "rayon"))]
+    for (k, chunk) in out.chunks_mut(CHUNK).enumerate() {
+        fill(&mut chunk_rng(seed, k), chunk);
+    }
+}

@@ -1,0 +1,67 @@
+//! What a sample carries, and the map from the unit square to a triangle.
+
+use glam::{Vec2, Vec3};
+
+use crate::MeshRef;
+
+/// A point on the surface, with everything a renderer or scatterer needs.
+///
+/// It is stored as `(face, barycentrics)`, so [`SurfacePoint::on`] can
+/// re-evaluate it on deformed vertex positions: an animated mesh keeps its
+/// points (the hair application of Šik & Křivánek 2013).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SurfacePoint {
+    /// The position.
+    pub position: Vec3,
+    /// The triangle it lies on.
+    pub face: u32,
+    /// Barycentric coordinates `[b0, b1, b2]` (summing to 1) with respect
+    /// to the triangle's three vertices.
+    pub barycentric: [f32; 3],
+    /// The geometric normal of the triangle (unit, right-hand rule).
+    pub normal: Vec3,
+    /// The interpolated shading normal, when the mesh has normals.
+    pub shading_normal: Option<Vec3>,
+    /// The interpolated texture coordinate, when the mesh has UVs.
+    pub uv: Option<Vec2>,
+    /// Density with respect to surface area at this point.
+    pub pdf: f32,
+}
+
+/// Barycentrics of a uniform point in a triangle from two uniform variates
+/// (Šik & Křivánek 2013, Sec. 3.5: `u = 1 − √ξ₁`, `v = ξ₂ √ξ₁`).
+#[inline]
+pub fn uniform_barycentric(xi1: f64, xi2: f64) -> [f32; 3] {
+    let s = xi1.sqrt();
+    let b0 = 1.0 - s;
+    let b1 = xi2 * s;
+    [b0 as f32, b1 as f32, (1.0 - b0 - b1).max(0.0) as f32]
+}
+
+impl SurfacePoint {
+    /// The point at `barycentric` on triangle `face` of `mesh`, with the
+    /// given density.
+    ///
+    /// # Panics
+    /// If `face` is not a triangle of `mesh`.
+    pub fn on(mesh: &MeshRef<'_>, face: u32, barycentric: [f32; 3], pdf: f32) -> Self {
+        let tri = mesh.indices[face as usize];
+        let [a, b, c] = tri.map(|i| mesh.positions[i as usize]);
+        let [w0, w1, w2] = barycentric;
+        let lerp3 = |v: [Vec3; 3]| v[0] * w0 + v[1] * w1 + v[2] * w2;
+        Self {
+            position: lerp3([a, b, c]),
+            face,
+            barycentric,
+            normal: (b - a).cross(c - a).normalize_or_zero(),
+            shading_normal: mesh
+                .normals
+                .map(|n| lerp3(tri.map(|i| n[i as usize])).normalize_or_zero()),
+            uv: mesh.uvs.map(|t| {
+                let [ta, tb, tc] = tri.map(|i| t[i as usize]);
+                ta * w0 + tb * w1 + tc * w2
+            }),
+            pdf,
+        }
+    }
+}

@@ -1,0 +1,119 @@
+//! Area-uniform sampling (the uniform-mesh-sampling article): a triangle
+//! with probability proportional to its area, from the guide-table CDF of
+//! `discrete-sampling`, then a uniform point in it.
+
+use discrete_sampling::{DiscreteSampler, GuideTable};
+use rand::distr::Distribution;
+
+use crate::parallel::for_each_chunk;
+use crate::point::uniform_barycentric;
+use crate::{Error, MeshRef, SurfacePoint};
+
+/// Draws points uniformly over a mesh's surface: density `1 / A` for a
+/// total area `A`. Zero-area triangles are never drawn.
+///
+/// # Example
+/// ```
+/// use glam::Vec3;
+/// use mesh_sampling::{MeshRef, UniformSampler};
+/// use rand::distr::Distribution;
+/// use rand::SeedableRng;
+///
+/// let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+/// let indices = [[0, 1, 2], [1, 3, 2]];
+/// let sampler = UniformSampler::new(MeshRef::new(&positions, &indices))?;
+/// let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(7);
+/// let p = sampler.sample(&mut rng);
+/// assert!((p.pdf - 1.0).abs() < 1e-6); // unit square
+/// let cloud = sampler.sample_n(42, 10_000); // parallel, deterministic
+/// assert_eq!(cloud.len(), 10_000);
+/// # Ok::<(), mesh_sampling::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct UniformSampler<'a> {
+    mesh: MeshRef<'a>,
+    triangles: GuideTable,
+    total_area: f64,
+    /// `1 / total_area`, the density of every reachable point.
+    density: f32,
+}
+
+impl<'a> UniformSampler<'a> {
+    /// Validates `mesh` and builds the area CDF (areas summed in `f64`).
+    ///
+    /// # Errors
+    /// [`Error`] for an empty mesh, an index out of range, a non-finite
+    /// position, attribute arrays of the wrong length, or no area at all.
+    pub fn new(mesh: MeshRef<'a>) -> Result<Self, Error> {
+        mesh.validate()?;
+        let areas: Vec<f64> = (0..mesh.indices.len()).map(|f| mesh.area(f)).collect();
+        let total_area: f64 = areas.iter().sum();
+        let triangles = GuideTable::new(&areas).map_err(|_| Error::NoArea {
+            triangles: areas.len(),
+        })?;
+        Ok(Self {
+            mesh,
+            triangles,
+            total_area,
+            density: (1.0 / total_area) as f32,
+        })
+    }
+
+    /// The mesh sampled.
+    pub fn mesh(&self) -> &MeshRef<'a> {
+        &self.mesh
+    }
+
+    /// The total surface area.
+    pub fn total_area(&self) -> f64 {
+        self.total_area
+    }
+
+    /// Density (w.r.t. area) of any point of triangle `face`: `1 / A`, or 0
+    /// for a zero-area triangle (never drawn). For multiple importance
+    /// sampling when a ray hits the mesh.
+    pub fn pdf(&self, face: usize) -> f32 {
+        if self.triangles.pdf(face) > 0.0 {
+            self.density
+        } else {
+            0.0
+        }
+    }
+
+    /// The point for uniform variates `u = [u0, u1]` in `[0, 1)²`: `u0`
+    /// picks the triangle and, through its remapped remainder, the first
+    /// barycentric variate; `u1` is the second.
+    pub fn sample_u(&self, u: [f64; 2]) -> SurfacePoint {
+        let (face, rest) = self.triangles.sample_remapped(u[0]);
+        SurfacePoint::on(
+            &self.mesh,
+            face as u32,
+            uniform_barycentric(rest, u[1]),
+            self.density,
+        )
+    }
+
+    /// Fills `out`, two `u64` of `rng` per point.
+    pub fn sample_into<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
+        for slot in out {
+            *slot = self.sample(rng);
+        }
+    }
+
+    /// `n` points from `seed`, on all threads when the `rayon` feature is
+    /// on. The result depends only on `(mesh, seed, n)`, never on the
+    /// number of threads.
+    pub fn sample_n(&self, seed: u64, n: usize) -> Vec<SurfacePoint> {
+        let mut out = vec![SurfacePoint::default(); n];
+        for_each_chunk(seed, &mut out, |rng, chunk| self.sample_into(rng, chunk));
+        out
+    }
+}
+
+impl Distribution<SurfacePoint> for UniformSampler<'_> {
+    fn sample<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
+        let u0 = crate::parallel::unit(rng.next_u64());
+        let u1 = crate::parallel::unit(rng.next_u64());
+        self.sample_u([u0, u1])
+    }
+}

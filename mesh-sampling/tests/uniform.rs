@@ -1,0 +1,265 @@
+//! Area-uniform sampling: the article's centroid-bias test (passes for the
+//! uniform sampler, fails for the naive one), chi-square of per-triangle
+//! counts against area, pdfs, determinism across thread counts, errors.
+
+#[path = "../../discrete-sampling/tests/support/stats.rs"]
+#[allow(
+    dead_code,
+    reason = "shared statistics helpers; this test uses a subset"
+)]
+mod stats;
+
+use glam::{Vec2, Vec3};
+use mesh_sampling::{Error, MeshRef, NaiveSampler, SurfacePoint, UniformSampler};
+use rand::SeedableRng;
+use rand::distr::Distribution;
+use rand_pcg::Pcg64Mcg;
+
+const N: usize = 1_000_000;
+
+/// One large triangle near x = +5 and 200 tiny ones near x = −5, plus a
+/// zero-area triangle: very unequal areas, the case that exposes the naive
+/// sampler.
+fn unequal_mesh() -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut positions = vec![
+        Vec3::new(4.0, 0.0, 0.0),
+        Vec3::new(6.0, 0.0, 0.0),
+        Vec3::new(5.0, 3.0, 1.0),
+    ];
+    let mut indices = vec![[0, 1, 2]];
+    for k in 0..200u32 {
+        let o = Vec3::new(-5.0 + 0.01 * k as f32, 0.0, 0.0);
+        let base = positions.len() as u32;
+        positions.extend([
+            o,
+            o + Vec3::new(0.005, 0.0, 0.0),
+            o + Vec3::new(0.0, 0.005, 0.002),
+        ]);
+        indices.push([base, base + 1, base + 2]);
+    }
+    indices.push([0, 0, 1]); // zero area
+    (positions, indices)
+}
+
+/// Area-weighted centroid of the mesh.
+fn centroid(mesh: &MeshRef<'_>) -> [f64; 3] {
+    let mut sum = [0.0f64; 3];
+    let mut area = 0.0;
+    for f in 0..mesh.indices.len() {
+        let a = mesh.area(f);
+        let [p, q, r] = mesh.corners(f).map(Vec3::as_dvec3);
+        let c = (p + q + r) / 3.0;
+        for (s, x) in sum.iter_mut().zip(c.to_array()) {
+            *s += a * x;
+        }
+        area += a;
+    }
+    sum.map(|s| s / area)
+}
+
+/// The article's test: per axis, is |mean − centroid| within 1.96 SEM?
+fn unbiased<D: Distribution<SurfacePoint>>(d: &D, mesh: &MeshRef<'_>, seed: u64) -> [bool; 3] {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let (mut sum, mut sq) = ([0.0f64; 3], [0.0f64; 3]);
+    for _ in 0..N {
+        let p = d.sample(&mut rng).position.as_dvec3().to_array();
+        for k in 0..3 {
+            sum[k] += p[k];
+            sq[k] += p[k] * p[k];
+        }
+    }
+    let c = centroid(mesh);
+    let n = N as f64;
+    std::array::from_fn(|k| {
+        let mean = sum[k] / n;
+        let sem = ((sq[k] / n - mean * mean).max(0.0) / n).sqrt();
+        (mean - c[k]).abs() <= 1.96 * sem
+    })
+}
+
+#[test]
+fn centroid_bias_test_passes_uniform_and_rejects_naive() {
+    let (positions, indices) = unequal_mesh();
+    let mesh = MeshRef::new(&positions, &indices);
+    let uniform = UniformSampler::new(mesh).unwrap();
+    assert_eq!(unbiased(&uniform, &mesh, 11), [true; 3]);
+    let naive = NaiveSampler::new(mesh).unwrap();
+    let verdict = unbiased(&naive, &mesh, 11);
+    assert!(
+        verdict.iter().any(|&ok| !ok),
+        "the naive sampler passed: {verdict:?}"
+    );
+}
+
+#[test]
+fn triangle_counts_follow_area() {
+    let (positions, indices) = unequal_mesh();
+    let mesh = MeshRef::new(&positions, &indices);
+    let areas: Vec<f64> = (0..indices.len()).map(|f| mesh.area(f)).collect();
+    let total: f64 = areas.iter().sum();
+    let expected: Vec<f64> = areas.iter().map(|a| a / total).collect();
+    let count = |d: &dyn Fn(&mut Pcg64Mcg) -> SurfacePoint| {
+        let mut rng = Pcg64Mcg::seed_from_u64(5);
+        let mut counts = vec![0u64; indices.len()];
+        for _ in 0..N {
+            counts[d(&mut rng).face as usize] += 1;
+        }
+        counts
+    };
+    let uniform = UniformSampler::new(mesh).unwrap();
+    let counts = count(&|r| uniform.sample(r));
+    assert_eq!(
+        counts[indices.len() - 1],
+        0,
+        "a zero-area triangle was drawn"
+    );
+    let test = stats::chi_square(&counts, &expected, 20.0);
+    assert!(test.p_value > 1e-3, "uniform: p = {:.2e}", test.p_value);
+    let naive = NaiveSampler::new(mesh).unwrap();
+    let test = stats::chi_square(&count(&|r| naive.sample(r)), &expected, 20.0);
+    assert!(
+        test.p_value < 1e-9,
+        "naive passed: p = {:.2e}",
+        test.p_value
+    );
+}
+
+#[test]
+fn points_lie_on_their_triangle_with_the_right_pdf() {
+    let positions = [
+        Vec3::ZERO,
+        Vec3::new(2.0, 0.0, 0.0),
+        Vec3::new(0.0, 2.0, 0.0),
+        Vec3::new(2.0, 2.0, 0.0),
+    ];
+    let indices = [[0, 1, 2], [1, 3, 2]];
+    let normals = [Vec3::Z; 4];
+    let uvs = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
+    let mesh = MeshRef {
+        positions: &positions,
+        indices: &indices,
+        normals: Some(&normals),
+        uvs: Some(&uvs),
+    };
+    let sampler = UniformSampler::new(mesh).unwrap();
+    assert!((sampler.total_area() - 4.0).abs() < 1e-12);
+    let mut rng = Pcg64Mcg::seed_from_u64(3);
+    for _ in 0..10_000 {
+        let p = sampler.sample(&mut rng);
+        assert!((p.pdf - 0.25).abs() < 1e-7);
+        assert_eq!(sampler.pdf(p.face as usize), p.pdf);
+        assert!(p.barycentric.iter().all(|&b| (0.0..=1.0).contains(&b)));
+        assert!((p.barycentric.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        assert!((0.0..=2.0).contains(&p.position.x) && (0.0..=2.0).contains(&p.position.y));
+        assert_eq!(p.normal, Vec3::Z);
+        assert_eq!(p.shading_normal, Some(Vec3::Z));
+        let uv = p.uv.unwrap();
+        assert!((uv - p.position.truncate() / 2.0).length() < 1e-5);
+    }
+    // Stored as (face, barycentrics): re-evaluated on a moved mesh.
+    let p = sampler.sample(&mut rng);
+    let moved: Vec<Vec3> = positions.iter().map(|v| *v + Vec3::Z).collect();
+    let q = SurfacePoint::on(
+        &MeshRef::new(&moved, &indices),
+        p.face,
+        p.barycentric,
+        p.pdf,
+    );
+    assert!((q.position - (p.position + Vec3::Z)).length() < 1e-6);
+}
+
+#[test]
+fn barycentric_map_is_uniform_over_the_triangle() {
+    // Split the triangle into 4 congruent sub-triangles by its midpoints:
+    // each must get a quarter of the points.
+    let mut counts = [0u64; 4];
+    let mut state = 0x1234_5678u64;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..400_000 {
+        let [b0, b1, b2] = mesh_sampling::uniform_barycentric(next(), next());
+        let k = if b0 > 0.5 {
+            0
+        } else if b1 > 0.5 {
+            1
+        } else if b2 > 0.5 {
+            2
+        } else {
+            3
+        };
+        counts[k] += 1;
+    }
+    assert!(
+        stats::chi_square(&counts, &[0.25; 4], 20.0).p_value > 1e-3,
+        "{counts:?}"
+    );
+}
+
+#[test]
+fn parallel_batches_do_not_depend_on_the_thread_count() {
+    let (positions, indices) = unequal_mesh();
+    let sampler = UniformSampler::new(MeshRef::new(&positions, &indices)).unwrap();
+    let n = 100_000;
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| sampler.sample_n(99, n))
+    };
+    let one = run(1);
+    assert_eq!(one, run(2));
+    assert_eq!(one, sampler.sample_n(99, n));
+    assert_ne!(one, sampler.sample_n(100, n));
+}
+
+#[test]
+fn bad_meshes_are_errors() {
+    let p = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let ok = [[0, 1, 2]];
+    assert_eq!(
+        UniformSampler::new(MeshRef::new(&p, &[])).unwrap_err(),
+        Error::Empty
+    );
+    assert_eq!(
+        UniformSampler::new(MeshRef::new(&p, &[[0, 1, 3]])).unwrap_err(),
+        Error::IndexOutOfRange {
+            triangle: 0,
+            vertex: 3,
+            count: 3
+        }
+    );
+    let nan = [Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0), Vec3::Y];
+    assert_eq!(
+        UniformSampler::new(MeshRef::new(&nan, &ok)).unwrap_err(),
+        Error::NonFinitePosition { vertex: 1 }
+    );
+    assert_eq!(
+        UniformSampler::new(MeshRef::new(&p, &[[0, 0, 1], [2, 2, 2]])).unwrap_err(),
+        Error::NoArea { triangles: 2 }
+    );
+    let short = [Vec2::ZERO];
+    let mesh = MeshRef {
+        uvs: Some(&short),
+        ..MeshRef::new(&p, &ok)
+    };
+    assert!(matches!(
+        UniformSampler::new(mesh).unwrap_err(),
+        Error::AttributeLength {
+            attribute: "uvs",
+            ..
+        }
+    ));
+    assert!(NaiveSampler::new(MeshRef::new(&p, &[[0, 0, 1]])).is_err());
+    let msg = UniformSampler::new(MeshRef::new(&p, &[[0, 1, 3]]))
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        msg,
+        "triangle 0 references vertex 3, but there are only 3 vertices"
+    );
+}
