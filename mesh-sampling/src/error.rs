@@ -39,6 +39,22 @@ pub enum Error {
         /// The number of triangles.
         triangles: usize,
     },
+    /// One mesh of several is invalid.
+    #[error("mesh {index}: {error}")]
+    InMesh {
+        /// Which mesh.
+        index: usize,
+        /// What is wrong with it.
+        error: Box<Error>,
+    },
+    /// A mesh index that does not exist.
+    #[error("there is no mesh {index} (there are {count})")]
+    NoSuchMesh {
+        /// The index given.
+        index: usize,
+        /// The number of meshes.
+        count: usize,
+    },
     /// The mesh has more triangles than a sampler can index.
     #[error("{0} triangles is more than a sampler can index")]
     TooLarge(usize),

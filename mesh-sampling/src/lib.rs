@@ -7,7 +7,9 @@
 //! `u = 1 − √ξ₁, v = ξ₂ √ξ₁` (Šik & Křivánek, Sec. 3.5). The density is
 //! `1 / A` everywhere. The article's naive sampler (a triangle chosen
 //! uniformly) is here too, documented as biased, so the tests can show
-//! that they reject it. Density-texture sampling by adaptive subdivision
+//! that they reject it. [`MultiMeshSampler`] samples several meshes at once
+//! (the article's last section): a CDF over the meshes' areas above one
+//! sampler per mesh, so editing one mesh rebuilds only its table. Density-texture sampling by adaptive subdivision
 //! (Šik & Křivánek Sec. 3.3–3.5) is the next part (issue 4).
 //!
 //! A sample is a [`SurfacePoint`]: position, face, barycentrics, geometric
@@ -36,6 +38,7 @@
 
 mod error;
 mod mesh;
+mod multi;
 mod naive;
 mod parallel;
 mod point;
@@ -43,6 +46,7 @@ mod uniform;
 
 pub use error::Error;
 pub use mesh::MeshRef;
+pub use multi::{MeshPoint, MultiMeshSampler};
 pub use naive::NaiveSampler;
 pub use point::{SurfacePoint, uniform_barycentric};
 pub use uniform::UniformSampler;

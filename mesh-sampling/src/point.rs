@@ -50,7 +50,10 @@ impl SurfacePoint {
         let [w0, w1, w2] = barycentric;
         let lerp3 = |v: [Vec3; 3]| v[0] * w0 + v[1] * w1 + v[2] * w2;
         Self {
-            position: lerp3([a, b, c]),
+            // a + w1 (b − a) + w2 (c − a): exact when the corners share a
+            // coordinate (a point on the plane z = 1 has z = 1 exactly),
+            // unlike w0 a + w1 b + w2 c.
+            position: a + (b - a) * w1 + (c - a) * w2,
             face,
             barycentric,
             normal: (b - a).cross(c - a).normalize_or_zero(),
@@ -59,7 +62,7 @@ impl SurfacePoint {
                 .map(|n| lerp3(tri.map(|i| n[i as usize])).normalize_or_zero()),
             uv: mesh.uvs.map(|t| {
                 let [ta, tb, tc] = tri.map(|i| t[i as usize]);
-                ta * w0 + tb * w1 + tc * w2
+                ta + (tb - ta) * w1 + (tc - ta) * w2
             }),
             pdf,
         }

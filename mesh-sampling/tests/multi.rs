@@ -1,0 +1,109 @@
+//! Several meshes at once: counts per mesh follow their areas, the
+//! density is uniform over the union, replacing a mesh changes only what
+//! it should, errors name the mesh.
+
+#[path = "../../discrete-sampling/tests/support/stats.rs"]
+#[allow(
+    dead_code,
+    reason = "shared statistics helpers; this test uses a subset"
+)]
+mod stats;
+
+use glam::Vec3;
+use mesh_sampling::{Error, MeshRef, MultiMeshSampler};
+use rand::SeedableRng;
+use rand::distr::Distribution;
+use rand_pcg::Pcg64Mcg;
+
+/// A square of side `s` at height `z` (area s²).
+fn square(s: f32, z: f32) -> Vec<Vec3> {
+    vec![
+        Vec3::new(0.0, 0.0, z),
+        Vec3::new(s, 0.0, z),
+        Vec3::new(0.0, s, z),
+        Vec3::new(s, s, z),
+    ]
+}
+
+const QUAD: [[u32; 3]; 2] = [[0, 1, 2], [1, 3, 2]];
+
+fn mesh_counts(sampler: &MultiMeshSampler<'_>, n: usize) -> Vec<u64> {
+    let mut rng = Pcg64Mcg::seed_from_u64(17);
+    let mut counts = vec![0u64; sampler.len()];
+    for _ in 0..n {
+        let p = sampler.sample(&mut rng);
+        counts[p.mesh] += 1;
+        // Each point lies on its own mesh (told apart by height).
+        assert_eq!(p.point.position.z, p.mesh as f32);
+        assert_eq!(p.point.pdf, sampler.pdf(p.mesh, p.point.face as usize));
+    }
+    counts
+}
+
+#[test]
+fn counts_follow_areas_and_replacement_updates_them() {
+    let (a, b, c) = (
+        square(1.0, 0.0),
+        square(3f32.sqrt(), 1.0),
+        square(3f32.sqrt(), 0.0),
+    );
+    let mut sampler =
+        MultiMeshSampler::new([MeshRef::new(&a, &QUAD), MeshRef::new(&b, &QUAD)]).unwrap();
+    assert!((sampler.total_area() - 4.0).abs() < 1e-5);
+    assert!((sampler.pdf(1, 0) - 0.25).abs() < 1e-6);
+    let counts = mesh_counts(&sampler, 400_000);
+    assert!(
+        stats::chi_square(&counts, &[0.25, 0.75], 20.0).p_value > 1e-3,
+        "{counts:?}"
+    );
+
+    // Mesh 0 grows to the size of mesh 1: the split becomes even.
+    sampler.replace(0, MeshRef::new(&c, &QUAD)).unwrap();
+    assert!((sampler.total_area() - 6.0).abs() < 1e-5);
+    let counts = mesh_counts(&sampler, 400_000);
+    assert!(
+        stats::chi_square(&counts, &[0.5, 0.5], 20.0).p_value > 1e-3,
+        "{counts:?}"
+    );
+    // The old split is rejected by the same test.
+    assert!(stats::chi_square(&counts, &[0.25, 0.75], 20.0).p_value < 1e-9);
+}
+
+#[test]
+fn batches_do_not_depend_on_the_thread_count() {
+    let (a, b) = (square(1.0, 0.0), square(2.0, 1.0));
+    let sampler =
+        MultiMeshSampler::new([MeshRef::new(&a, &QUAD), MeshRef::new(&b, &QUAD)]).unwrap();
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| sampler.sample_n(5, 50_000))
+    };
+    assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn errors_name_the_mesh_and_leave_the_sampler_unchanged() {
+    let a = square(1.0, 0.0);
+    assert_eq!(MultiMeshSampler::new([]).unwrap_err(), Error::Empty);
+    let err = MultiMeshSampler::new([MeshRef::new(&a, &QUAD), MeshRef::new(&a, &[[0, 1, 9]])])
+        .unwrap_err();
+    assert!(matches!(err, Error::InMesh { index: 1, .. }), "{err}");
+    assert_eq!(
+        err.to_string(),
+        "mesh 1: triangle 0 references vertex 9, but there are only 4 vertices"
+    );
+
+    let mut sampler = MultiMeshSampler::new([MeshRef::new(&a, &QUAD)]).unwrap();
+    assert_eq!(
+        sampler.replace(3, MeshRef::new(&a, &QUAD)).unwrap_err(),
+        Error::NoSuchMesh { index: 3, count: 1 }
+    );
+    assert!(sampler.replace(0, MeshRef::new(&a, &[[0, 0, 1]])).is_err());
+    assert!(
+        (sampler.total_area() - 1.0).abs() < 1e-6,
+        "unchanged after a failed replace"
+    );
+}
