@@ -55,6 +55,9 @@ pub enum Error {
         /// The number of meshes.
         count: usize,
     },
+    /// A point density that is negative, NaN or infinite.
+    #[error("points per unit area must be finite and >= 0, got {0}")]
+    InvalidDensity(f64),
     /// The mesh has more triangles than a sampler can index.
     #[error("{0} triangles is more than a sampler can index")]
     TooLarge(usize),

@@ -3,9 +3,10 @@
 //! `discrete-sampling`, then a uniform point in it.
 
 use discrete_sampling::{DiscreteSampler, GuideTable};
+use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::parallel::for_each_chunk;
+use crate::parallel::{for_each_chunk, unit};
 use crate::point::uniform_barycentric;
 use crate::{Error, MeshRef, SurfacePoint};
 
@@ -110,10 +111,60 @@ impl<'a> UniformSampler<'a> {
     }
 }
 
+impl UniformSampler<'_> {
+    /// Blender's "Distribute Points on Faces" behaviour: each triangle
+    /// draws its own number of points, its expected count
+    /// `points_per_unit_area · A_f` rounded down or up at random (up with
+    /// the probability of the fraction), and their positions, all from a
+    /// random stream seeded by `(seed, triangle index)`. Editing part of a
+    /// mesh therefore leaves the points of the other triangles unchanged,
+    /// as long as their indices stay the same. Points come in triangle
+    /// order, the same on any number of threads; their total is random,
+    /// with mean `points_per_unit_area · A`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidDensity`] for a negative, NaN or infinite density.
+    pub fn sample_stable(
+        &self,
+        seed: u64,
+        points_per_unit_area: f64,
+    ) -> Result<Vec<SurfacePoint>, Error> {
+        if !(points_per_unit_area >= 0.0 && points_per_unit_area.is_finite()) {
+            return Err(Error::InvalidDensity(points_per_unit_area));
+        }
+        let triangle = |face: usize| -> Vec<SurfacePoint> {
+            let area = self.mesh.area(face);
+            if area <= 0.0 {
+                return Vec::new();
+            }
+            let mut rng = crate::parallel::chunk_rng(seed, face);
+            let expected = points_per_unit_area * area;
+            let whole = expected.floor();
+            let extra = unit(rng.next_u64()) < expected - whole;
+            let count = whole as usize + usize::from(extra);
+            (0..count)
+                .map(|_| {
+                    let bary = uniform_barycentric(unit(rng.next_u64()), unit(rng.next_u64()));
+                    SurfacePoint::on(&self.mesh, face as u32, bary, self.density)
+                })
+                .collect()
+        };
+        let faces = 0..self.mesh.indices.len();
+        #[cfg(feature = "rayon")]
+        let points = {
+            use rayon::prelude::*;
+            faces.into_par_iter().flat_map_iter(triangle).collect()
+        };
+        #[cfg(not(feature = "rayon"))]
+        let points = faces.flat_map(triangle).collect();
+        Ok(points)
+    }
+}
+
 impl Distribution<SurfacePoint> for UniformSampler<'_> {
     fn sample<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
-        let u0 = crate::parallel::unit(rng.next_u64());
-        let u1 = crate::parallel::unit(rng.next_u64());
+        let u0 = unit(rng.next_u64());
+        let u1 = unit(rng.next_u64());
         self.sample_u([u0, u1])
     }
 }

@@ -300,3 +300,50 @@ fn teapot_centroid_test_as_in_the_article() {
         "naive passed on the teapot: z = {naive:?}"
     );
 }
+
+#[test]
+fn stable_mode_keeps_points_of_untouched_triangles() {
+    let (positions, indices) = unequal_mesh();
+    let mesh = MeshRef::new(&positions, &indices);
+    let density = 2_000.0;
+    let sampler = UniformSampler::new(mesh).unwrap();
+    let before = sampler.sample_stable(8, density).unwrap();
+    // Each triangle gets its expected count rounded down or up.
+    for f in 0..indices.len() {
+        let n = before.iter().filter(|p| p.face as usize == f).count() as f64;
+        let expected = density * mesh.area(f);
+        assert!(
+            n == expected.floor() || n == expected.ceil(),
+            "face {f}: {n} for {expected}"
+        );
+    }
+    // Where the points are (their density 1/A changes with the total area).
+    let on_other = |points: &[SurfacePoint]| -> Vec<(u32, Vec3, [f32; 3])> {
+        points
+            .iter()
+            .filter(|p| p.face != 0)
+            .map(|p| (p.face, p.position, p.barycentric))
+            .collect()
+    };
+    // Move the big triangle only: every other point stays where it was.
+    let mut moved = positions.clone();
+    moved[2] += Vec3::new(0.0, 1.0, 0.0);
+    let edited = UniformSampler::new(MeshRef::new(&moved, &indices)).unwrap();
+    let after = edited.sample_stable(8, density).unwrap();
+    assert_eq!(on_other(&before), on_other(&after));
+    assert_ne!(before.len(), after.len(), "the moved triangle grew");
+    // Same result on one and two threads; a bad density is an error.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    assert_eq!(
+        one.install(|| sampler.sample_stable(8, density).unwrap()),
+        before
+    );
+    assert_eq!(
+        sampler.sample_stable(8, -1.0).unwrap_err(),
+        Error::InvalidDensity(-1.0)
+    );
+    assert!(sampler.sample_stable(8, f64::NAN).is_err());
+}
