@@ -245,16 +245,22 @@ fn elements_22(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
                 region = physical_tag(c, at, tag)?;
             }
         }
-        let mut tags = [0i64; 4];
-        for slot in &mut tags {
-            *slot = c.i64("a node tag")?;
-        }
-        if kind == 11 {
-            c.skip_line();
-        }
-        parts.tets.push((tags, region, at));
+        parts.tets.push((corner_tags(c, kind)?, region, at));
     }
     c.keyword("$EndElements")
+}
+
+/// The four corner node tags of an ASCII tetrahedron record, skipping a
+/// 10-node tetrahedron's edge nodes.
+fn corner_tags(c: &mut Cursor<'_>, kind: u64) -> Result<[i64; 4]> {
+    let mut tags = [0i64; 4];
+    for slot in &mut tags {
+        *slot = c.i64("a node tag")?;
+    }
+    if kind == 11 {
+        c.skip_line();
+    }
+    Ok(tags)
 }
 
 fn i32_at(bytes: &[u8], k: usize) -> i32 {
@@ -461,14 +467,7 @@ fn elements_41(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
             c.skip_space();
             let at = c.offset();
             c.u64("an element tag")?;
-            let mut tags = [0i64; 4];
-            for slot in &mut tags {
-                *slot = c.i64("a node tag")?;
-            }
-            if kind == 11 {
-                c.skip_line();
-            }
-            parts.tets.push((tags, region, at));
+            parts.tets.push((corner_tags(c, kind)?, region, at));
         }
     }
     c.keyword("$EndElements")
