@@ -385,32 +385,17 @@ fn figure_8(lum: &hdr::Luminance) {
     let d2_gt = Distribution2D::<GuideTable>::with_sampler(&weights, w, h).expect("valid map");
     let samples = 1 << 22;
     let mut times: [Vec<f64>; 4] = Default::default();
+    let seconds = |run: &dyn Fn() -> usize| {
+        let t = Instant::now();
+        black_box(run());
+        t.elapsed().as_secs_f64()
+    };
     for round in 0..ROUNDS {
-        let seed = round as u64 + 1;
-        let t = Instant::now();
-        black_box(draw_batch(
-            &d1_bis,
-            &mut Pcg64Mcg::seed_from_u64(seed),
-            samples,
-        ));
-        times[0].push(t.elapsed().as_secs_f64());
-        let t = Instant::now();
-        black_box(draw_batch(
-            &d1_gt,
-            &mut Pcg64Mcg::seed_from_u64(seed),
-            samples,
-        ));
-        times[1].push(t.elapsed().as_secs_f64());
-        let t = Instant::now();
-        black_box(draw_2d(
-            &d2_bis,
-            &mut Pcg64Mcg::seed_from_u64(seed),
-            samples,
-        ));
-        times[2].push(t.elapsed().as_secs_f64());
-        let t = Instant::now();
-        black_box(draw_2d(&d2_gt, &mut Pcg64Mcg::seed_from_u64(seed), samples));
-        times[3].push(t.elapsed().as_secs_f64());
+        let rng = || Pcg64Mcg::seed_from_u64(round as u64 + 1);
+        times[0].push(seconds(&|| draw_batch(&d1_bis, &mut rng(), samples)));
+        times[1].push(seconds(&|| draw_batch(&d1_gt, &mut rng(), samples)));
+        times[2].push(seconds(&|| draw_2d(&d2_bis, &mut rng(), samples)));
+        times[3].push(seconds(&|| draw_2d(&d2_gt, &mut rng(), samples)));
     }
     let ns: Vec<f64> = times
         .into_iter()

@@ -1,7 +1,7 @@
 //! The interface shared by the 1D samplers.
 
 use crate::Error;
-use crate::uniform::{bits_to_unit, clamp_unit, fill_batch, unit_f64};
+use crate::uniform::{bits_to_unit, fill_batch, unit_f64};
 
 /// A discrete distribution over `0..len()` that can be sampled by inversion
 /// of a uniform variate.
@@ -46,7 +46,7 @@ pub trait DiscreteSampler: Sized {
 
     /// Draws one entry using one `u64` of `rng`.
     fn sample_rng<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> usize {
-        self.sample_u(clamp_unit(unit_f64(rng)))
+        self.sample_u(unit_f64(rng))
     }
 
     /// Fills `out` with independent draws, one `u64` of `rng` each, the

@@ -114,15 +114,14 @@ pub fn read_with(path: &Path, options: ReadOptions) -> Result<Image> {
 /// # Errors
 /// As for [`read`].
 pub fn decode(bytes: &[u8], name: &Path, options: ReadOptions) -> Result<Image> {
-    let path = name;
-    let format = format_of(path)?;
+    let format = format_of(name)?;
     let mut limits = Limits::default();
     limits.max_image_width = Some(options.max_dimension);
     limits.max_image_height = Some(options.max_dimension);
     limits.max_alloc = Some(options.max_bytes);
     let mut reader = ImageReader::with_format(IoCursor::new(bytes), format);
     reader.limits(limits);
-    let image = reader.decode().map_err(|e| codec_error(path, format, e))?;
+    let image = reader.decode().map_err(|e| codec_error(name, format, e))?;
     Ok(to_linear(image, options.raw))
 }
 
@@ -218,38 +217,26 @@ impl Image {
 /// size; codec and I/O errors.
 pub fn write_png(path: &Path, image: &Image, depth: PngDepth) -> Result<()> {
     image.check(path)?;
-    let encode = |p: &[f32; 4], k: usize| {
-        if k < 3 {
-            linear_to_srgb(p[k])
-        } else {
-            p[k].clamp(0.0, 1.0)
-        }
-    };
+    // sRGB-encode colour, keep alpha linear; image's conversion to 8 or
+    // 16 bits then clamps to [0, 1], scales and rounds.
+    let encoded: Vec<f32> = image
+        .pixels
+        .iter()
+        .flat_map(|p| {
+            [
+                linear_to_srgb(p[0]),
+                linear_to_srgb(p[1]),
+                linear_to_srgb(p[2]),
+                p[3],
+            ]
+        })
+        .collect();
+    let buffer = image::Rgba32FImage::from_raw(image.width, image.height, encoded)
+        .ok_or_else(|| Error::new(path, ErrorKind::InvalidInput("pixel buffer size".into())))?;
+    let float = DynamicImage::ImageRgba32F(buffer);
     let dynamic = match depth {
-        PngDepth::Eight => {
-            let data: Vec<u8> = image
-                .pixels
-                .iter()
-                .flat_map(|p| (0..4).map(move |k| (encode(p, k) * 255.0).round() as u8))
-                .collect();
-            DynamicImage::ImageRgba8(
-                image::RgbaImage::from_raw(image.width, image.height, data).ok_or_else(|| {
-                    Error::new(path, ErrorKind::InvalidInput("pixel buffer size".into()))
-                })?,
-            )
-        }
-        PngDepth::Sixteen => {
-            let data: Vec<u16> = image
-                .pixels
-                .iter()
-                .flat_map(|p| (0..4).map(move |k| (encode(p, k) * 65535.0).round() as u16))
-                .collect();
-            DynamicImage::ImageRgba16(
-                image::ImageBuffer::from_raw(image.width, image.height, data).ok_or_else(|| {
-                    Error::new(path, ErrorKind::InvalidInput("pixel buffer size".into()))
-                })?,
-            )
-        }
+        PngDepth::Eight => DynamicImage::ImageRgba8(float.to_rgba8()),
+        PngDepth::Sixteen => DynamicImage::ImageRgba16(float.to_rgba16()),
     };
     dynamic
         .save_with_format(path, ImageFormat::Png)

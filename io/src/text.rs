@@ -220,7 +220,7 @@ impl<'a> Cursor<'a> {
 /// Parses an optionally signed decimal integer; `None` on anything else or
 /// on overflow.
 #[inline]
-fn parse_i64(tok: &[u8]) -> Option<i64> {
+pub(crate) fn parse_i64(tok: &[u8]) -> Option<i64> {
     let (negative, digits) = match tok.first()? {
         b'-' => (true, &tok[1..]),
         b'+' => (false, &tok[1..]),

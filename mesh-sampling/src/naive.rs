@@ -18,6 +18,8 @@ pub struct NaiveSampler<'a> {
     mesh: MeshRef<'a>,
     /// The triangles of non-zero area.
     faces: Vec<u32>,
+    /// Their densities `1 / (N · A_f)`, computed once.
+    densities: Vec<f32>,
 }
 
 impl<'a> NaiveSampler<'a> {
@@ -36,7 +38,16 @@ impl<'a> NaiveSampler<'a> {
                 triangles: mesh.indices.len(),
             });
         }
-        Ok(Self { mesh, faces })
+        let n = faces.len() as f64;
+        let densities = faces
+            .iter()
+            .map(|&f| (1.0 / (n * mesh.area(f as usize))) as f32)
+            .collect();
+        Ok(Self {
+            mesh,
+            faces,
+            densities,
+        })
     }
 
     /// Density (w.r.t. area) on triangle `face`: `1 / (N · A_face)`.
@@ -54,8 +65,7 @@ impl Distribution<SurfacePoint> for NaiveSampler<'_> {
     fn sample<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
         let x = unit(rng.next_u64()) * self.faces.len() as f64;
         let k = (x as usize).min(self.faces.len() - 1);
-        let face = self.faces[k];
         let bary = uniform_barycentric(x - k as f64, unit(rng.next_u64()));
-        SurfacePoint::on(&self.mesh, face, bary, self.pdf(face as usize))
+        SurfacePoint::on(&self.mesh, self.faces[k], bary, self.densities[k])
     }
 }

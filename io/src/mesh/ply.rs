@@ -218,7 +218,7 @@ pub fn from_bytes(data: &[u8], path: &Path) -> Result<PlyData> {
         let per = element.properties.len().max(1) * if ascii { 2 } else { 1 };
         reader
             .c
-            .check_count(leak_name(&element.name), element.count as u64, per)?;
+            .check_count(counted_noun(&element.name), element.count as u64, per)?;
         match element.name.as_str() {
             "vertex" if !vertex_seen => {
                 vertex_seen = true;
@@ -257,9 +257,9 @@ pub fn from_bytes(data: &[u8], path: &Path) -> Result<PlyData> {
     Ok(out)
 }
 
-/// Error messages name the counted element; the few standard names are
-/// static, others are reported generically.
-fn leak_name(name: &str) -> &'static str {
+/// What an element count counts, for error messages: the standard
+/// elements by name, others generically.
+fn counted_noun(name: &str) -> &'static str {
     match name {
         "vertex" => "vertices",
         "face" => "faces",

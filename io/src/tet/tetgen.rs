@@ -55,15 +55,19 @@ pub fn read(path: &Path) -> Result<TetMesh> {
 /// # Errors
 /// As for [`read`].
 pub fn from_bytes(node: &[u8], ele: &[u8], path: &Path) -> Result<TetMesh> {
-    let node_path = sibling(path, "node");
-    let ele_path = sibling(path, "ele");
-    let (positions, first_index) = parse_nodes(node, &node_path)?;
-    let (tets, regions) = parse_elements(ele, &ele_path, first_index, positions.len())?;
-    Ok(TetMesh {
+    parse_pair(node, ele, path).map(|(mesh, _)| mesh)
+}
+
+/// The mesh of a `.node` and an `.ele` file, and the first node index.
+fn parse_pair(node: &[u8], ele: &[u8], path: &Path) -> Result<(TetMesh, i64)> {
+    let (positions, first_index) = parse_nodes(node, &sibling(path, "node"))?;
+    let (tets, regions) = parse_elements(ele, &sibling(path, "ele"), first_index, positions.len())?;
+    let mesh = TetMesh {
         positions,
         tets,
         regions,
-    })
+    };
+    Ok((mesh, first_index))
 }
 
 /// Reads the mesh and, if it exists, the `.face` file beside it.
@@ -71,32 +75,22 @@ pub fn from_bytes(node: &[u8], ele: &[u8], path: &Path) -> Result<TetMesh> {
 /// # Errors
 /// As for [`read`], and for the `.face` file.
 pub fn read_all(path: &Path) -> Result<TetGenFiles> {
-    let node_path = sibling(path, "node");
-    let ele_path = sibling(path, "ele");
+    let node = read_bytes(&sibling(path, "node"))?;
+    let ele = read_bytes(&sibling(path, "ele"))?;
+    let (mesh, first_index) = parse_pair(&node, &ele, path)?;
     let face_path = sibling(path, "face");
-    let (positions, first_index) = parse_nodes(&read_bytes(&node_path)?, &node_path)?;
-    let (tets, regions) = parse_elements(
-        &read_bytes(&ele_path)?,
-        &ele_path,
-        first_index,
-        positions.len(),
-    )?;
     let faces = match std::fs::read(&face_path) {
         Ok(data) => Some(parse_faces(
             &data,
             &face_path,
             first_index,
-            positions.len(),
+            mesh.positions.len(),
         )?),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => None,
         Err(e) => return Err(Error::io(&face_path, e)),
     };
     Ok(TetGenFiles {
-        mesh: TetMesh {
-            positions,
-            tets,
-            regions,
-        },
+        mesh,
         first_index,
         faces,
     })
