@@ -230,6 +230,10 @@ impl DiscreteSampler for AliasTable {
         Self::new(weights)
     }
 
+    fn memory_bytes(&self) -> usize {
+        Self::memory_bytes(self)
+    }
+
     fn len(&self) -> usize {
         self.columns.len()
     }

@@ -65,6 +65,10 @@ impl DiscreteSampler for CdfBisection {
         Self::new(weights)
     }
 
+    fn memory_bytes(&self) -> usize {
+        Self::memory_bytes(self)
+    }
+
     fn len(&self) -> usize {
         self.cdf.entries()
     }

@@ -271,6 +271,10 @@ impl DiscreteSampler for GuideTable {
         Self::new(weights)
     }
 
+    fn memory_bytes(&self) -> usize {
+        Self::memory_bytes(self)
+    }
+
     fn len(&self) -> usize {
         self.cdf.entries()
     }

@@ -32,6 +32,9 @@ pub trait DiscreteSampler: Sized {
     /// renderer should use for multiple importance sampling.
     fn pdf(&self, index: usize) -> f64;
 
+    /// Heap memory used, in bytes.
+    fn memory_bytes(&self) -> usize;
+
     /// Draws the entry for a uniform variate `u` in `[0, 1)` and returns it
     /// with the remapped remainder of `u`: a fresh uniform variate in
     /// `[0, 1)` that the caller may reuse (as pbrt does). Values of `u`

@@ -67,6 +67,9 @@ impl DiscreteSampler for OffByOne {
     fn pdf(&self, index: usize) -> f64 {
         self.0.pdf(index)
     }
+    fn memory_bytes(&self) -> usize {
+        self.0.memory_bytes()
+    }
     fn sample_remapped(&self, u: f64) -> (usize, f64) {
         let i = self
             .0
