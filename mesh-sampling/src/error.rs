@@ -61,4 +61,78 @@ pub enum Error {
     /// The mesh has more triangles than a sampler can index.
     #[error("{0} triangles is more than a sampler can index")]
     TooLarge(usize),
+    /// A density texture of width or height 0.
+    #[error("the density texture is {width}×{height}: it has no texels")]
+    EmptyTexture {
+        /// Its width.
+        width: usize,
+        /// Its height.
+        height: usize,
+    },
+    /// The texel data does not match the texture size.
+    #[error("the density texture needs {expected} values, got {len}")]
+    TextureSize {
+        /// Values needed.
+        expected: usize,
+        /// Values given.
+        len: usize,
+    },
+    /// A texel that is negative, NaN or infinite.
+    #[error("density texel ({x}, {y}) is {value}: densities must be finite and >= 0")]
+    InvalidTexel {
+        /// Column.
+        x: usize,
+        /// Row.
+        y: usize,
+        /// The value.
+        value: f32,
+    },
+    /// A channel the pixels do not have.
+    #[error("channel {channel:?} asked of {channels}-channel pixels")]
+    InvalidChannel {
+        /// The channel asked for.
+        channel: crate::Channel,
+        /// Channels per pixel.
+        channels: usize,
+    },
+    /// A texture density asked of a mesh without texture coordinates.
+    #[error("a texture density needs texture coordinates, and the mesh has none")]
+    MissingUvs,
+    /// A texture coordinate that is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite texture coordinate")]
+    NonFiniteUv {
+        /// The vertex.
+        vertex: usize,
+    },
+    /// Per-face or per-vertex weights of the wrong length.
+    #[error("{what} weights: {len} given for {expected} {what}s")]
+    WeightLength {
+        /// "face" or "vertex".
+        what: &'static str,
+        /// Weights given.
+        len: usize,
+        /// Faces or vertices of the mesh.
+        expected: usize,
+    },
+    /// A per-face or per-vertex weight that is negative, NaN or infinite.
+    #[error("{what} {index} has weight {value}: weights must be finite and >= 0")]
+    InvalidWeight {
+        /// "face" or "vertex".
+        what: &'static str,
+        /// Its index.
+        index: usize,
+        /// The weight.
+        value: f32,
+    },
+    /// The density is zero on the whole mesh.
+    #[error(
+        "the density is zero everywhere on the mesh ({triangles} triangles): nothing to sample"
+    )]
+    ZeroDensity {
+        /// The number of triangles.
+        triangles: usize,
+    },
+    /// A subdivision option out of range.
+    #[error("invalid option: {0}")]
+    InvalidOption(String),
 }

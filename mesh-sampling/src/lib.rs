@@ -36,17 +36,26 @@
 
 #![forbid(unsafe_code)]
 
+mod density;
 mod error;
 mod mesh;
 mod multi;
 mod naive;
 mod parallel;
 mod point;
+mod projection;
+mod rejection;
+mod subdivision;
+mod texture;
 mod uniform;
 
+pub use density::{Density, DensitySampler, Mode, Options};
 pub use error::Error;
 pub use mesh::MeshRef;
 pub use multi::{MeshPoint, MultiMeshSampler};
 pub use naive::NaiveSampler;
 pub use point::{SurfacePoint, uniform_barycentric};
+pub use projection::spherical_uvs;
+pub use rejection::RejectionSampler;
+pub use texture::{Channel, DensityTexture, Filter, Wrap};
 pub use uniform::UniformSampler;

@@ -65,6 +65,11 @@ impl<'a> UniformSampler<'a> {
         &self.mesh
     }
 
+    /// Heap memory of the sampler (its area table).
+    pub fn memory_bytes(&self) -> usize {
+        self.triangles.memory_bytes()
+    }
+
     /// The total surface area.
     pub fn total_area(&self) -> f64 {
         self.total_area
@@ -85,13 +90,16 @@ impl<'a> UniformSampler<'a> {
     /// picks the triangle and, through its remapped remainder, the first
     /// barycentric variate; `u1` is the second.
     pub fn sample_u(&self, u: [f64; 2]) -> SurfacePoint {
+        let (face, bary) = self.locate(u);
+        SurfacePoint::on(&self.mesh, face, bary, self.density)
+    }
+
+    /// The triangle and barycentrics [`sample_u`](Self::sample_u) places
+    /// its point at.
+    #[inline]
+    pub(crate) fn locate(&self, u: [f64; 2]) -> (u32, [f32; 3]) {
         let (face, rest) = self.triangles.sample_remapped(u[0]);
-        SurfacePoint::on(
-            &self.mesh,
-            face as u32,
-            uniform_barycentric(rest, u[1]),
-            self.density,
-        )
+        (face as u32, uniform_barycentric(rest, u[1]))
     }
 
     /// Fills `out`, two `u64` of `rng` per point.

@@ -1,0 +1,617 @@
+//! Sampling with a density: a texture by adaptive subdivision (Šik &
+//! Křivánek 2013, Sec. 3.3–3.5), optionally exact, or per-face and
+//! per-vertex weights.
+
+use discrete_sampling::{DiscreteSampler, GuideTable};
+use glam::{DVec2, Vec2};
+use rand::Rng;
+use rand::distr::Distribution;
+
+use crate::parallel::{for_each_chunk, unit};
+use crate::point::uniform_barycentric;
+use crate::subdivision::{self, MAX_LEVEL, Merge, SubTriangle};
+use crate::{DensityTexture, Error, MeshRef, SurfacePoint};
+
+/// Where the density comes from.
+#[derive(Debug, Clone, Copy)]
+pub enum Density<'a> {
+    /// A texture looked up at the mesh's UVs.
+    Texture(&'a DensityTexture),
+    /// One weight per triangle, constant over it.
+    PerFace(&'a [f32]),
+    /// One weight per vertex, linear over each triangle.
+    PerVertex(&'a [f32]),
+}
+
+/// Which density a texture sampler draws from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Mode {
+    /// The paper's `p′` (Eq. 2): the density sampled at each
+    /// sub-triangle's barycenter, constant over the sub-triangle. Fastest;
+    /// a sub-triangle straddling a texel edge gets one value.
+    #[default]
+    Approximate,
+    /// The filtered texture exactly: `p′`'s subdivision as the proposal,
+    /// weighted by each sub-triangle's exact maximum, and a rejection
+    /// step. [`DensitySampler::acceptance`] says how often it accepts.
+    Exact,
+}
+
+/// How finely a texture density is subdivided and merged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// Approximate (the paper) or exact.
+    pub mode: Mode,
+    /// The deepest subdivision level, at most 13 (`4^13` sub-triangles for
+    /// one triangle). Default 11: a triangle spanning a 2048² texture.
+    pub max_level: u8,
+    /// Levels beyond the one that makes sub-triangle edges no longer than
+    /// a texel. Each one divides the approximation error of
+    /// [`Mode::Approximate`] (or the rejection rate of [`Mode::Exact`])
+    /// roughly by two, and costs four times the memory.
+    pub extra_levels: u8,
+    /// Relative tolerance for merging siblings: 0 (default) merges only
+    /// equal values, so `p′` is unchanged; `t > 0` merges when
+    /// `max − min ≤ t · max`, trading accuracy (approximate mode: the mean
+    /// replaces the four values) or acceptance (exact mode: the maximum)
+    /// for memory.
+    pub merge_tolerance: f32,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            mode: Mode::Approximate,
+            max_level: 11,
+            extra_levels: 0,
+            merge_tolerance: 0.0,
+        }
+    }
+}
+
+/// One entry of the discrete distribution: a sub-triangle (or linear
+/// component) of a face, with its density value (exact mode: its bound).
+#[derive(Debug, Clone, Copy)]
+struct Piece {
+    face: u32,
+    part: SubTriangle,
+    value: f32,
+}
+
+/// Draws points on a mesh with probability density proportional to a
+/// texture, per-face or per-vertex weights.
+///
+/// A texture density is resampled on an adaptive subdivision of each
+/// triangle (Šik & Křivánek 2013): the depth makes sub-triangle edges no
+/// longer than one texel (the longest UV edge decides, so slivers are
+/// subdivided too), the density is looked up at each sub-triangle's
+/// barycenter, and four siblings of equal value merge into their parent.
+/// A sub-triangle costs a CDF entry, its triangle and a 32-bit code of its
+/// level and position (Fig. 4), decoded in O(1). `S` is the 1D sampler
+/// that picks a sub-triangle: the guide table by default,
+/// [`CdfBisection`](discrete_sampling::CdfBisection) for the paper's
+/// "without table" variant.
+///
+/// Per-face weights are sampled exactly (triangle by weight × area, then
+/// uniformly in it), and so are per-vertex weights: a linear density is a
+/// mixture of three components, each "proportional to one barycentric
+/// weight", drawn in closed form.
+///
+/// # Example
+/// ```
+/// use glam::{Vec2, Vec3};
+/// use mesh_sampling::{Density, DensitySampler, DensityTexture, MeshRef};
+///
+/// let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+/// let uvs = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
+/// let indices = [[0, 1, 2], [1, 3, 2]];
+/// let mesh = MeshRef { uvs: Some(&uvs), ..MeshRef::new(&positions, &indices) };
+/// // Left half black, right half white.
+/// let texture = DensityTexture::new(2, 1, vec![0.0, 1.0])?
+///     .with_filter(mesh_sampling::Filter::Nearest);
+/// let sampler = DensitySampler::new(mesh, Density::Texture(&texture))?;
+/// for p in sampler.sample_n(1, 1000) {
+///     assert!(p.position.x >= 0.5);
+///     assert!((p.pdf - 2.0).abs() < 1e-4); // density 1 over half the area
+/// }
+/// # Ok::<(), mesh_sampling::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct DensitySampler<'a, S = GuideTable> {
+    mesh: MeshRef<'a>,
+    density: Density<'a>,
+    mode: Mode,
+    pieces: Vec<Piece>,
+    table: S,
+    /// Pieces of face `f`: `face_start[f]..face_start[f + 1]`.
+    face_start: Vec<u32>,
+    /// Subdivision depth of each face (texture densities).
+    face_level: Vec<u8>,
+    /// `1 / ∫ density dA` of the density sampled.
+    norm: f64,
+    /// Expected fraction of proposals accepted (1 without rejection).
+    acceptance: f64,
+}
+
+impl<'a> DensitySampler<'a, GuideTable> {
+    /// A sampler with default [`Options`] and the guide table.
+    ///
+    /// # Errors
+    /// As for [`with_options`](Self::with_options).
+    pub fn new(mesh: MeshRef<'a>, density: Density<'a>) -> Result<Self, Error> {
+        Self::with_options(mesh, density, &Options::default())
+    }
+
+    /// A sampler with the guide table and `options`.
+    ///
+    /// # Errors
+    /// As for [`with_table`](Self::with_table).
+    pub fn with_options(
+        mesh: MeshRef<'a>,
+        density: Density<'a>,
+        options: &Options,
+    ) -> Result<Self, Error> {
+        Self::with_table(mesh, density, options)
+    }
+}
+
+impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
+    /// Validates the mesh and the density, subdivides (in parallel with
+    /// the `rayon` feature; the result does not depend on the thread
+    /// count) and builds the table of type `S`:
+    /// `DensitySampler::<CdfBisection>::with_table(…)` is the paper's
+    /// variant without the lookup table.
+    ///
+    /// # Errors
+    /// The mesh's errors ([`MeshRef::validate`]); [`Error::MissingUvs`] or
+    /// [`Error::NonFiniteUv`] for a texture density;
+    /// [`Error::WeightLength`], [`Error::InvalidWeight`] for weights;
+    /// [`Error::InvalidOption`]; [`Error::ZeroDensity`] when the density
+    /// is zero on every triangle of non-zero area.
+    pub fn with_table(
+        mesh: MeshRef<'a>,
+        density: Density<'a>,
+        options: &Options,
+    ) -> Result<Self, Error> {
+        mesh.validate()?;
+        if options.max_level > MAX_LEVEL {
+            return Err(Error::InvalidOption(format!(
+                "max_level {} exceeds {MAX_LEVEL}",
+                options.max_level
+            )));
+        }
+        if !(options.merge_tolerance >= 0.0 && options.merge_tolerance <= 1.0) {
+            return Err(Error::InvalidOption(format!(
+                "merge_tolerance {} is not in [0, 1]",
+                options.merge_tolerance
+            )));
+        }
+        let faces = mesh.indices.len();
+        let (per_face, face_level, exact_mass) = match density {
+            Density::Texture(texture) => {
+                let uvs = texture_uvs(&mesh)?;
+                let levels: Vec<u8> = map_faces(faces, |f| {
+                    face_level(texture, face_uvs(uvs, mesh.indices[f]), options)
+                });
+                let build = |f: usize| texture_pieces(&mesh, uvs, texture, levels[f], options, f);
+                let per_face = map_faces(faces, build);
+                let exact = (options.mode == Mode::Exact).then(|| {
+                    map_faces(faces, |f| exact_mass(&mesh, uvs, texture, f))
+                        .iter()
+                        .sum()
+                });
+                (per_face, levels, exact)
+            }
+            Density::PerFace(w) => {
+                check_weights("face", w, faces)?;
+                let per_face = map_faces(faces, |f| {
+                    let ok = w[f] > 0.0 && mesh.area(f) > 0.0;
+                    ok.then_some((SubTriangle::ROOT, w[f]))
+                        .into_iter()
+                        .collect()
+                });
+                (per_face, vec![0; faces], None)
+            }
+            Density::PerVertex(w) => {
+                check_weights("vertex", w, mesh.positions.len())?;
+                let per_face = map_faces(faces, |f| {
+                    if mesh.area(f) <= 0.0 {
+                        return Vec::new();
+                    }
+                    let tri = mesh.indices[f];
+                    (0..3)
+                        .filter(|&c| w[tri[c] as usize] > 0.0)
+                        .map(|c| (SubTriangle::vertex(c), w[tri[c] as usize]))
+                        .collect()
+                });
+                (per_face, vec![0; faces], None)
+            }
+        };
+        let mut face_start = Vec::with_capacity(faces + 1);
+        let mut pieces = Vec::with_capacity(per_face.iter().map(Vec::len).sum());
+        for (f, parts) in per_face.into_iter().enumerate() {
+            face_start.push(pieces.len() as u32);
+            pieces.extend(parts.into_iter().map(|(part, value)| Piece {
+                face: f as u32,
+                part,
+                value,
+            }));
+        }
+        face_start.push(pieces.len() as u32);
+        if pieces.len() > u32::MAX as usize {
+            return Err(Error::TooLarge(pieces.len()));
+        }
+        let areas: Vec<f64> = map_faces(faces, |f| mesh.area(f));
+        let masses: Vec<f64> = pieces
+            .iter()
+            .map(|p| f64::from(p.value) * areas[p.face as usize] * piece_fraction(p.part))
+            .collect();
+        let proposal_mass: f64 = masses.iter().sum();
+        let table =
+            S::from_weights(&masses).map_err(|_| Error::ZeroDensity { triangles: faces })?;
+        let mass = exact_mass.unwrap_or(proposal_mass);
+        if mass.is_nan() || mass <= 0.0 {
+            return Err(Error::ZeroDensity { triangles: faces });
+        }
+        Ok(Self {
+            mesh,
+            density,
+            mode: if exact_mass.is_some() {
+                Mode::Exact
+            } else {
+                Mode::Approximate
+            },
+            pieces,
+            table,
+            face_start,
+            face_level,
+            norm: 1.0 / mass,
+            acceptance: (mass / proposal_mass).min(1.0),
+        })
+    }
+
+    /// The mesh sampled.
+    pub fn mesh(&self) -> &MeshRef<'a> {
+        &self.mesh
+    }
+
+    /// The mode actually used: [`Mode::Exact`] only for a texture density
+    /// built with it (per-face and per-vertex densities are always exact).
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// Number of sub-triangles (or linear components) in the table.
+    pub fn pieces(&self) -> usize {
+        self.pieces.len()
+    }
+
+    /// The subdivision depth of triangle `face` (0 for weights).
+    pub fn level(&self, face: usize) -> u8 {
+        self.face_level.get(face).copied().unwrap_or(0)
+    }
+
+    /// The integral of the sampled density's unnormalised form over the
+    /// mesh: `Σ f_i |D_i|` (Eq. 2's denominator) in approximate mode, the
+    /// exact integral of the filtered texture in exact mode.
+    pub fn total_mass(&self) -> f64 {
+        1.0 / self.norm
+    }
+
+    /// The expected fraction of proposals accepted: 1 in approximate mode
+    /// and for weights, `∫ f / Σ bound_i |D_i|` in exact mode.
+    pub fn acceptance(&self) -> f64 {
+        self.acceptance
+    }
+
+    /// Heap memory of the sampler (pieces, table and face index), not
+    /// counting the mesh and texture it borrows.
+    pub fn memory_bytes(&self) -> usize {
+        self.pieces.len() * size_of::<Piece>()
+            + self.table.memory_bytes()
+            + self.face_start.len() * size_of::<u32>()
+            + self.face_level.len()
+    }
+
+    /// The density (w.r.t. area, normalised over the mesh) this sampler
+    /// draws from, at barycentrics `barycentric` of triangle `face`: what a
+    /// path tracer needs for multiple importance sampling when a ray hits
+    /// the mesh. 0 outside the mesh or on a zero-area triangle.
+    pub fn pdf(&self, face: usize, barycentric: [f32; 3]) -> f32 {
+        let Some(range) = self.face_range(face) else {
+            return 0.0;
+        };
+        let [b0, b1, b2] = barycentric.map(f64::from);
+        let value = match self.density {
+            Density::PerFace(w) => {
+                if range.is_empty() {
+                    0.0
+                } else {
+                    f64::from(w[face])
+                }
+            }
+            Density::PerVertex(w) => {
+                if range.is_empty() {
+                    return 0.0;
+                }
+                let t = self.mesh.indices[face].map(|i| f64::from(w[i as usize]));
+                t[0] * b0 + t[1] * b1 + t[2] * b2
+            }
+            Density::Texture(texture) => match self.mode {
+                Mode::Exact if range.is_empty() => 0.0,
+                Mode::Exact => texture.eval(self.uv_at(face, b1, b2)),
+                Mode::Approximate => self.approximate_value(range, face, b1, b2),
+            },
+        };
+        (value * self.norm) as f32
+    }
+
+    fn face_range(&self, face: usize) -> Option<std::ops::Range<usize>> {
+        let start = *self.face_start.get(face)? as usize;
+        let end = *self.face_start.get(face + 1)? as usize;
+        Some(start..end)
+    }
+
+    /// `p′` before normalisation at `(u, v)` of `face`: the value of the
+    /// stored sub-triangle containing it, found by bisection on the
+    /// depth-first keys of the face's sub-triangles.
+    fn approximate_value(&self, range: std::ops::Range<usize>, face: usize, u: f64, v: f64) -> f64 {
+        let depth = self.face_level[face];
+        let key = SubTriangle::locate(depth, u, v).key(depth);
+        let pieces = &self.pieces[range];
+        let k = pieces.partition_point(|p| p.part.key(depth) <= key);
+        let Some(p) = k.checked_sub(1).map(|k| pieces[k]) else {
+            return 0.0;
+        };
+        let span = 1u64 << (2 * (depth - p.part.level()));
+        if key < p.part.key(depth) + span {
+            f64::from(p.value)
+        } else {
+            0.0
+        }
+    }
+
+    /// The texture coordinate at `(u, v)` of `face`.
+    #[inline]
+    fn uv_at(&self, face: usize, u: f64, v: f64) -> DVec2 {
+        let uvs = self.mesh.uvs.unwrap_or_default();
+        let [a, b, c] = face_uvs(uvs, self.mesh.indices[face]);
+        a + (b - a) * u + (c - a) * v
+    }
+
+    /// The proposal for variates `u0` (piece and first barycentric
+    /// variate, through the remapped remainder) and `u1`: the piece and the
+    /// parent barycentrics.
+    #[inline]
+    fn propose(&self, u0: f64, u1: f64) -> (Piece, [f32; 3]) {
+        let (k, rest) = self.table.sample_remapped(u0);
+        let piece = self.pieces[k];
+        let bary = match piece.part.corner() {
+            Some(corner) => linear_corner_barycentric(corner, rest, u1),
+            None => {
+                let [_, a, b] = uniform_barycentric(rest, u1);
+                let (u, v) = piece.part.to_parent(f64::from(a), f64::from(b));
+                [(1.0 - u - v).max(0.0) as f32, u as f32, v as f32]
+            }
+        };
+        (piece, bary)
+    }
+
+    /// Fills `out` from `rng`: two `u64` per point, three per proposal in
+    /// exact mode.
+    pub fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
+        for slot in out {
+            *slot = self.sample(rng);
+        }
+    }
+
+    /// `n` points from `seed`, on all threads with the `rayon` feature; the
+    /// result depends only on `(mesh, density, options, seed, n)`.
+    pub fn sample_n(&self, seed: u64, n: usize) -> Vec<SurfacePoint> {
+        let mut out = vec![SurfacePoint::default(); n];
+        for_each_chunk(seed, &mut out, |rng, chunk| self.sample_into(rng, chunk));
+        out
+    }
+}
+
+impl<S: DiscreteSampler + Sync> Distribution<SurfacePoint> for DensitySampler<'_, S> {
+    fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
+        loop {
+            let u0 = unit(rng.next_u64());
+            let u1 = unit(rng.next_u64());
+            let (piece, bary) = self.propose(u0, u1);
+            let face = piece.face as usize;
+            let value = match (self.density, self.mode) {
+                (Density::Texture(texture), Mode::Exact) => {
+                    let [_, u, v] = bary.map(f64::from);
+                    let f = texture.eval(self.uv_at(face, u, v));
+                    // Accept with probability f / bound (bound ≥ f).
+                    if unit(rng.next_u64()) * f64::from(piece.value) >= f {
+                        continue;
+                    }
+                    f
+                }
+                (Density::PerVertex(w), _) => {
+                    let t = self.mesh.indices[face].map(|i| w[i as usize]);
+                    f64::from(t[0] * bary[0] + t[1] * bary[1] + t[2] * bary[2])
+                }
+                _ => f64::from(piece.value),
+            };
+            return SurfacePoint::on(&self.mesh, piece.face, bary, (value * self.norm) as f32);
+        }
+    }
+}
+
+/// Barycentrics with density proportional to the weight of `corner`: that
+/// weight is Beta(2, 2) (the uniform marginal `2(1 − b)` times `b`), drawn
+/// by inverting its CDF `3b² − 2b³` in closed form; the other two split
+/// the rest uniformly.
+fn linear_corner_barycentric(corner: usize, xi1: f64, xi2: f64) -> [f32; 3] {
+    // 4y³ − 3y = 1 − 2ξ for y = b − 1/2 is cos 3θ = 1 − 2ξ with y = cos θ;
+    // the root in [−1/2, 1/2] has 3θ in [π, 2π].
+    let theta = (2.0 * std::f64::consts::PI - (1.0 - 2.0 * xi1).clamp(-1.0, 1.0).acos()) / 3.0;
+    let b = (0.5 + theta.cos()).clamp(0.0, 1.0);
+    let other = xi2 * (1.0 - b);
+    let mut bary = [0.0f32; 3];
+    bary[corner] = b as f32;
+    bary[(corner + 1) % 3] = other as f32;
+    bary[(corner + 2) % 3] = (1.0 - b - other).max(0.0) as f32;
+    bary
+}
+
+/// The share of its face's area (times the weight's normalisation) a
+/// piece covers: `4^-level` for sub-triangles, 1/3 for a linear component
+/// (∫ b_c dA = A / 3).
+fn piece_fraction(part: SubTriangle) -> f64 {
+    if part.corner().is_some() {
+        1.0 / 3.0
+    } else {
+        part.area_fraction()
+    }
+}
+
+fn check_weights(what: &'static str, w: &[f32], expected: usize) -> Result<(), Error> {
+    if w.len() != expected {
+        return Err(Error::WeightLength {
+            what,
+            len: w.len(),
+            expected,
+        });
+    }
+    if let Some(index) = w.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
+        return Err(Error::InvalidWeight {
+            what,
+            index,
+            value: w[index],
+        });
+    }
+    Ok(())
+}
+
+/// The mesh's UVs, checked finite on every referenced vertex.
+pub(crate) fn texture_uvs<'a>(mesh: &MeshRef<'a>) -> Result<&'a [Vec2], Error> {
+    let uvs = mesh.uvs.ok_or(Error::MissingUvs)?;
+    for tri in mesh.indices {
+        for &i in tri {
+            if !uvs[i as usize].is_finite() {
+                return Err(Error::NonFiniteUv { vertex: i as usize });
+            }
+        }
+    }
+    Ok(uvs)
+}
+
+#[inline]
+fn face_uvs(uvs: &[Vec2], tri: [u32; 3]) -> [DVec2; 3] {
+    tri.map(|i| uvs[i as usize].as_dvec2())
+}
+
+/// The depth at which sub-triangle edges are at most one texel long: from
+/// the longest UV edge in texels, so a sliver (long, with little area) is
+/// subdivided as finely as its length needs.
+fn face_level(texture: &DensityTexture, uv: [DVec2; 3], options: &Options) -> u8 {
+    let scale = DVec2::new(texture.width() as f64, texture.height() as f64);
+    let longest = (0..3)
+        .map(|k| ((uv[(k + 1) % 3] - uv[k]) * scale).length())
+        .fold(0.0f64, f64::max);
+    let level = if longest > 1.0 {
+        longest.log2().ceil().min(f64::from(MAX_LEVEL)) as u8
+    } else {
+        0
+    };
+    (level.saturating_add(options.extra_levels)).min(options.max_level)
+}
+
+/// Sub-triangles of face `f` with their values (approximate mode: the
+/// density at the barycenter; exact: the density's maximum over the
+/// sub-triangle), merged, zeros dropped.
+fn texture_pieces(
+    mesh: &MeshRef<'_>,
+    uvs: &[Vec2],
+    texture: &DensityTexture,
+    level: u8,
+    options: &Options,
+    f: usize,
+) -> Vec<(SubTriangle, f32)> {
+    if mesh.area(f) <= 0.0 {
+        return Vec::new();
+    }
+    let [a, b, c] = face_uvs(uvs, mesh.indices[f]);
+    let at = |(u, v): (f64, f64)| a + (b - a) * u + (c - a) * v;
+    let mut out = Vec::new();
+    match options.mode {
+        Mode::Approximate => {
+            let value = |s: SubTriangle| texture.eval(at(s.barycenter())) as f32;
+            subdivision::build(
+                level,
+                options.merge_tolerance,
+                Merge::Mean,
+                &value,
+                &mut out,
+            );
+        }
+        Mode::Exact => {
+            // Rounded up to f32 so that the bound stays a bound.
+            let value = |s: SubTriangle| round_up(texture.max_over(s.corners().map(at)));
+            subdivision::build(level, options.merge_tolerance, Merge::Max, &value, &mut out);
+        }
+    }
+    out.retain(|&(_, v)| v > 0.0);
+    out
+}
+
+/// The smallest `f32` not below `x`.
+fn round_up(x: f64) -> f32 {
+    let y = x as f32;
+    if f64::from(y) < x { y.next_up() } else { y }
+}
+
+/// The exact integral of the filtered texture over face `f` in 3D area:
+/// the UV integral times the face's area scale (affine map). A face whose
+/// UV triangle is degenerate takes its area times the density at its UV
+/// centroid.
+pub(crate) fn exact_mass(
+    mesh: &MeshRef<'_>,
+    uvs: &[Vec2],
+    texture: &DensityTexture,
+    f: usize,
+) -> f64 {
+    let area = mesh.area(f);
+    if area <= 0.0 {
+        return 0.0;
+    }
+    let uv = face_uvs(uvs, mesh.indices[f]);
+    let uv_area = 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
+    if uv_area > 0.0 {
+        texture.integral(uv) * area / uv_area
+    } else {
+        area * texture.eval((uv[0] + uv[1] + uv[2]) / 3.0)
+    }
+}
+
+/// `f(0..n)` collected in order, in parallel with the `rayon` feature.
+pub(crate) fn map_faces<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+    #[cfg(feature = "rayon")]
+    {
+        use rayon::prelude::*;
+        (0..n).into_par_iter().map(f).collect()
+    }
+    #[cfg(not(feature = "rayon"))]
+    (0..n).map(f).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn linear_corner_component_has_beta22_weight() {
+        // The CDF of the corner weight is 3b² − 2b³: invert and check.
+        for k in 0..=100 {
+            let xi = k as f64 / 100.0;
+            let b = f64::from(linear_corner_barycentric(1, xi, 0.3)[1]);
+            let cdf = 3.0 * b * b - 2.0 * b * b * b;
+            assert!((cdf - xi).abs() < 1e-5, "{xi} -> {b} -> {cdf}");
+        }
+    }
+}

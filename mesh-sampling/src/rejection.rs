@@ -1,0 +1,116 @@
+//! Rejection sampling with a density texture, the baseline of Šik &
+//! Křivánek 2013 (Sec. 3.2): a uniform point, accepted with probability
+//! `f(m(x)) / M` for the texture's maximum `M`. Exact for the filtered
+//! density, but it accepts only `mean / M` of its proposals.
+
+use glam::Vec2;
+use rand::Rng;
+use rand::distr::Distribution;
+
+use crate::parallel::{for_each_chunk, unit};
+use crate::{DensityTexture, Error, MeshRef, SurfacePoint, UniformSampler};
+
+/// Draws points with density proportional to a texture by rejection from
+/// the uniform distribution. Prefer [`DensitySampler`](crate::DensitySampler);
+/// this is the baseline it is measured against.
+#[derive(Debug, Clone)]
+pub struct RejectionSampler<'a> {
+    uniform: UniformSampler<'a>,
+    uvs: &'a [Vec2],
+    texture: &'a DensityTexture,
+    /// `M`: the largest texel.
+    bound: f64,
+    /// `1 / ∫ f dA`, for the points' pdf.
+    norm: f64,
+    acceptance: f64,
+}
+
+impl<'a> RejectionSampler<'a> {
+    /// Builds the area table and integrates the texture over the mesh
+    /// exactly (for the points' pdf).
+    ///
+    /// # Errors
+    /// As for [`UniformSampler::new`]; [`Error::MissingUvs`],
+    /// [`Error::NonFiniteUv`]; [`Error::ZeroDensity`] when the texture is
+    /// zero on the whole mesh.
+    pub fn new(mesh: MeshRef<'a>, texture: &'a DensityTexture) -> Result<Self, Error> {
+        let uniform = UniformSampler::new(mesh)?;
+        let uvs = crate::density::texture_uvs(&mesh)?;
+        let faces = mesh.indices.len();
+        let mass: f64 = crate::density::map_faces(faces, |f| {
+            crate::density::exact_mass(&mesh, uvs, texture, f)
+        })
+        .iter()
+        .sum();
+        if mass.is_nan() || mass <= 0.0 {
+            return Err(Error::ZeroDensity { triangles: faces });
+        }
+        let bound = f64::from(texture.max());
+        Ok(Self {
+            acceptance: mass / (uniform.total_area() * bound),
+            uniform,
+            uvs,
+            texture,
+            bound,
+            norm: 1.0 / mass,
+        })
+    }
+
+    /// The expected fraction of proposals accepted: `∫ f dA / (A · M)`.
+    pub fn acceptance(&self) -> f64 {
+        self.acceptance
+    }
+
+    /// The integral of the texture over the mesh.
+    pub fn total_mass(&self) -> f64 {
+        1.0 / self.norm
+    }
+
+    /// The density (w.r.t. area) at barycentrics of `face`.
+    pub fn pdf(&self, face: usize, barycentric: [f32; 3]) -> f32 {
+        if self.uniform.pdf(face) == 0.0 {
+            return 0.0;
+        }
+        let tri = self.uniform.mesh().indices[face];
+        let [a, b, c] = tri.map(|i| self.uvs[i as usize].as_dvec2());
+        let [_, u, v] = barycentric.map(f64::from);
+        (self.texture.eval(a + (b - a) * u + (c - a) * v) * self.norm) as f32
+    }
+
+    /// Heap memory of the sampler (its area table).
+    pub fn memory_bytes(&self) -> usize {
+        self.uniform.memory_bytes()
+    }
+
+    /// Fills `out` from `rng`: three `u64` per proposal.
+    pub fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
+        for slot in out {
+            *slot = self.sample(rng);
+        }
+    }
+
+    /// `n` points from `seed`, the same on any number of threads.
+    pub fn sample_n(&self, seed: u64, n: usize) -> Vec<SurfacePoint> {
+        let mut out = vec![SurfacePoint::default(); n];
+        for_each_chunk(seed, &mut out, |rng, chunk| self.sample_into(rng, chunk));
+        out
+    }
+}
+
+impl Distribution<SurfacePoint> for RejectionSampler<'_> {
+    fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
+        let mesh = self.uniform.mesh();
+        loop {
+            let (face, bary) = self
+                .uniform
+                .locate([unit(rng.next_u64()), unit(rng.next_u64())]);
+            let tri = mesh.indices[face as usize];
+            let [a, b, c] = tri.map(|i| self.uvs[i as usize].as_dvec2());
+            let [_, u, v] = bary.map(f64::from);
+            let f = self.texture.eval(a + (b - a) * u + (c - a) * v);
+            if unit(rng.next_u64()) * self.bound < f {
+                return SurfacePoint::on(mesh, face, bary, (f * self.norm) as f32);
+            }
+        }
+    }
+}

@@ -1,0 +1,551 @@
+//! A density texture: one non-negative value per texel, filtered bilinearly
+//! (or nearest), repeated or clamped outside `[0, 1]²`.
+//!
+//! Besides point lookups it answers the two questions exact sampling needs
+//! about a UV triangle: the exact integral of the filtered density over it
+//! and its exact maximum. Both rely on the density being bilinear (or
+//! constant) inside each cell between texel centres, so a triangle is cut
+//! into cell pieces and each piece handled in closed form.
+
+use glam::DVec2;
+
+use crate::Error;
+
+/// What happens outside `[0, 1]²`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Wrap {
+    /// The texture tiles the plane (tiled UV maps).
+    #[default]
+    Repeat,
+    /// The edge texels extend outwards.
+    Clamp,
+}
+
+/// How the density between texel centres is reconstructed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Filter {
+    /// Bilinear interpolation of the four nearest texel centres.
+    #[default]
+    Bilinear,
+    /// The value of the texel the point lies in (piecewise constant).
+    Nearest,
+}
+
+/// Which value of a multi-channel image becomes the density.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Channel {
+    /// One channel, by index.
+    Index(usize),
+    /// Rec. 709 luminance `0.2126 R + 0.7152 G + 0.0722 B` of the first
+    /// three channels (for HDR luminaires: sample by emitted power).
+    Luminance,
+}
+
+/// A density texture. Texel `(x, y)` covers `u ∈ [x/W, (x+1)/W)`,
+/// `v ∈ [y/H, (y+1)/H)`, and row 0 is the first row of the data: images
+/// stored top row first (PNG, EXR, HDR) match glTF's UV convention; for
+/// OBJ's (v up) use [`flip_rows`](Self::flip_rows).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DensityTexture {
+    width: usize,
+    height: usize,
+    texels: Vec<f32>,
+    wrap: Wrap,
+    filter: Filter,
+    max: f32,
+}
+
+impl DensityTexture {
+    /// A texture of `width × height` values, row by row.
+    ///
+    /// # Errors
+    /// [`Error::EmptyTexture`] for a size of 0, [`Error::TextureSize`] when
+    /// `texels` does not hold `width · height` values,
+    /// [`Error::InvalidTexel`] naming the first negative, NaN or infinite
+    /// value.
+    pub fn new(width: usize, height: usize, texels: Vec<f32>) -> Result<Self, Error> {
+        if width == 0 || height == 0 {
+            return Err(Error::EmptyTexture { width, height });
+        }
+        let expected = width.checked_mul(height).ok_or(Error::TextureSize {
+            expected: usize::MAX,
+            len: texels.len(),
+        })?;
+        if texels.len() != expected {
+            return Err(Error::TextureSize {
+                expected,
+                len: texels.len(),
+            });
+        }
+        if let Some(i) = texels.iter().position(|t| !(t.is_finite() && *t >= 0.0)) {
+            return Err(Error::InvalidTexel {
+                x: i % width,
+                y: i / width,
+                value: texels[i],
+            });
+        }
+        let max = texels.iter().copied().fold(0.0f32, f32::max);
+        Ok(Self {
+            width,
+            height,
+            texels,
+            wrap: Wrap::default(),
+            filter: Filter::default(),
+            max,
+        })
+    }
+
+    /// A texture from interleaved `channels`-channel pixels (such as
+    /// `trilux-io`'s RGBA images), keeping one channel or the luminance.
+    ///
+    /// # Errors
+    /// [`Error::InvalidChannel`] for a channel the pixels do not have
+    /// (luminance needs three), and the errors of [`new`](Self::new).
+    pub fn from_channels(
+        width: usize,
+        height: usize,
+        data: &[f32],
+        channels: usize,
+        channel: Channel,
+    ) -> Result<Self, Error> {
+        let needed = match channel {
+            Channel::Index(c) => c + 1,
+            Channel::Luminance => 3,
+        };
+        if channels < needed {
+            return Err(Error::InvalidChannel { channel, channels });
+        }
+        if !data.len().is_multiple_of(channels) {
+            return Err(Error::TextureSize {
+                expected: width.saturating_mul(height).saturating_mul(channels),
+                len: data.len(),
+            });
+        }
+        let texels = data
+            .chunks_exact(channels)
+            .map(|p| match channel {
+                Channel::Index(c) => p[c],
+                Channel::Luminance => 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2],
+            })
+            .collect();
+        Self::new(width, height, texels)
+    }
+
+    /// The same texture with wrap mode `wrap`.
+    #[must_use]
+    pub fn with_wrap(mut self, wrap: Wrap) -> Self {
+        self.wrap = wrap;
+        self
+    }
+
+    /// The same texture with filter `filter`.
+    #[must_use]
+    pub fn with_filter(mut self, filter: Filter) -> Self {
+        self.filter = filter;
+        self
+    }
+
+    /// The same texture upside down (for OBJ-style UVs, v pointing up).
+    #[must_use]
+    pub fn flip_rows(mut self) -> Self {
+        let w = self.width;
+        let h = self.height;
+        for y in 0..h / 2 {
+            let (top, bottom) = self.texels.split_at_mut((h - 1 - y) * w);
+            top[y * w..(y + 1) * w].swap_with_slice(&mut bottom[..w]);
+        }
+        self
+    }
+
+    /// Width in texels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in texels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The wrap mode.
+    pub fn wrap(&self) -> Wrap {
+        self.wrap
+    }
+
+    /// The filter.
+    pub fn filter(&self) -> Filter {
+        self.filter
+    }
+
+    /// The largest texel: the supremum of the filtered density, the bound
+    /// rejection sampling (Šik & Křivánek Sec. 3.2) uses.
+    pub fn max(&self) -> f32 {
+        self.max
+    }
+
+    /// The texels, row by row.
+    pub fn texels(&self) -> &[f32] {
+        &self.texels
+    }
+
+    /// Heap memory used, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        self.texels.len() * size_of::<f32>()
+    }
+
+    /// The texel at integer coordinates, wrapped or clamped.
+    #[inline]
+    fn texel(&self, x: i64, y: i64) -> f64 {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let (x, y) = match self.wrap {
+            Wrap::Repeat => (x.rem_euclid(w), y.rem_euclid(h)),
+            Wrap::Clamp => (x.clamp(0, w - 1), y.clamp(0, h - 1)),
+        };
+        f64::from(self.texels[y as usize * self.width + x as usize])
+    }
+
+    /// Texel-space coordinates of `uv`: integers at the texel centres
+    /// (bilinear) or at the texel corners (nearest), so the density is
+    /// bilinear (or constant) on every unit cell.
+    #[inline]
+    fn to_cells(&self, uv: DVec2) -> DVec2 {
+        let p = uv * DVec2::new(self.width as f64, self.height as f64);
+        match self.filter {
+            Filter::Bilinear => p - 0.5,
+            Filter::Nearest => p,
+        }
+    }
+
+    /// The density at a point in cell coordinates.
+    #[inline]
+    fn at_cell(&self, p: DVec2) -> f64 {
+        // Saturating casts: a UV of 1e30 is a valid (if silly) tiled UV.
+        let (x0, y0) = (p.x.floor(), p.y.floor());
+        let (xi, yi) = (x0 as i64, y0 as i64);
+        match self.filter {
+            Filter::Nearest => self.texel(xi, yi),
+            Filter::Bilinear => {
+                let (fx, fy) = (p.x - x0, p.y - y0);
+                let top = lerp(self.texel(xi, yi), self.texel(xi + 1, yi), fx);
+                let bottom = lerp(self.texel(xi, yi + 1), self.texel(xi + 1, yi + 1), fx);
+                lerp(top, bottom, fy)
+            }
+        }
+    }
+
+    /// The filtered density at texture coordinate `uv`.
+    #[inline]
+    pub fn eval(&self, uv: DVec2) -> f64 {
+        self.at_cell(self.to_cells(uv))
+    }
+
+    /// The exact integral of the filtered density over the UV triangle
+    /// `uv`, in UV area (the unit square has area 1).
+    pub fn integral(&self, uv: [DVec2; 3]) -> f64 {
+        let scale = 1.0 / (self.width as f64 * self.height as f64);
+        let tri = uv.map(|p| self.to_cells(p));
+        let mut sum = 0.0;
+        self.for_each_cell_piece(tri, |piece, cell| {
+            sum += integrate_piece(piece, |p| self.in_cell(cell, p));
+        });
+        sum * scale
+    }
+
+    /// The exact maximum of the filtered density over the UV triangle `uv`
+    /// (closed), rounded up by a relative 1e-6 so that it bounds every
+    /// value [`eval`](Self::eval) returns inside, rounding included.
+    pub fn max_over(&self, uv: [DVec2; 3]) -> f64 {
+        let tri = uv.map(|p| self.to_cells(p));
+        let mut max = 0.0f64;
+        match self.filter {
+            // Constant per cell: the largest cell the triangle overlaps.
+            // A zero-area piece is the triangle touching a cell's border
+            // (it does not reach into the cell), unless the whole triangle
+            // is degenerate.
+            Filter::Nearest => {
+                let degenerate = polygon_area(&tri) == 0.0;
+                self.for_each_cell_piece(tri, |piece, cell| {
+                    if degenerate || polygon_area(piece) != 0.0 {
+                        max = max.max(self.texel(cell.0, cell.1));
+                    }
+                });
+            }
+            // Bilinear pieces have no interior maximum (the Hessian of a
+            // bilinear function is indefinite or zero), so the maximum is
+            // on a piece's boundary: at a corner, or at the apex of the
+            // quadratic an edge traces.
+            Filter::Bilinear => self.for_each_cell_piece(tri, |piece, cell| {
+                let f = |p: DVec2| self.in_cell(cell, p);
+                for k in 0..piece.len() {
+                    let (a, b) = (piece[k], piece[(k + 1) % piece.len()]);
+                    let (fa, fm, fb) = (f(a), f((a + b) * 0.5), f(b));
+                    max = max.max(fa).max(fb);
+                    // f(s) = fa + β s + γ s² on s ∈ [0, 1].
+                    let gamma = 2.0 * (fb - 2.0 * fm + fa);
+                    let beta = fb - fa - gamma;
+                    if gamma < 0.0 {
+                        let s = -beta / (2.0 * gamma);
+                        if s > 0.0 && s < 1.0 {
+                            max = max.max(fa + beta * s + gamma * s * s);
+                        }
+                    }
+                }
+            }),
+        }
+        max * (1.0 + 1e-6)
+    }
+
+    /// The density at `p` evaluated with the texels of cell `cell`, so
+    /// points on the cell's border use the cell's own formula.
+    #[inline]
+    fn in_cell(&self, cell: (i64, i64), p: DVec2) -> f64 {
+        match self.filter {
+            Filter::Nearest => self.texel(cell.0, cell.1),
+            Filter::Bilinear => {
+                let (fx, fy) = (p.x - cell.0 as f64, p.y - cell.1 as f64);
+                let (x, y) = cell;
+                let top = lerp(self.texel(x, y), self.texel(x + 1, y), fx);
+                let bottom = lerp(self.texel(x, y + 1), self.texel(x + 1, y + 1), fx);
+                lerp(top, bottom, fy)
+            }
+        }
+    }
+
+    /// Calls `f(piece, cell)` for the intersection of triangle `tri` (in
+    /// cell coordinates) with every unit cell it overlaps. With clamping,
+    /// the cells beyond the texture's edge have the edge's values, which
+    /// the cell formula reproduces.
+    fn for_each_cell_piece(&self, tri: [DVec2; 3], mut f: impl FnMut(&[DVec2], (i64, i64))) {
+        let lo = tri[0].min(tri[1]).min(tri[2]);
+        let hi = tri[0].max(tri[1]).max(tri[2]);
+        let (x0, x1) = (lo.x.floor() as i64, hi.x.ceil() as i64);
+        let (y0, y1) = (lo.y.floor() as i64, hi.y.ceil() as i64);
+        let tri = Polygon::from(tri);
+        for y in y0..y1.max(y0 + 1) {
+            let row = tri.clip(1, y as f64, y as f64 + 1.0);
+            if row.len < 3 {
+                continue;
+            }
+            let points = row.points();
+            let rlo = points.iter().fold(f64::INFINITY, |m, p| m.min(p.x));
+            let rhi = points.iter().fold(f64::NEG_INFINITY, |m, p| m.max(p.x));
+            let (cx0, cx1) = ((rlo.floor() as i64).max(x0), (rhi.ceil() as i64).min(x1));
+            for x in cx0..cx1.max(cx0 + 1) {
+                let piece = row.clip(0, x as f64, x as f64 + 1.0);
+                if piece.len >= 3 {
+                    f(piece.points(), (x, y));
+                }
+            }
+        }
+    }
+}
+
+#[inline]
+fn lerp(a: f64, b: f64, t: f64) -> f64 {
+    a + (b - a) * t
+}
+
+/// A convex polygon of at most 8 corners on the stack: a triangle clipped
+/// by four axis-aligned half-planes has at most 7.
+#[derive(Clone, Copy)]
+struct Polygon {
+    corners: [DVec2; 8],
+    len: usize,
+}
+
+impl From<[DVec2; 3]> for Polygon {
+    fn from(t: [DVec2; 3]) -> Self {
+        let mut corners = [DVec2::ZERO; 8];
+        corners[..3].copy_from_slice(&t);
+        Self { corners, len: 3 }
+    }
+}
+
+impl Polygon {
+    fn points(&self) -> &[DVec2] {
+        &self.corners[..self.len]
+    }
+
+    /// The part in the slab `lo ≤ p[axis] ≤ hi`.
+    fn clip(&self, axis: usize, lo: f64, hi: f64) -> Self {
+        self.clip_half(|p| p[axis] - lo).clip_half(|p| hi - p[axis])
+    }
+
+    /// Sutherland–Hodgman against the half-plane `side(p) ≥ 0`.
+    fn clip_half(&self, side: impl Fn(DVec2) -> f64) -> Self {
+        let mut out = Self {
+            corners: [DVec2::ZERO; 8],
+            len: 0,
+        };
+        let mut push = |p: DVec2| {
+            if out.len < out.corners.len() {
+                out.corners[out.len] = p;
+                out.len += 1;
+            }
+        };
+        let points = self.points();
+        for k in 0..points.len() {
+            let (a, b) = (points[k], points[(k + 1) % points.len()]);
+            let (sa, sb) = (side(a), side(b));
+            if sa >= 0.0 {
+                push(a);
+            }
+            if (sa >= 0.0) != (sb >= 0.0) {
+                push(a + (b - a) * (sa / (sa - sb)));
+            }
+        }
+        out
+    }
+}
+
+/// Signed area of a polygon.
+fn polygon_area(poly: &[DVec2]) -> f64 {
+    let mut twice = 0.0;
+    for k in 0..poly.len() {
+        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+        twice += a.perp_dot(b);
+    }
+    0.5 * twice
+}
+
+/// ∫ f over a convex polygon where `f` is at most quadratic: a fan of
+/// triangles, each by the edge-midpoint rule (exact for degree 2).
+fn integrate_piece(piece: &[DVec2], f: impl Fn(DVec2) -> f64) -> f64 {
+    let o = piece[0];
+    let mut sum = 0.0;
+    for k in 1..piece.len() - 1 {
+        let (a, b) = (piece[k], piece[k + 1]);
+        let area = 0.5 * (a - o).perp_dot(b - o).abs();
+        let mid = f((o + a) * 0.5) + f((a + b) * 0.5) + f((b + o) * 0.5);
+        sum += area * mid / 3.0;
+    }
+    sum
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn noise(w: usize, h: usize) -> DensityTexture {
+        let texels = (0..w * h)
+            .map(|i| ((i * 2_654_435_761) % 1000) as f32 / 100.0)
+            .collect();
+        DensityTexture::new(w, h, texels).unwrap()
+    }
+
+    /// Midpoint-rule integral on a fine grid of the triangle (reference).
+    fn brute_integral(t: &DensityTexture, uv: [DVec2; 3], n: usize) -> f64 {
+        let mut sum = 0.0;
+        let e1 = uv[1] - uv[0];
+        let e2 = uv[2] - uv[0];
+        let area = 0.5 * e1.perp_dot(e2).abs();
+        let mut count = 0usize;
+        for i in 0..n {
+            for j in 0..n - i {
+                // Up triangles' centroids of a regular n-subdivision, and
+                // the down ones'.
+                for (a, b) in [(i as f64 + 1.0 / 3.0, j as f64 + 1.0 / 3.0)]
+                    .into_iter()
+                    .chain((i + j + 1 < n).then(|| (i as f64 + 2.0 / 3.0, j as f64 + 2.0 / 3.0)))
+                {
+                    sum += t.eval(uv[0] + e1 * (a / n as f64) + e2 * (b / n as f64));
+                    count += 1;
+                }
+            }
+        }
+        sum / count as f64 * area
+    }
+
+    #[test]
+    fn integral_matches_a_fine_quadrature() {
+        let tri = [
+            DVec2::new(-0.13, 0.2),
+            DVec2::new(1.4, 0.05),
+            DVec2::new(0.3, 1.21),
+        ];
+        for wrap in [Wrap::Repeat, Wrap::Clamp] {
+            for filter in [Filter::Bilinear, Filter::Nearest] {
+                let t = noise(7, 5).with_wrap(wrap).with_filter(filter);
+                let exact = t.integral(tri);
+                let brute = brute_integral(&t, tri, 1500);
+                let tol = if filter == Filter::Nearest {
+                    2e-3
+                } else {
+                    1e-5
+                };
+                assert!(
+                    (exact - brute).abs() <= tol * brute,
+                    "{wrap:?} {filter:?}: {exact} vs {brute}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn integral_of_a_constant_is_the_area() {
+        let t = DensityTexture::new(3, 2, vec![2.0; 6]).unwrap();
+        let tri = [DVec2::ZERO, DVec2::new(3.0, 0.0), DVec2::new(0.0, 5.0)];
+        assert!((t.integral(tri) - 15.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn max_over_bounds_every_point_and_is_attained() {
+        let t = noise(6, 6);
+        let tri = [
+            DVec2::new(0.11, 0.3),
+            DVec2::new(0.52, 0.34),
+            DVec2::new(0.2, 0.71),
+        ];
+        let bound = t.max_over(tri);
+        let mut seen = 0.0f64;
+        let n = 400;
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (a, b) = (i as f64 / n as f64, j as f64 / n as f64);
+                let p = tri[0] + (tri[1] - tri[0]) * a + (tri[2] - tri[0]) * b;
+                seen = seen.max(t.eval(p));
+            }
+        }
+        assert!(seen <= bound, "{seen} > {bound}");
+        assert!(seen >= bound * 0.999, "bound {bound} is loose: max {seen}");
+    }
+
+    #[test]
+    fn bilinear_reproduces_texels_at_centres_and_wraps() {
+        let t = noise(4, 3);
+        for y in 0..3 {
+            for x in 0..4 {
+                let uv = DVec2::new((x as f64 + 0.5) / 4.0, (y as f64 + 0.5) / 3.0);
+                let v = f64::from(t.texels()[y * 4 + x]);
+                assert!((t.eval(uv) - v).abs() < 1e-6);
+                assert!((t.eval(uv + DVec2::new(2.0, -3.0)) - v).abs() < 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn channels_and_luminance() {
+        let rgba = [1.0, 2.0, 3.0, 4.0, 0.0, 1.0, 0.0, 1.0];
+        let g = DensityTexture::from_channels(2, 1, &rgba, 4, Channel::Index(1)).unwrap();
+        assert_eq!(g.texels(), &[2.0, 1.0]);
+        let y = DensityTexture::from_channels(2, 1, &rgba, 4, Channel::Luminance).unwrap();
+        assert!((y.texels()[1] - 0.7152).abs() < 1e-6);
+        assert_eq!(
+            DensityTexture::from_channels(2, 1, &rgba, 4, Channel::Index(4)),
+            Err(Error::InvalidChannel {
+                channel: Channel::Index(4),
+                channels: 4
+            })
+        );
+        assert!(matches!(
+            DensityTexture::from_channels(2, 1, &rgba[..7], 4, Channel::Luminance),
+            Err(Error::TextureSize { .. })
+        ));
+    }
+
+    #[test]
+    fn flip_rows_reverses_rows() {
+        let t = DensityTexture::new(2, 3, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0]).unwrap();
+        assert_eq!(t.flip_rows().texels(), &[5.0, 6.0, 3.0, 4.0, 1.0, 2.0]);
+    }
+}
