@@ -7,10 +7,10 @@ use glam::{DVec2, Vec2};
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::parallel::{for_each_chunk, unit};
+use crate::parallel::unit;
 use crate::point::uniform_barycentric;
 use crate::subdivision::{self, MAX_LEVEL, Merge, SubTriangle};
-use crate::{DensityTexture, Error, MeshRef, SurfacePoint};
+use crate::{DensityTexture, Error, MeshRef, SurfacePoint, SurfaceSampler};
 
 /// Where the density comes from.
 #[derive(Debug, Clone, Copy)]
@@ -100,7 +100,7 @@ struct Piece {
 /// # Example
 /// ```
 /// use glam::{Vec2, Vec3};
-/// use mesh_sampling::{Density, DensitySampler, DensityTexture, MeshRef};
+/// use mesh_sampling::{Density, DensitySampler, DensityTexture, MeshRef, SurfaceSampler};
 ///
 /// let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
 /// let uvs = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
@@ -396,23 +396,11 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         };
         (piece, bary)
     }
-
-    /// Fills `out` from `rng`: two `u64` per point, three per proposal in
-    /// exact mode.
-    pub fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
-        for slot in out {
-            *slot = self.sample(rng);
-        }
-    }
-
-    /// `n` points from `seed`, on all threads with the `rayon` feature; the
-    /// result depends only on `(mesh, density, options, seed, n)`.
-    pub fn sample_n(&self, seed: u64, n: usize) -> Vec<SurfacePoint> {
-        let mut out = vec![SurfacePoint::default(); n];
-        for_each_chunk(seed, &mut out, |rng, chunk| self.sample_into(rng, chunk));
-        out
-    }
 }
+
+/// Two `u64` of the random stream per point; three per proposal in exact
+/// mode.
+impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {}
 
 impl<S: DiscreteSampler + Sync> Distribution<SurfacePoint> for DensitySampler<'_, S> {
     fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {

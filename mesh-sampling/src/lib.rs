@@ -36,6 +36,7 @@
 
 #![forbid(unsafe_code)]
 
+mod batch;
 mod density;
 mod error;
 mod mesh;
@@ -49,6 +50,7 @@ mod subdivision;
 mod texture;
 mod uniform;
 
+pub use batch::SurfaceSampler;
 pub use density::{Density, DensitySampler, Mode, Options};
 pub use error::Error;
 pub use mesh::MeshRef;

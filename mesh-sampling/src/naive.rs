@@ -7,7 +7,7 @@ use rand::distr::Distribution;
 
 use crate::parallel::unit;
 use crate::point::uniform_barycentric;
-use crate::{Error, MeshRef, SurfacePoint};
+use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 
 /// Draws a triangle uniformly among those of non-zero area, then a uniform
 /// point in it. Its density is `1 / (N · A_f)` on triangle `f`, which it
@@ -69,3 +69,6 @@ impl Distribution<SurfacePoint> for NaiveSampler<'_> {
         SurfacePoint::on(&self.mesh, self.faces[k], bary, self.densities[k])
     }
 }
+
+/// Two `u64` of the random stream per point.
+impl SurfaceSampler for NaiveSampler<'_> {}

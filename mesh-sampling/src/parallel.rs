@@ -42,3 +42,34 @@ pub(crate) fn for_each_chunk<T: Send>(
         fill(&mut chunk_rng(seed, k), chunk);
     }
 }
+
+/// Like [`for_each_chunk`] over `n` items, but each chunk is filled into a
+/// reused buffer and handed to `consume(first_index, chunk)` instead of
+/// being kept: the same values, without holding all `n` in memory.
+pub(crate) fn stream<T: Default + Clone + Send>(
+    seed: u64,
+    n: usize,
+    fill: impl Fn(&mut Pcg64Mcg, &mut [T]) + Sync,
+    consume: impl Fn(usize, &[T]) + Sync,
+) {
+    let run = |buf: &mut Vec<T>, k: usize| {
+        buf.resize(CHUNK.min(n - k * CHUNK), T::default());
+        fill(&mut chunk_rng(seed, k), buf);
+        consume(k * CHUNK, buf);
+    };
+    let chunks = n.div_ceil(CHUNK);
+    #[cfg(feature = "rayon")]
+    {
+        use rayon::prelude::*;
+        (0..chunks)
+            .into_par_iter()
+            .for_each_init(Vec::new, |buf, k| run(buf, k));
+    }
+    #[cfg(not(feature = "rayon"))]
+    {
+        let mut buf = Vec::new();
+        for k in 0..chunks {
+            run(&mut buf, k);
+        }
+    }
+}

@@ -7,8 +7,8 @@ use glam::Vec2;
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::parallel::{for_each_chunk, unit};
-use crate::{DensityTexture, Error, MeshRef, SurfacePoint, UniformSampler};
+use crate::parallel::unit;
+use crate::{DensityTexture, Error, MeshRef, SurfacePoint, SurfaceSampler, UniformSampler};
 
 /// Draws points with density proportional to a texture by rejection from
 /// the uniform distribution. Prefer [`DensitySampler`](crate::DensitySampler);
@@ -81,21 +81,10 @@ impl<'a> RejectionSampler<'a> {
     pub fn memory_bytes(&self) -> usize {
         self.uniform.memory_bytes()
     }
-
-    /// Fills `out` from `rng`: three `u64` per proposal.
-    pub fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
-        for slot in out {
-            *slot = self.sample(rng);
-        }
-    }
-
-    /// `n` points from `seed`, the same on any number of threads.
-    pub fn sample_n(&self, seed: u64, n: usize) -> Vec<SurfacePoint> {
-        let mut out = vec![SurfacePoint::default(); n];
-        for_each_chunk(seed, &mut out, |rng, chunk| self.sample_into(rng, chunk));
-        out
-    }
 }
+
+/// Three `u64` of the random stream per proposal.
+impl SurfaceSampler for RejectionSampler<'_> {}
 
 impl Distribution<SurfacePoint> for RejectionSampler<'_> {
     fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {

@@ -6,9 +6,9 @@ use discrete_sampling::{DiscreteSampler, GuideTable};
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::parallel::{for_each_chunk, unit};
+use crate::parallel::unit;
 use crate::point::uniform_barycentric;
-use crate::{Error, MeshRef, SurfacePoint};
+use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 
 /// Draws points uniformly over a mesh's surface: density `1 / A` for a
 /// total area `A`. Zero-area triangles are never drawn.
@@ -16,7 +16,7 @@ use crate::{Error, MeshRef, SurfacePoint};
 /// # Example
 /// ```
 /// use glam::Vec3;
-/// use mesh_sampling::{MeshRef, UniformSampler};
+/// use mesh_sampling::{MeshRef, SurfaceSampler, UniformSampler};
 /// use rand::distr::Distribution;
 /// use rand::SeedableRng;
 ///
@@ -101,22 +101,6 @@ impl<'a> UniformSampler<'a> {
         let (face, rest) = self.triangles.sample_remapped(u[0]);
         (face as u32, uniform_barycentric(rest, u[1]))
     }
-
-    /// Fills `out`, two `u64` of `rng` per point.
-    pub fn sample_into<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
-        for slot in out {
-            *slot = self.sample(rng);
-        }
-    }
-
-    /// `n` points from `seed`, on all threads when the `rayon` feature is
-    /// on. The result depends only on `(mesh, seed, n)`, never on the
-    /// number of threads.
-    pub fn sample_n(&self, seed: u64, n: usize) -> Vec<SurfacePoint> {
-        let mut out = vec![SurfacePoint::default(); n];
-        for_each_chunk(seed, &mut out, |rng, chunk| self.sample_into(rng, chunk));
-        out
-    }
 }
 
 impl UniformSampler<'_> {
@@ -176,3 +160,6 @@ impl Distribution<SurfacePoint> for UniformSampler<'_> {
         self.sample_u([u0, u1])
     }
 }
+
+/// Two `u64` of the random stream per point.
+impl SurfaceSampler for UniformSampler<'_> {}

@@ -13,7 +13,7 @@ mod stats;
 use glam::{DVec2, Vec2, Vec3};
 use mesh_sampling::{
     Density, DensitySampler, DensityTexture, Error, Filter, MeshRef, Mode, Options,
-    RejectionSampler, SurfacePoint, UniformSampler, Wrap,
+    RejectionSampler, SurfacePoint, SurfaceSampler, UniformSampler, Wrap,
 };
 
 /// Positions, UVs and triangles.
@@ -515,6 +515,20 @@ fn batches_do_not_depend_on_the_thread_count() {
             .install(|| r.sample_n(20, 50_000))
     };
     assert_eq!(run(1), run(2));
+}
+
+#[test]
+fn streaming_hands_out_the_points_of_sample_n() {
+    let t = noise(16, 16);
+    let m = grid(6, skewed);
+    let sampler =
+        DensitySampler::with_options(mesh_ref(&m), Density::Texture(&t), &exact()).unwrap();
+    let n = 40_000; // two full chunks and a partial one
+    let streamed = std::sync::Mutex::new(vec![SurfacePoint::default(); n]);
+    sampler.sample_stream(25, n, |first, chunk| {
+        streamed.lock().unwrap()[first..first + chunk.len()].copy_from_slice(chunk);
+    });
+    assert_eq!(streamed.into_inner().unwrap(), sampler.sample_n(25, n));
 }
 
 #[test]

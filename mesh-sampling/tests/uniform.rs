@@ -10,7 +10,7 @@
 mod stats;
 
 use glam::{Vec2, Vec3};
-use mesh_sampling::{Error, MeshRef, NaiveSampler, SurfacePoint, UniformSampler};
+use mesh_sampling::{Error, MeshRef, NaiveSampler, SurfacePoint, SurfaceSampler, UniformSampler};
 use rand::SeedableRng;
 use rand::distr::Distribution;
 use rand_pcg::Pcg64Mcg;

@@ -1,0 +1,37 @@
+//! What every single-mesh sampler offers beyond one point at a time:
+//! deterministic parallel batches.
+
+use rand::Rng;
+use rand::distr::Distribution;
+
+use crate::SurfacePoint;
+use crate::parallel::{for_each_chunk, stream};
+
+/// A sampler of points on a mesh, with batch APIs whose output depends
+/// only on the seed, never on the number of threads: points come in
+/// chunks of 16,384, each from its own random stream seeded by
+/// `(seed, chunk index)`, and the chunks run on all threads with the
+/// `rayon` feature.
+pub trait SurfaceSampler: Distribution<SurfacePoint> + Sync {
+    /// Fills `out` with independent points drawn from `rng`.
+    fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
+        for slot in out {
+            *slot = self.sample(rng);
+        }
+    }
+
+    /// `n` points from `seed`.
+    fn sample_n(&self, seed: u64, n: usize) -> Vec<SurfacePoint> {
+        let mut out = vec![SurfacePoint::default(); n];
+        for_each_chunk(seed, &mut out, |rng, chunk| self.sample_into(rng, chunk));
+        out
+    }
+
+    /// The points of [`sample_n`](Self::sample_n), handed chunk by chunk
+    /// to `consume(index of the chunk's first point, chunk)` (from several
+    /// threads at once, in no particular order) instead of being stored:
+    /// for streaming millions of points into a renderer or a file.
+    fn sample_stream(&self, seed: u64, n: usize, consume: impl Fn(usize, &[SurfacePoint]) + Sync) {
+        stream(seed, n, |rng, chunk| self.sample_into(rng, chunk), consume);
+    }
+}
