@@ -7,8 +7,8 @@ use glam::{DVec2, Vec2};
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::parallel::unit;
-use crate::point::uniform_barycentric;
+use crate::parallel::{BLOCK, unit};
+use crate::point::{Frame, uniform_barycentric};
 use crate::subdivision::{self, MAX_LEVEL, Merge, SubTriangle};
 use crate::{DensityTexture, Error, MeshRef, SurfacePoint, SurfaceSampler};
 
@@ -32,7 +32,8 @@ pub enum Mode {
     #[default]
     Approximate,
     /// The filtered texture exactly: `p′`'s subdivision as the proposal,
-    /// weighted by each sub-triangle's exact maximum, and a rejection
+    /// weighted by a bound of the density on each sub-triangle (its exact
+    /// maximum over the sub-triangle's UV bounding box), and a rejection
     /// step. [`DensitySampler::acceptance`] says how often it accepts.
     Exact,
 }
@@ -45,8 +46,8 @@ pub struct Options {
     /// The deepest subdivision level, at most 13 (`4^13` sub-triangles for
     /// one triangle). Default 11: a triangle spanning a 2048² texture.
     pub max_level: u8,
-    /// Levels beyond the one that makes sub-triangle edges no longer than
-    /// a texel. Each one divides the approximation error of
+    /// Levels beyond the one that makes sub-triangles no larger than a
+    /// texel (and their edges no longer than two). Each one divides the approximation error of
     /// [`Mode::Approximate`] (or the rejection rate of [`Mode::Exact`])
     /// roughly by two, and costs four times the memory.
     pub extra_levels: u8,
@@ -71,7 +72,7 @@ impl Default for Options {
 
 /// One entry of the discrete distribution: a sub-triangle (or linear
 /// component) of a face, with its density value (exact mode: its bound).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Piece {
     face: u32,
     part: SubTriangle,
@@ -82,9 +83,10 @@ struct Piece {
 /// texture, per-face or per-vertex weights.
 ///
 /// A texture density is resampled on an adaptive subdivision of each
-/// triangle (Šik & Křivánek 2013): the depth makes sub-triangle edges no
-/// longer than one texel (the longest UV edge decides, so slivers are
-/// subdivided too), the density is looked up at each sub-triangle's
+/// triangle (Šik & Křivánek 2013): the depth makes sub-triangles no larger
+/// than a texel and their edges no longer than two texels (so slivers are
+/// subdivided along their length too), the density is looked up at each
+/// sub-triangle's
 /// barycenter, and four siblings of equal value merge into their parent.
 /// A sub-triangle costs a CDF entry, its triangle and a 32-bit code of its
 /// level and position (Fig. 4), decoded in O(1). `S` is the 1D sampler
@@ -127,6 +129,8 @@ pub struct DensitySampler<'a, S = GuideTable> {
     face_start: Vec<u32>,
     /// Subdivision depth of each face (texture densities).
     face_level: Vec<u8>,
+    /// Per face, its corner, edges and normal: one memory access.
+    frames: Vec<Frame>,
     /// `1 / ∫ density dA` of the density sampled.
     norm: f64,
     /// Expected fraction of proposals accepted (1 without rejection).
@@ -265,6 +269,7 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
             table,
             face_start,
             face_level,
+            frames: Frame::all(&mesh),
             norm: 1.0 / mass,
             acceptance: (mass / proposal_mass).min(1.0),
         })
@@ -304,13 +309,14 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         self.acceptance
     }
 
-    /// Heap memory of the sampler (pieces, table and face index), not
+    /// Heap memory of the sampler (pieces, table, face index and frames), not
     /// counting the mesh and texture it borrows.
     pub fn memory_bytes(&self) -> usize {
         self.pieces.len() * size_of::<Piece>()
             + self.table.memory_bytes()
             + self.face_start.len() * size_of::<u32>()
             + self.face_level.len()
+            + self.frames.len() * size_of::<Frame>()
     }
 
     /// The density (w.r.t. area, normalised over the mesh) this sampler
@@ -379,53 +385,97 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         a + (b - a) * u + (c - a) * v
     }
 
-    /// The proposal for variates `u0` (piece and first barycentric
-    /// variate, through the remapped remainder) and `u1`: the piece and the
-    /// parent barycentrics.
+    /// Where piece `k` puts the point for variates `xi1`, `xi2`: parent
+    /// barycentrics.
     #[inline]
-    fn propose(&self, u0: f64, u1: f64) -> (Piece, [f32; 3]) {
-        let (k, rest) = self.table.sample_remapped(u0);
-        let piece = self.pieces[k];
-        let bary = match piece.part.corner() {
-            Some(corner) => linear_corner_barycentric(corner, rest, u1),
+    fn place(&self, piece: Piece, xi1: f64, xi2: f64) -> [f32; 3] {
+        match piece.part.corner() {
+            Some(corner) => linear_corner_barycentric(corner, xi1, xi2),
             None => {
-                let [_, a, b] = uniform_barycentric(rest, u1);
+                let [_, a, b] = uniform_barycentric(xi1, xi2);
                 let (u, v) = piece.part.to_parent(f64::from(a), f64::from(b));
                 [(1.0 - u - v).max(0.0) as f32, u as f32, v as f32]
             }
-        };
-        (piece, bary)
+        }
+    }
+
+    /// The point at `bary` of the piece's face, with its density (which
+    /// for the approximate mode and per-face weights is the piece's value,
+    /// and for per-vertex weights is interpolated).
+    #[inline]
+    fn point(&self, piece: Piece, bary: [f32; 3], value: f64) -> SurfacePoint {
+        let face = piece.face;
+        let frame = &self.frames[face as usize];
+        SurfacePoint::in_frame(&self.mesh, frame, face, bary, (value * self.norm) as f32)
+    }
+
+    /// The unnormalised density of a non-rejected point.
+    #[inline]
+    fn value(&self, piece: Piece, bary: [f32; 3]) -> f64 {
+        match self.density {
+            Density::PerVertex(w) => {
+                let t = self.mesh.indices[piece.face as usize].map(|i| w[i as usize]);
+                f64::from(t[0] * bary[0] + t[1] * bary[1] + t[2] * bary[2])
+            }
+            _ => f64::from(piece.value),
+        }
+    }
+
+    fn exact_texture(&self) -> Option<&DensityTexture> {
+        match (self.density, self.mode) {
+            (Density::Texture(t), Mode::Exact) => Some(t),
+            _ => None,
+        }
     }
 }
 
-/// Two `u64` of the random stream per point; three per proposal in exact
-/// mode.
-impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {}
+/// Three `u64` of the random stream per point (one for the piece, two for
+/// the point in it); four per proposal in exact mode.
+impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {
+    /// Computed in blocks, like
+    /// [`UniformSampler`](crate::UniformSampler)'s: the block's pieces by
+    /// the table's batch search, then their records, then the points. Exact mode draws one
+    /// point at a time (rejection).
+    fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
+        if self.exact_texture().is_some() {
+            for slot in out {
+                *slot = self.sample(rng);
+            }
+            return;
+        }
+        let mut picks = [0usize; BLOCK];
+        let mut pieces = [Piece::default(); BLOCK];
+        for block in out.chunks_mut(BLOCK) {
+            let n = block.len();
+            self.table.sample_into(rng, &mut picks[..n]);
+            // Gathered in a pass of their own: independent loads overlap.
+            for (piece, &k) in pieces.iter_mut().zip(&picks[..n]) {
+                *piece = self.pieces[k];
+            }
+            for (slot, &piece) in block.iter_mut().zip(&pieces) {
+                let xi1 = unit(rng.next_u64());
+                let bary = self.place(piece, xi1, unit(rng.next_u64()));
+                *slot = self.point(piece, bary, self.value(piece, bary));
+            }
+        }
+    }
+}
 
 impl<S: DiscreteSampler + Sync> Distribution<SurfacePoint> for DensitySampler<'_, S> {
     fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
         loop {
-            let u0 = unit(rng.next_u64());
-            let u1 = unit(rng.next_u64());
-            let (piece, bary) = self.propose(u0, u1);
-            let face = piece.face as usize;
-            let value = match (self.density, self.mode) {
-                (Density::Texture(texture), Mode::Exact) => {
-                    let [_, u, v] = bary.map(f64::from);
-                    let f = texture.eval(self.uv_at(face, u, v));
-                    // Accept with probability f / bound (bound ≥ f).
-                    if unit(rng.next_u64()) * f64::from(piece.value) >= f {
-                        continue;
-                    }
-                    f
-                }
-                (Density::PerVertex(w), _) => {
-                    let t = self.mesh.indices[face].map(|i| w[i as usize]);
-                    f64::from(t[0] * bary[0] + t[1] * bary[1] + t[2] * bary[2])
-                }
-                _ => f64::from(piece.value),
+            let piece = self.pieces[self.table.sample_rng(rng)];
+            let xi1 = unit(rng.next_u64());
+            let bary = self.place(piece, xi1, unit(rng.next_u64()));
+            let Some(texture) = self.exact_texture() else {
+                return self.point(piece, bary, self.value(piece, bary));
             };
-            return SurfacePoint::on(&self.mesh, piece.face, bary, (value * self.norm) as f32);
+            let [_, u, v] = bary.map(f64::from);
+            let f = texture.eval(self.uv_at(piece.face as usize, u, v));
+            // Accept with probability f / bound (bound ≥ f).
+            if unit(rng.next_u64()) * f64::from(piece.value) < f {
+                return self.point(piece, bary, f);
+            }
         }
     }
 }
@@ -494,24 +544,34 @@ fn face_uvs(uvs: &[Vec2], tri: [u32; 3]) -> [DVec2; 3] {
     tri.map(|i| uvs[i as usize].as_dvec2())
 }
 
-/// The depth at which sub-triangle edges are at most one texel long: from
-/// the longest UV edge in texels, so a sliver (long, with little area) is
-/// subdivided as finely as its length needs.
+/// The depth at which sub-triangles are no larger than a texel (Šik &
+/// Křivánek Sec. 3.4: `4^L` sub-triangles for the texels the triangle
+/// covers) and, so that a sliver (long, with little area) is cut along its
+/// length too, no edge is longer than two texels.
 fn face_level(texture: &DensityTexture, uv: [DVec2; 3], options: &Options) -> u8 {
     let scale = DVec2::new(texture.width() as f64, texture.height() as f64);
+    let t = uv.map(|p| p * scale);
+    let texels = 0.5 * (t[1] - t[0]).perp_dot(t[2] - t[0]).abs();
     let longest = (0..3)
-        .map(|k| ((uv[(k + 1) % 3] - uv[k]) * scale).length())
+        .map(|k| (t[(k + 1) % 3] - t[k]).length())
         .fold(0.0f64, f64::max);
-    let level = if longest > 1.0 {
-        longest.log2().ceil().min(f64::from(MAX_LEVEL)) as u8
+    // 4^L ≥ texels and 2^L ≥ longest / 2.
+    let by_area = if texels > 1.0 {
+        texels.log2() / 2.0
     } else {
-        0
+        0.0
     };
+    let by_edge = if longest > 2.0 {
+        (longest / 2.0).log2()
+    } else {
+        0.0
+    };
+    let level = by_area.max(by_edge).ceil().min(f64::from(MAX_LEVEL)) as u8;
     (level.saturating_add(options.extra_levels)).min(options.max_level)
 }
 
 /// Sub-triangles of face `f` with their values (approximate mode: the
-/// density at the barycenter; exact: the density's maximum over the
+/// density at the barycenter; exact: a bound of the density over the
 /// sub-triangle), merged, zeros dropped.
 fn texture_pieces(
     mesh: &MeshRef<'_>,
@@ -539,8 +599,12 @@ fn texture_pieces(
             );
         }
         Mode::Exact => {
-            // Rounded up to f32 so that the bound stays a bound.
-            let value = |s: SubTriangle| round_up(texture.max_over(s.corners().map(at)));
+            // The maximum over the sub-triangle's UV bounding box, rounded
+            // up to f32 so that it stays a bound.
+            let value = |s: SubTriangle| {
+                let [p, q, r] = s.corners().map(at);
+                round_up(texture.max_over_box(p.min(q).min(r), p.max(q).max(r)))
+            };
             subdivision::build(level, options.merge_tolerance, Merge::Max, &value, &mut out);
         }
     }

@@ -8,6 +8,10 @@ use rand_pcg::Pcg64Mcg;
 /// Points per chunk (and per random stream).
 pub(crate) const CHUNK: usize = 1 << 14;
 
+/// Points computed together by the batch paths, so that the memory
+/// accesses of independent samples overlap.
+pub(crate) const BLOCK: usize = 64;
+
 /// A uniform `f64` in `[0, 1)` from the top 53 bits of a `u64`.
 #[inline]
 pub(crate) fn unit(x: u64) -> f64 {

@@ -45,26 +45,73 @@ impl SurfacePoint {
     /// # Panics
     /// If `face` is not a triangle of `mesh`.
     pub fn on(mesh: &MeshRef<'_>, face: u32, barycentric: [f32; 3], pdf: f32) -> Self {
-        let tri = mesh.indices[face as usize];
-        let [a, b, c] = tri.map(|i| mesh.positions[i as usize]);
-        let [w0, w1, w2] = barycentric;
-        let lerp3 = |v: [Vec3; 3]| v[0] * w0 + v[1] * w1 + v[2] * w2;
-        Self {
-            // a + w1 (b − a) + w2 (c − a): exact when the corners share a
-            // coordinate (a point on the plane z = 1 has z = 1 exactly),
-            // unlike w0 a + w1 b + w2 c.
-            position: a + (b - a) * w1 + (c - a) * w2,
+        Self::in_frame(
+            mesh,
+            &Frame::new(mesh, face as usize),
             face,
             barycentric,
-            normal: (b - a).cross(c - a).normalize_or_zero(),
+            pdf,
+        )
+    }
+
+    /// [`on`](Self::on) with the triangle's frame at hand: the samplers
+    /// keep one per triangle, so that a point costs one memory access for
+    /// its geometry.
+    #[inline]
+    pub(crate) fn in_frame(
+        mesh: &MeshRef<'_>,
+        frame: &Frame,
+        face: u32,
+        barycentric: [f32; 3],
+        pdf: f32,
+    ) -> Self {
+        let [w0, w1, w2] = barycentric;
+        let corners = || mesh.indices[face as usize];
+        let lerp3 = |v: [Vec3; 3]| v[0] * w0 + v[1] * w1 + v[2] * w2;
+        Self {
+            position: frame.origin + frame.e1 * w1 + frame.e2 * w2,
+            face,
+            barycentric,
+            normal: frame.normal,
             shading_normal: mesh
                 .normals
-                .map(|n| lerp3(tri.map(|i| n[i as usize])).normalize_or_zero()),
+                .map(|n| lerp3(corners().map(|i| n[i as usize])).normalize_or_zero()),
             uv: mesh.uvs.map(|t| {
-                let [ta, tb, tc] = tri.map(|i| t[i as usize]);
+                let [ta, tb, tc] = corners().map(|i| t[i as usize]);
                 ta + (tb - ta) * w1 + (tc - ta) * w2
             }),
             pdf,
         }
+    }
+}
+
+/// A triangle as its first corner `a`, its edges `b − a` and `c − a`, and
+/// its unit normal (right-hand rule): a point is `a + w1 (b − a) + w2 (c − a)`,
+/// exact when the corners share a coordinate (a point on the plane z = 1
+/// has z = 1 exactly), unlike `w0 a + w1 b + w2 c`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Frame {
+    origin: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    normal: Vec3,
+}
+
+impl Frame {
+    pub(crate) fn new(mesh: &MeshRef<'_>, face: usize) -> Self {
+        let [a, b, c] = mesh.corners(face);
+        Self {
+            origin: a,
+            e1: b - a,
+            e2: c - a,
+            normal: (b - a).cross(c - a).normalize_or_zero(),
+        }
+    }
+
+    /// The frames of every triangle of `mesh`.
+    pub(crate) fn all(mesh: &MeshRef<'_>) -> Vec<Self> {
+        (0..mesh.indices.len())
+            .map(|f| Self::new(mesh, f))
+            .collect()
     }
 }

@@ -83,22 +83,22 @@ impl<'a> RejectionSampler<'a> {
     }
 }
 
-/// Three `u64` of the random stream per proposal.
+/// Four `u64` of the random stream per proposal.
 impl SurfaceSampler for RejectionSampler<'_> {}
 
 impl Distribution<SurfacePoint> for RejectionSampler<'_> {
     fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
         let mesh = self.uniform.mesh();
         loop {
-            let (face, bary) = self
-                .uniform
-                .locate([unit(rng.next_u64()), unit(rng.next_u64())]);
+            let (face, bary) = self.uniform.pick(rng);
             let tri = mesh.indices[face as usize];
             let [a, b, c] = tri.map(|i| self.uvs[i as usize].as_dvec2());
             let [_, u, v] = bary.map(f64::from);
             let f = self.texture.eval(a + (b - a) * u + (c - a) * v);
             if unit(rng.next_u64()) * self.bound < f {
-                return SurfacePoint::on(mesh, face, bary, (f * self.norm) as f32);
+                let mut point = self.uniform.point(face, bary);
+                point.pdf = (f * self.norm) as f32;
+                return point;
             }
         }
     }

@@ -1,11 +1,12 @@
 //! A density texture: one non-negative value per texel, filtered bilinearly
 //! (or nearest), repeated or clamped outside `[0, 1]²`.
 //!
-//! Besides point lookups it answers the two questions exact sampling needs
-//! about a UV triangle: the exact integral of the filtered density over it
-//! and its exact maximum. Both rely on the density being bilinear (or
-//! constant) inside each cell between texel centres, so a triangle is cut
-//! into cell pieces and each piece handled in closed form.
+//! Besides point lookups it answers the two questions exact sampling needs:
+//! the exact integral of the filtered density over a UV triangle, and its
+//! exact maximum over a UV box. Both rely on the density being bilinear
+//! (or constant) inside each cell between texel centres: a triangle is cut
+//! into cell pieces, each integrated in closed form, and a box peaks on
+//! the grid of its corners and the cell lines.
 
 use glam::DVec2;
 
@@ -193,15 +194,26 @@ impl DensityTexture {
         self.texels.len() * size_of::<f32>()
     }
 
+    /// Column or row `i` wrapped or clamped into `0..n`.
+    #[inline]
+    fn wrap_index(&self, i: i64, n: usize) -> usize {
+        if (0..n as i64).contains(&i) {
+            return i as usize; // the common case: no division
+        }
+        match self.wrap {
+            Wrap::Repeat => i.rem_euclid(n as i64) as usize,
+            Wrap::Clamp => i.clamp(0, n as i64 - 1) as usize,
+        }
+    }
+
     /// The texel at integer coordinates, wrapped or clamped.
     #[inline]
     fn texel(&self, x: i64, y: i64) -> f64 {
-        let (w, h) = (self.width as i64, self.height as i64);
-        let (x, y) = match self.wrap {
-            Wrap::Repeat => (x.rem_euclid(w), y.rem_euclid(h)),
-            Wrap::Clamp => (x.clamp(0, w - 1), y.clamp(0, h - 1)),
-        };
-        f64::from(self.texels[y as usize * self.width + x as usize])
+        let (x, y) = (
+            self.wrap_index(x, self.width),
+            self.wrap_index(y, self.height),
+        );
+        f64::from(self.texels[y * self.width + x])
     }
 
     /// Texel-space coordinates of `uv`: integers at the texel centres
@@ -220,17 +232,7 @@ impl DensityTexture {
     #[inline]
     fn at_cell(&self, p: DVec2) -> f64 {
         // Saturating casts: a UV of 1e30 is a valid (if silly) tiled UV.
-        let (x0, y0) = (p.x.floor(), p.y.floor());
-        let (xi, yi) = (x0 as i64, y0 as i64);
-        match self.filter {
-            Filter::Nearest => self.texel(xi, yi),
-            Filter::Bilinear => {
-                let (fx, fy) = (p.x - x0, p.y - y0);
-                let top = lerp(self.texel(xi, yi), self.texel(xi + 1, yi), fx);
-                let bottom = lerp(self.texel(xi, yi + 1), self.texel(xi + 1, yi + 1), fx);
-                lerp(top, bottom, fy)
-            }
-        }
+        self.in_cell((p.x.floor() as i64, p.y.floor() as i64), p)
     }
 
     /// The filtered density at texture coordinate `uv`.
@@ -251,46 +253,41 @@ impl DensityTexture {
         sum * scale
     }
 
-    /// The exact maximum of the filtered density over the UV triangle `uv`
-    /// (closed), rounded up by a relative 1e-6 so that it bounds every
-    /// value [`eval`](Self::eval) returns inside, rounding included.
-    pub fn max_over(&self, uv: [DVec2; 3]) -> f64 {
-        let tri = uv.map(|p| self.to_cells(p));
+    /// The maximum of the filtered density over the UV box `[lo, hi]`,
+    /// rounded up by a relative 1e-6 so that it bounds every value
+    /// [`eval`](Self::eval) returns inside, rounding included. Exact: a
+    /// bilinear function is linear along each axis, so on a box inside
+    /// one cell it peaks at a corner, and the box's maximum is at a point
+    /// of the grid its corners and the cell lines crossing it make.
+    pub fn max_over_box(&self, lo: DVec2, hi: DVec2) -> f64 {
+        let (lo, hi) = (self.to_cells(lo), self.to_cells(hi));
         let mut max = 0.0f64;
         match self.filter {
-            // Constant per cell: the largest cell the triangle overlaps.
-            // A zero-area piece is the triangle touching a cell's border
-            // (it does not reach into the cell), unless the whole triangle
-            // is degenerate.
             Filter::Nearest => {
-                let degenerate = polygon_area(&tri) == 0.0;
-                self.for_each_cell_piece(tri, |piece, cell| {
-                    if degenerate || polygon_area(piece) != 0.0 {
-                        max = max.max(self.texel(cell.0, cell.1));
-                    }
-                });
-            }
-            // Bilinear pieces have no interior maximum (the Hessian of a
-            // bilinear function is indefinite or zero), so the maximum is
-            // on a piece's boundary: at a corner, or at the apex of the
-            // quadratic an edge traces.
-            Filter::Bilinear => self.for_each_cell_piece(tri, |piece, cell| {
-                let f = |p: DVec2| self.in_cell(cell, p);
-                for k in 0..piece.len() {
-                    let (a, b) = (piece[k], piece[(k + 1) % piece.len()]);
-                    let (fa, fm, fb) = (f(a), f((a + b) * 0.5), f(b));
-                    max = max.max(fa).max(fb);
-                    // f(s) = fa + β s + γ s² on s ∈ [0, 1].
-                    let gamma = 2.0 * (fb - 2.0 * fm + fa);
-                    let beta = fb - fa - gamma;
-                    if gamma < 0.0 {
-                        let s = -beta / (2.0 * gamma);
-                        if s > 0.0 && s < 1.0 {
-                            max = max.max(fa + beta * s + gamma * s * s);
-                        }
+                // Cells [k, k + 1) the box reaches into (its upper edge
+                // only touches the cell it ends on).
+                let last = |l: f64, h: f64| {
+                    let c = h.ceil() as i64 - 1;
+                    c.max(l.floor() as i64)
+                };
+                for y in lo.y.floor() as i64..=last(lo.y, hi.y) {
+                    for x in lo.x.floor() as i64..=last(lo.x, hi.x) {
+                        max = max.max(self.texel(x, y));
                     }
                 }
-            }),
+            }
+            Filter::Bilinear => {
+                let stops = |l: f64, h: f64| {
+                    std::iter::once(l)
+                        .chain((l.floor() as i64 + 1..=h.ceil() as i64 - 1).map(|k| k as f64))
+                        .chain(std::iter::once(h))
+                };
+                for y in stops(lo.y, hi.y) {
+                    for x in stops(lo.x, hi.x) {
+                        max = max.max(self.at_cell(DVec2::new(x, y)));
+                    }
+                }
+            }
         }
         max * (1.0 + 1e-6)
     }
@@ -303,9 +300,13 @@ impl DensityTexture {
             Filter::Nearest => self.texel(cell.0, cell.1),
             Filter::Bilinear => {
                 let (fx, fy) = (p.x - cell.0 as f64, p.y - cell.1 as f64);
-                let (x, y) = cell;
-                let top = lerp(self.texel(x, y), self.texel(x + 1, y), fx);
-                let bottom = lerp(self.texel(x, y + 1), self.texel(x + 1, y + 1), fx);
+                let x0 = self.wrap_index(cell.0, self.width);
+                let x1 = self.wrap_index(cell.0 + 1, self.width);
+                let row0 = self.wrap_index(cell.1, self.height) * self.width;
+                let row1 = self.wrap_index(cell.1 + 1, self.height) * self.width;
+                let t = |i: usize| f64::from(self.texels[i]);
+                let top = lerp(t(row0 + x0), t(row0 + x1), fx);
+                let bottom = lerp(t(row1 + x0), t(row1 + x1), fx);
                 lerp(top, bottom, fy)
             }
         }
@@ -398,16 +399,6 @@ impl Polygon {
     }
 }
 
-/// Signed area of a polygon.
-fn polygon_area(poly: &[DVec2]) -> f64 {
-    let mut twice = 0.0;
-    for k in 0..poly.len() {
-        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
-        twice += a.perp_dot(b);
-    }
-    0.5 * twice
-}
-
 /// ∫ f over a convex polygon where `f` is at most quadratic: a fan of
 /// triangles, each by the edge-midpoint rule (exact for degree 2).
 fn integrate_piece(piece: &[DVec2], f: impl Fn(DVec2) -> f64) -> f64 {
@@ -489,25 +480,30 @@ mod tests {
     }
 
     #[test]
-    fn max_over_bounds_every_point_and_is_attained() {
-        let t = noise(6, 6);
-        let tri = [
-            DVec2::new(0.11, 0.3),
-            DVec2::new(0.52, 0.34),
-            DVec2::new(0.2, 0.71),
-        ];
-        let bound = t.max_over(tri);
-        let mut seen = 0.0f64;
-        let n = 400;
-        for i in 0..=n {
-            for j in 0..=n - i {
-                let (a, b) = (i as f64 / n as f64, j as f64 / n as f64);
-                let p = tri[0] + (tri[1] - tri[0]) * a + (tri[2] - tri[0]) * b;
-                seen = seen.max(t.eval(p));
+    fn max_over_box_bounds_every_point_and_is_attained() {
+        for filter in [Filter::Bilinear, Filter::Nearest] {
+            let t = noise(6, 6).with_filter(filter);
+            let (lo, hi) = (DVec2::new(0.11, 0.3), DVec2::new(0.52, 0.71));
+            let bound = t.max_over_box(lo, hi);
+            let mut seen = 0.0f64;
+            let n = 400;
+            for i in 0..=n {
+                for j in 0..=n {
+                    let p = lo + (hi - lo) * DVec2::new(i as f64, j as f64) / n as f64;
+                    seen = seen.max(t.eval(p));
+                }
             }
+            assert!(seen <= bound, "{filter:?}: {seen} > {bound}");
+            assert!(
+                seen >= bound * 0.99,
+                "{filter:?}: bound {bound} is loose: max {seen}"
+            );
         }
-        assert!(seen <= bound, "{seen} > {bound}");
-        assert!(seen >= bound * 0.999, "bound {bound} is loose: max {seen}");
+        // A box on texel edges does not reach the next texel (nearest).
+        let t = DensityTexture::new(2, 1, vec![1.0, 5.0])
+            .unwrap()
+            .with_filter(Filter::Nearest);
+        assert!(t.max_over_box(DVec2::ZERO, DVec2::new(0.5, 1.0)) < 1.01);
     }
 
     #[test]

@@ -6,8 +6,8 @@ use discrete_sampling::{DiscreteSampler, GuideTable};
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::parallel::unit;
-use crate::point::uniform_barycentric;
+use crate::parallel::{BLOCK, unit};
+use crate::point::{Frame, uniform_barycentric};
 use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 
 /// Draws points uniformly over a mesh's surface: density `1 / A` for a
@@ -34,6 +34,8 @@ use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 pub struct UniformSampler<'a> {
     mesh: MeshRef<'a>,
     triangles: GuideTable,
+    /// Per triangle, its corner, edges and normal: one memory access.
+    frames: Vec<Frame>,
     total_area: f64,
     /// `1 / total_area`, the density of every reachable point.
     density: f32,
@@ -55,6 +57,7 @@ impl<'a> UniformSampler<'a> {
         Ok(Self {
             mesh,
             triangles,
+            frames: Frame::all(&mesh),
             total_area,
             density: (1.0 / total_area) as f32,
         })
@@ -65,9 +68,9 @@ impl<'a> UniformSampler<'a> {
         &self.mesh
     }
 
-    /// Heap memory of the sampler (its area table).
+    /// Heap memory of the sampler (its area table and triangle frames).
     pub fn memory_bytes(&self) -> usize {
-        self.triangles.memory_bytes()
+        self.triangles.memory_bytes() + self.frames.len() * size_of::<Frame>()
     }
 
     /// The total surface area.
@@ -89,17 +92,28 @@ impl<'a> UniformSampler<'a> {
     /// The point for uniform variates `u = [u0, u1]` in `[0, 1)²`: `u0`
     /// picks the triangle and, through its remapped remainder, the first
     /// barycentric variate; `u1` is the second.
+    /// For stratified or low-discrepancy variates; the random-number
+    /// paths use three variates instead, which is faster (no division, no
+    /// unpredictable branch).
     pub fn sample_u(&self, u: [f64; 2]) -> SurfacePoint {
-        let (face, bary) = self.locate(u);
-        SurfacePoint::on(&self.mesh, face, bary, self.density)
+        let (face, rest) = self.triangles.sample_remapped(u[0]);
+        self.point(face as u32, uniform_barycentric(rest, u[1]))
     }
 
-    /// The triangle and barycentrics [`sample_u`](Self::sample_u) places
-    /// its point at.
+    /// A triangle and barycentrics from three `u64` of `rng`: one for the
+    /// triangle, two for the point.
     #[inline]
-    pub(crate) fn locate(&self, u: [f64; 2]) -> (u32, [f32; 3]) {
-        let (face, rest) = self.triangles.sample_remapped(u[0]);
-        (face as u32, uniform_barycentric(rest, u[1]))
+    pub(crate) fn pick<R: Rng + ?Sized>(&self, rng: &mut R) -> (u32, [f32; 3]) {
+        let face = self.triangles.sample_rng(rng) as u32;
+        let u0 = unit(rng.next_u64());
+        (face, uniform_barycentric(u0, unit(rng.next_u64())))
+    }
+
+    /// The point at `bary` of `face`, with the uniform density.
+    #[inline]
+    pub(crate) fn point(&self, face: u32, bary: [f32; 3]) -> SurfacePoint {
+        let frame = &self.frames[face as usize];
+        SurfacePoint::in_frame(&self.mesh, frame, face, bary, self.density)
     }
 }
 
@@ -137,7 +151,7 @@ impl UniformSampler<'_> {
             (0..count)
                 .map(|_| {
                     let bary = uniform_barycentric(unit(rng.next_u64()), unit(rng.next_u64()));
-                    SurfacePoint::on(&self.mesh, face as u32, bary, self.density)
+                    self.point(face as u32, bary)
                 })
                 .collect()
         };
@@ -154,12 +168,31 @@ impl UniformSampler<'_> {
 }
 
 impl Distribution<SurfacePoint> for UniformSampler<'_> {
+    /// Three `u64` of `rng`: the triangle, then the point.
     fn sample<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
-        let u0 = unit(rng.next_u64());
-        let u1 = unit(rng.next_u64());
-        self.sample_u([u0, u1])
+        let (face, bary) = self.pick(rng);
+        self.point(face, bary)
     }
 }
 
-/// Two `u64` of the random stream per point.
-impl SurfaceSampler for UniformSampler<'_> {}
+/// Three `u64` of the random stream per point.
+impl SurfaceSampler for UniformSampler<'_> {
+    /// Computed in blocks: first the block's triangles, by the guide
+    /// table's batch search (one `u64` each), then its points (two `u64`
+    /// each), so that the memory accesses of neighbouring samples overlap
+    /// instead of waiting for each other. The points differ from those of
+    /// repeated [`sample`](Distribution::sample) calls, which interleave
+    /// the variates.
+    fn sample_into<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
+        let mut faces = [0usize; BLOCK];
+        for block in out.chunks_mut(BLOCK) {
+            let faces = &mut faces[..block.len()];
+            self.triangles.sample_into(rng, faces);
+            for (slot, &face) in block.iter_mut().zip(faces.iter()) {
+                let u0 = unit(rng.next_u64());
+                let bary = uniform_barycentric(u0, unit(rng.next_u64()));
+                *slot = self.point(face as u32, bary);
+            }
+        }
+    }
+}

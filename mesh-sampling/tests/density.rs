@@ -81,7 +81,8 @@ fn area(p: [Vec3; 3]) -> f64 {
 }
 
 /// The paper's `p′` mass per texel, computed from scratch: every face cut
-/// into `4^L` sub-triangles (L from the longest UV edge in texels), each
+/// into `4^L` sub-triangles (L from the texels covered and the longest
+/// UV edge), each
 /// weighted by the bilinear density at its barycenter times its area, and
 /// binned by the texel its barycenter lies in.
 fn approximate_bin_masses(m: &Mesh, t: &DensityTexture) -> Vec<f64> {
@@ -89,15 +90,16 @@ fn approximate_bin_masses(m: &Mesh, t: &DensityTexture) -> Vec<f64> {
     let mut bins = vec![0.0; w * h];
     for tri in &m.2 {
         let uv = tri.map(|i| m.1[i as usize].as_dvec2());
-        let texels = DVec2::new(w as f64, h as f64);
+        // 4^L ≥ texels covered, 2^L ≥ longest edge / 2 texels.
+        let tx = uv.map(|p| p * DVec2::new(w as f64, h as f64));
+        let texels = 0.5 * (tx[1] - tx[0]).perp_dot(tx[2] - tx[0]).abs();
         let longest = (0..3)
-            .map(|k| ((uv[(k + 1) % 3] - uv[k]) * texels).length())
+            .map(|k| (tx[(k + 1) % 3] - tx[k]).length())
             .fold(0.0, f64::max);
-        let level = if longest > 1.0 {
-            longest.log2().ceil() as u32
-        } else {
-            0
-        };
+        let mut level = 0u32;
+        while f64::from(1u32 << (2 * level)) < texels || f64::from(1u32 << level) < longest / 2.0 {
+            level += 1;
+        }
         let n = 1u32 << level;
         let sub_area = area(tri.map(|i| m.0[i as usize])) / f64::from(n * n);
         for i in 0..n {
@@ -208,7 +210,7 @@ fn approximate_mode_samples_the_papers_p_prime() {
     let t = noise(16, 16);
     let m = grid(8, |uv| uv);
     let sampler = DensitySampler::new(mesh_ref(&m), Density::Texture(&t)).unwrap();
-    assert!((0..m.2.len()).all(|f| sampler.level(f) == 2));
+    assert!((0..m.2.len()).all(|f| sampler.level(f) == 1));
     let expected = approximate_bin_masses(&m, &t);
     let counts = texel_counts(&m, &t, &sampler.sample_n(5, N));
     let test = stats::chi_square(&counts, &stats::probabilities(&expected), 20.0);
@@ -448,7 +450,7 @@ fn merging_keeps_one_piece_per_face_for_a_constant_density() {
     let m = grid(4, |uv| uv);
     let sampler = DensitySampler::new(mesh_ref(&m), Density::Texture(&t)).unwrap();
     assert_eq!(sampler.pieces(), m.2.len());
-    assert!((0..m.2.len()).all(|f| sampler.level(f) == 5));
+    assert!((0..m.2.len()).all(|f| sampler.level(f) == 4));
 }
 
 #[test]
@@ -462,8 +464,9 @@ fn a_sliver_is_subdivided_by_its_longest_edge() {
     };
     let t = noise(256, 256);
     let sampler = DensitySampler::new(mesh, Density::Texture(&t)).unwrap();
-    // 256 texels long (0.13 texels² of area): 2⁸ segments per edge.
-    assert_eq!(sampler.level(0), 8);
+    // 256 texels long but 0.13 texels² of area: cut along its length, into
+    // 2⁷ segments of two texels per edge.
+    assert_eq!(sampler.level(0), 7);
 }
 
 #[test]

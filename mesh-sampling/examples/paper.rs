@@ -1,0 +1,824 @@
+//! Šik & Křivánek 2013, Fig. 10 and Table 1: sampling rate, preprocessing
+//! time and memory of rejection sampling and of adaptive subdivision
+//! (without and with the lookup table, and our exact mode), per mesh and
+//! density texture, on one and two threads; then the issue's bar, and the
+//! comparison with trimesh and Open3D at N = 10⁷ on the bunny.
+//!
+//! ```text
+//! cargo run --release -p mesh-sampling --example paper -- [--json] [--mesh FILE]
+//!     [--density D] [--threads T] [--no-peers]
+//! ```
+//!
+//! Meshes: every mesh in `$TRILUX_DATA/meshes` (those without UVs get
+//! [`spherical_uvs`]), or, without `TRILUX_DATA`, a generated icosphere and
+//! torus. Densities at 1024×1024: `uniform`, `checker2`, `checker16`,
+//! `checker128` (black = 0), `perlin4`, `perlin16`, `perlin64`, and
+//! `hdr:<file>` for each image of `$TRILUX_DATA/hdr` (luminance, rows
+//! doubled to 1024²), or a generated `hdr:sun` without data. Rates are
+//! medians of five timed runs of about 0.2 s each; points are streamed
+//! through [`SurfaceSampler::sample_stream`] and summed, so memory
+//! bandwidth for storing them is not what is measured (the peer comparison
+//! stores them, as the peers do).
+
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+use std::time::Instant;
+
+use discrete_sampling::CdfBisection;
+use glam::{Vec2, Vec3};
+use mesh_sampling::{
+    Density, DensitySampler, DensityTexture, MeshRef, Mode, Options, RejectionSampler,
+    SurfaceSampler, UniformSampler, spherical_uvs,
+};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+const SIZE: usize = 1024;
+const RUNS: usize = 5;
+const BUILDS: usize = 3;
+const TARGET_S: f64 = 0.2;
+const PEER_N: usize = 10_000_000;
+
+struct Args {
+    json: bool,
+    mesh: Option<String>,
+    density: Option<String>,
+    threads: Vec<usize>,
+    peers: bool,
+}
+
+fn parse_args() -> Result<Args, String> {
+    let mut args = Args {
+        json: false,
+        mesh: None,
+        density: None,
+        threads: vec![1, 2],
+        peers: true,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(a) = it.next() {
+        let mut value = |name: &str| it.next().ok_or(format!("{name} needs a value"));
+        match a.as_str() {
+            "--json" => args.json = true,
+            "--no-peers" => args.peers = false,
+            "--mesh" => args.mesh = Some(value("--mesh")?),
+            "--density" => args.density = Some(value("--density")?),
+            "--threads" => {
+                let t: usize = value("--threads")?
+                    .parse()
+                    .map_err(|e| format!("--threads: {e}"))?;
+                if t == 0 {
+                    return Err("--threads must be at least 1".into());
+                }
+                args.threads = vec![t];
+            }
+            "-h" | "--help" => {
+                return Err(
+                    "usage: paper [--json] [--mesh FILE] [--density D] [--threads T] [--no-peers]"
+                        .into(),
+                );
+            }
+            other => return Err(format!("unknown argument {other} (try --help)")),
+        }
+    }
+    Ok(args)
+}
+
+/// A mesh ready to sample: positions, UVs, triangles.
+struct TestMesh {
+    name: String,
+    positions: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    indices: Vec<[u32; 3]>,
+}
+
+impl TestMesh {
+    fn mesh(&self) -> MeshRef<'_> {
+        MeshRef {
+            uvs: Some(&self.uvs),
+            ..MeshRef::new(&self.positions, &self.indices)
+        }
+    }
+}
+
+fn data_dir() -> Option<PathBuf> {
+    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    Some(if given.is_dir() {
+        given
+    } else {
+        root.join(given)
+    })
+}
+
+fn load_meshes(filter: Option<&str>) -> Result<Vec<TestMesh>, String> {
+    let mut out = Vec::new();
+    let files: Vec<PathBuf> = match (filter, data_dir()) {
+        (Some(f), _) if Path::new(f).is_file() => vec![PathBuf::from(f)],
+        (_, Some(dir)) => {
+            let dir = dir.join("meshes");
+            let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+                .map_err(|e| format!("{}: {e}", dir.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    p.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+                        matches!(
+                            e.to_ascii_lowercase().as_str(),
+                            "obj" | "ply" | "gltf" | "glb"
+                        )
+                    })
+                })
+                .filter(|p| filter.is_none_or(|f| p.file_name().is_some_and(|n| n == f)))
+                .collect();
+            files.sort();
+            files
+        }
+        (_, None) => {
+            let built_in = [icosphere(5), torus(192, 96)];
+            return Ok(built_in
+                .into_iter()
+                .filter(|m| filter.is_none_or(|f| m.name == f))
+                .collect());
+        }
+    };
+    for file in files {
+        let m = trilux_io::mesh::TriMesh::read(&file).map_err(|e| e.to_string())?;
+        let name = file
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned();
+        let (positions, uvs, indices) = match m.uvs {
+            Some(uvs) => (m.positions, uvs, m.indices),
+            None => spherical_uvs(&m.positions, &m.indices),
+        };
+        out.push(TestMesh {
+            name,
+            positions,
+            uvs,
+            indices,
+        });
+    }
+    if out.is_empty() {
+        return Err(format!("no mesh matches {filter:?}"));
+    }
+    Ok(out)
+}
+
+/// A unit icosphere, `levels` times 1-to-4 subdivided, spherically mapped.
+fn icosphere(levels: u32) -> TestMesh {
+    let t = (1.0 + 5f32.sqrt()) / 2.0;
+    let mut positions: Vec<Vec3> = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ]
+    .map(|(x, y, z)| Vec3::new(x, y, z).normalize())
+    .to_vec();
+    let mut indices: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..levels {
+        let mut midpoints = std::collections::HashMap::new();
+        let mut mid = |a: u32, b: u32, positions: &mut Vec<Vec3>| -> u32 {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                positions.push((positions[a as usize] + positions[b as usize]).normalize());
+                positions.len() as u32 - 1
+            })
+        };
+        let mut next = Vec::with_capacity(indices.len() * 4);
+        for [a, b, c] in indices {
+            let (ab, bc, ca) = (
+                mid(a, b, &mut positions),
+                mid(b, c, &mut positions),
+                mid(c, a, &mut positions),
+            );
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        indices = next;
+    }
+    let (positions, uvs, indices) = spherical_uvs(&positions, &indices);
+    TestMesh {
+        name: "icosphere".into(),
+        positions,
+        uvs,
+        indices,
+    }
+}
+
+/// A torus with its natural (around, across) UV map.
+fn torus(around: u32, across: u32) -> TestMesh {
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    for j in 0..=across {
+        for i in 0..=around {
+            let (u, v) = (i as f32 / around as f32, j as f32 / across as f32);
+            let (a, b) = (u * std::f32::consts::TAU, v * std::f32::consts::TAU);
+            let r = 1.0 + 0.35 * b.cos();
+            positions.push(Vec3::new(r * a.cos(), 0.35 * b.sin(), r * a.sin()));
+            uvs.push(Vec2::new(u, v));
+        }
+    }
+    let at = |i: u32, j: u32| j * (around + 1) + i;
+    let mut indices = Vec::new();
+    for j in 0..across {
+        for i in 0..around {
+            indices.push([at(i, j), at(i + 1, j), at(i, j + 1)]);
+            indices.push([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    TestMesh {
+        name: "torus".into(),
+        positions,
+        uvs,
+        indices,
+    }
+}
+
+/// The density textures, by name.
+fn densities(filter: Option<&str>) -> Result<Vec<(String, DensityTexture)>, String> {
+    let mut names: Vec<String> = [
+        "uniform",
+        "checker2",
+        "checker16",
+        "checker128",
+        "perlin4",
+        "perlin16",
+        "perlin64",
+    ]
+    .map(String::from)
+    .to_vec();
+    let hdr_files: Vec<PathBuf> = match data_dir() {
+        Some(dir) => {
+            let mut f: Vec<PathBuf> = std::fs::read_dir(dir.join("hdr"))
+                .map_err(|e| format!("{}: {e}", dir.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("hdr")))
+                .collect();
+            f.sort();
+            f
+        }
+        None => Vec::new(),
+    };
+    if hdr_files.is_empty() {
+        names.push("hdr:sun".into());
+    }
+    for f in &hdr_files {
+        names.push(format!(
+            "hdr:{}",
+            f.file_name().unwrap_or_default().to_string_lossy()
+        ));
+    }
+    let mut out = Vec::new();
+    for name in names {
+        if filter.is_some_and(|f| f != name && !(f == "hdr" && name.starts_with("hdr:"))) {
+            continue;
+        }
+        let texels: Vec<f32> = match name.as_str() {
+            "uniform" => vec![1.0; SIZE * SIZE],
+            n if n.starts_with("checker") => {
+                let k: usize = n["checker".len()..].parse().map_err(|_| n.to_string())?;
+                grid_fn(|x, y| ((x * k / SIZE + y * k / SIZE) % 2) as f32)
+            }
+            n if n.starts_with("perlin") => {
+                let f: usize = n["perlin".len()..].parse().map_err(|_| n.to_string())?;
+                grid_fn(|x, y| {
+                    let (u, v) = (
+                        (x as f64 + 0.5) / SIZE as f64,
+                        (y as f64 + 0.5) / SIZE as f64,
+                    );
+                    (0.5 + 0.7 * perlin(u * f as f64, v * f as f64, f)).clamp(0.0, 1.0) as f32
+                })
+            }
+            "hdr:sun" => grid_fn(|x, y| {
+                let (u, v) = (x as f32 / SIZE as f32, y as f32 / SIZE as f32);
+                let sky = 0.2 + 0.8 * (1.0 - v);
+                let d2 = (u - 0.7).powi(2) + (v - 0.3).powi(2);
+                if d2 < 0.004f32.powi(2) { 5e4 } else { sky }
+            }),
+            n => {
+                let file = hdr_files
+                    .iter()
+                    .find(|f| f.file_name().is_some_and(|f| f.to_string_lossy() == n[4..]))
+                    .ok_or(format!("no density {n}"))?;
+                let image = trilux_io::image::read(file).map_err(|e| e.to_string())?;
+                let (w, h) = (image.width as usize, image.height as usize);
+                grid_fn(|x, y| {
+                    let p = image.pixels[(y * h / SIZE) * w + x * w / SIZE];
+                    0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+                })
+            }
+        };
+        out.push((
+            name,
+            DensityTexture::new(SIZE, SIZE, texels).map_err(|e| e.to_string())?,
+        ));
+    }
+    if out.is_empty() {
+        return Err(format!("no density matches {filter:?}"));
+    }
+    Ok(out)
+}
+
+fn grid_fn(f: impl Fn(usize, usize) -> f32) -> Vec<f32> {
+    (0..SIZE * SIZE).map(|i| f(i % SIZE, i / SIZE)).collect()
+}
+
+/// Periodic 2D Perlin gradient noise with `period` cells, in about
+/// [−0.7, 0.7].
+fn perlin(x: f64, y: f64, period: usize) -> f64 {
+    let gradient = |i: i64, j: i64| {
+        let (i, j) = (
+            i.rem_euclid(period as i64) as u64,
+            j.rem_euclid(period as i64) as u64,
+        );
+        let mut h = i.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ j.wrapping_mul(0xC2B2_AE3D_27D4_EB4F);
+        h ^= h >> 29;
+        h = h.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        let angle = (h >> 11) as f64 / (1u64 << 53) as f64 * std::f64::consts::TAU;
+        (angle.cos(), angle.sin())
+    };
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let fade = |t: f64| t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+    let corner = |di: i64, dj: i64| {
+        let g = gradient(x0 as i64 + di, y0 as i64 + dj);
+        g.0 * (fx - di as f64) + g.1 * (fy - dj as f64)
+    };
+    let (sx, sy) = (fade(fx), fade(fy));
+    let top = corner(0, 0) + (corner(1, 0) - corner(0, 0)) * sx;
+    let bottom = corner(0, 1) + (corner(1, 1) - corner(0, 1)) * sx;
+    top + (bottom - top) * sy
+}
+
+/// One measured row.
+#[derive(Debug, Clone)]
+struct Row {
+    mesh: String,
+    triangles: usize,
+    density: String,
+    method: &'static str,
+    threads: usize,
+    msamples_per_s: f64,
+    preprocess_ms: f64,
+    memory_mb: f64,
+    max_over_mean: f64,
+    acceptance: f64,
+    pieces: usize,
+}
+
+impl Row {
+    fn json(&self) -> String {
+        format!(
+            "{{\"mesh\": \"{}\", \"density\": \"{}\", \"method\": \"{}\", \"msamples_per_s\": {:.3}, \
+             \"preprocess_ms\": {:.2}, \"memory_mb\": {:.2}, \"threads\": {}, \"max_over_mean\": {:.3}, \
+             \"triangles\": {}, \"acceptance\": {:.4}, \"pieces\": {}}}",
+            self.mesh,
+            self.density,
+            self.method,
+            self.msamples_per_s,
+            self.preprocess_ms,
+            self.memory_mb,
+            self.threads,
+            self.max_over_mean,
+            self.triangles,
+            self.acceptance,
+            self.pieces
+        )
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Million points per second of `sample` (streamed), median of [`RUNS`]
+/// runs sized to about [`TARGET_S`] each.
+fn rate(sampler: &impl SurfaceSampler) -> f64 {
+    let run = |n: usize| {
+        let start = Instant::now();
+        sampler.sample_stream(1, n, |_, chunk| {
+            let s: f32 = chunk.iter().map(|p| p.position.x + p.pdf).sum();
+            black_box(s);
+        });
+        start.elapsed().as_secs_f64()
+    };
+    measure(run)
+}
+
+/// Million triples of `u64` per second from the chunked generators the
+/// samplers use: the cost of the random numbers a point consumes (one for
+/// the table, two for the point in the triangle).
+fn rng_rate() -> f64 {
+    let run = |n: usize| {
+        let start = Instant::now();
+        let chunks = n.div_ceil(1 << 14);
+        let work = |k: usize| {
+            let mut rng = Pcg64Mcg::seed_from_u64(k as u64);
+            let mut s = 0u64;
+            for _ in 0..1 << 14 {
+                s = s.wrapping_add(rng.next_u64() ^ rng.next_u64() ^ rng.next_u64());
+            }
+            black_box(s);
+        };
+        {
+            use rayon::prelude::*;
+            (0..chunks).into_par_iter().for_each(work);
+        }
+        start.elapsed().as_secs_f64()
+    };
+    measure(run)
+}
+
+fn measure(run: impl Fn(usize) -> f64) -> f64 {
+    let mut n = 1 << 16;
+    let mut t = run(n);
+    while t < TARGET_S / 8.0 {
+        n *= 4;
+        t = run(n);
+    }
+    let n = ((n as f64 * TARGET_S / t) as usize).max(1 << 14);
+    let times: Vec<f64> = (0..RUNS).map(|_| run(n)).collect();
+    n as f64 / median(times) / 1e6
+}
+
+/// Median build time (ms) of [`BUILDS`] builds, and the last build.
+fn build<T>(f: impl Fn() -> T) -> (f64, T) {
+    let mut times = Vec::new();
+    let mut last = None;
+    for _ in 0..BUILDS {
+        let start = Instant::now();
+        let built = f();
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+        last = Some(built);
+    }
+    (median(times), last.expect("BUILDS > 0"))
+}
+
+fn measure_pair(
+    m: &TestMesh,
+    name: &str,
+    texture: &DensityTexture,
+    threads: usize,
+) -> Result<Vec<Row>, String> {
+    let mesh = m.mesh();
+    let texture_mb = texture.memory_bytes() as f64 / 1e6;
+    let (reject_ms, rejection) = build(|| RejectionSampler::new(mesh, texture));
+    let rejection = rejection.map_err(|e| format!("{}, {name}: {e}", m.name))?;
+    let area = UniformSampler::new(mesh)
+        .map_err(|e| e.to_string())?
+        .total_area();
+    let max_over_mean = f64::from(texture.max()) * area / rejection.total_mass();
+    let row = |method, msamples_per_s, preprocess_ms, memory_mb, acceptance, pieces| Row {
+        mesh: m.name.clone(),
+        triangles: m.indices.len(),
+        density: name.to_string(),
+        method,
+        threads,
+        msamples_per_s,
+        preprocess_ms,
+        memory_mb,
+        max_over_mean,
+        acceptance,
+        pieces,
+    };
+    let mut rows = vec![row(
+        "rejection",
+        rate(&rejection),
+        reject_ms,
+        rejection.memory_bytes() as f64 / 1e6 + texture_mb,
+        rejection.acceptance(),
+        m.indices.len(),
+    )];
+    let density = Density::Texture(texture);
+    let (ms, no_table) =
+        build(|| DensitySampler::<CdfBisection>::with_table(mesh, density, &Options::default()));
+    let no_table = no_table.map_err(|e| e.to_string())?;
+    rows.push(row(
+        "subdivision-no-table",
+        rate(&no_table),
+        ms,
+        no_table.memory_bytes() as f64 / 1e6,
+        1.0,
+        no_table.pieces(),
+    ));
+    drop(no_table);
+    let (ms, table) = build(|| DensitySampler::new(mesh, density));
+    let table = table.map_err(|e| e.to_string())?;
+    rows.push(row(
+        "subdivision",
+        rate(&table),
+        ms,
+        table.memory_bytes() as f64 / 1e6,
+        1.0,
+        table.pieces(),
+    ));
+    drop(table);
+    let exact_options = Options {
+        mode: Mode::Exact,
+        ..Options::default()
+    };
+    let (ms, exact) = build(|| DensitySampler::with_options(mesh, density, &exact_options));
+    let exact = exact.map_err(|e| e.to_string())?;
+    rows.push(row(
+        "exact",
+        rate(&exact),
+        ms,
+        exact.memory_bytes() as f64 / 1e6 + texture_mb,
+        exact.acceptance(),
+        exact.pieces(),
+    ));
+    Ok(rows)
+}
+
+fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())
+}
+
+fn print_markdown(rows: &[Row]) {
+    println!(
+        "| mesh | triangles | density | max/mean | method | threads | M samples/s | preprocess ms | memory MB | pieces | acceptance |"
+    );
+    println!("|---|---:|---|---:|---|---:|---:|---:|---:|---:|---:|");
+    for r in rows {
+        println!(
+            "| {} | {} | {} | {:.1} | {} | {} | {:.2} | {:.1} | {:.1} | {} | {:.3} |",
+            r.mesh,
+            r.triangles,
+            r.density,
+            r.max_over_mean,
+            r.method,
+            r.threads,
+            r.msamples_per_s,
+            r.preprocess_ms,
+            r.memory_mb,
+            r.pieces,
+            r.acceptance
+        );
+    }
+}
+
+/// The issue's bar, from the rows of this run.
+fn print_bar(rows: &[Row]) {
+    println!("\n## Bar\n");
+    let find = |mesh: &str, density: &str, method: &str, threads: usize| {
+        rows.iter().find(|r| {
+            r.mesh == mesh && r.density == density && r.method == method && r.threads == threads
+        })
+    };
+    let mut worst_uniform: Option<(f64, &Row)> = None;
+    let mut worst_rejection: Option<(f64, &Row)> = None;
+    let mut worst_scaling: Option<(f64, &Row)> = None;
+    for r in rows.iter().filter(|r| r.method == "subdivision") {
+        if let Some(u) = find(&r.mesh, "uniform", "subdivision", r.threads) {
+            let ratio = r.msamples_per_s / u.msamples_per_s;
+            if worst_uniform.is_none_or(|(w, _)| ratio < w) {
+                worst_uniform = Some((ratio, r));
+            }
+        }
+        if let Some(rej) = find(&r.mesh, &r.density, "rejection", r.threads) {
+            let margin = (r.msamples_per_s / rej.msamples_per_s) / (0.5 * r.max_over_mean);
+            if worst_rejection.is_none_or(|(w, _)| margin < w) {
+                worst_rejection = Some((margin, r));
+            }
+        }
+        if r.threads == 2
+            && let Some(one) = find(&r.mesh, &r.density, "subdivision", 1)
+        {
+            let s = r.msamples_per_s / one.msamples_per_s;
+            if worst_scaling.is_none_or(|(w, _)| s < w) {
+                worst_scaling = Some((s, r));
+            }
+        }
+    }
+    let verdict = |ok: bool| if ok { "met" } else { "MISSED" };
+    if let Some((ratio, r)) = worst_uniform {
+        println!(
+            "- Rate with any density / rate with the uniform density: worst {:.0}% ({}, {}, {} thread(s)); bar 65%: {}",
+            100.0 * ratio,
+            r.mesh,
+            r.density,
+            r.threads,
+            verdict(ratio >= 0.65)
+        );
+    }
+    if let Some((margin, r)) = worst_rejection {
+        let rej = find(&r.mesh, &r.density, "rejection", r.threads).expect("found above");
+        println!(
+            "- Speed-up over rejection / (max/mean ÷ 2): worst {:.2} ({}, {}: {:.1}× at max/mean {:.1}); bar 1: {}",
+            margin,
+            r.mesh,
+            r.density,
+            r.msamples_per_s / rej.msamples_per_s,
+            r.max_over_mean,
+            verdict(margin >= 1.0)
+        );
+    }
+    let bunny = rows
+        .iter()
+        .find(|r| r.mesh.contains("bunny"))
+        .map(|r| r.mesh.clone());
+    let rng = rows.iter().find(|r| r.method == "rng" && r.threads == 1);
+    if let (Some(b), Some(rng)) = (bunny, rng)
+        && let Some(s) = find(&b, "uniform", "subdivision", 1)
+    {
+        let cost = rng.msamples_per_s / s.msamples_per_s;
+        println!(
+            "- One thread, uniform density, {b}: {:.1} ns per point, {:.1} ns for its three random u64: {:.2}×; bar 3×: {}",
+            1e3 / s.msamples_per_s,
+            1e3 / rng.msamples_per_s,
+            cost,
+            verdict(cost <= 3.0)
+        );
+    }
+    if let Some((s, r)) = worst_scaling {
+        println!(
+            "- Two threads / one thread: worst {:.2}× ({}, {}); bar 1.8×: {}",
+            s,
+            r.mesh,
+            r.density,
+            verdict(s >= 1.8)
+        );
+    }
+}
+
+/// Our uniform sampler against trimesh and Open3D at N = 10⁷, all storing
+/// the points (the peers return arrays).
+fn peers(m: &TestMesh, file: &Path, threads: &[usize], json: bool) -> Result<(), String> {
+    let mesh = m.mesh();
+    let uniform = UniformSampler::new(mesh).map_err(|e| e.to_string())?;
+    let mut ours = Vec::new();
+    for &t in threads {
+        let times: Vec<f64> = pool(t)?.install(|| {
+            (0..3)
+                .map(|seed| {
+                    let start = Instant::now();
+                    black_box(uniform.sample_n(seed, PEER_N));
+                    start.elapsed().as_secs_f64()
+                })
+                .collect()
+        });
+        ours.push((t, PEER_N as f64 / median(times) / 1e6));
+    }
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("bench/peers.sh");
+    eprintln!("running the Python peers (first run installs them into target/peers-venv)…");
+    let out = Command::new("bash")
+        .arg(&script)
+        .arg(file)
+        .arg(PEER_N.to_string())
+        .arg("3")
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| format!("{}: {e}", script.display()))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let field = |line: &str, key: &str| -> Option<String> {
+        let at = line.find(&format!("\"{key}\": "))? + key.len() + 4;
+        let rest = &line[at..];
+        let end = rest.find([',', '}'])?;
+        Some(rest[..end].trim_matches('"').to_string())
+    };
+    let mut peer_rates = Vec::new();
+    for line in text.lines().filter(|l| l.starts_with('{')) {
+        let peer = field(line, "peer").unwrap_or_default();
+        match field(line, "msamples_per_s").and_then(|v| v.parse::<f64>().ok()) {
+            Some(r) => peer_rates.push((peer, r)),
+            None => eprintln!("peer {peer} failed: {line}"),
+        }
+    }
+    if json {
+        for (t, r) in &ours {
+            println!(
+                "{{\"mesh\": \"{}\", \"density\": \"uniform\", \"method\": \"uniform-sample-n\", \"msamples_per_s\": {r:.3}, \"threads\": {t}, \"n\": {PEER_N}}}",
+                m.name
+            );
+        }
+        for line in text.lines().filter(|l| l.starts_with('{')) {
+            println!("{line}");
+        }
+        return Ok(());
+    }
+    println!(
+        "\n## Against trimesh and Open3D ({}, N = 10⁷, points stored)\n",
+        m.name
+    );
+    println!("| sampler | threads | M samples/s |");
+    println!("|---|---:|---:|");
+    for (t, r) in &ours {
+        println!("| mesh-sampling UniformSampler::sample_n | {t} | {r:.1} |");
+    }
+    for (peer, r) in &peer_rates {
+        println!("| {peer} | 1 | {r:.2} |");
+    }
+    println!();
+    for (peer, r) in &peer_rates {
+        for (t, ours) in &ours {
+            let x = ours / r;
+            println!(
+                "- {t} thread(s) vs {peer}: {x:.1}×; bar 15×: {}",
+                if x >= 15.0 { "met" } else { "MISSED" }
+            );
+        }
+    }
+    Ok(())
+}
+
+fn run() -> Result<(), String> {
+    let args = parse_args()?;
+    let meshes = load_meshes(args.mesh.as_deref())?;
+    let textures = densities(args.density.as_deref())?;
+    let mut rows = Vec::new();
+    for &t in &args.threads {
+        let r = pool(t)?.install(rng_rate);
+        let rng_row = Row {
+            mesh: String::new(),
+            triangles: 0,
+            density: String::new(),
+            method: "rng",
+            threads: t,
+            msamples_per_s: r,
+            preprocess_ms: 0.0,
+            memory_mb: 0.0,
+            max_over_mean: 1.0,
+            acceptance: 1.0,
+            pieces: 0,
+        };
+        if args.json {
+            println!("{}", rng_row.json());
+        }
+        rows.push(rng_row);
+    }
+    for m in &meshes {
+        for (name, texture) in &textures {
+            for &t in &args.threads {
+                eprintln!("{} / {name} / {t} thread(s)…", m.name);
+                let measured = pool(t)?.install(|| measure_pair(m, name, texture, t))?;
+                if args.json {
+                    for r in &measured {
+                        println!("{}", r.json());
+                    }
+                }
+                rows.extend(measured);
+            }
+        }
+    }
+    if !args.json {
+        println!("# mesh-sampling: Šik & Křivánek 2013, Fig. 10 and Table 1\n");
+        print_markdown(&rows);
+        print_bar(&rows);
+    }
+    if args.peers
+        && let Some(bunny) = meshes.iter().find(|m| m.name.contains("bunny"))
+        && let Some(dir) = data_dir()
+    {
+        peers(
+            bunny,
+            &dir.join("meshes").join(&bunny.name),
+            &args.threads,
+            args.json,
+        )?;
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
