@@ -46,8 +46,8 @@ pub struct Options {
     /// The deepest subdivision level, at most 13 (`4^13` sub-triangles for
     /// one triangle). Default 11: a triangle spanning a 2048² texture.
     pub max_level: u8,
-    /// Levels beyond the one that makes sub-triangles no larger than a
-    /// texel (and their edges no longer than two). Each one divides the approximation error of
+    /// Levels beyond the one that makes sub-triangles about a texel (and
+    /// their edges no longer than two). Each one divides the approximation error of
     /// [`Mode::Approximate`] (or the rejection rate of [`Mode::Exact`])
     /// roughly by two, and costs four times the memory.
     pub extra_levels: u8,
@@ -83,8 +83,8 @@ struct Piece {
 /// texture, per-face or per-vertex weights.
 ///
 /// A texture density is resampled on an adaptive subdivision of each
-/// triangle (Šik & Křivánek 2013): the depth makes sub-triangles no larger
-/// than a texel and their edges no longer than two texels (so slivers are
+/// triangle (Šik & Křivánek 2013): the depth makes sub-triangles about a
+/// texel and their edges no longer than two texels (so slivers are
 /// subdivided along their length too), the density is looked up at each
 /// sub-triangle's
 /// barycenter, and four siblings of equal value merge into their parent.
@@ -434,17 +434,32 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
 impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {
     /// Computed in blocks, like
     /// [`UniformSampler`](crate::UniformSampler)'s: the block's pieces by
-    /// the table's batch search, then their records, then the points. Exact mode draws one
-    /// point at a time (rejection).
+    /// the table's batch search, then their records, then the points; in
+    /// exact mode, blocks of proposals of which the accepted are kept.
     fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
-        if self.exact_texture().is_some() {
-            for slot in out {
-                *slot = self.sample(rng);
+        let mut picks = [0usize; BLOCK];
+        let mut pieces = [Piece::default(); BLOCK];
+        if let Some(texture) = self.exact_texture() {
+            // Proposals in blocks, the accepted ones kept in order.
+            let mut filled = 0;
+            while filled < out.len() {
+                self.table.sample_into(rng, &mut picks);
+                for (piece, &k) in pieces.iter_mut().zip(&picks) {
+                    *piece = self.pieces[k];
+                }
+                for &piece in &pieces {
+                    let xi1 = unit(rng.next_u64());
+                    let bary = self.place(piece, xi1, unit(rng.next_u64()));
+                    let [_, u, v] = bary.map(f64::from);
+                    let f = texture.eval(self.uv_at(piece.face as usize, u, v));
+                    if unit(rng.next_u64()) * f64::from(piece.value) < f && filled < out.len() {
+                        out[filled] = self.point(piece, bary, f);
+                        filled += 1;
+                    }
+                }
             }
             return;
         }
-        let mut picks = [0usize; BLOCK];
-        let mut pieces = [Piece::default(); BLOCK];
         for block in out.chunks_mut(BLOCK) {
             let n = block.len();
             self.table.sample_into(rng, &mut picks[..n]);
@@ -544,10 +559,12 @@ fn face_uvs(uvs: &[Vec2], tri: [u32; 3]) -> [DVec2; 3] {
     tri.map(|i| uvs[i as usize].as_dvec2())
 }
 
-/// The depth at which sub-triangles are no larger than a texel (Šik &
-/// Křivánek Sec. 3.4: `4^L` sub-triangles for the texels the triangle
-/// covers) and, so that a sliver (long, with little area) is cut along its
-/// length too, no edge is longer than two texels.
+/// The depth at which sub-triangles are about a texel (Šik & Křivánek
+/// Sec. 3.4: the sub-triangle size matches the texture resolution; `4^L`
+/// is the texels the triangle covers, rounded to the nearest power of 4,
+/// so sub-triangles cover half a texel to two) and, so that a sliver (long,
+/// with little area) is cut along its length too, no edge is longer than
+/// two texels.
 fn face_level(texture: &DensityTexture, uv: [DVec2; 3], options: &Options) -> u8 {
     let scale = DVec2::new(texture.width() as f64, texture.height() as f64);
     let t = uv.map(|p| p * scale);
@@ -555,18 +572,18 @@ fn face_level(texture: &DensityTexture, uv: [DVec2; 3], options: &Options) -> u8
     let longest = (0..3)
         .map(|k| (t[(k + 1) % 3] - t[k]).length())
         .fold(0.0f64, f64::max);
-    // 4^L ≥ texels and 2^L ≥ longest / 2.
+    // 4^L ≈ texels and 2^L ≥ longest / 2.
     let by_area = if texels > 1.0 {
-        texels.log2() / 2.0
+        (texels.log2() / 2.0).round()
     } else {
         0.0
     };
     let by_edge = if longest > 2.0 {
-        (longest / 2.0).log2()
+        (longest / 2.0).log2().ceil()
     } else {
         0.0
     };
-    let level = by_area.max(by_edge).ceil().min(f64::from(MAX_LEVEL)) as u8;
+    let level = by_area.max(by_edge).min(f64::from(MAX_LEVEL)) as u8;
     (level.saturating_add(options.extra_levels)).min(options.max_level)
 }
 

@@ -1,36 +1,55 @@
-//! Random points on triangle meshes.
+//! Random points on triangle meshes: uniform over the area, or with a
+//! density given by a texture, per-face or per-vertex weights; each point
+//! with its pdf, for scattering, point clouds, hair roots and emissive
+//! meshes in a path tracer (multiple importance sampling).
 //!
-//! This first part implements **area-uniform sampling** as in the
-//! uniform-mesh-sampling article: a triangle drawn with probability
-//! `A_i / ΣA` (from the lookup-table CDF of Šik & Křivánek 2013, Sec. 4, in
-//! `discrete-sampling`), then a uniform point in it by the square-root map
-//! `u = 1 − √ξ₁, v = ξ₂ √ξ₁` (Šik & Křivánek, Sec. 3.5). The density is
-//! `1 / A` everywhere. The article's naive sampler (a triangle chosen
-//! uniformly) is here too, documented as biased, so the tests can show
-//! that they reject it. [`MultiMeshSampler`] samples several meshes at once
-//! (the article's last section): a CDF over the meshes' areas above one
-//! sampler per mesh, so editing one mesh rebuilds only its table. Density-texture sampling by adaptive subdivision
-//! (Šik & Křivánek Sec. 3.3–3.5) is the next part (issue 4).
+//! - **Uniform** ([`UniformSampler`], the uniform-mesh-sampling article):
+//!   triangle `i` with probability `A_i / ΣA` from the lookup-table CDF of
+//!   Šik & Křivánek 2013 (Sec. 4, in `discrete-sampling`), then the
+//!   square-root map `u = 1 − √ξ₁, v = ξ₂ √ξ₁` (Sec. 3.5); density `1 / A`.
+//!   [`NaiveSampler`] (a triangle chosen uniformly) is the article's biased
+//!   baseline, kept so that the tests show they can fail.
+//!   [`MultiMeshSampler`] samples several meshes at once (the article's
+//!   last section); `sample_stable` is Blender's per-triangle mode.
+//! - **Density textures** ([`DensitySampler`], Šik & Křivánek Sec.
+//!   3.3–3.5): each triangle is subdivided 1-to-4 until its sub-triangles
+//!   are about a texel, the bilinear density `f_i` is taken at
+//!   each sub-triangle's barycenter, equal siblings are merged, and a
+//!   sub-triangle is drawn with probability `P_i = f_i |D_i| / Σ f_j |D_j|`
+//!   (Eq. 2: the approximation `p′` of Eq. 1's `p(x) = f(m(x)) / ∫ f dA`).
+//!   [`Mode::Exact`] goes beyond the paper and samples Eq. 1 itself.
+//!   [`RejectionSampler`] is the paper's Sec. 3.2 baseline.
+//! - **Weights**: [`Density::PerFace`] and [`Density::PerVertex`] (linear
+//!   over each triangle), both sampled exactly.
 //!
-//! A sample is a [`SurfacePoint`]: position, face, barycentrics, geometric
+//! A point is a [`SurfacePoint`]: position, face, barycentrics, geometric
 //! and shading normal, UV, and its density. Stored as (face, barycentrics),
 //! it can be re-evaluated on a deformed mesh with [`SurfacePoint::on`].
+//! Every sampler's batches ([`SurfaceSampler`]) run on all threads with
+//! the `rayon` feature and depend only on the seed.
 //!
 //! # Example
 //!
 //! ```
-//! use glam::Vec3;
-//! use mesh_sampling::{MeshRef, UniformSampler};
-//! use rand::distr::Distribution;
-//! use rand::SeedableRng;
+//! use glam::{Vec2, Vec3};
+//! use mesh_sampling::{
+//!     Density, DensitySampler, DensityTexture, MeshRef, SurfaceSampler, UniformSampler,
+//! };
 //!
-//! let positions = [Vec3::ZERO, Vec3::X, Vec3::Y];
-//! let indices = [[0, 1, 2]];
-//! let sampler = UniformSampler::new(MeshRef::new(&positions, &indices))?;
-//! let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
-//! let p = sampler.sample(&mut rng);
-//! assert_eq!(p.face, 0);
-//! assert!((p.pdf - 2.0).abs() < 1e-6); // area 1/2
+//! // A unit square with UVs, and a 2×2 density brightest in one texel.
+//! let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+//! let uvs = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
+//! let indices = [[0, 1, 2], [1, 3, 2]];
+//! let mesh = MeshRef { uvs: Some(&uvs), ..MeshRef::new(&positions, &indices) };
+//!
+//! let uniform = UniformSampler::new(mesh)?;
+//! assert!(uniform.sample_n(1, 1000).iter().all(|p| (p.pdf - 1.0).abs() < 1e-6));
+//!
+//! let texture = DensityTexture::new(2, 2, vec![1.0, 1.0, 1.0, 9.0])?;
+//! let sampler = DensitySampler::new(mesh, Density::Texture(&texture))?;
+//! let points = sampler.sample_n(2, 10_000); // same on any number of threads
+//! let p = points[0];
+//! assert!((sampler.pdf(p.face as usize, p.barycentric) - p.pdf).abs() < 1e-6); // for MIS
 //! # Ok::<(), mesh_sampling::Error>(())
 //! ```
 

@@ -7,7 +7,8 @@ use glam::Vec2;
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::parallel::unit;
+use crate::parallel::{BLOCK, unit};
+use crate::point::uniform_barycentric;
 use crate::{DensityTexture, Error, MeshRef, SurfacePoint, SurfaceSampler, UniformSampler};
 
 /// Draws points with density proportional to a texture by rejection from
@@ -77,24 +78,53 @@ impl<'a> RejectionSampler<'a> {
         (self.texture.eval(a + (b - a) * u + (c - a) * v) * self.norm) as f32
     }
 
-    /// Heap memory of the sampler (its area table).
+    /// The unnormalised density at `bary` of `face`.
+    #[inline]
+    fn density_at(&self, face: u32, bary: [f32; 3]) -> f64 {
+        let tri = self.uniform.mesh().indices[face as usize];
+        let [a, b, c] = tri.map(|i| self.uvs[i as usize].as_dvec2());
+        let [_, u, v] = bary.map(f64::from);
+        self.texture.eval(a + (b - a) * u + (c - a) * v)
+    }
+
+    /// Heap memory of the sampler (its area table and triangle frames).
     pub fn memory_bytes(&self) -> usize {
         self.uniform.memory_bytes()
     }
 }
 
 /// Four `u64` of the random stream per proposal.
-impl SurfaceSampler for RejectionSampler<'_> {}
+impl SurfaceSampler for RejectionSampler<'_> {
+    /// Proposals in blocks (the triangles by the table's batch search,
+    /// then the points and their tests), the accepted ones kept in order:
+    /// the same speed-ups as the other samplers' batches, so that the
+    /// comparison is fair.
+    fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
+        let mut faces = [0usize; BLOCK];
+        let mut filled = 0;
+        while filled < out.len() {
+            self.uniform.faces_into(rng, &mut faces);
+            for &face in &faces {
+                let face = face as u32;
+                let u0 = unit(rng.next_u64());
+                let bary = uniform_barycentric(u0, unit(rng.next_u64()));
+                let f = self.density_at(face, bary);
+                if unit(rng.next_u64()) * self.bound < f && filled < out.len() {
+                    let mut point = self.uniform.point(face, bary);
+                    point.pdf = (f * self.norm) as f32;
+                    out[filled] = point;
+                    filled += 1;
+                }
+            }
+        }
+    }
+}
 
 impl Distribution<SurfacePoint> for RejectionSampler<'_> {
     fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
-        let mesh = self.uniform.mesh();
         loop {
             let (face, bary) = self.uniform.pick(rng);
-            let tri = mesh.indices[face as usize];
-            let [a, b, c] = tri.map(|i| self.uvs[i as usize].as_dvec2());
-            let [_, u, v] = bary.map(f64::from);
-            let f = self.texture.eval(a + (b - a) * u + (c - a) * v);
+            let f = self.density_at(face, bary);
             if unit(rng.next_u64()) * self.bound < f {
                 let mut point = self.uniform.point(face, bary);
                 point.pdf = (f * self.norm) as f32;

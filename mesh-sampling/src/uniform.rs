@@ -109,6 +109,13 @@ impl<'a> UniformSampler<'a> {
         (face, uniform_barycentric(u0, unit(rng.next_u64())))
     }
 
+    /// Fills `faces` with triangles drawn by area (the table's batch
+    /// search, one `u64` each).
+    #[inline]
+    pub(crate) fn faces_into<R: Rng + ?Sized>(&self, rng: &mut R, faces: &mut [usize]) {
+        self.triangles.sample_into(rng, faces);
+    }
+
     /// The point at `bary` of `face`, with the uniform density.
     #[inline]
     pub(crate) fn point(&self, face: u32, bary: [f32; 3]) -> SurfacePoint {

@@ -90,14 +90,15 @@ fn approximate_bin_masses(m: &Mesh, t: &DensityTexture) -> Vec<f64> {
     let mut bins = vec![0.0; w * h];
     for tri in &m.2 {
         let uv = tri.map(|i| m.1[i as usize].as_dvec2());
-        // 4^L ≥ texels covered, 2^L ≥ longest edge / 2 texels.
+        // 4^L ≈ texels covered (nearest power of 4), 2^L ≥ longest edge
+        // / 2 texels.
         let tx = uv.map(|p| p * DVec2::new(w as f64, h as f64));
         let texels = 0.5 * (tx[1] - tx[0]).perp_dot(tx[2] - tx[0]).abs();
         let longest = (0..3)
             .map(|k| (tx[(k + 1) % 3] - tx[k]).length())
             .fold(0.0, f64::max);
-        let mut level = 0u32;
-        while f64::from(1u32 << (2 * level)) < texels || f64::from(1u32 << level) < longest / 2.0 {
+        let mut level = texels.max(1.0).log(4.0).round() as u32;
+        while f64::from(1u32 << level) < longest / 2.0 {
             level += 1;
         }
         let n = 1u32 << level;
