@@ -18,7 +18,7 @@
 //! medians of five timed runs of about 0.2 s each; points are streamed
 //! through [`SurfaceSampler::sample_stream`] and summed, so memory
 //! bandwidth for storing them is not what is measured (the peer comparison
-//! stores them, as the peers do).
+//! stores their positions, as the peers do).
 
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -683,7 +683,7 @@ fn print_bar(rows: &[Row]) {
 }
 
 /// Our uniform sampler against trimesh and Open3D at N = 10⁷, all storing
-/// the points (the peers return arrays).
+/// the positions (the peers return arrays; trimesh adds face indices).
 fn peers(m: &TestMesh, file: &Path, threads: &[usize], json: bool) -> Result<(), String> {
     let mesh = m.mesh();
     let uniform = UniformSampler::new(mesh).map_err(|e| e.to_string())?;
@@ -693,7 +693,7 @@ fn peers(m: &TestMesh, file: &Path, threads: &[usize], json: bool) -> Result<(),
             (0..3)
                 .map(|seed| {
                     let start = Instant::now();
-                    black_box(uniform.sample_n(seed, PEER_N));
+                    black_box(uniform.sample_positions(seed, PEER_N));
                     start.elapsed().as_secs_f64()
                 })
                 .collect()
@@ -728,7 +728,7 @@ fn peers(m: &TestMesh, file: &Path, threads: &[usize], json: bool) -> Result<(),
     if json {
         for (t, r) in &ours {
             println!(
-                "{{\"mesh\": \"{}\", \"density\": \"uniform\", \"method\": \"uniform-sample-n\", \"msamples_per_s\": {r:.3}, \"threads\": {t}, \"n\": {PEER_N}}}",
+                "{{\"mesh\": \"{}\", \"density\": \"uniform\", \"method\": \"uniform-sample-positions\", \"msamples_per_s\": {r:.3}, \"threads\": {t}, \"n\": {PEER_N}}}",
                 m.name
             );
         }
@@ -738,13 +738,13 @@ fn peers(m: &TestMesh, file: &Path, threads: &[usize], json: bool) -> Result<(),
         return Ok(());
     }
     println!(
-        "\n## Against trimesh and Open3D ({}, N = 10⁷, points stored)\n",
+        "\n## Against trimesh and Open3D ({}, N = 10⁷, positions stored)\n",
         m.name
     );
     println!("| sampler | threads | M samples/s |");
     println!("|---|---:|---:|");
     for (t, r) in &ours {
-        println!("| mesh-sampling UniformSampler::sample_n | {t} | {r:.1} |");
+        println!("| mesh-sampling UniformSampler::sample_positions | {t} | {r:.1} |");
     }
     for (peer, r) in &peer_rates {
         println!("| {peer} | 1 | {r:.2} |");

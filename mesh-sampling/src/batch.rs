@@ -5,7 +5,7 @@ use rand::Rng;
 use rand::distr::Distribution;
 
 use crate::SurfacePoint;
-use crate::parallel::{for_each_chunk, stream};
+use crate::parallel::{for_each_chunk, for_each_chunk_via, stream};
 
 /// A sampler of points on a mesh, with batch APIs whose output depends
 /// only on the seed, never on the number of threads: points come in
@@ -24,6 +24,23 @@ pub trait SurfaceSampler: Distribution<SurfacePoint> + Sync {
     fn sample_n(&self, seed: u64, n: usize) -> Vec<SurfacePoint> {
         let mut out = vec![SurfacePoint::default(); n];
         for_each_chunk(seed, &mut out, |rng, chunk| self.sample_into(rng, chunk));
+        out
+    }
+
+    /// The positions of the points of [`sample_n`](Self::sample_n), as
+    /// plain `[x, y, z]`: a point cloud in a sixth of the memory (the
+    /// output of trimesh's `sample_surface` or Open3D's
+    /// `sample_points_uniformly`), which for 10⁷ points is also faster to
+    /// allocate and write.
+    fn sample_positions(&self, seed: u64, n: usize) -> Vec<[f32; 3]> {
+        // Zeroed arrays come from the allocator as zero pages, written once.
+        let mut out = vec![[0.0f32; 3]; n];
+        for_each_chunk_via(
+            seed,
+            &mut out,
+            |rng, chunk| self.sample_into(rng, chunk),
+            |p: &SurfacePoint| p.position.to_array(),
+        );
         out
     }
 

@@ -10,7 +10,8 @@
 //!   [`NaiveSampler`] (a triangle chosen uniformly) is the article's biased
 //!   baseline, kept so that the tests show they can fail.
 //!   [`MultiMeshSampler`] samples several meshes at once (the article's
-//!   last section); `sample_stable` is Blender's per-triangle mode.
+//!   last section), [`MultiDensitySampler`] the same by density mass;
+//!   `sample_stable` is Blender's per-triangle mode.
 //! - **Density textures** ([`DensitySampler`], Šik & Křivánek Sec.
 //!   3.3–3.5): each triangle is subdivided 1-to-4 until its sub-triangles
 //!   are about a texel, the bilinear density `f_i` is taken at
@@ -73,7 +74,7 @@ pub use batch::SurfaceSampler;
 pub use density::{Density, DensitySampler, Mode, Options};
 pub use error::Error;
 pub use mesh::MeshRef;
-pub use multi::{MeshPoint, MultiMeshSampler};
+pub use multi::{MeshPoint, MultiDensitySampler, MultiMeshSampler};
 pub use naive::NaiveSampler;
 pub use point::{SurfacePoint, uniform_barycentric};
 pub use projection::spherical_uvs;

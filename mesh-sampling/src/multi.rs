@@ -1,13 +1,14 @@
 //! Several meshes at once (the uniform-mesh-sampling article, last
-//! section): a small CDF over the meshes by total area above one sampler
-//! per mesh. Replacing or editing one mesh rebuilds only its own table and
-//! the top-level one, not a CDF over every triangle of the scene.
+//! section): a small CDF over the meshes by total area (or total density
+//! mass) above one sampler per mesh. Replacing or editing one mesh
+//! rebuilds only its own table and the top-level one, not a CDF over every
+//! triangle of the scene.
 
 use discrete_sampling::{DiscreteSampler, GuideTable};
 use rand::distr::Distribution;
 
 use crate::parallel::{for_each_chunk, unit};
-use crate::{Error, MeshRef, SurfacePoint, UniformSampler};
+use crate::{DensitySampler, Error, MeshRef, SurfacePoint, UniformSampler};
 
 /// A point and the mesh it lies on.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -144,5 +145,109 @@ impl Distribution<MeshPoint> for MultiMeshSampler<'_> {
         let u0 = unit(rng.next_u64());
         let u1 = unit(rng.next_u64());
         self.sample_u([u0, u1])
+    }
+}
+
+/// Draws points over several meshes, each with its own density (a
+/// texture, per-face or per-vertex weights, approximate or exact): mesh
+/// `i` with probability `M_i / ΣM` for the total masses `M_i` of its
+/// [`DensitySampler`] (its `∫ f dA`), then a point from that sampler. The
+/// densities should share a scale (the same texture units), as they do
+/// for one emitter split over several meshes.
+#[derive(Debug, Clone)]
+pub struct MultiDensitySampler<'a> {
+    meshes: Vec<DensitySampler<'a>>,
+    top: GuideTable,
+    /// Per mesh, `M_i / ΣM`: a point's density over the union is its
+    /// density on its own mesh times this.
+    shares: Vec<f64>,
+}
+
+impl<'a> MultiDensitySampler<'a> {
+    /// The table over the samplers' masses.
+    ///
+    /// # Errors
+    /// [`Error::Empty`] for no sampler.
+    pub fn new(meshes: impl IntoIterator<Item = DensitySampler<'a>>) -> Result<Self, Error> {
+        let meshes: Vec<DensitySampler<'a>> = meshes.into_iter().collect();
+        let (top, shares) = Self::top(&meshes)?;
+        Ok(Self {
+            meshes,
+            top,
+            shares,
+        })
+    }
+
+    fn top(meshes: &[DensitySampler<'a>]) -> Result<(GuideTable, Vec<f64>), Error> {
+        if meshes.is_empty() {
+            return Err(Error::Empty);
+        }
+        let masses: Vec<f64> = meshes.iter().map(DensitySampler::total_mass).collect();
+        let total: f64 = masses.iter().sum();
+        // Every sampler has a positive finite mass, so this cannot fail.
+        let top = GuideTable::new(&masses).map_err(|_| Error::ZeroDensity {
+            triangles: meshes.iter().map(|m| m.mesh().indices.len()).sum(),
+        })?;
+        Ok((top, masses.iter().map(|m| m / total).collect()))
+    }
+
+    /// Replaces the sampler of mesh `index` (after an edit of the mesh or
+    /// its density), rebuilding only the top-level table.
+    ///
+    /// # Errors
+    /// [`Error::NoSuchMesh`]; the sampler is unchanged then.
+    pub fn replace(&mut self, index: usize, sampler: DensitySampler<'a>) -> Result<(), Error> {
+        let count = self.meshes.len();
+        if index >= count {
+            return Err(Error::NoSuchMesh { index, count });
+        }
+        self.meshes[index] = sampler;
+        (self.top, self.shares) = Self::top(&self.meshes)?;
+        Ok(())
+    }
+
+    /// Number of meshes.
+    pub fn len(&self) -> usize {
+        self.meshes.len()
+    }
+
+    /// Always `false`: a sampler has at least one mesh.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// The total mass `ΣM` over all meshes.
+    pub fn total_mass(&self) -> f64 {
+        self.meshes.iter().map(DensitySampler::total_mass).sum()
+    }
+
+    /// The density (w.r.t. the area of all meshes) at barycentrics of
+    /// `face` of mesh `mesh`; 0 for no such mesh or face.
+    pub fn pdf(&self, mesh: usize, face: usize, barycentric: [f32; 3]) -> f32 {
+        match self.meshes.get(mesh) {
+            Some(m) => (f64::from(m.pdf(face, barycentric)) * self.shares[mesh]) as f32,
+            None => 0.0,
+        }
+    }
+
+    /// `n` points from `seed`, the same on any number of threads.
+    pub fn sample_n(&self, seed: u64, n: usize) -> Vec<MeshPoint> {
+        let mut out = vec![MeshPoint::default(); n];
+        for_each_chunk(seed, &mut out, |rng, chunk| {
+            for slot in chunk {
+                *slot = self.sample(rng);
+            }
+        });
+        out
+    }
+}
+
+impl Distribution<MeshPoint> for MultiDensitySampler<'_> {
+    /// One `u64` for the mesh, then the mesh's own sampler.
+    fn sample<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> MeshPoint {
+        let mesh = self.top.sample_rng(rng);
+        let mut point = self.meshes[mesh].sample(rng);
+        point.pdf = (f64::from(point.pdf) * self.shares[mesh]) as f32;
+        MeshPoint { mesh, point }
     }
 }

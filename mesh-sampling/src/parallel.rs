@@ -77,3 +77,35 @@ pub(crate) fn stream<T: Default + Clone + Send>(
         }
     }
 }
+
+/// Like [`for_each_chunk`], but each chunk is first filled into a reused
+/// buffer of `B` by `fill`, then converted into `out` by `store`: for
+/// outputs smaller than what the samplers produce.
+pub(crate) fn for_each_chunk_via<B: Default + Clone + Send, T: Send>(
+    seed: u64,
+    out: &mut [T],
+    fill: impl Fn(&mut Pcg64Mcg, &mut [B]) + Sync,
+    store: impl Fn(&B) -> T + Sync,
+) {
+    let run = |buf: &mut Vec<B>, (k, chunk): (usize, &mut [T])| {
+        buf.resize(chunk.len(), B::default());
+        fill(&mut chunk_rng(seed, k), buf);
+        for (slot, b) in chunk.iter_mut().zip(buf.iter()) {
+            *slot = store(b);
+        }
+    };
+    #[cfg(feature = "rayon")]
+    {
+        use rayon::prelude::*;
+        out.par_chunks_mut(CHUNK)
+            .enumerate()
+            .for_each_init(Vec::new, run);
+    }
+    #[cfg(not(feature = "rayon"))]
+    {
+        let mut buf = Vec::new();
+        for item in out.chunks_mut(CHUNK).enumerate() {
+            run(&mut buf, item);
+        }
+    }
+}

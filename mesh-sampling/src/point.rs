@@ -69,7 +69,7 @@ impl SurfacePoint {
         let corners = || mesh.indices[face as usize];
         let lerp3 = |v: [Vec3; 3]| v[0] * w0 + v[1] * w1 + v[2] * w2;
         Self {
-            position: frame.origin + frame.e1 * w1 + frame.e2 * w2,
+            position: frame.at(w1, w2),
             face,
             barycentric,
             normal: frame.normal,
@@ -106,6 +106,13 @@ impl Frame {
             e2: c - a,
             normal: (b - a).cross(c - a).normalize_or_zero(),
         }
+    }
+
+    /// The point with barycentric weights `w1`, `w2` on the second and
+    /// third corner.
+    #[inline]
+    pub(crate) fn at(&self, w1: f32, w2: f32) -> Vec3 {
+        self.origin + self.e1 * w1 + self.e2 * w2
     }
 
     /// The frames of every triangle of `mesh`.

@@ -6,7 +6,7 @@ use discrete_sampling::{DiscreteSampler, GuideTable};
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::parallel::{BLOCK, unit};
+use crate::parallel::{BLOCK, for_each_chunk, unit};
 use crate::point::{Frame, uniform_barycentric};
 use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 
@@ -191,14 +191,40 @@ impl SurfaceSampler for UniformSampler<'_> {
     /// repeated [`sample`](Distribution::sample) calls, which interleave
     /// the variates.
     fn sample_into<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
+        self.blocks(rng, out, |face, bary| self.point(face, bary));
+    }
+
+    /// The positions of [`sample_n`](SurfaceSampler::sample_n)'s points,
+    /// computed without the rest of each point.
+    fn sample_positions(&self, seed: u64, n: usize) -> Vec<[f32; 3]> {
+        let mut out = vec![[0.0f32; 3]; n];
+        for_each_chunk(seed, &mut out, |rng, chunk| {
+            self.blocks(rng, chunk, |face, [_, w1, w2]| {
+                self.frames[face as usize].at(w1, w2).to_array()
+            });
+        });
+        out
+    }
+}
+
+impl UniformSampler<'_> {
+    /// Fills `out` with `make(face, barycentrics)` for blocks of draws:
+    /// the block's triangles first, by the guide table's batch search (one
+    /// `u64` each), then the points (two `u64` each).
+    #[inline]
+    fn blocks<R: rand::Rng + ?Sized, T>(
+        &self,
+        rng: &mut R,
+        out: &mut [T],
+        make: impl Fn(u32, [f32; 3]) -> T,
+    ) {
         let mut faces = [0usize; BLOCK];
         for block in out.chunks_mut(BLOCK) {
             let faces = &mut faces[..block.len()];
             self.triangles.sample_into(rng, faces);
             for (slot, &face) in block.iter_mut().zip(faces.iter()) {
                 let u0 = unit(rng.next_u64());
-                let bary = uniform_barycentric(u0, unit(rng.next_u64()));
-                *slot = self.point(face as u32, bary);
+                *slot = make(face as u32, uniform_barycentric(u0, unit(rng.next_u64())));
             }
         }
     }

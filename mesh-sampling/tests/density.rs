@@ -532,7 +532,10 @@ fn streaming_hands_out_the_points_of_sample_n() {
     sampler.sample_stream(25, n, |first, chunk| {
         streamed.lock().unwrap()[first..first + chunk.len()].copy_from_slice(chunk);
     });
-    assert_eq!(streamed.into_inner().unwrap(), sampler.sample_n(25, n));
+    let points = sampler.sample_n(25, n);
+    assert_eq!(streamed.into_inner().unwrap(), points);
+    let positions: Vec<[f32; 3]> = points.iter().map(|p| p.position.to_array()).collect();
+    assert_eq!(sampler.sample_positions(25, n), positions);
 }
 
 #[test]

@@ -10,7 +10,9 @@
 mod stats;
 
 use glam::Vec3;
-use mesh_sampling::{Error, MeshRef, MultiMeshSampler};
+use mesh_sampling::{
+    Density, DensitySampler, Error, MeshRef, MultiDensitySampler, MultiMeshSampler,
+};
 use rand::SeedableRng;
 use rand::distr::Distribution;
 use rand_pcg::Pcg64Mcg;
@@ -106,4 +108,45 @@ fn errors_name_the_mesh_and_leave_the_sampler_unchanged() {
         (sampler.total_area() - 1.0).abs() < 1e-6,
         "unchanged after a failed replace"
     );
+}
+
+#[test]
+fn densities_over_several_meshes_follow_their_masses() {
+    let (a, b) = (square(1.0, 0.0), square(3f32.sqrt(), 1.0));
+    // Masses: 1 · 1 and 2 · 3.
+    let (wa, wb, wc) = ([1.0f32; 2], [2.0f32; 2], [6.0f32; 2]);
+    fn build<'a>(p: &'a [Vec3], w: &'a [f32]) -> DensitySampler<'a> {
+        DensitySampler::new(MeshRef::new(p, &QUAD), Density::PerFace(w)).unwrap()
+    }
+    let mut sampler = MultiDensitySampler::new([build(&a, &wa), build(&b, &wb)]).unwrap();
+    assert!((sampler.total_mass() - 7.0).abs() < 1e-5);
+    let count = |s: &MultiDensitySampler<'_>| {
+        let mut counts = vec![0u64; 2];
+        for p in s.sample_n(3, 200_000) {
+            counts[p.mesh] += 1;
+            assert_eq!(p.point.position.z, p.mesh as f32);
+            let pdf = s.pdf(p.mesh, p.point.face as usize, p.point.barycentric);
+            assert!((pdf - p.point.pdf).abs() < 1e-6 * pdf);
+        }
+        counts
+    };
+    let counts = count(&sampler);
+    let test = stats::chi_square(&counts, &[1.0 / 7.0, 6.0 / 7.0], 20.0);
+    assert!(test.p_value > 1e-3, "{counts:?}");
+    // Density 1/7 per unit area on mesh 0, 2/7 on mesh 1: ∫ = 1/7 + 6/7.
+    assert!((sampler.pdf(0, 0, [0.3, 0.3, 0.4]) - 1.0 / 7.0).abs() < 1e-6);
+    assert!((sampler.pdf(1, 1, [0.3, 0.3, 0.4]) - 2.0 / 7.0).abs() < 1e-6);
+    // Mesh 0's weight grows to 6: masses 6 and 6.
+    sampler.replace(0, build(&a, &wc)).unwrap();
+    let counts = count(&sampler);
+    assert!(
+        stats::chi_square(&counts, &[0.5, 0.5], 20.0).p_value > 1e-3,
+        "{counts:?}"
+    );
+    assert!(stats::chi_square(&counts, &[1.0 / 7.0, 6.0 / 7.0], 20.0).p_value < 1e-9);
+    assert!(matches!(
+        sampler.replace(2, build(&a, &wa)),
+        Err(Error::NoSuchMesh { index: 2, count: 2 })
+    ));
+    assert!(matches!(MultiDensitySampler::new([]), Err(Error::Empty)));
 }

@@ -219,6 +219,8 @@ fn parallel_batches_do_not_depend_on_the_thread_count() {
     let one = run(1);
     assert_eq!(one, run(2));
     assert_eq!(one, sampler.sample_n(99, n));
+    let positions: Vec<[f32; 3]> = one.iter().map(|p| p.position.to_array()).collect();
+    assert_eq!(sampler.sample_positions(99, n), positions);
     assert_ne!(one, sampler.sample_n(100, n));
 }
 
