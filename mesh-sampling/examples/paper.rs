@@ -531,22 +531,24 @@ fn measure_pair(
     let (ms, no_table) =
         build(|| DensitySampler::<CdfBisection>::with_table(mesh, density, &Options::default()));
     let no_table = no_table.map_err(|e| e.to_string())?;
+    let bytes = no_table.memory_bytes();
     rows.push(row(
         "subdivision-no-table",
         rate(&no_table),
         ms,
-        no_table.memory_bytes() as f64 / 1e6,
+        bytes as f64 / 1e6,
         1.0,
         no_table.pieces(),
     ));
     drop(no_table);
     let (ms, table) = build(|| DensitySampler::new(mesh, density));
     let table = table.map_err(|e| e.to_string())?;
+    let bytes = table.memory_bytes();
     rows.push(row(
         "subdivision",
         rate(&table),
         ms,
-        table.memory_bytes() as f64 / 1e6,
+        bytes as f64 / 1e6,
         1.0,
         table.pieces(),
     ));

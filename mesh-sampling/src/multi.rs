@@ -130,13 +130,7 @@ impl<'a> MultiMeshSampler<'a> {
 
     /// `n` points from `seed`, the same on any number of threads.
     pub fn sample_n(&self, seed: u64, n: usize) -> Vec<MeshPoint> {
-        let mut out = vec![MeshPoint::default(); n];
-        for_each_chunk(seed, &mut out, |rng, chunk| {
-            for slot in chunk {
-                *slot = self.sample(rng);
-            }
-        });
-        out
+        sample_points(self, seed, n)
     }
 }
 
@@ -232,13 +226,7 @@ impl<'a> MultiDensitySampler<'a> {
 
     /// `n` points from `seed`, the same on any number of threads.
     pub fn sample_n(&self, seed: u64, n: usize) -> Vec<MeshPoint> {
-        let mut out = vec![MeshPoint::default(); n];
-        for_each_chunk(seed, &mut out, |rng, chunk| {
-            for slot in chunk {
-                *slot = self.sample(rng);
-            }
-        });
-        out
+        sample_points(self, seed, n)
     }
 }
 
@@ -250,4 +238,19 @@ impl Distribution<MeshPoint> for MultiDensitySampler<'_> {
         point.pdf = (f64::from(point.pdf) * self.shares[mesh]) as f32;
         MeshPoint { mesh, point }
     }
+}
+
+/// `n` points of `sampler` from `seed`, in chunks with their own streams.
+fn sample_points(
+    sampler: &(impl Distribution<MeshPoint> + Sync),
+    seed: u64,
+    n: usize,
+) -> Vec<MeshPoint> {
+    let mut out = vec![MeshPoint::default(); n];
+    for_each_chunk(seed, &mut out, |rng, chunk| {
+        for slot in chunk {
+            *slot = sampler.sample(rng);
+        }
+    });
+    out
 }

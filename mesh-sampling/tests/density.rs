@@ -749,23 +749,14 @@ fn bunny_checkerboard_exact_mode_never_lands_on_black() {
     .unwrap()
     .with_filter(Filter::Nearest);
     let m: Mesh = (positions.clone(), uvs.clone(), indices.clone());
-    let sampler = DensitySampler::with_options(mesh, Density::Texture(&t), &exact()).unwrap();
-    let counts = texel_counts(&m, &t, &sampler.sample_n(24, 200_000));
-    let black: u64 = counts
-        .iter()
-        .zip(t.texels())
-        .filter(|(_, v)| **v == 0.0)
-        .map(|(c, _)| c)
-        .sum();
-    assert_eq!(black, 0);
-    let approximate = DensitySampler::new(mesh, Density::Texture(&t)).unwrap();
-    let counts = texel_counts(&m, &t, &approximate.sample_n(24, 200_000));
-    let black: u64 = counts
-        .iter()
-        .zip(t.texels())
-        .filter(|(_, v)| **v == 0.0)
-        .map(|(c, _)| c)
-        .sum();
+    let on_black = |s: &DensitySampler<'_>| -> u64 {
+        let counts = texel_counts(&m, &t, &s.sample_n(24, 200_000));
+        let black = counts.iter().zip(t.texels()).filter(|(_, v)| **v == 0.0);
+        black.map(|(c, _)| c).sum()
+    };
+    let exact_sampler = DensitySampler::with_options(mesh, Density::Texture(&t), &exact()).unwrap();
+    assert_eq!(on_black(&exact_sampler), 0);
+    let black = on_black(&DensitySampler::new(mesh, Density::Texture(&t)).unwrap());
     eprintln!(
         "approximate mode: {black} of 200000 points on black (sub-triangles straddling texel edges)"
     );
