@@ -11,7 +11,7 @@
 //!   baseline, kept so that the tests show they can fail.
 //!   [`MultiMeshSampler`] samples several meshes at once (the article's
 //!   last section), [`MultiDensitySampler`] the same by density mass;
-//!   `sample_stable` is Blender's per-triangle mode.
+//!   `sample_stable` (here and on [`DensitySampler`]) is Blender's per-triangle mode.
 //! - **Density textures** ([`DensitySampler`], Šik & Křivánek Sec.
 //!   3.3–3.5): each triangle is subdivided 1-to-4 until its sub-triangles
 //!   are about a texel, the bilinear density `f_i` is taken at

@@ -361,6 +361,72 @@ fn per_face_and_per_vertex_weights() {
 }
 
 #[test]
+fn stable_mode_counts_by_mass_and_keeps_untouched_triangles() {
+    let m = grid(6, |uv| uv);
+    let mesh = mesh_ref(&m);
+    let face_w: Vec<f32> = (0..m.2.len()).map(|f| ((f * 7) % 5) as f32).collect();
+    let rate = 3_000.0;
+    let sampler = DensitySampler::new(mesh, Density::PerFace(&face_w)).unwrap();
+    let before = sampler.sample_stable(5, rate).unwrap();
+    // Each triangle gets rate · mass rounded down or up; none on weight 0.
+    for (f, tri) in m.2.iter().enumerate() {
+        let n = before.iter().filter(|p| p.face as usize == f).count() as f64;
+        let expected = rate * f64::from(face_w[f]) * area(tri.map(|i| m.0[i as usize]));
+        assert!(
+            (n - expected.floor()).abs() < 1e-9 || (n - expected.ceil()).abs() < 1e-9,
+            "face {f}: {n} for {expected}"
+        );
+    }
+    // Reweighting triangle 0 moves none of the other points.
+    let mut reweighted = face_w.clone();
+    reweighted[0] = 4.5;
+    let edited = DensitySampler::new(mesh, Density::PerFace(&reweighted)).unwrap();
+    let after = edited.sample_stable(5, rate).unwrap();
+    let others = |points: &[SurfacePoint]| -> Vec<(u32, [f32; 3])> {
+        points
+            .iter()
+            .filter(|p| p.face != 0)
+            .map(|p| (p.face, p.barycentric))
+            .collect()
+    };
+    assert_eq!(others(&before), others(&after));
+    assert_ne!(before.len(), after.len());
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    assert_eq!(
+        one.install(|| sampler.sample_stable(5, rate).unwrap()),
+        before
+    );
+    assert!(sampler.sample_stable(5, f64::NAN).is_err());
+    assert!(sampler.sample_stable(5, -2.0).is_err());
+
+    // Exact mode thins the proposals: never on black, and the total keeps
+    // rate · (exact mass) within a few standard deviations.
+    let k = 8;
+    let texels = (0..k * k).map(|i| ((i % k + i / k) % 2) as f32).collect();
+    let t = DensityTexture::new(k, k, texels).unwrap();
+    let m = grid(9, skewed);
+    let sampler =
+        DensitySampler::with_options(mesh_ref(&m), Density::Texture(&t), &exact()).unwrap();
+    let rate = 200_000.0;
+    let points = sampler.sample_stable(6, rate).unwrap();
+    let expected: f64 = rate * exact_face_masses(&m, &t).iter().sum::<f64>();
+    let n = points.len() as f64;
+    assert!(
+        (n - expected).abs() < 5.0 * expected.sqrt(),
+        "{n} points for {expected}"
+    );
+    for p in &points {
+        assert!(
+            bilinear(&t, uv_of(&m, p)) > 0.0,
+            "a point where the density is 0"
+        );
+    }
+}
+
+#[test]
 fn a_linear_density_is_linear_inside_the_triangle() {
     // Weight on the first corner only: density ∝ b0, so b0 ~ Beta(2, 2)
     // (CDF 3x² − 2x³) and b1 has CDF 1 − (1 − x)³.
