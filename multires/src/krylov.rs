@@ -1,0 +1,431 @@
+//! Krylov solvers: Jacobi-preconditioned CG for symmetric positive
+//! definite systems, CG with any symmetric preconditioner, and
+//! Jacobi-preconditioned BiCGSTAB for the non-symmetric coarse systems.
+//!
+//! Every solver starts from the `x` it is given (a warm start), stops at a
+//! relative residual `‖b − A x‖ / ‖b‖ ≤ tolerance` or after
+//! `max_iterations`, and reports the residual of the `x` it returns,
+//! recomputed from `b − A x` rather than taken from the recurrence (which
+//! drifts in floating point); when the two disagree the solver restarts
+//! from the current `x` instead of stopping early.
+
+use std::ops::ControlFlow;
+
+use sprs::CsMat;
+
+use crate::Error;
+use crate::matrix::{check_square, check_vector, inverse_diagonal, mul_vec};
+use crate::vector::{axpy, cg_update, dot, norm, scale_dot, xpby};
+
+/// When a solver stops.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveOptions {
+    /// Relative residual `‖b − A x‖ / ‖b‖` to reach.
+    pub tolerance: f64,
+    /// Iterations allowed (one mat-vec each for CG, two for BiCGSTAB).
+    pub max_iterations: usize,
+}
+
+impl Default for SolveOptions {
+    /// `10⁻⁶` in at most 10 000 iterations.
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-6,
+            max_iterations: 10_000,
+        }
+    }
+}
+
+impl SolveOptions {
+    fn check(&self) -> Result<(), Error> {
+        if !(self.tolerance >= 0.0 && self.tolerance.is_finite()) {
+            return Err(Error::InvalidOption("tolerance must be finite and ≥ 0"));
+        }
+        Ok(())
+    }
+}
+
+/// Why a solver stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stop {
+    /// The relative residual reached the tolerance.
+    Converged,
+    /// The iteration cap came first.
+    MaxIterations,
+    /// A scalar of the recurrence vanished or stopped being finite (for
+    /// CG: the matrix or preconditioner is not positive definite); `x` is
+    /// the last finite iterate.
+    Breakdown,
+    /// The monitor asked to stop (a time budget, an outside error target).
+    Interrupted,
+    /// A restart from the current `x` no longer lowered the true residual:
+    /// the accuracy floating point allows is reached above the tolerance.
+    Stagnated,
+}
+
+/// What a solve did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Report {
+    /// Why it stopped.
+    pub stop: Stop,
+    /// Iterations done.
+    pub iterations: usize,
+    /// `‖b − A x‖ / ‖b‖` of the returned `x` (`‖b − A x‖` when `b = 0`).
+    pub residual: f64,
+}
+
+impl Report {
+    /// Whether the tolerance was reached.
+    pub fn converged(&self) -> bool {
+        self.stop == Stop::Converged
+    }
+}
+
+/// A symmetric positive definite approximation of `A⁻¹`, applied as
+/// `z ← M⁻¹ r` in [`pcg`].
+pub trait Preconditioner: Sync {
+    /// `z ← M⁻¹ r`.
+    fn apply(&self, r: &[f64], z: &mut [f64]);
+}
+
+/// Jacobi: `M = diag(A)`.
+#[derive(Debug, Clone)]
+pub struct Jacobi {
+    inverse: Vec<f64>,
+}
+
+impl Jacobi {
+    /// # Errors
+    /// [`Error::BadDiagonal`] for a zero or negative diagonal entry, and
+    /// the checks of [`cg`].
+    pub fn new(a: &CsMat<f64>) -> Result<Self, Error> {
+        check_square(a)?;
+        Ok(Self {
+            inverse: inverse_diagonal(a, true)?,
+        })
+    }
+}
+
+impl Preconditioner for Jacobi {
+    fn apply(&self, r: &[f64], z: &mut [f64]) {
+        use rayon::prelude::*;
+        z.par_iter_mut()
+            .zip(r.par_iter().zip(&self.inverse))
+            .for_each(|(z, (r, d))| *z = r * d);
+    }
+}
+
+/// Called after every iteration with its number and the current `x`;
+/// returning `ControlFlow::Break(())` stops the solver (an interactive
+/// application's time budget, a benchmark's error target).
+pub type Monitor<'m> = &'m mut dyn FnMut(usize, &[f64]) -> ControlFlow<()>;
+
+fn no_monitor() -> impl FnMut(usize, &[f64]) -> ControlFlow<()> {
+    |_, _| ControlFlow::Continue(())
+}
+
+/// Jacobi-preconditioned conjugate gradients for a symmetric positive
+/// definite `a`, from the start vector `x`.
+///
+/// # Errors
+/// [`Error::NotCsr`], [`Error::NotSquare`], [`Error::DimensionMismatch`],
+/// [`Error::NotFiniteEntry`] / [`Error::NotFiniteVector`] for NaN or
+/// infinite input, [`Error::BadDiagonal`] for a zero or negative diagonal.
+///
+/// # Example
+/// ```
+/// use multires::{cg, grid, SolveOptions};
+/// let problem = grid::diffusion([8, 8, 8], 3.0);
+/// let mut x = vec![0.0; problem.matrix.rows()];
+/// let report = cg(&problem.matrix, &problem.rhs, &mut x, &SolveOptions::default()).unwrap();
+/// assert!(report.converged() && report.residual <= 1e-6);
+/// ```
+pub fn cg(
+    a: &CsMat<f64>,
+    b: &[f64],
+    x: &mut [f64],
+    options: &SolveOptions,
+) -> Result<Report, Error> {
+    cg_monitored(a, b, x, options, &mut no_monitor())
+}
+
+/// [`cg`] calling `monitor` after every iteration.
+///
+/// # Errors
+/// As [`cg`].
+pub fn cg_monitored(
+    a: &CsMat<f64>,
+    b: &[f64],
+    x: &mut [f64],
+    options: &SolveOptions,
+    monitor: Monitor<'_>,
+) -> Result<Report, Error> {
+    let jacobi = Jacobi::new(a)?;
+    pcg_monitored(a, b, x, &jacobi, options, monitor)
+}
+
+/// Conjugate gradients preconditioned by `m` (symmetric positive definite).
+///
+/// # Errors
+/// As [`cg`], without the diagonal check.
+pub fn pcg(
+    a: &CsMat<f64>,
+    b: &[f64],
+    x: &mut [f64],
+    m: &impl Preconditioner,
+    options: &SolveOptions,
+) -> Result<Report, Error> {
+    pcg_monitored(a, b, x, m, options, &mut no_monitor())
+}
+
+/// [`pcg`] calling `monitor` after every iteration.
+///
+/// # Errors
+/// As [`pcg`].
+pub fn pcg_monitored(
+    a: &CsMat<f64>,
+    b: &[f64],
+    x: &mut [f64],
+    m: &(impl Preconditioner + ?Sized),
+    options: &SolveOptions,
+    monitor: Monitor<'_>,
+) -> Result<Report, Error> {
+    let n = check_square(a)?;
+    check_vector("right-hand side", b, n)?;
+    check_vector("start vector", x, n)?;
+    options.check()?;
+    let scale = nonzero(norm(b));
+    let mut r = vec![0.0; n];
+    let mut z = vec![0.0; n];
+    let mut p = vec![0.0; n];
+    let mut q = vec![0.0; n];
+    let mut done = 0;
+    let mut residual = residual_into(a, b, x, &mut r) / scale;
+    while done < options.max_iterations && residual > options.tolerance {
+        // One CG run; it ends when its recurrence says converged, then the
+        // true residual decides whether to restart.
+        m.apply(&r, &mut z);
+        let mut rz = dot(&r, &z);
+        p.copy_from_slice(&z);
+        let mut broke = false;
+        let mut interrupted = false;
+        while done < options.max_iterations {
+            mul_vec(a, &p, &mut q);
+            let pq = dot(&p, &q);
+            let alpha = rz / pq;
+            if !(alpha.is_finite() && pq > 0.0) {
+                broke = true;
+                break;
+            }
+            let rr = cg_update(alpha, &p, &q, x, &mut r);
+            done += 1;
+            if monitor(done, x).is_break() {
+                interrupted = true;
+                break;
+            }
+            if rr.sqrt() / scale <= options.tolerance {
+                break;
+            }
+            let rz_next = scale_dot_precond(m, &r, &mut z);
+            let beta = rz_next / rz;
+            if !beta.is_finite() {
+                broke = true;
+                break;
+            }
+            rz = rz_next;
+            xpby(&z, beta, &mut p);
+        }
+        let before = residual;
+        residual = residual_into(a, b, x, &mut r) / scale;
+        if broke || !residual.is_finite() {
+            return Ok(Report {
+                stop: Stop::Breakdown,
+                iterations: done,
+                residual,
+            });
+        }
+        if interrupted {
+            return Ok(Report {
+                stop: Stop::Interrupted,
+                iterations: done,
+                residual,
+            });
+        }
+        if residual > options.tolerance && residual >= before && done < options.max_iterations {
+            // A restart that gains nothing would loop: the attainable accuracy is reached.
+            return Ok(Report {
+                stop: Stop::Stagnated,
+                iterations: done,
+                residual,
+            });
+        }
+    }
+    Ok(Report {
+        stop: if residual <= options.tolerance {
+            Stop::Converged
+        } else {
+            Stop::MaxIterations
+        },
+        iterations: done,
+        residual,
+    })
+}
+
+/// `z ← M⁻¹ r`, returning `r · z`.
+fn scale_dot_precond(m: &(impl Preconditioner + ?Sized), r: &[f64], z: &mut [f64]) -> f64 {
+    m.apply(r, z);
+    dot(r, z)
+}
+
+/// Jacobi-preconditioned BiCGSTAB (van der Vorst 1992, right
+/// preconditioning) for a general non-singular `a`, from the start vector
+/// `x`. Each iteration costs two mat-vecs.
+///
+/// # Errors
+/// As [`cg`], with [`Error::BadDiagonal`] only for a zero diagonal entry.
+pub fn bicgstab(
+    a: &CsMat<f64>,
+    b: &[f64],
+    x: &mut [f64],
+    options: &SolveOptions,
+) -> Result<Report, Error> {
+    bicgstab_monitored(a, b, x, options, &mut no_monitor())
+}
+
+/// [`bicgstab`] calling `monitor` after every iteration.
+///
+/// # Errors
+/// As [`bicgstab`].
+pub fn bicgstab_monitored(
+    a: &CsMat<f64>,
+    b: &[f64],
+    x: &mut [f64],
+    options: &SolveOptions,
+    monitor: Monitor<'_>,
+) -> Result<Report, Error> {
+    let n = check_square(a)?;
+    check_vector("right-hand side", b, n)?;
+    check_vector("start vector", x, n)?;
+    options.check()?;
+    let inverse = inverse_diagonal(a, false)?;
+    let scale = nonzero(norm(b));
+    let mut r = vec![0.0; n];
+    let mut done = 0;
+    let mut residual = residual_into(a, b, x, &mut r) / scale;
+    let (mut p, mut v, mut y, mut s, mut z, mut t) = (
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0.0; n],
+    );
+    while done < options.max_iterations && residual > options.tolerance {
+        let shadow = r.clone();
+        let (mut rho, mut alpha, mut omega) = (1.0, 1.0, 1.0);
+        p.fill(0.0);
+        v.fill(0.0);
+        let mut broke = false;
+        let mut interrupted = false;
+        while done < options.max_iterations {
+            let rho_next = dot(&shadow, &r);
+            let beta = (rho_next / rho) * (alpha / omega);
+            if rho_next == 0.0 || !beta.is_finite() {
+                broke = true;
+                break;
+            }
+            rho = rho_next;
+            // p ← r + β (p − ω v)
+            axpy(-omega, &v, &mut p);
+            xpby(&r, beta, &mut p);
+            let _ = scale_dot(&inverse, &p, &mut y, &p);
+            mul_vec(a, &y, &mut v);
+            alpha = rho / dot(&shadow, &v);
+            if !alpha.is_finite() {
+                broke = true;
+                break;
+            }
+            s.copy_from_slice(&r);
+            axpy(-alpha, &v, &mut s);
+            done += 1;
+            if norm(&s) / scale <= options.tolerance {
+                axpy(alpha, &y, x);
+                interrupted = monitor(done, x).is_break();
+                break;
+            }
+            let _ = scale_dot(&inverse, &s, &mut z, &s);
+            mul_vec(a, &z, &mut t);
+            let tt = dot(&t, &t);
+            omega = dot(&t, &s) / tt;
+            if !(omega.is_finite() && omega != 0.0) {
+                broke = true;
+                break;
+            }
+            axpy(alpha, &y, x);
+            axpy(omega, &z, x);
+            r.copy_from_slice(&s);
+            axpy(-omega, &t, &mut r);
+            if monitor(done, x).is_break() {
+                interrupted = true;
+                break;
+            }
+            if norm(&r) / scale <= options.tolerance {
+                break;
+            }
+        }
+        let before = residual;
+        residual = residual_into(a, b, x, &mut r) / scale;
+        if !residual.is_finite() {
+            return Ok(Report {
+                stop: Stop::Breakdown,
+                iterations: done,
+                residual,
+            });
+        }
+        if residual <= options.tolerance {
+            break;
+        }
+        if interrupted {
+            return Ok(Report {
+                stop: Stop::Interrupted,
+                iterations: done,
+                residual,
+            });
+        }
+        if broke && residual >= before {
+            return Ok(Report {
+                stop: Stop::Breakdown,
+                iterations: done,
+                residual,
+            });
+        }
+        if !broke && residual >= before && done < options.max_iterations {
+            return Ok(Report {
+                stop: Stop::Stagnated,
+                iterations: done,
+                residual,
+            });
+        }
+    }
+    Ok(Report {
+        stop: if residual <= options.tolerance {
+            Stop::Converged
+        } else {
+            Stop::MaxIterations
+        },
+        iterations: done,
+        residual,
+    })
+}
+
+/// `r ← b − A x`, returning `‖r‖`.
+pub(crate) fn residual_into(a: &CsMat<f64>, b: &[f64], x: &[f64], r: &mut [f64]) -> f64 {
+    mul_vec(a, x, r);
+    xpby(b, -1.0, r);
+    norm(r)
+}
+
+/// `‖b‖`, or 1 for `b = 0` (then the residual is absolute).
+fn nonzero(v: f64) -> f64 {
+    if v > 0.0 { v } else { 1.0 }
+}

@@ -1,0 +1,69 @@
+//! Sparse linear solvers for diffusion-type systems: Jacobi-preconditioned
+//! CG and BiCGSTAB on [`sprs`] CSR matrices, and the parallel
+//! multi-resolution solver of TransCut (Li et al., *TransCut: Interactive
+//! Rendering of Translucent Cutouts*, Sec. 4) — a graph hierarchy built
+//! from scratch in parallel whenever the matrix changes (after every cut),
+//! then solved coarse to fine.
+//!
+//! - [`cg`], [`bicgstab`], [`pcg`]: warm start, relative-residual
+//!   tolerance, iteration cap, and a [`Report`] that says whether they
+//!   converged, in how many iterations, with the true final residual.
+//!   Mat-vecs and vector operations run in parallel with results that do
+//!   not depend on the number of threads.
+//! - [`Hierarchy`] (Sec. 4.1): per-vertex 32-bit codes (hashed random
+//!   high bits, the index in the low bits); rounds of independent-set
+//!   selection where a vertex whose code is below its candidate
+//!   neighbours' is kept; the enhancement that re-inserts vertices until
+//!   every edge between two dropped vertices has a kept common neighbour;
+//!   coarse edges between kept vertices two rings apart, sorted and
+//!   deduplicated; the interpolation of Eq. 16,
+//!   `φ^l_i = Σ_{j∈R(i)} λ_ij φ^{l+1}_j / λ_i` with `λ_ij = 1/|x_i − x_j|`
+//!   or caller-given weights.
+//! - [`coarse`] (Sec. 4.2): Eq. 17's coarse systems `S M P`, `S b`, and
+//!   the Galerkin operator `Pᵀ M P`.
+//! - [`Cascade`]: the paper's solve — coarsest level by BiCGSTAB to
+//!   convergence (falling back to the next finer level if it does not
+//!   converge), a few BiCGSTAB iterations per intermediate level, CG on
+//!   the original system.
+//! - [`VCycle`] (beyond the paper, which notes its interpolation could
+//!   drive a full multigrid solver): a symmetric V-cycle (Galerkin coarse
+//!   operators, damped Jacobi, exact coarsest solve) preconditioning CG.
+//! - [`grid`]: the 7-point diffusion system on 3D grids, for tests and
+//!   benchmarks.
+//!
+//! # Example
+//! ```
+//! use multires::{cg, grid, SolveOptions, VCycle, VCycleOptions, Weights};
+//! let p = grid::diffusion([20, 20, 20], 6.0);
+//! let options = SolveOptions { tolerance: 1e-8, max_iterations: 1_000 };
+//!
+//! let mut plain = vec![0.0; p.rhs.len()];
+//! let jacobi = cg(&p.matrix, &p.rhs, &mut plain, &options).unwrap();
+//!
+//! let v = VCycle::new(&p.matrix, Weights::Positions(&p.positions), &VCycleOptions::default()).unwrap();
+//! let mut x = vec![0.0; p.rhs.len()];
+//! let multigrid = v.solve(&p.rhs, &mut x, &options).unwrap();
+//! assert!(multigrid.converged() && multigrid.iterations < jacobi.iterations);
+//! ```
+
+pub mod cascade;
+pub mod coarse;
+mod dense;
+mod error;
+pub mod graph;
+pub mod grid;
+pub mod hierarchy;
+pub mod krylov;
+pub mod matrix;
+pub mod vcycle;
+pub mod vector;
+
+pub use cascade::{Cascade, CascadeOptions, CascadeReport, CoarseSystem};
+pub use error::Error;
+pub use graph::Graph;
+pub use hierarchy::{Coarsening, Hierarchy, HierarchyOptions, Weights};
+pub use krylov::{
+    Jacobi, Monitor, Preconditioner, Report, SolveOptions, Stop, bicgstab, bicgstab_monitored, cg,
+    cg_monitored, pcg, pcg_monitored,
+};
+pub use vcycle::{VCycle, VCycleOptions};

@@ -1,0 +1,303 @@
+//! Beyond the paper: the hierarchy's interpolation (Eq. 16) as the
+//! prolongation of an algebraic multigrid V-cycle, used as the
+//! preconditioner of CG on the original system. Coarse operators are
+//! Galerkin products `Pᵀ M P` (symmetric positive definite when `M` is),
+//! restriction is `Pᵀ`, smoothing is damped Jacobi with as many sweeps
+//! after the coarse correction as before it, and the coarsest level is
+//! solved exactly by Cholesky — so the V-cycle is a symmetric positive
+//! definite operator and CG's theory holds.
+
+use rayon::prelude::*;
+use sprs::CsMat;
+
+use crate::Error;
+use crate::coarse::galerkin;
+use crate::dense::Cholesky;
+use crate::graph::Graph;
+use crate::hierarchy::{Hierarchy, HierarchyOptions, Weights};
+use crate::krylov::{Monitor, Preconditioner, Report, SolveOptions, pcg_monitored};
+use crate::matrix::{check_square, inverse_diagonal, mul_vec, transpose};
+use crate::vector::CHUNK;
+
+/// How the V-cycle is built and smooths.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VCycleOptions {
+    /// How the hierarchy is built (no enhancement by default: Galerkin
+    /// operators keep every connection by themselves).
+    pub hierarchy: HierarchyOptions,
+    /// Jacobi sweeps before and after each coarse correction.
+    pub sweeps: usize,
+    /// Jacobi damping ω.
+    pub damping: f64,
+}
+
+impl Default for VCycleOptions {
+    fn default() -> Self {
+        Self {
+            hierarchy: HierarchyOptions {
+                coarsest: 400,
+                max_levels: 20,
+                enhance: false,
+                ..HierarchyOptions::default()
+            },
+            sweeps: 2,
+            damping: 0.6,
+        }
+    }
+}
+
+/// Coarsest levels above this size are smoothed instead of factored.
+const DENSE_LIMIT: usize = 3_000;
+
+/// One level of the V-cycle below the original.
+#[derive(Debug, Clone)]
+struct Level {
+    matrix: CsMat<f64>,
+    inverse_diagonal: Vec<f64>,
+}
+
+/// The V-cycle preconditioner of a matrix `m` it borrows.
+#[derive(Debug)]
+pub struct VCycle<'m> {
+    fine: &'m CsMat<f64>,
+    fine_inverse_diagonal: Vec<f64>,
+    /// Levels 1.. (Galerkin operators).
+    levels: Vec<Level>,
+    /// `P_l` and `P_lᵀ` between level `l` and `l + 1`.
+    prolong: Vec<CsMat<f64>>,
+    restrict: Vec<CsMat<f64>>,
+    coarsest: Option<Cholesky>,
+    options: VCycleOptions,
+    hierarchy: Hierarchy,
+    work: std::sync::Mutex<Option<Work>>,
+}
+
+impl<'m> VCycle<'m> {
+    /// Builds the hierarchy and the Galerkin operators of `m`
+    /// (symmetric positive definite).
+    ///
+    /// # Errors
+    /// Those of [`Hierarchy::new`]; [`Error::BadDiagonal`] for a diagonal
+    /// entry ≤ 0; [`Error::NotPositiveDefinite`] if the coarsest operator
+    /// cannot be factored; [`Error::InvalidOption`] for a damping outside
+    /// (0, 1].
+    pub fn new(
+        m: &'m CsMat<f64>,
+        weights: Weights<'_>,
+        options: &VCycleOptions,
+    ) -> Result<Self, Error> {
+        if !(options.damping > 0.0 && options.damping <= 1.0) {
+            return Err(Error::InvalidOption("damping must be in (0, 1]"));
+        }
+        check_square(m)?;
+        let fine_inverse_diagonal = inverse_diagonal(m, true)?;
+        // Each level's graph is that of its Galerkin operator, so the
+        // coarsening follows the couplings the operator really has.
+        let mut levels: Vec<Level> = Vec::new();
+        let mut failure = None;
+        let hierarchy = Hierarchy::build(m, weights, &options.hierarchy, |_, step| {
+            let finer = levels.last().map_or(m, |l| &l.matrix);
+            let matrix = galerkin(finer, step);
+            let graph = Graph::from_matrix(&matrix);
+            match inverse_diagonal(&matrix, true) {
+                Ok(inverse_diagonal) => levels.push(Level {
+                    matrix,
+                    inverse_diagonal,
+                }),
+                Err(e) => failure = Some(e),
+            }
+            failure.clone().map_or(Ok(graph), Err)
+        })?;
+        // The last step may have been rejected (too little coarsening).
+        levels.truncate(hierarchy.steps.len());
+        let prolong: Vec<CsMat<f64>> = hierarchy
+            .steps
+            .iter()
+            .map(|s| s.interpolation.clone())
+            .collect();
+        let restrict: Vec<CsMat<f64>> = prolong.iter().map(transpose).collect();
+        let last = levels.last().map_or(m, |l| &l.matrix);
+        let coarsest = if last.rows() <= DENSE_LIMIT {
+            Some(Cholesky::new(last)?)
+        } else {
+            None
+        };
+        Ok(Self {
+            fine: m,
+            fine_inverse_diagonal,
+            levels,
+            prolong,
+            restrict,
+            coarsest,
+            options: *options,
+            hierarchy,
+            work: std::sync::Mutex::new(None),
+        })
+    }
+
+    /// The hierarchy.
+    pub fn hierarchy(&self) -> &Hierarchy {
+        &self.hierarchy
+    }
+
+    /// Stored entries of all operators divided by those of the original
+    /// (the "operator complexity" of multigrid).
+    pub fn operator_complexity(&self) -> f64 {
+        let coarse: usize = self.levels.iter().map(|l| l.matrix.nnz()).sum();
+        (self.fine.nnz() + coarse) as f64 / self.fine.nnz() as f64
+    }
+
+    fn matrix(&self, level: usize) -> (&CsMat<f64>, &[f64]) {
+        match level {
+            0 => (self.fine, &self.fine_inverse_diagonal),
+            l => (
+                &self.levels[l - 1].matrix,
+                &self.levels[l - 1].inverse_diagonal,
+            ),
+        }
+    }
+
+    /// `z₀ ← V r₀`: down the levels (smooth from zero, restrict the
+    /// residual), the exact coarsest solve, up the levels (prolong the
+    /// correction, smooth again).
+    fn cycle(&self, work: &mut Work) {
+        let coarse_levels = self.levels.len();
+        for l in 0..coarse_levels {
+            let (a, inv) = self.matrix(l);
+            let (r, z, t) = (&work.r[l], &mut work.z[l], &mut work.t[l]);
+            self.smooth_from_zero(a, inv, r, z, t);
+            // t ← r − A z, then r_{l+1} ← Pᵀ t.
+            mul_vec(a, z, t);
+            t.par_iter_mut().zip(r).for_each(|(t, r)| *t = r - *t);
+            let (fine, coarse) = work.r.split_at_mut(l + 1);
+            mul_vec(&self.restrict[l], &work.t[l], &mut coarse[0]);
+            let _ = fine;
+        }
+        {
+            let l = coarse_levels;
+            let (a, inv) = self.matrix(l);
+            let (r, z, t) = (&work.r[l], &mut work.z[l], &mut work.t[l]);
+            match &self.coarsest {
+                Some(c) => c.solve(r, z),
+                None => {
+                    self.smooth_from_zero(a, inv, r, z, t);
+                    self.smooth(a, inv, r, z, t, 10 * self.options.sweeps.max(1));
+                }
+            }
+        }
+        for l in (0..coarse_levels).rev() {
+            let (a, inv) = self.matrix(l);
+            let (fine, coarse) = work.z.split_at_mut(l + 1);
+            let t = &mut work.t[l];
+            mul_vec(&self.prolong[l], &coarse[0], t);
+            let z = &mut fine[l];
+            z.par_iter_mut().zip(&*t).for_each(|(z, c)| *z += c);
+            self.smooth(a, inv, &work.r[l], z, t, self.options.sweeps);
+        }
+    }
+
+    /// `sweeps` damped Jacobi sweeps from `z = 0`; the first needs no
+    /// mat-vec.
+    fn smooth_from_zero(
+        &self,
+        a: &CsMat<f64>,
+        inv: &[f64],
+        r: &[f64],
+        z: &mut [f64],
+        t: &mut [f64],
+    ) {
+        let omega = self.options.damping;
+        if self.options.sweeps == 0 {
+            z.fill(0.0);
+            return;
+        }
+        z.par_iter_mut()
+            .zip(r.par_iter().zip(inv))
+            .for_each(|(z, (r, d))| *z = omega * d * r);
+        self.smooth(a, inv, r, z, t, self.options.sweeps - 1);
+    }
+
+    /// `sweeps` damped Jacobi sweeps `z ← z + ω D⁻¹ (r − A z)`, `t` scratch.
+    fn smooth(
+        &self,
+        a: &CsMat<f64>,
+        inv: &[f64],
+        r: &[f64],
+        z: &mut [f64],
+        t: &mut [f64],
+        sweeps: usize,
+    ) {
+        let omega = self.options.damping;
+        for _ in 0..sweeps {
+            mul_vec(a, z, t);
+            z.par_chunks_mut(CHUNK)
+                .zip(t.par_chunks(CHUNK))
+                .zip(r.par_chunks(CHUNK).zip(inv.par_chunks(CHUNK)))
+                .for_each(|((z, az), (r, d))| {
+                    for k in 0..z.len() {
+                        z[k] += omega * d[k] * (r[k] - az[k]);
+                    }
+                });
+        }
+    }
+
+    fn new_work(&self) -> Work {
+        let sizes: Vec<usize> = (0..=self.levels.len())
+            .map(|l| self.matrix(l).0.rows())
+            .collect();
+        let vectors = || sizes.iter().map(|&n| vec![0.0; n]).collect::<Vec<_>>();
+        Work {
+            r: vectors(),
+            z: vectors(),
+            t: vectors(),
+        }
+    }
+
+    /// CG on the original system preconditioned by this V-cycle.
+    ///
+    /// # Errors
+    /// Those of [`crate::pcg`].
+    pub fn solve(&self, b: &[f64], x: &mut [f64], options: &SolveOptions) -> Result<Report, Error> {
+        pcg_monitored(self.fine, b, x, self, options, &mut |_, _| {
+            std::ops::ControlFlow::Continue(())
+        })
+    }
+
+    /// [`solve`](Self::solve) calling `monitor` after every iteration.
+    ///
+    /// # Errors
+    /// As [`solve`](Self::solve).
+    pub fn solve_monitored(
+        &self,
+        b: &[f64],
+        x: &mut [f64],
+        options: &SolveOptions,
+        monitor: Monitor<'_>,
+    ) -> Result<Report, Error> {
+        pcg_monitored(self.fine, b, x, self, options, monitor)
+    }
+}
+
+/// Per-level vectors of a cycle, kept between applications: allocating
+/// (and first touching) them each time costs as much as a mat-vec.
+#[derive(Debug)]
+struct Work {
+    r: Vec<Vec<f64>>,
+    z: Vec<Vec<f64>>,
+    t: Vec<Vec<f64>>,
+}
+
+impl Preconditioner for VCycle<'_> {
+    fn apply(&self, r: &[f64], z: &mut [f64]) {
+        // PCG applies the preconditioner from one thread at a time; the
+        // lock only makes the V-cycle usable from several.
+        let mut guard = self
+            .work
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let work = guard.get_or_insert_with(|| self.new_work());
+        work.r[0].copy_from_slice(r);
+        self.cycle(work);
+        z.copy_from_slice(&work.z[0]);
+    }
+}
