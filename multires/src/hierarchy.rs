@@ -66,6 +66,10 @@ pub struct HierarchyOptions {
     /// reproduces linear functions of position (needs
     /// [`Weights::Positions`]).
     pub linear_precision: bool,
+    /// With `linear_precision`, interpolate a dropped vertex whose kept
+    /// neighbours do not surround it from the kept vertices of its 2-ring
+    /// too (beyond Eq. 16, which uses the 1-ring only).
+    pub wide_interpolation: bool,
 }
 
 impl Default for HierarchyOptions {
@@ -76,6 +80,7 @@ impl Default for HierarchyOptions {
             enhance: true,
             seed: 0x7A5C_0DE5,
             linear_precision: false,
+            wide_interpolation: false,
         }
     }
 }
@@ -390,7 +395,37 @@ fn coarsen(
                 .filter(|&&j| coarse_index[j as usize] != u32::MAX)
                 .map(|&j| at(j as usize))
                 .collect();
-            linear_correction(at(i), &neighbours, &mut out[start..]);
+            if linear_correction(at(i), &neighbours, &mut out[start..])
+                || !options.wide_interpolation
+            {
+                return;
+            }
+            // The kept 1-ring does not surround the vertex: interpolate from
+            // the kept vertices of its 2-ring as well.
+            out.truncate(start);
+            let mut ring: Vec<u32> = graph.neighbors(i).to_vec();
+            for &j in graph.neighbors(i) {
+                if coarse_index[j as usize] == u32::MAX {
+                    ring.extend_from_slice(graph.neighbors(j as usize));
+                }
+            }
+            ring.sort_unstable();
+            ring.dedup();
+            let mut points = Vec::new();
+            let mut total = 0.0;
+            for &j in &ring {
+                let (j, k) = (j as usize, coarse_index[j as usize]);
+                let d = dist(at(i), at(j));
+                if k != u32::MAX && j != i && d > 0.0 {
+                    total += 1.0 / d;
+                    out.push((k as usize, 1.0 / d));
+                    points.push(at(j));
+                }
+            }
+            for (_, w) in &mut out[start..] {
+                *w /= total;
+            }
+            linear_correction(at(i), &points, &mut out[start..]);
         }
     });
     Ok(Coarsening {
@@ -410,7 +445,7 @@ fn coarsen(
     clippy::needless_range_loop,
     reason = "4×4 dense algebra reads clearest with indices"
 )]
-fn linear_correction(x: [f64; 3], p: &[[f64; 3]], w: &mut [(usize, f64)]) {
+fn linear_correction(x: [f64; 3], p: &[[f64; 3]], w: &mut [(usize, f64)]) -> bool {
     // Rows of A: 1 and the three offsets; residual r = c − A w.
     let row = |j: usize, k: usize| if k == 0 { 1.0 } else { p[j][k - 1] - x[k - 1] };
     let mut g = [[0.0f64; 4]; 4];
@@ -464,6 +499,11 @@ fn linear_correction(x: [f64; 3], p: &[[f64; 3]], w: &mut [(usize, f64)]) {
         let delta: f64 = (0..4).map(|a| row(j, a) * lambda[a]).sum();
         *wj += *wj * delta;
     }
+    live.iter().all(|&l| l)
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
 }
 
 /// `E^{l+1}`: kept vertices joined when some dropped vertex neighbours

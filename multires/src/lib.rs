@@ -24,7 +24,9 @@
 //! - [`Cascade`]: the paper's solve — coarsest level by BiCGSTAB to
 //!   convergence (falling back to the next finer level if it does not
 //!   converge), a few BiCGSTAB iterations per intermediate level, CG on
-//!   the original system.
+//!   the original system. [`CascadeOptions::galerkin`] is the faster
+//!   variant for absorbing media: Galerkin coarse systems and
+//!   interpolation that reproduces linear functions (beyond the paper).
 //! - [`VCycle`] (beyond the paper, which notes its interpolation could
 //!   drive a full multigrid solver): a symmetric V-cycle (Galerkin coarse
 //!   operators, damped Jacobi, exact coarsest solve) preconditioning CG.

@@ -261,6 +261,17 @@ fn galerkin_and_linear_precision_give_an_accurate_start() {
         ..CascadeOptions::default()
     });
     assert!(consistent < 5e-3, "Galerkin start error {consistent}");
+    let preset = start_error(&CascadeOptions {
+        hierarchy: HierarchyOptions {
+            coarsest: 500,
+            ..CascadeOptions::galerkin().hierarchy
+        },
+        ..CascadeOptions::galerkin()
+    });
+    assert!(
+        preset < 5e-2 && preset < paper / 5.0,
+        "CascadeOptions::galerkin() start error {preset} (paper {paper})"
+    );
     assert!(paper < 1.0, "the paper's cascade did not start");
     assert!(
         paper > 10.0 * consistent,
