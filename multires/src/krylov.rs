@@ -15,7 +15,7 @@ use sprs::CsMat;
 
 use crate::Error;
 use crate::matrix::{check_square, check_vector, inverse_diagonal, mul_vec};
-use crate::vector::{axpy, cg_update, dot, norm, scale_dot, xpby};
+use crate::vector::{axpy, cg_update, dot, norm, scale as diagonal_scale, xpby};
 
 /// When a solver stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -108,10 +108,7 @@ impl Jacobi {
 
 impl Preconditioner for Jacobi {
     fn apply(&self, r: &[f64], z: &mut [f64]) {
-        use rayon::prelude::*;
-        z.par_iter_mut()
-            .zip(r.par_iter().zip(&self.inverse))
-            .for_each(|(z, (r, d))| *z = r * d);
+        diagonal_scale(&self.inverse, r, z);
     }
 }
 
@@ -226,7 +223,7 @@ pub fn pcg_monitored(
             if rr.sqrt() / scale <= options.tolerance {
                 break;
             }
-            let rz_next = scale_dot_precond(m, &r, &mut z);
+            let rz_next = precondition_dot(m, &r, &mut z);
             let beta = rz_next / rz;
             if !beta.is_finite() {
                 broke = true;
@@ -272,7 +269,7 @@ pub fn pcg_monitored(
 }
 
 /// `z ← M⁻¹ r`, returning `r · z`.
-fn scale_dot_precond(m: &(impl Preconditioner + ?Sized), r: &[f64], z: &mut [f64]) -> f64 {
+fn precondition_dot(m: &(impl Preconditioner + ?Sized), r: &[f64], z: &mut [f64]) -> f64 {
     m.apply(r, z);
     dot(r, z)
 }
@@ -338,7 +335,7 @@ pub fn bicgstab_monitored(
             // p ← r + β (p − ω v)
             axpy(-omega, &v, &mut p);
             xpby(&r, beta, &mut p);
-            let _ = scale_dot(&inverse, &p, &mut y, &p);
+            diagonal_scale(&inverse, &p, &mut y);
             mul_vec(a, &y, &mut v);
             alpha = rho / dot(&shadow, &v);
             if !alpha.is_finite() {
@@ -353,7 +350,7 @@ pub fn bicgstab_monitored(
                 interrupted = monitor(done, x).is_break();
                 break;
             }
-            let _ = scale_dot(&inverse, &s, &mut z, &s);
+            diagonal_scale(&inverse, &s, &mut z);
             mul_vec(a, &z, &mut t);
             let tt = dot(&t, &t);
             omega = dot(&t, &s) / tt;

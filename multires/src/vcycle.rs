@@ -17,7 +17,7 @@ use crate::graph::Graph;
 use crate::hierarchy::{Hierarchy, HierarchyOptions, Weights};
 use crate::krylov::{Monitor, Preconditioner, Report, SolveOptions, pcg_monitored};
 use crate::matrix::{check_square, inverse_diagonal, mul_vec, transpose};
-use crate::vector::CHUNK;
+use crate::vector::{CHUNK, scale};
 
 /// How the V-cycle is built and smooths.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -212,9 +212,7 @@ impl<'m> VCycle<'m> {
             z.fill(0.0);
             return;
         }
-        z.par_iter_mut()
-            .zip(r.par_iter().zip(inv))
-            .for_each(|(z, (r, d))| *z = d * r);
+        scale(inv, r, z);
         self.smooth(a, inv, r, z, t, self.options.sweeps - 1);
     }
 

@@ -55,23 +55,15 @@ pub fn xpby(x: &[f64], beta: f64, y: &mut [f64]) {
         });
 }
 
-/// `out ← a ⊙ b` (element-wise), returning `Σ out ⊙ c`: a diagonal
-/// preconditioner applied and its inner product in one pass.
-pub(crate) fn scale_dot(a: &[f64], b: &[f64], out: &mut [f64], c: &[f64]) -> f64 {
-    let partial: Vec<f64> = out
-        .par_chunks_mut(CHUNK)
-        .zip(a.par_chunks(CHUNK))
-        .zip(b.par_chunks(CHUNK).zip(c.par_chunks(CHUNK)))
-        .map(|((out, a), (b, c))| {
-            let mut s = 0.0;
-            for i in 0..out.len() {
-                out[i] = a[i] * b[i];
-                s += out[i] * c[i];
+/// `out ← a ⊙ b` (element-wise): a diagonal preconditioner applied.
+pub(crate) fn scale(a: &[f64], b: &[f64], out: &mut [f64]) {
+    out.par_chunks_mut(CHUNK)
+        .zip(a.par_chunks(CHUNK).zip(b.par_chunks(CHUNK)))
+        .for_each(|(out, (a, b))| {
+            for ((o, a), b) in out.iter_mut().zip(a).zip(b) {
+                *o = a * b;
             }
-            s
-        })
-        .collect();
-    partial.iter().sum()
+        });
 }
 
 /// `x ← x + α p`, `r ← r − α q`, returning `‖r‖²`: CG's update in one pass.
