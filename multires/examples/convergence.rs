@@ -385,7 +385,13 @@ fn main() {
     let mut systems = Vec::new();
     for &n in &args.grids {
         let dims = grid::cube_for(n);
-        let p = grid::diffusion(dims, 30.0);
+        let p = match grid::diffusion(dims, 30.0) {
+            Ok(p) => p,
+            Err(e) => {
+                eprintln!("--grid {n}: {e}");
+                std::process::exit(2);
+            }
+        };
         systems.push(System {
             name: format!("grid{}x{}x{}", dims[0], dims[1], dims[2]),
             matrix: p.matrix,

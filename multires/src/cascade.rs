@@ -119,12 +119,13 @@ impl Cascade {
     /// # Example
     /// ```
     /// use multires::{grid, Cascade, CascadeOptions, SolveOptions, Weights};
-    /// let p = grid::diffusion([16, 16, 16], 5.0);
+    /// let p = grid::diffusion([16, 16, 16], 5.0)?;
     /// let options = CascadeOptions::default();
-    /// let cascade = Cascade::new(&p.matrix, Weights::Positions(&p.positions), &options).unwrap();
+    /// let cascade = Cascade::new(&p.matrix, Weights::Positions(&p.positions), &options)?;
     /// let mut x = vec![0.0; p.rhs.len()];
-    /// let report = cascade.solve(&p.matrix, &p.rhs, &mut x, &SolveOptions::default()).unwrap();
+    /// let report = cascade.solve(&p.matrix, &p.rhs, &mut x, &SolveOptions::default())?;
     /// assert!(report.finest.converged());
+    /// # Ok::<(), multires::Error>(())
     /// ```
     pub fn new(
         m: &CsMat<f64>,

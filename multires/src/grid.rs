@@ -4,6 +4,7 @@
 
 use sprs::CsMat;
 
+use crate::Error;
 use crate::matrix::assemble;
 
 /// A linear system with the positions of its unknowns.
@@ -23,13 +24,22 @@ pub struct Problem {
 /// boundaries), lit from one side: `b = 1` on the face `x = 0`, 0
 /// elsewhere. Unknown `(x, y, z)` has index `x + n₀ (y + n₁ z)`.
 ///
-/// # Panics
-/// If a dimension is 0 or `length` is not positive.
-pub fn diffusion(n: [usize; 3], length: f64) -> Problem {
-    assert!(
-        n.iter().all(|&d| d > 0) && length > 0.0,
-        "empty grid or length ≤ 0"
-    );
+/// # Errors
+/// [`Error::InvalidOption`] for a dimension of 0, a length that is not
+/// positive and finite, or more than 2³² unknowns.
+pub fn diffusion(n: [usize; 3], length: f64) -> Result<Problem, Error> {
+    if n.contains(&0) {
+        return Err(Error::InvalidOption("grid dimensions must be at least 1"));
+    }
+    if !(length > 0.0 && length.is_finite()) {
+        return Err(Error::InvalidOption(
+            "diffusion length must be positive and finite",
+        ));
+    }
+    let total = n.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
+    if total.is_none_or(|t| t > u32::MAX as usize) {
+        return Err(Error::InvalidOption("grid larger than 2³² unknowns"));
+    }
     let total = n[0] * n[1] * n[2];
     let mass = 1.0 / (length * length);
     let coords = |i: usize| [i % n[0], (i / n[0]) % n[1], i / (n[0] * n[1])];
@@ -53,11 +63,11 @@ pub fn diffusion(n: [usize; 3], length: f64) -> Problem {
         .map(|i| if coords(i)[0] == 0 { 1.0 } else { 0.0 })
         .collect();
     let positions = (0..total).map(|i| coords(i).map(|c| c as f64)).collect();
-    Problem {
+    Ok(Problem {
         matrix,
         rhs,
         positions,
-    }
+    })
 }
 
 /// A grid of about `unknowns` points, as cubic as possible.

@@ -132,10 +132,11 @@ fn no_monitor() -> impl FnMut(usize, &[f64]) -> ControlFlow<()> {
 /// # Example
 /// ```
 /// use multires::{cg, grid, SolveOptions};
-/// let problem = grid::diffusion([8, 8, 8], 3.0);
+/// let problem = grid::diffusion([8, 8, 8], 3.0)?;
 /// let mut x = vec![0.0; problem.matrix.rows()];
-/// let report = cg(&problem.matrix, &problem.rhs, &mut x, &SolveOptions::default()).unwrap();
+/// let report = cg(&problem.matrix, &problem.rhs, &mut x, &SolveOptions::default())?;
 /// assert!(report.converged() && report.residual <= 1e-6);
+/// # Ok::<(), multires::Error>(())
 /// ```
 pub fn cg(
     a: &CsMat<f64>,

@@ -36,16 +36,17 @@
 //! # Example
 //! ```
 //! use multires::{cg, grid, SolveOptions, VCycle, VCycleOptions, Weights};
-//! let p = grid::diffusion([20, 20, 20], 6.0);
+//! let p = grid::diffusion([20, 20, 20], 6.0)?;
 //! let options = SolveOptions { tolerance: 1e-8, max_iterations: 1_000 };
 //!
 //! let mut plain = vec![0.0; p.rhs.len()];
-//! let jacobi = cg(&p.matrix, &p.rhs, &mut plain, &options).unwrap();
+//! let jacobi = cg(&p.matrix, &p.rhs, &mut plain, &options)?;
 //!
-//! let v = VCycle::new(&p.matrix, Weights::Positions(&p.positions), &VCycleOptions::default()).unwrap();
+//! let v = VCycle::new(&p.matrix, Weights::Positions(&p.positions), &VCycleOptions::default())?;
 //! let mut x = vec![0.0; p.rhs.len()];
-//! let multigrid = v.solve(&p.rhs, &mut x, &options).unwrap();
+//! let multigrid = v.solve(&p.rhs, &mut x, &options)?;
 //! assert!(multigrid.converged() && multigrid.iterations < jacobi.iterations);
+//! # Ok::<(), multires::Error>(())
 //! ```
 
 pub mod cascade;

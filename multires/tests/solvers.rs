@@ -74,7 +74,7 @@ fn a_warm_start_at_the_solution_needs_no_iteration() {
 
 /// A non-symmetric system: diffusion plus upwind convection on a grid.
 fn convection(side: usize) -> CsMat<f64> {
-    let g = grid::diffusion([side, side, side], 4.0);
+    let g = grid::diffusion([side, side, side], 4.0).unwrap();
     let mut t = TriMat::new((g.matrix.rows(), g.matrix.cols()));
     for (v, (i, j)) in g.matrix.iter() {
         t.add_triplet(i, j, *v);
@@ -163,7 +163,7 @@ fn the_monitor_can_stop_a_solve() {
 
 #[test]
 fn the_cascade_and_the_v_cycle_solve_to_the_reported_residual() {
-    let g = grid::diffusion([20, 18, 16], 8.0);
+    let g = grid::diffusion([20, 18, 16], 8.0).unwrap();
     let w = Weights::Positions(&g.positions);
     let mut reference = vec![0.0; g.rhs.len()];
     cg(&g.matrix, &g.rhs, &mut reference, &tight()).unwrap();
@@ -216,7 +216,7 @@ fn the_cascade_and_the_v_cycle_solve_to_the_reported_residual() {
 #[test]
 fn the_v_cycle_is_a_symmetric_positive_definite_preconditioner() {
     use multires::Preconditioner;
-    let g = grid::diffusion([16, 15, 14], 7.0);
+    let g = grid::diffusion([16, 15, 14], 7.0).unwrap();
     let v = VCycle::new(
         &g.matrix,
         Weights::Positions(&g.positions),
@@ -248,7 +248,7 @@ fn galerkin_and_linear_precision_give_an_accurate_start() {
     // source while it stands for several: on an absorbing medium their
     // solution is off. Galerkin systems with linear-precision interpolation
     // are consistent: the interpolated start is already close.
-    let g = grid::diffusion([24, 24, 24], 6.0);
+    let g = grid::diffusion([24, 24, 24], 6.0).unwrap();
     let mut reference = vec![0.0; g.rhs.len()];
     cg(&g.matrix, &g.rhs, &mut reference, &tight()).unwrap();
     let start_error = |o: &CascadeOptions| {
@@ -310,7 +310,7 @@ fn galerkin_and_linear_precision_give_an_accurate_start() {
 
 #[test]
 fn a_coarse_level_that_does_not_converge_falls_back_to_the_finer_one() {
-    let g = grid::diffusion([14, 14, 14], 5.0);
+    let g = grid::diffusion([14, 14, 14], 5.0).unwrap();
     let mut o = CascadeOptions {
         hierarchy: HierarchyOptions {
             coarsest: 100,
@@ -332,7 +332,7 @@ fn a_coarse_level_that_does_not_converge_falls_back_to_the_finer_one() {
 
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
-    let g = grid::diffusion([30, 30, 30], 10.0);
+    let g = grid::diffusion([30, 30, 30], 10.0).unwrap();
     let w = Weights::Positions(&g.positions);
     let options = SolveOptions {
         tolerance: 1e-9,
@@ -433,6 +433,14 @@ fn bad_input_is_an_error() {
             &o
         ),
         Err(Error::DimensionMismatch { .. })
+    ));
+    assert!(matches!(
+        grid::diffusion([0, 3, 3], 2.0),
+        Err(Error::InvalidOption(_))
+    ));
+    assert!(matches!(
+        grid::diffusion([3, 3, 3], f64::NAN),
+        Err(Error::InvalidOption(_))
     ));
     let damped = VCycleOptions {
         damping: 0.0,

@@ -61,7 +61,7 @@ pub(crate) fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// The diffusion grid of the benchmark, smaller.
 pub(crate) fn grid_problem(side: usize) -> grid::Problem {
-    grid::diffusion([side, side + 1, side + 2], 6.0)
+    grid::diffusion([side, side + 1, side + 2], 6.0).unwrap()
 }
 
 /// `‖b − A x‖ / ‖b‖`, computed serially from scratch.
