@@ -79,10 +79,10 @@ impl CascadeOptions {
             },
             system: CoarseSystem::Galerkin,
             coarsest: SolveOptions {
-                tolerance: 5e-2,
+                tolerance: 1e-1,
                 max_iterations: 1_000,
             },
-            intermediate_iterations: 2,
+            intermediate_iterations: 1,
         }
     }
 }
