@@ -53,6 +53,7 @@
 #![forbid(unsafe_code)]
 
 mod error;
+pub mod file;
 mod filter;
 mod mip;
 mod structure;

@@ -95,6 +95,22 @@ impl MipMap {
     /// of every edge at the finer level (interpolated, by the continuity
     /// rule, on an edge coarser than that level). Sums are in `f64`.
     pub fn new(colors: MeshColors) -> Self {
+        let mut mip = Self::zeroed(colors);
+        mip.copy_finest();
+        let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); mip.colors.topology.vertex_count];
+        for (e, &[a, b]) in mip.colors.topology.edges.iter().enumerate() {
+            vertex_edges[a as usize].push(e as u32);
+            vertex_edges[b as usize].push(e as u32);
+        }
+        let top = mip.colors.vertex_level.iter().copied().max().unwrap_or(0);
+        for l in (0..top).rev() {
+            mip.build_level(l, &vertex_edges);
+        }
+        mip
+    }
+
+    /// The layout for `colors` with every value zero.
+    pub(crate) fn zeroed(colors: MeshColors) -> Self {
         let c = colors.channels;
         let mut next = 0usize;
         let vertex_offset: Vec<usize> = colors
@@ -124,24 +140,30 @@ impl MipMap {
                 at
             })
             .collect();
-        let mut mip = MipMap {
+        MipMap {
             data: vec![0.0; next * c],
             vertex_offset,
             edge_offset,
             face_offset,
             colors,
-        };
-        mip.copy_finest();
-        let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); mip.colors.topology.vertex_count];
-        for (e, &[a, b]) in mip.colors.topology.edges.iter().enumerate() {
-            vertex_edges[a as usize].push(e as u32);
-            vertex_edges[b as usize].push(e as u32);
         }
-        let top = mip.colors.vertex_level.iter().copied().max().unwrap_or(0);
-        for l in (0..top).rev() {
-            mip.build_level(l, &vertex_edges);
-        }
-        mip
+    }
+
+    /// The number of values (samples × channels) a pyramid of `colors`
+    /// holds, without building it.
+    pub(crate) fn len_for(colors: &MeshColors) -> u64 {
+        let v: u64 = colors.vertex_level.iter().map(|&n| u64::from(n) + 1).sum();
+        let e: u64 = colors
+            .edge_level
+            .iter()
+            .map(|&n| edge_level_offset(n + 1) as u64)
+            .sum();
+        let f: u64 = colors
+            .face_level
+            .iter()
+            .map(|&n| FACE_LEVEL_OFFSET[n as usize + 1] as u64)
+            .sum();
+        (v + e + f) * colors.channels as u64
     }
 
     /// The mesh colours (finest level) this pyramid was built from.
