@@ -52,6 +52,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod convert;
 mod error;
 pub mod file;
 mod filter;
