@@ -204,9 +204,15 @@ fn on_edge<S: Store>(s: &S, e: usize, q: u8, t: f32, nearest: bool, out: &mut [f
 /// (overwritten).
 #[inline]
 pub(crate) fn eval<S: Store>(s: &S, f: usize, b: [f32; 3], q: u8, nearest: bool, out: &mut [f32]) {
+    eval_at(s, f, place(s.colors(), f, b), q, nearest, out);
+}
+
+/// As [`eval`], for a point already classified by [`place`].
+#[inline]
+pub(crate) fn eval_at<S: Store>(s: &S, f: usize, at: Place, q: u8, nearest: bool, out: &mut [f32]) {
     out.fill(0.0);
     let mc = s.colors();
-    let c = match place(mc, f, b) {
+    let c = match at {
         Place::Vertex(v) => {
             add(out, vertex(s, v, q), 1.0);
             return;

@@ -2,10 +2,10 @@
 //! edge rule, Eq. 6), trilinear filtering from a footprint, and
 //! anisotropic filtering from screen-space derivatives (Sec. 4.3).
 
-use crate::filter::{FINEST, Place, Store, check, edge_point, eval, lattice, place};
+use crate::filter::{FINEST, Place, Store, check, edge_point, eval, eval_at, lattice, place};
 use crate::structure::{MeshColors, interior_index, samples_per_face};
 use crate::topology::NO_FACE;
-use crate::{Error, MAX_LEVEL};
+use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
 
 /// Offset of level `l` within a face's levels: `Σ_{m<l} (2^m−1)(2^m−2)/2`.
 const fn face_level_offsets() -> [usize; MAX_LEVEL as usize + 2] {
@@ -377,7 +377,8 @@ impl MipMap {
     #[inline]
     fn trilinear_unchecked(&self, face: usize, b: [f32; 3], lambda: f32, out: &mut [f32]) {
         let mc = &self.colors;
-        let top = match place(mc, face, b) {
+        let at = place(mc, face, b);
+        let top = match at {
             Place::Vertex(v) => mc.vertex_level[v as usize],
             Place::Edge(e, _) => mc.edge_level[e],
             Place::Inside(_) => mc.face_level[face],
@@ -385,24 +386,15 @@ impl MipMap {
         let l0 = lambda.floor();
         let frac = lambda - l0;
         let l0 = l0 as u8;
+        eval_at(self, face, at, l0, false, out);
         if l0 >= top || frac == 0.0 {
-            eval(self, face, b, l0, false, out);
             return;
         }
         let c = mc.channels;
-        let mut fine = [0.0f32; 16];
-        eval(self, face, b, l0, false, out);
-        if c <= fine.len() {
-            eval(self, face, b, l0 + 1, false, &mut fine[..c]);
-            for (o, &x) in out.iter_mut().zip(&fine[..c]) {
-                *o = (1.0 - frac) * *o + frac * x;
-            }
-        } else {
-            let mut fine = vec![0.0f32; c];
-            eval(self, face, b, l0 + 1, false, &mut fine);
-            for (o, &x) in out.iter_mut().zip(&fine) {
-                *o = (1.0 - frac) * *o + frac * x;
-            }
+        let mut fine = [0.0f32; MAX_CHANNELS];
+        eval_at(self, face, at, l0 + 1, false, &mut fine[..c]);
+        for (o, &x) in out.iter_mut().zip(&fine[..c]) {
+            *o = (1.0 - frac) * *o + frac * x;
         }
     }
 
@@ -448,24 +440,15 @@ impl MipMap {
             self.trilinear_unchecked(face, b, lambda, out);
             return Ok(());
         }
-        let mut acc = [0.0f32; 16];
-        let mut probe = vec![0.0f32; c];
-        let mut big = if c > acc.len() {
-            vec![0.0f32; c]
-        } else {
-            Vec::new()
-        };
-        let sum: &mut [f32] = if c <= acc.len() {
-            &mut acc[..c]
-        } else {
-            &mut big
-        };
+        let mut acc = [0.0f32; MAX_CHANNELS];
+        let mut probe = [0.0f32; MAX_CHANNELS];
+        let (sum, probe) = (&mut acc[..c], &mut probe[..c]);
         let count = n as u32;
         for k in 0..count {
             let t = (k as f32 + 0.5) / n - 0.5;
             let p = [0, 1, 2].map(|m| (b[m] + t * axis[m]).max(0.0));
-            self.trilinear_unchecked(face, p, lambda, &mut probe);
-            for (s, &x) in sum.iter_mut().zip(&probe) {
+            self.trilinear_unchecked(face, p, lambda, probe);
+            for (s, &x) in sum.iter_mut().zip(probe.iter()) {
                 *s += x;
             }
         }
