@@ -53,6 +53,7 @@
 #![forbid(unsafe_code)]
 
 pub mod convert;
+pub mod edit;
 mod error;
 pub mod file;
 mod filter;
