@@ -58,12 +58,14 @@ mod error;
 pub mod file;
 mod filter;
 mod mip;
+mod paint;
 mod structure;
 mod texture;
 mod topology;
 
 pub use error::Error;
 pub use mip::{FINEST_LEVEL, MipMap};
+pub use paint::{Blend, Brush, Painter, Stroke};
 pub use structure::{
     MeshColors, Site, lattice_points, level_of, sample_position, samples_per_edge, samples_per_face,
 };
