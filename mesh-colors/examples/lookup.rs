@@ -17,6 +17,9 @@ use mesh_colors::{Topology, convert};
 /// Lookups per measurement; the best of `REPEATS` runs is kept (the
 /// machine is shared, so the fastest run is the least disturbed).
 const POINTS: usize = 1_000_000;
+
+/// One mesh colour lookup: (point index, face, barycentrics, output).
+type Lookup<'a> = &'a dyn Fn(usize, usize, [f32; 3], &mut [f32; 3]);
 const REPEATS: usize = 3;
 
 fn best_mlookups(mut run: impl FnMut() -> f32) -> f64 {
@@ -82,7 +85,7 @@ fn main() {
         let mut texture = m.texture.clone();
         texture.build_mips();
         let mut out = [0.0f32; 3];
-        let run_mc = |lookup: &dyn Fn(usize, usize, [f32; 3], &mut [f32; 3])| -> f64 {
+        let run_mc = |lookup: Lookup<'_>| -> f64 {
             let mut out = [0.0f32; 3];
             best_mlookups(|| {
                 let mut acc = 0.0f32;

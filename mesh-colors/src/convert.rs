@@ -48,7 +48,7 @@ fn texel_area(uv: &[Vec2; 3], texture: &Texture) -> f64 {
 /// The level for a face covering `area` texels at `density`.
 fn level_for(area: f64, density: f64, max_level: u8) -> u8 {
     let r = (2.0 * area * density).sqrt();
-    if !(r > 1.0) {
+    if r.is_nan() || r <= 1.0 {
         return 0;
     }
     (r.log2().round() as i64).clamp(0, i64::from(max_level)) as u8

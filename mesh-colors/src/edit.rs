@@ -259,12 +259,12 @@ impl MeshColors {
                     let r = 1u32 << le;
                     for s in 1..r {
                         let t = s as f32 / r as f32;
-                        for ch in 0..c {
+                        for (ch, v) in value.iter_mut().enumerate() {
                             let (a, b) = (
                                 out.samples[key[0] as usize * c + ch],
                                 out.samples[key[1] as usize * c + ch],
                             );
-                            value[ch] = (1.0 - t) * a + t * b;
+                            *v = (1.0 - t) * a + t * b;
                         }
                         out.sample_mut(first + s as usize - 1)
                             .copy_from_slice(&value);

@@ -40,14 +40,14 @@ const FLAG_MIP: u32 = 1;
 /// # Errors
 /// [`Error::ChannelMismatch`] if `mip` does not belong to `colors`.
 pub fn to_bytes(colors: &MeshColors, mip: Option<&MipMap>) -> Result<Vec<u8>, Error> {
-    if let Some(m) = mip {
-        if m.colors.topology != colors.topology || m.colors.face_level != colors.face_level {
-            return Err(Error::ChannelMismatch {
-                what: "MIP pyramid built from other mesh colours",
-                expected: colors.samples.len(),
-                got: m.colors.samples.len(),
-            });
-        }
+    if let Some(m) = mip
+        && (m.colors.topology != colors.topology || m.colors.face_level != colors.face_level)
+    {
+        return Err(Error::ChannelMismatch {
+            what: "MIP pyramid built from other mesh colours",
+            expected: colors.samples.len(),
+            got: m.colors.samples.len(),
+        });
     }
     let t = &colors.topology;
     let mut out = Vec::with_capacity(

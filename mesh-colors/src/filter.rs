@@ -79,6 +79,10 @@ fn edge_node<S: Store>(s: &S, e: usize, q: u8, le: u8, i: u32) -> &[f32] {
 /// sample, or (between two, when the face is finer than the edge) their
 /// linear interpolation, the continuity rule.
 #[inline]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "the hot path keeps its inputs in registers"
+)]
 pub(crate) fn edge_point<S: Store>(
     s: &S,
     e: usize,

@@ -52,6 +52,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod atlas;
 pub mod convert;
 pub mod edit;
 mod error;

@@ -311,13 +311,13 @@ impl MipMap {
             }
         }
         // Vertices, Eq. 6.
-        for v in 0..mc.topology.vertex_count {
+        for (v, edges) in vertex_edges.iter().enumerate() {
             if mc.vertex_level[v] <= l {
                 continue;
             }
             sum.fill(0.0);
             let r2 = 1u32 << q;
-            for &e in &vertex_edges[v] {
+            for &e in edges {
                 let e = e as usize;
                 let p = if mc.topology.edges[e][0] as usize == v {
                     1
@@ -328,7 +328,7 @@ impl MipMap {
                 edge_point(self, e, q, q, p, 1.0, false, &mut tmp);
                 accumulate(&mut sum, &tmp);
             }
-            combine(self.vertex_at(v, q), &sum, vertex_edges[v].len(), &mut val);
+            combine(self.vertex_at(v, q), &sum, edges.len(), &mut val);
             writes.push((self.vertex_offset[v] + l as usize, val.clone()));
         }
         for (at, v) in writes {

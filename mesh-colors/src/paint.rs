@@ -188,7 +188,7 @@ impl Painter {
                 got: colors.sample_count(),
             });
         }
-        if !(brush.radius.is_finite() && brush.radius > 0.0) || !brush.center.is_finite() {
+        if !(brush.radius.is_finite() && brush.radius > 0.0 && brush.center.is_finite()) {
             return Err(Error::NonFinite {
                 what: "brush",
                 index: 0,

@@ -52,8 +52,8 @@ impl Site {
     pub fn position(&self, topology: &Topology, positions: &[glam::Vec3]) -> Option<DVec3> {
         let face = topology.faces.get(self.face as usize)?;
         let mut p = DVec3::ZERO;
-        for k in 0..3 {
-            p += self.barycentric[k] * positions.get(face[k] as usize)?.as_dvec3();
+        for (b, &v) in self.barycentric.iter().zip(face) {
+            p += *b * positions.get(v as usize)?.as_dvec3();
         }
         Some(p)
     }
@@ -277,13 +277,13 @@ impl MeshColors {
         for f in 0..self.face_count() {
             let r = self.face_resolution(f);
             for a in lattice_points(r) {
-                if let Some(i) = self.lattice_index(f, a) {
-                    if sites[i].face == NO_FACE {
-                        sites[i] = Site {
-                            face: f as u32,
-                            barycentric: sample_position(r, a[0], a[1]),
-                        };
-                    }
+                if let Some(i) = self.lattice_index(f, a)
+                    && sites[i].face == NO_FACE
+                {
+                    sites[i] = Site {
+                        face: f as u32,
+                        barycentric: sample_position(r, a[0], a[1]),
+                    };
                 }
             }
         }
