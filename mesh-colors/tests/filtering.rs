@@ -319,3 +319,48 @@ fn anisotropic_filter_averages_along_the_long_axis() {
     }
     assert!(differs > 500, "{differs}");
 }
+
+#[test]
+fn mip_finest_level_and_small_footprints_are_the_linear_filter() {
+    let (_, faces, mc) = mixed(9);
+    let mip = mc.mip_map();
+    let mut rng = Rng(10);
+    let (mut a, mut b, mut c) = ([0.0f32; 3], [0.0f32; 3], [0.0f32; 3]);
+    for _ in 0..20_000 {
+        let f = rng.below(faces.len() as u64) as usize;
+        let bary = rng.barycentric();
+        mc.linear(f, bary, &mut a).unwrap();
+        mip.at_level(f, bary, mesh_colors::FINEST_LEVEL, &mut b)
+            .unwrap();
+        mip.trilinear(f, bary, 1e-6, &mut c).unwrap();
+        assert_eq!(a, b);
+        assert_eq!(a, c);
+    }
+}
+
+#[test]
+fn odd_barycentrics_do_not_panic() {
+    let (_, _, mc) = mixed(1);
+    let mip = mc.mip_map();
+    let mut out = [0.0f32; 3];
+    for b in [
+        [f32::NAN; 3],
+        [-1.0, -2.0, -3.0],
+        [0.0, 0.0, 0.0],
+        [f32::INFINITY, 1.0, 0.0],
+        [1e30, 1e-30, 5.0],
+        [-0.5, 0.75, 0.75],
+    ] {
+        mc.linear(3, b, &mut out).unwrap();
+        mc.nearest(3, b, &mut out).unwrap();
+        mip.trilinear(3, b, f32::NAN, &mut out).unwrap();
+        mip.anisotropic(3, b, [f32::NAN; 3], [1.0, 0.0, -1.0], 16, &mut out)
+            .unwrap();
+    }
+    // Negative weights are clamped: a point outside across edge 1-2 reads
+    // the edge.
+    let (mut a, mut b) = ([0.0f32; 3], [0.0f32; 3]);
+    mc.linear(3, [-0.5, 0.75, 0.75], &mut a).unwrap();
+    mc.linear(3, [0.0, 0.5, 0.5], &mut b).unwrap();
+    assert_eq!(a, b);
+}
