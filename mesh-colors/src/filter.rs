@@ -248,6 +248,15 @@ pub(crate) fn eval_at<S: Store>(s: &S, f: usize, at: Place, q: u8, nearest: bool
             [fx + fy - 1.0, 1.0 - fy, 1.0 - fx],
         )
     };
+    if !nearest && i >= 1 && j >= 1 && k >= 3 {
+        // The whole lattice triangle is inside the face (the common case
+        // on fine faces): three interior samples, no vertex or edge.
+        for t in 0..3 {
+            let idx = interior_index(r, pts[t][0], pts[t][1]);
+            add(out, s.face_at(f, lf, idx), ws[t]);
+        }
+        return;
+    }
     if nearest {
         let best = if ws[0] >= ws[1] && ws[0] >= ws[2] {
             0
