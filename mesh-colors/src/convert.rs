@@ -5,7 +5,8 @@
 //! shared vertices and edges plus its interior), so `R ≈ √(2 · A_texels ·
 //! density)`, rounded to the nearest power of two in log scale and capped.
 //! A sample budget (by default the texture's texel count) lowers the
-//! density until the total fits. Every sample takes the bilinearly
+//! density until the total fits, then raises the faces furthest below
+//! their choice while the budget allows. Every sample takes the bilinearly
 //! filtered texture at its UV; a vertex or edge sample that has several
 //! UVs (it lies on a UV seam) takes the mean over its distinct UVs, which
 //! removes the seam.
@@ -116,8 +117,57 @@ pub fn choose_levels(
             }
         }
         levels = levels_at(lo);
+        top_up(
+            topology,
+            &mut levels,
+            &levels_at(options.density),
+            &areas,
+            budget,
+        );
     }
     Ok(levels)
+}
+
+/// Spends what the bisection left of the budget: raises faces one level at
+/// a time, those furthest below their unconstrained level first, while the
+/// total stays within `budget` (the count changes only at the face and its
+/// three edges, so each step is O(1)).
+fn top_up(topology: &Topology, levels: &mut [u8], target: &[u8], areas: &[f64], budget: u64) {
+    let mut total = count(topology, levels);
+    let edge_count = |n: u8| u64::from(samples_per_edge(1 << n));
+    for _ in 0..=MAX_LEVEL {
+        let mut order: Vec<usize> = (0..levels.len())
+            .filter(|&f| levels[f] < target[f])
+            .collect();
+        // Largest texel area per current sample first.
+        order.sort_by(|&a, &b| {
+            let d = |f: usize| areas[f] / f64::from(1u32 << (2 * levels[f]));
+            d(b).total_cmp(&d(a))
+        });
+        let mut changed = false;
+        for f in order {
+            let (old, new) = (levels[f], levels[f] + 1);
+            let mut grow =
+                u64::from(samples_per_face(1 << new)) - u64::from(samples_per_face(1 << old));
+            for &e in &topology.face_edges[f] {
+                let other = topology.edge_faces[e as usize]
+                    .iter()
+                    .filter(|&&g| g != crate::NO_FACE && g as usize != f)
+                    .map(|&g| levels[g as usize])
+                    .min()
+                    .unwrap_or(u8::MAX);
+                grow += edge_count(new.min(other)) - edge_count(old.min(other));
+            }
+            if total + grow <= budget {
+                levels[f] = new;
+                total += grow;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
 }
 
 /// Converts a UV-textured mesh to mesh colours with as many channels as the

@@ -139,3 +139,39 @@ fn textured_meshes_convert_with_35_db_and_no_more_samples_than_texels() {
     }
     assert!(failures.is_empty(), "below 35 dB: {failures:?}");
 }
+
+#[test]
+fn the_sample_budget_is_kept_and_used() {
+    // A grid whose UV triangles differ in size by 30×, on a 256² texture.
+    let (positions, faces) = support::grid(8, 0.1);
+    let uvs: Vec<[Vec2; 3]> = faces
+        .iter()
+        .map(|f| {
+            f.map(|v| {
+                let p = positions[v as usize];
+                Vec2::new(p.x * p.x, p.y)
+            })
+        })
+        .collect();
+    let texture = Texture::new(256, 256, 1, vec![0.5; 256 * 256]).unwrap();
+    let topology = Topology::new(positions.len(), &faces).unwrap();
+    for budget in [500, 2_000, 7_000, 20_000] {
+        let options = convert::Options {
+            max_samples: Some(budget),
+            ..Default::default()
+        };
+        let mc = convert::from_texture(topology.clone(), &uvs, &texture, &options).unwrap();
+        assert!(
+            mc.sample_count() <= budget,
+            "{} > {budget}",
+            mc.sample_count()
+        );
+        // Raising any one face more would break the budget or pass its own
+        // choice; in practice most of the budget is used.
+        assert!(
+            mc.sample_count() * 2 > budget,
+            "{} of {budget}",
+            mc.sample_count()
+        );
+    }
+}
