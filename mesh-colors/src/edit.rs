@@ -43,14 +43,26 @@ impl Subdivided {
     /// Vertex positions of the subdivided mesh: the old ones, then edge
     /// midpoints (a caller applying a smoothing scheme moves them after;
     /// the colours do not depend on positions).
-    pub fn positions(&self, old: &[Vec3]) -> Vec<Vec3> {
-        let mut p = old.to_vec();
+    ///
+    /// # Errors
+    /// [`Error::ChannelMismatch`] if `old` has fewer positions than the
+    /// mesh had vertices.
+    pub fn positions(&self, old: &[Vec3]) -> Result<Vec<Vec3>, Error> {
+        let need = self.colors.topology.vertex_count - self.midpoints.len();
+        if old.len() < need {
+            return Err(Error::ChannelMismatch {
+                what: "vertex positions",
+                expected: need,
+                got: old.len(),
+            });
+        }
+        let mut p = old[..need].to_vec();
         p.extend(
             self.midpoints
                 .iter()
                 .map(|&[a, b]| 0.5 * (old[a as usize] + old[b as usize])),
         );
-        p
+        Ok(p)
     }
 }
 

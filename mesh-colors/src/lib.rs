@@ -23,7 +23,7 @@
 //!   samples they touch.
 //! - **UV textures** ([`convert`], [`atlas`]): from a textured mesh (seams
 //!   averaged away) and back to an atlas with per-corner UVs.
-//! - **Files** ([`file`]): the versioned little-endian `.meshcolors` format.
+//! - **Files** ([`mod@file`]): the versioned little-endian `.meshcolors` format.
 //!
 //! # Example
 //!
@@ -65,7 +65,7 @@ mod texture;
 mod topology;
 
 pub use error::Error;
-pub use mip::{FINEST_LEVEL, MipMap};
+pub use mip::{FINEST_LEVEL, MAX_PROBES, MipMap};
 pub use paint::{Blend, Brush, Painter, Stroke};
 pub use structure::{
     MeshColors, Site, lattice_points, level_of, sample_position, samples_per_edge, samples_per_face,

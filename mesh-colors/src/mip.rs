@@ -404,6 +404,7 @@ impl MipMap {
     /// `max_samples` trilinear probes, spaced along the longer axis of the
     /// pixel footprint and clamped into the face (mesh colours cannot reach
     /// across faces), are averaged at the level of the shorter axis.
+    /// `max_samples` is capped at [`MAX_PROBES`].
     ///
     /// # Errors
     /// As for [`MipMap::at_level`].
@@ -427,7 +428,7 @@ impl MipMap {
         } else {
             (ly, lx, db_dy)
         };
-        let max_n = max_samples.max(1) as f32;
+        let max_n = max_samples.clamp(1, MAX_PROBES) as f32;
         let n = if minor > 0.0 {
             (major / minor).ceil().clamp(1.0, max_n)
         } else {
@@ -458,6 +459,9 @@ impl MipMap {
         Ok(())
     }
 }
+
+/// The most probes an anisotropic lookup takes, whatever it is asked.
+pub const MAX_PROBES: u32 = 64;
 
 /// `λ = −log2(footprint)`, clamped to the levels that exist.
 #[inline]

@@ -136,7 +136,9 @@ impl Painter {
     ) -> usize {
         let lo = cell_of(center - Vec3::splat(radius), self.cell);
         let hi = cell_of(center + Vec3::splat(radius), self.cell);
-        let span = (0..3).map(|k| (hi[k] - lo[k] + 1) as u64).product::<u64>();
+        let span = (0..3).fold(1u64, |s, k| {
+            s.saturating_mul((i64::from(hi[k]) - i64::from(lo[k]) + 1) as u64)
+        });
         let mut examined = 0;
         let mut visit = |list: &Vec<u32>| {
             for &i in list {

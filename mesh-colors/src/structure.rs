@@ -185,7 +185,8 @@ impl MeshColors {
         self.samples.len() / self.channels
     }
 
-    /// Face `f`'s resolution `R`.
+    /// Face `f`'s resolution `R`. The per-primitive accessors below panic
+    /// on an index out of range, like slice indexing; lookups return `Err`.
     pub fn face_resolution(&self, f: usize) -> u32 {
         1 << self.face_level[f]
     }
@@ -228,11 +229,17 @@ impl MeshColors {
     }
 
     /// Sample `i`'s values.
+    ///
+    /// # Panics
+    /// If `i >= sample_count()`, like slice indexing.
     pub fn sample(&self, i: usize) -> &[f32] {
         &self.samples[i * self.channels..(i + 1) * self.channels]
     }
 
     /// Sample `i`'s values, mutable.
+    ///
+    /// # Panics
+    /// If `i >= sample_count()`, like slice indexing.
     pub fn sample_mut(&mut self, i: usize) -> &mut [f32] {
         &mut self.samples[i * self.channels..(i + 1) * self.channels]
     }
@@ -242,8 +249,11 @@ impl MeshColors {
     /// resolution, when a stored sample sits there; `None` for a point on
     /// an edge of lower resolution that falls between two stored samples.
     pub fn lattice_index(&self, f: usize, a: [u32; 3]) -> Option<usize> {
-        let n = self.face_level[f];
+        let n = *self.face_level.get(f)?;
         let r = 1u32 << n;
+        if u64::from(a[0]) + u64::from(a[1]) + u64::from(a[2]) != u64::from(r) {
+            return None;
+        }
         let face = self.topology.faces[f];
         for k in 0..3 {
             if a[k] == r {

@@ -115,11 +115,10 @@ impl Topology {
         &self.edge_faces
     }
 
-    /// The edge between two vertices, if there is one.
+    /// The edge between two vertices, if there is one. Linear in the face
+    /// count (no vertex-to-edge index is kept): for occasional queries.
     pub fn edge_between(&self, a: u32, b: u32) -> Option<u32> {
         let (lo, hi) = (a.min(b), a.max(b));
-        // The edges of a vertex are few; scan the faces of the vertex-free
-        // way: the edge list is not indexed by vertex, so search faces.
         self.faces.iter().zip(&self.face_edges).find_map(|(f, fe)| {
             (0..3).find_map(|k| {
                 let (x, y) = (f[k], f[(k + 1) % 3]);

@@ -83,7 +83,8 @@ fn subdivision_leaves_every_lookup_unchanged() {
     assert_eq!(bits(&mc), bits(&sub.colors));
     // Positions: midpoints after the old vertices.
     let (positions, _) = support::grid(5, 0.3);
-    let p = sub.positions(&positions);
+    let p = sub.positions(&positions).unwrap();
+    assert!(sub.positions(&positions[..3]).is_err());
     let [x, y] = sub.midpoints[3];
     assert_eq!(
         p[positions.len() + 3],

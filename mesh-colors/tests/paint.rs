@@ -77,6 +77,21 @@ fn a_dab_touches_exactly_the_samples_within_its_radius() {
     };
     let s = painter.paint(&mut mc, &all).unwrap();
     assert_eq!(s.touched, mc.sample_count());
+    // A brush far away, or spanning an absurd number of cells, is cheap.
+    let far = Brush {
+        center: Vec3::splat(1e12),
+        radius: 1.0,
+        ..brush
+    };
+    assert_eq!(painter.paint(&mut mc, &far).unwrap().touched, 0);
+    let wide = Brush {
+        radius: 1e30,
+        ..brush
+    };
+    assert_eq!(
+        painter.paint(&mut mc, &wide).unwrap().touched,
+        mc.sample_count()
+    );
     // Bad input.
     assert!(
         painter

@@ -80,6 +80,13 @@ fn every_lattice_point_maps_to_one_sample_and_sites_follow_eq_4() {
     assert_eq!(one.face_index(0), 3 + 3 * 7);
     assert_eq!(one.lattice_index(0, [8, 0, 0]), Some(0));
     assert_eq!(one.lattice_index(0, [1, 1, 6]), Some(24));
+    assert_eq!(
+        one.lattice_index(0, [1, 1, 1]),
+        None,
+        "not on the R = 8 lattice"
+    );
+    assert_eq!(one.lattice_index(0, [u32::MAX, 1, 8]), None);
+    assert_eq!(one.lattice_index(1, [8, 0, 0]), None, "no face 1");
 }
 
 #[test]
