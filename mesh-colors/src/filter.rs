@@ -204,6 +204,30 @@ fn on_edge<S: Store>(s: &S, e: usize, q: u8, t: f32, nearest: bool, out: &mut [f
     }
 }
 
+/// The lattice triangle of Fig. 7 holding the point with (clamped,
+/// unnormalised) barycentrics `c` on a face of resolution `r`, and its
+/// weights: `w = RP − B` (case a) or `[1, 1, 1] − w` (case b).
+#[inline(always)]
+pub(crate) fn triangle(c: [f32; 3], r: u32) -> ([[u32; 3]; 3], [f32; 3]) {
+    let scale = r as f32 / (c[0] + c[1] + c[2]);
+    let (x, y) = (c[0] * scale, c[1] * scale);
+    let i = (x as u32).min(r - 1);
+    let j = (y as u32).min(r - 1 - i);
+    let (fx, fy) = (x - i as f32, y - j as f32);
+    let k = r - i - j;
+    if fx + fy <= 1.0 || k == 1 {
+        (
+            [[i, j, k], [i + 1, j, k - 1], [i, j + 1, k - 1]],
+            [1.0 - fx - fy, fx, fy],
+        )
+    } else {
+        (
+            [[i + 1, j + 1, k - 2], [i + 1, j, k - 1], [i, j + 1, k - 1]],
+            [fx + fy - 1.0, 1.0 - fy, 1.0 - fx],
+        )
+    }
+}
+
 /// Evaluates face `f` at barycentrics `b` at query level `q` into `out`
 /// (overwritten).
 #[inline]
@@ -229,26 +253,8 @@ pub(crate) fn eval_at<S: Store>(s: &S, f: usize, at: Place, q: u8, nearest: bool
     };
     let lf = q.min(mc.face_level[f]);
     let r = 1u32 << lf;
-    let scale = r as f32 / (c[0] + c[1] + c[2]);
-    let (x, y) = (c[0] * scale, c[1] * scale);
-    let i = (x as u32).min(r - 1);
-    let j = (y as u32).min(r - 1 - i);
-    let (fx, fy) = (x - i as f32, y - j as f32);
-    let k = r - i - j;
-    // Fig. 7: the lattice triangle containing the point; weights w = RP − B
-    // (case a) or [1, 1, 1] − w (case b).
-    let (pts, ws) = if fx + fy <= 1.0 || k == 1 {
-        (
-            [[i, j, k], [i + 1, j, k - 1], [i, j + 1, k - 1]],
-            [1.0 - fx - fy, fx, fy],
-        )
-    } else {
-        (
-            [[i + 1, j + 1, k - 2], [i + 1, j, k - 1], [i, j + 1, k - 1]],
-            [fx + fy - 1.0, 1.0 - fy, 1.0 - fx],
-        )
-    };
-    if !nearest && i >= 1 && j >= 1 && k >= 3 {
+    let (pts, ws) = triangle(c, r);
+    if !nearest && pts.iter().all(|p| p[0] >= 1 && p[1] >= 1 && p[2] >= 1) {
         // The whole lattice triangle is inside the face (the common case
         // on fine faces): three interior samples, no vertex or edge.
         for t in 0..3 {

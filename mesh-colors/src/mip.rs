@@ -2,7 +2,7 @@
 //! edge rule, Eq. 6), trilinear filtering from a footprint, and
 //! anisotropic filtering from screen-space derivatives (Sec. 4.3).
 
-use crate::filter::{FINEST, Place, Store, check, edge_point, eval, eval_at, lattice, place};
+use crate::filter::{FINEST, Place, Store, check, edge_point, eval_at, lattice, place, triangle};
 use crate::structure::{MeshColors, interior_index, samples_per_face};
 use crate::topology::NO_FACE;
 use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
@@ -51,6 +51,39 @@ pub struct MipMap {
     pub(crate) edge_offset: Vec<usize>,
     pub(crate) face_offset: Vec<usize>,
     pub(crate) data: Vec<f32>,
+    /// A lookup cache: per face, every level's full lattice (vertex and
+    /// edge values copied in, interpolated where the edge is coarser), so
+    /// a lookup inside a face reads three values without branching. Slot
+    /// `l ≤ n_f` is the face seen at query level `l`; slot `n_f + 1` at any
+    /// level from the finest of its corners up (vertices keep refining
+    /// after a coarse face stops).
+    pub(crate) flat_offset: Vec<usize>,
+    pub(crate) flat: Vec<f32>,
+    /// Per face, the finest level of its three corners.
+    pub(crate) corner_level: Vec<u8>,
+}
+
+/// Lattice points of a face of resolution `r`: `(r + 1)(r + 2)/2`.
+const fn lattice_len(r: usize) -> usize {
+    (r + 1) * (r + 2) / 2
+}
+
+/// Offset of slot `s` within a face's cache: `Σ_{m<s} lattice_len(2^m)`.
+const fn flat_slot_offsets() -> [usize; MAX_LEVEL as usize + 3] {
+    let mut out = [0usize; MAX_LEVEL as usize + 3];
+    let mut l = 1;
+    while l < out.len() {
+        out[l] = out[l - 1] + lattice_len(1 << (l - 1));
+        l += 1;
+    }
+    out
+}
+const FLAT_SLOT_OFFSET: [usize; MAX_LEVEL as usize + 3] = flat_slot_offsets();
+
+/// Row-major index of lattice point `(i, j, ·)` of resolution `r`.
+#[inline(always)]
+fn lattice_row_index(r: u32, i: u32, j: u32) -> usize {
+    (i * (2 * r + 3 - i) / 2 + j) as usize
 }
 
 impl Store for MipMap {
@@ -106,6 +139,7 @@ impl MipMap {
         for l in (0..top).rev() {
             mip.build_level(l, &vertex_edges);
         }
+        mip.build_cache();
         mip
     }
 
@@ -146,6 +180,9 @@ impl MipMap {
             edge_offset,
             face_offset,
             colors,
+            flat_offset: Vec::new(),
+            flat: Vec::new(),
+            corner_level: Vec::new(),
         }
     }
 
@@ -195,7 +232,88 @@ impl MipMap {
             });
         }
         self.data = data;
+        self.build_cache();
         Ok(())
+    }
+
+    /// Fills the lookup cache from the pyramid (see the `flat` field).
+    fn build_cache(&mut self) {
+        let mc = &self.colors;
+        let c = mc.channels;
+        let mut offsets = Vec::with_capacity(mc.face_level.len());
+        let mut next = 0;
+        for &n in &mc.face_level {
+            offsets.push(next);
+            next += FLAT_SLOT_OFFSET[n as usize + 2];
+        }
+        let corner_level: Vec<u8> = mc
+            .topology
+            .faces
+            .iter()
+            .map(|face| {
+                face.iter()
+                    .map(|&v| mc.vertex_level[v as usize])
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        let mut flat = vec![0.0f32; next * c];
+        for f in 0..mc.face_level.len() {
+            let n = mc.face_level[f];
+            for slot in 0..=n + 1 {
+                let (q, lf) = if slot <= n { (slot, slot) } else { (FINEST, n) };
+                let r = 1u32 << lf;
+                let base = offsets[f] + FLAT_SLOT_OFFSET[slot as usize];
+                for i in 0..=r {
+                    for j in 0..=r - i {
+                        let at = (base + lattice_row_index(r, i, j)) * c;
+                        lattice(
+                            self,
+                            f,
+                            q,
+                            lf,
+                            [i, j, r - i - j],
+                            1.0,
+                            false,
+                            &mut flat[at..at + c],
+                        );
+                    }
+                }
+            }
+        }
+        self.flat_offset = offsets;
+        self.flat = flat;
+        self.corner_level = corner_level;
+    }
+
+    /// A lookup at query level `q` of a point inside face `f`, from the
+    /// cache when it holds that view of the face.
+    #[inline]
+    fn inside(&self, f: usize, at: Place, q: u8, out: &mut [f32]) {
+        let Place::Inside(bc) = at else {
+            eval_at(self, f, at, q, false, out);
+            return;
+        };
+        let n = self.colors.face_level[f];
+        let (slot, lf) = if q <= n {
+            (q, q)
+        } else if q >= self.corner_level[f] {
+            (n + 1, n)
+        } else {
+            eval_at(self, f, at, q, false, out);
+            return;
+        };
+        let r = 1u32 << lf;
+        let (pts, ws) = triangle(bc, r);
+        let c = self.colors.channels;
+        let base = self.flat_offset[f] + FLAT_SLOT_OFFSET[slot as usize];
+        out.fill(0.0);
+        for t in 0..3 {
+            let at = (base + lattice_row_index(r, pts[t][0], pts[t][1])) * c;
+            for (o, &x) in out.iter_mut().zip(&self.flat[at..at + c]) {
+                *o += ws[t] * x;
+            }
+        }
     }
 
     fn copy_finest(&mut self) {
@@ -349,7 +467,7 @@ impl MipMap {
         out: &mut [f32],
     ) -> Result<(), Error> {
         check(&self.colors, face, out)?;
-        eval(self, face, b, level, false, out);
+        self.inside(face, place(&self.colors, face, b), level, out);
         Ok(())
     }
 
@@ -386,13 +504,13 @@ impl MipMap {
         let l0 = lambda.floor();
         let frac = lambda - l0;
         let l0 = l0 as u8;
-        eval_at(self, face, at, l0, false, out);
+        self.inside(face, at, l0, out);
         if l0 >= top || frac == 0.0 {
             return;
         }
         let c = mc.channels;
         let mut fine = [0.0f32; MAX_CHANNELS];
-        eval_at(self, face, at, l0 + 1, false, &mut fine[..c]);
+        self.inside(face, at, l0 + 1, &mut fine[..c]);
         for (o, &x) in out.iter_mut().zip(&fine[..c]) {
             *o = (1.0 - frac) * *o + frac * x;
         }

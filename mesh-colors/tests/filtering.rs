@@ -333,8 +333,13 @@ fn mip_finest_level_and_small_footprints_are_the_linear_filter() {
         mip.at_level(f, bary, mesh_colors::FINEST_LEVEL, &mut b)
             .unwrap();
         mip.trilinear(f, bary, 1e-6, &mut c).unwrap();
-        assert_eq!(a, b);
-        assert_eq!(a, c);
+        // The pyramid's lookup cache holds interpolated edge values ready
+        // made, so a lattice triangle that touches a coarser edge rounds
+        // once instead of twice: equal to a few ulp.
+        let d = (0..3)
+            .map(|k| (a[k] - b[k]).abs().max((a[k] - c[k]).abs()))
+            .fold(0.0, f32::max);
+        assert!(d < 1e-6, "{a:?} {b:?} {c:?}");
     }
 }
 
