@@ -258,12 +258,11 @@ impl MipMap {
             })
             .collect();
         let mut flat = vec![0.0f32; next * c];
-        for f in 0..mc.face_level.len() {
-            let n = mc.face_level[f];
+        for (f, (&n, &first)) in mc.face_level.iter().zip(&offsets).enumerate() {
             for slot in 0..=n + 1 {
                 let (q, lf) = if slot <= n { (slot, slot) } else { (FINEST, n) };
                 let r = 1u32 << lf;
-                let base = offsets[f] + FLAT_SLOT_OFFSET[slot as usize];
+                let base = first + FLAT_SLOT_OFFSET[slot as usize];
                 for i in 0..=r {
                     for j in 0..=r - i {
                         let at = (base + lattice_row_index(r, i, j)) * c;
