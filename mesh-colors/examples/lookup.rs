@@ -14,23 +14,13 @@ use std::time::Instant;
 
 use mesh_colors::{Topology, convert};
 
-/// Lookups per measurement; the best of `REPEATS` runs is kept (the
-/// machine is shared, so the fastest run is the least disturbed).
+/// Lookups per measurement; the best of `REPEATS` interleaved runs is
+/// kept (the machine is shared, so the fastest run is the least disturbed).
 const POINTS: usize = 1_000_000;
 
 /// One mesh colour lookup: (point index, face, barycentrics, output).
 type Lookup<'a> = &'a dyn Fn(usize, usize, [f32; 3], &mut [f32; 3]);
-const REPEATS: usize = 3;
-
-fn best_mlookups(mut run: impl FnMut() -> f32) -> f64 {
-    let mut best = f64::INFINITY;
-    for _ in 0..REPEATS {
-        let t = Instant::now();
-        black_box(run());
-        best = best.min(t.elapsed().as_secs_f64());
-    }
-    POINTS as f64 / best / 1e6
-}
+const REPEATS: usize = 5;
 
 fn main() {
     let json = std::env::args().any(|a| a == "--json");
@@ -84,48 +74,68 @@ fn main() {
             .collect();
         let mut texture = m.texture.clone();
         texture.build_mips();
-        let mut out = [0.0f32; 3];
-        let run_mc = |lookup: Lookup<'_>| -> f64 {
+        // One pass of 10^6 lookups per filter; the passes of all six
+        // filters are interleaved and repeated, and each keeps its fastest,
+        // so a burst of load on the shared machine hits every filter alike.
+        let pass_mc = |lookup: Lookup<'_>| -> f32 {
             let mut out = [0.0f32; 3];
-            best_mlookups(|| {
-                let mut acc = 0.0f32;
-                for (i, &(f, b)) in points.iter().enumerate() {
-                    lookup(i, f as usize, b, &mut out);
-                    acc += out[0];
-                }
-                acc
-            })
+            let mut acc = 0.0f32;
+            for (i, &(f, b)) in points.iter().enumerate() {
+                lookup(i, f as usize, b, &mut out);
+                acc += out[0];
+            }
+            acc
         };
-        let nearest = run_mc(&|_, f, b, out| {
+        let nearest = |_: usize, f: usize, b: [f32; 3], out: &mut [f32; 3]| {
             let _ = mc.nearest(f, b, out);
-        });
-        let linear = run_mc(&|_, f, b, out| {
+        };
+        let linear = |_: usize, f: usize, b: [f32; 3], out: &mut [f32; 3]| {
             let _ = mc.linear(f, b, out);
-        });
-        let mipr = run_mc(&|i, f, b, out| {
+        };
+        let mipf = |i: usize, f: usize, b: [f32; 3], out: &mut [f32; 3]| {
             let _ = mip.trilinear(f, b, footprints[i], out);
-        });
+        };
         // A footprint four times longer along one edge than across it.
-        let aniso = run_mc(&|i, f, b, out| {
+        let aniso = |i: usize, f: usize, b: [f32; 3], out: &mut [f32; 3]| {
             let s = footprints[i];
             let _ = mip.anisotropic(f, b, [4.0 * s, -4.0 * s, 0.0], [0.0, s, -s], 8, out);
-        });
-        let bilinear = best_mlookups(|| {
+        };
+        let bilinear = || {
+            let mut out = [0.0f32; 3];
             let mut acc = 0.0f32;
             for uv in &uvs {
                 texture.bilinear(*uv, &mut out);
                 acc += out[0];
             }
             acc
-        });
-        let trilinear = best_mlookups(|| {
+        };
+        let trilinear = || {
+            let mut out = [0.0f32; 3];
             let mut acc = 0.0f32;
             for (uv, &lod) in uvs.iter().zip(&lods) {
                 texture.trilinear(*uv, lod, &mut out);
                 acc += out[0];
             }
             acc
-        });
+        };
+        let mut best = [f64::INFINITY; 6];
+        for _ in 0..REPEATS {
+            let passes: [&dyn Fn() -> f32; 6] = [
+                &|| pass_mc(&nearest),
+                &|| pass_mc(&linear),
+                &|| pass_mc(&mipf),
+                &|| pass_mc(&aniso),
+                &bilinear,
+                &trilinear,
+            ];
+            for (k, pass) in passes.iter().enumerate() {
+                let t = Instant::now();
+                black_box(pass());
+                best[k] = best[k].min(t.elapsed().as_secs_f64());
+            }
+        }
+        let rate = best.map(|t| POINTS as f64 / t / 1e6);
+        let [nearest, linear, mipr, aniso, bilinear, trilinear] = rate;
         for (filter, v) in [
             ("nearest", nearest),
             ("linear", linear),
