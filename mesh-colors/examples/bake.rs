@@ -36,7 +36,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &Default::default(),
     )?;
     file::save(out.join("spot.meshcolors"), &colors, None)?;
-    let baked = atlas::bake(&colors, &atlas::Options { gutter: 2 })?;
+    let baked = atlas::bake(
+        &colors,
+        &atlas::Options {
+            gutter: 2,
+            ..Default::default()
+        },
+    )?;
 
     // One OBJ vertex per corner (the atlas gives every face its own UVs);
     // OBJ's v points up, so flip it.

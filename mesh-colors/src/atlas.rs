@@ -17,13 +17,24 @@
 //! a finer face meets a coarser edge, the continuity rule), so both sides
 //! of a mesh edge read identical values: no seam at level 0.
 //!
-//! **Packing.** Two faces of the same resolution share an
+//! **Packing.** By default two faces of the same resolution share an
 //! `(R+3) × (R+2)` block, the second turned half a turn into the unused
-//! half, so the atlas holds about one texel per sample plus a border;
-//! blocks get a gutter of `gutter` texels that repeat their border texels,
-//! so that the first `log2(gutter + 1)` MIP levels an engine builds do not
-//! mix neighbouring blocks (coarser levels will; mesh colours' own MIP
-//! levels, [`crate::MipMap`], have no such limit).
+//! half, so the atlas holds about one texel per sample plus a border, and
+//! blocks get a gutter of `gutter` texels repeating their border: right
+//! for bilinear filtering, while an engine's MIP levels would start to mix
+//! the paired faces and neighbouring blocks.
+//!
+//! **MIP-safe packing** ([`Options::mip_levels`] = `k > 0`): one face per
+//! block, blocks sized and placed on multiples of `2^k` with a gutter of at
+//! least `2^k`, and every texel of the block outside the triangle holding
+//! the linear extrapolation of the nearest lattice triangle. An engine's
+//! 2×2 box-filtered levels 1..=k then average only texels of one face, and
+//! for colours that are affine on the face every level is exact, so no
+//! seam opens at those levels (tested); otherwise the error at level `j` is
+//! the colour's variation over `2^j` texels, as for any texture. The
+//! per-face gutters make it costly: 4× the texels of the default packing
+//! for spot at `k = 2`, more for meshes of many small faces. (Mesh
+//! colours' own [`crate::MipMap`] has no such limit.)
 
 use glam::Vec2;
 
@@ -47,11 +58,17 @@ pub struct Atlas {
 pub struct Options {
     /// Texels of padding around each block.
     pub gutter: u32,
+    /// MIP levels an engine may build without faces bleeding into each
+    /// other (0: the compact paired packing; see the module docs).
+    pub mip_levels: u32,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Self { gutter: 1 }
+        Self {
+            gutter: 1,
+            mip_levels: 0,
+        }
     }
 }
 
@@ -62,38 +79,63 @@ struct Block {
     y: u32,
 }
 
+fn round_up(x: u32, to: u32) -> u32 {
+    x.div_ceil(to) * to
+}
+
 /// Bakes mesh colours into an atlas (see the module docs for the layout).
 ///
 /// # Errors
 /// [`Error::BadTexture`] if the atlas would exceed 32768 texels a side.
 pub fn bake(colors: &MeshColors, options: &Options) -> Result<Atlas, Error> {
-    let g = options.gutter;
+    let k = options.mip_levels.min(8);
+    let align = 1u32 << k;
+    let paired = k == 0;
+    let g = if paired {
+        options.gutter
+    } else {
+        options.gutter.max(align)
+    };
     let n = colors.face_count();
-    // Pair faces of equal resolution.
     let mut by_level: Vec<Vec<usize>> = vec![Vec::new(); crate::MAX_LEVEL as usize + 1];
     for f in 0..n {
         by_level[colors.face_level(f) as usize].push(f);
     }
     let mut blocks = Vec::new();
     for (l, faces) in by_level.iter().enumerate().rev() {
-        for pair in faces.chunks(2) {
+        let per = if paired { 2 } else { 1 };
+        for group in faces.chunks(per) {
             blocks.push(Block {
-                faces: [Some(pair[0]), pair.get(1).copied()],
+                faces: [Some(group[0]), group.get(1).copied()],
                 r: 1 << l,
                 x: 0,
                 y: 0,
             });
         }
     }
-    let size = |b: &Block| (b.r + 3 + 2 * g, b.r + 2 + 2 * g);
+    // Inner block: the lattice (and, paired, the second face).
+    let inner = |r: u32| {
+        if paired {
+            (r + 3, r + 2)
+        } else {
+            (r + 2, r + 2)
+        }
+    };
+    let size = |b: &Block| {
+        let (w, h) = inner(b.r);
+        (round_up(w + 2 * g, align), round_up(h + 2 * g, align))
+    };
     let area: u64 = blocks
         .iter()
         .map(|b| u64::from(size(b).0) * u64::from(size(b).1))
         .sum();
     let widest = blocks.iter().map(|b| size(b).0).max().unwrap_or(1);
-    let width = ((area as f64 * 1.05).sqrt().ceil() as u32)
-        .max(widest)
-        .max(1);
+    let width = round_up(
+        ((area as f64 * 1.05).sqrt().ceil() as u32)
+            .max(widest)
+            .max(1),
+        align,
+    );
     // Shelf packing, tallest blocks first (they are sorted by level).
     let (mut x, mut y, mut shelf) = (0u32, 0u32, 0u32);
     for b in &mut blocks {
@@ -108,7 +150,7 @@ pub fn bake(colors: &MeshColors, options: &Options) -> Result<Atlas, Error> {
         x += w;
         shelf = shelf.max(h);
     }
-    let height = (y + shelf).max(1);
+    let height = round_up((y + shelf).max(1), align);
     if width > 32_768 || height > 32_768 {
         return Err(Error::BadTexture {
             width: width as usize,
@@ -143,10 +185,6 @@ pub fn bake(colors: &MeshColors, options: &Options) -> Result<Atlas, Error> {
                 }
             };
             let lf = colors.face_level(f);
-            let mut put = |x: u32, y: u32, v: &[f32]| {
-                let i = (y as usize * w + x as usize) * c;
-                data[i..i + c].copy_from_slice(v);
-            };
             let mut lat = vec![0.0f32; ((r + 1) * (r + 2) / 2) as usize * c];
             let idx = |i: u32, j: u32| ((i * (2 * r + 3 - i) / 2 + j) as usize) * c;
             for i in 0..=r {
@@ -163,41 +201,73 @@ pub fn bake(colors: &MeshColors, options: &Options) -> Result<Atlas, Error> {
                         &mut value,
                     );
                     lat[idx(i, j)..idx(i, j) + c].copy_from_slice(&value);
-                    let (x, y) = at(i, j);
-                    put(x, y, &value);
                 }
             }
-            // The hypotenuse's outer row: parallelogram extrapolation.
-            for i in 0..=r + 1 {
-                let j = r + 1 - i;
-                for ch in 0..c {
-                    value[ch] = if i == 0 {
-                        lat[idx(0, r) + ch]
-                    } else if j == 0 {
-                        lat[idx(r, 0) + ch]
-                    } else {
-                        lat[idx(i, j - 1) + ch] + lat[idx(i - 1, j) + ch]
-                            - lat[idx(i - 1, j - 1) + ch]
-                    };
+            // The value at block-local lattice coordinates (i, j): the
+            // sample on the lattice, else the linear extrapolation of the
+            // nearest lattice triangle (for texels just past the
+            // hypotenuse, the triangle whose parallelogram they complete).
+            let extrapolate = |i: i64, j: i64, out: &mut [f32]| {
+                let ri = i64::from(r);
+                if i >= 0 && j >= 0 && i + j <= ri {
+                    let at = idx(i as u32, j as u32);
+                    out.copy_from_slice(&lat[at..at + c]);
+                    return;
                 }
-                let (x, y) = at(i, j);
-                put(x, y, &value);
+                let d = i64::from(i + j > ri);
+                let i0 = (i - d).clamp(0, ri - 1);
+                let j0 = (j - d).clamp(0, ri - 1 - i0);
+                let (di, dj) = ((i - i0) as f32, (j - j0) as f32);
+                let (b0, bi, bj) = (
+                    idx(i0 as u32, j0 as u32),
+                    idx(i0 as u32 + 1, j0 as u32),
+                    idx(i0 as u32, j0 as u32 + 1),
+                );
+                for (ch, o) in out.iter_mut().enumerate() {
+                    let base = lat[b0 + ch];
+                    *o = base + di * (lat[bi + ch] - base) + dj * (lat[bj + ch] - base);
+                }
+            };
+            let mut put = |x: u32, y: u32, v: &[f32]| {
+                let i = (y as usize * w + x as usize) * c;
+                data[i..i + c].copy_from_slice(v);
+            };
+            if paired {
+                for i in 0..=r + 1 {
+                    for j in 0..=r + 1 - i {
+                        extrapolate(i64::from(i), i64::from(j), &mut value);
+                        let (x, y) = at(i, j);
+                        put(x, y, &value);
+                    }
+                }
+            } else {
+                let (bw, bh) = size(b);
+                for yy in b.y..b.y + bh {
+                    for xx in b.x..b.x + bw {
+                        let (i, j) = (i64::from(xx) - i64::from(ox), i64::from(yy) - i64::from(oy));
+                        extrapolate(i, j, &mut value);
+                        put(xx, yy, &value);
+                    }
+                }
             }
             let (x0, y0) = at(r, 0);
             let (x1, y1) = at(0, r);
             let (x2, y2) = at(0, 0);
             corner_uvs[f] = [uv(x0, y0), uv(x1, y1), uv(x2, y2)];
         }
-        // Gutter: repeat the block's border texels outwards.
-        let (iw, ih) = (r + 3, r + 2);
-        for yy in b.y..b.y + ih + 2 * g {
-            for xx in b.x..b.x + iw + 2 * g {
-                let cx = xx.clamp(ox, ox + iw - 1);
-                let cy = yy.clamp(oy, oy + ih - 1);
-                if (cx, cy) != (xx, yy) {
-                    let from = (cy as usize * w + cx as usize) * c;
-                    let to = (yy as usize * w + xx as usize) * c;
-                    data.copy_within(from..from + c, to);
+        if paired {
+            // Gutter: repeat the block's border texels outwards.
+            let (iw, ih) = inner(r);
+            let (bw, bh) = size(b);
+            for yy in b.y..b.y + bh {
+                for xx in b.x..b.x + bw {
+                    let cx = xx.clamp(ox, ox + iw - 1);
+                    let cy = yy.clamp(oy, oy + ih - 1);
+                    if (cx, cy) != (xx, yy) {
+                        let from = (cy as usize * w + cx as usize) * c;
+                        let to = (yy as usize * w + xx as usize) * c;
+                        data.copy_within(from..from + c, to);
+                    }
                 }
             }
         }
