@@ -53,6 +53,7 @@
 #![forbid(unsafe_code)]
 
 pub mod atlas;
+mod batch;
 pub mod convert;
 pub mod edit;
 mod error;

@@ -369,3 +369,36 @@ fn odd_barycentrics_do_not_panic() {
     mc.linear(3, [0.0, 0.5, 0.5], &mut b).unwrap();
     assert_eq!(a, b);
 }
+
+#[test]
+fn batch_lookups_equal_single_lookups() {
+    let (_, faces, mc) = mixed(13);
+    let mip = mc.mip_map();
+    let mut rng = Rng(14);
+    let points: Vec<(u32, [f32; 3])> = (0..10_000)
+        .map(|_| (rng.below(faces.len() as u64) as u32, rng.barycentric()))
+        .collect();
+    let footprints: Vec<f32> = (0..points.len())
+        .map(|i| 0.01 + (i % 50) as f32 / 60.0)
+        .collect();
+    let mut batch = vec![0.0f32; 3 * points.len()];
+    let mut one = [0.0f32; 3];
+    mc.linear_into(&points, &mut batch).unwrap();
+    for (i, &(f, b)) in points.iter().enumerate() {
+        mc.linear(f as usize, b, &mut one).unwrap();
+        assert_eq!(&batch[3 * i..3 * i + 3], &one);
+    }
+    mip.trilinear_into(&points, &footprints, &mut batch)
+        .unwrap();
+    for (i, &(f, b)) in points.iter().enumerate() {
+        mip.trilinear(f as usize, b, footprints[i], &mut one)
+            .unwrap();
+        assert_eq!(&batch[3 * i..3 * i + 3], &one);
+    }
+    assert!(mc.linear_into(&points, &mut batch[1..]).is_err());
+    assert!(mc.linear_into(&[(9999, [0.3; 3])], &mut [0.0; 3]).is_err());
+    assert!(
+        mip.trilinear_into(&points, &footprints[1..], &mut batch)
+            .is_err()
+    );
+}
