@@ -16,7 +16,9 @@
 //! - **Filtering** (Sec. 4): nearest and linear (Fig. 7), per-primitive
 //!   MIP-maps ([`MipMap`]: Eq. 5 for faces, the six-neighbour rule for
 //!   edges, Eq. 6 for vertices), trilinear from a footprint, anisotropic
-//!   from screen-space derivatives of the barycentrics (Sec. 4.3).
+//!   from screen-space derivatives of the barycentrics (Sec. 4.3); batch
+//!   lookups ([`MeshColors::linear_into`], [`MipMap::trilinear_into`]) on
+//!   all threads with the `rayon` feature.
 //! - **Editing** (Sec. 3.3, [`edit`]): exact 1-to-4 subdivision, adding
 //!   and deleting faces, changing one face's resolution.
 //! - **Painting** ([`Painter`], Sec. 5.1): brush strokes whose cost is the
