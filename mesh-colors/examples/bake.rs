@@ -1,0 +1,130 @@
+//! Texture → mesh colours → atlas, written as OBJ + MTL + PNG that any
+//! viewer opens, then read back with `trilux-io` and compared with the
+//! source texture at random surface points.
+//!
+//! `cargo run --release -p mesh-colors --example bake -- [out_dir]`
+//! (needs `$TRILUX_DATA`; writes `spot_atlas.{obj,mtl,png}`).
+
+#[path = "../tests/support/data.rs"]
+mod data;
+
+use std::path::PathBuf;
+
+use glam::Vec2;
+use mesh_colors::{Texture, Topology, atlas, convert, file};
+use trilux_io::image::{Image, PngDepth, linear_to_srgb, srgb_to_linear};
+use trilux_io::mesh::{Object, TriMesh};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let Some(dir) = data::data_dir() else {
+        eprintln!("TRILUX_DATA is not set: nothing to bake");
+        return Ok(());
+    };
+    let out = std::env::args()
+        .nth(1)
+        .map_or_else(std::env::temp_dir, PathBuf::from);
+    std::fs::create_dir_all(&out)?;
+    let spot = data::textured_meshes(&dir)
+        .into_iter()
+        .next()
+        .ok_or("no spot")?;
+    let topology = Topology::new(spot.positions.len(), &spot.faces)?;
+    let colors = convert::from_texture(
+        topology,
+        &spot.corner_uvs,
+        &spot.texture,
+        &Default::default(),
+    )?;
+    file::save(out.join("spot.meshcolors"), &colors, None)?;
+    let baked = atlas::bake(
+        &colors,
+        &atlas::Options {
+            gutter: 2,
+            ..Default::default()
+        },
+    )?;
+
+    // One OBJ vertex per corner (the atlas gives every face its own UVs);
+    // OBJ's v points up, so flip it.
+    let mut mesh = TriMesh::default();
+    for (f, face) in spot.faces.iter().enumerate() {
+        let base = mesh.positions.len() as u32;
+        for (k, &v) in face.iter().enumerate() {
+            mesh.positions.push(spot.positions[v as usize]);
+            let uv = baked.corner_uvs[f][k];
+            mesh.uvs
+                .get_or_insert_with(Vec::new)
+                .push(Vec2::new(uv.x, 1.0 - uv.y));
+        }
+        mesh.indices.push([base, base + 1, base + 2]);
+    }
+    mesh.objects.push(Object {
+        name: "spot".into(),
+        triangles: 0..mesh.indices.len(),
+        material: None,
+    });
+    let obj = out.join("spot_atlas.obj");
+    trilux_io::mesh::obj::write(&obj, &mesh)?;
+    let text = std::fs::read_to_string(&obj)?;
+    std::fs::write(&obj, format!("mtllib spot_atlas.mtl\nusemtl atlas\n{text}"))?;
+    std::fs::write(
+        out.join("spot_atlas.mtl"),
+        "newmtl atlas\nKd 1 1 1\nmap_Kd spot_atlas.png\n",
+    )?;
+    let t = &baked.texture;
+    let image = Image {
+        width: t.width() as u32,
+        height: t.height() as u32,
+        pixels: t
+            .data()
+            .chunks_exact(3)
+            .map(|c| {
+                [
+                    srgb_to_linear(c[0]),
+                    srgb_to_linear(c[1]),
+                    srgb_to_linear(c[2]),
+                    1.0,
+                ]
+            })
+            .collect(),
+    };
+    trilux_io::image::write_png(&out.join("spot_atlas.png"), &image, PngDepth::Eight)?;
+
+    // Read both back as a user would, and compare with the source texture.
+    let back = TriMesh::read(&obj)?;
+    let png = trilux_io::image::read(out.join("spot_atlas.png"))?;
+    let data = png
+        .pixels
+        .iter()
+        .flat_map(|p| [0, 1, 2].map(|c| linear_to_srgb(p[c])))
+        .collect();
+    let texture = Texture::new(png.width as usize, png.height as usize, 3, data)?;
+    let uvs = back.uvs.ok_or("no UVs read back")?;
+    let points = data::surface_points(&spot.positions, &spot.faces, 1_000_000, 5);
+    let (mut a, mut b) = ([0.0f32; 3], [0.0f32; 3]);
+    let mut se = 0.0f64;
+    for &(f, bary) in &points {
+        let uv = spot.corner_uvs[f as usize];
+        spot.texture.bilinear(
+            (bary[0] * uv[0] + bary[1] * uv[1] + bary[2] * uv[2]).into(),
+            &mut a,
+        );
+        let tri = back.indices[f as usize];
+        let p: Vec2 = (0..3).map(|k| bary[k] * uvs[tri[k] as usize]).sum();
+        texture.bilinear([p.x, 1.0 - p.y], &mut b);
+        se += (0..3).map(|c| f64::from(a[c] - b[c]).powi(2)).sum::<f64>();
+    }
+    let psnr = 10.0 * (1.0 / (se / (3 * points.len()) as f64)).log10();
+    println!(
+        "spot: {} colours -> {}×{} atlas ({} texels; source {}×{}), written to {}; \
+         read back: {psnr:.2} dB against the source texture (8-bit PNG)",
+        colors.sample_count(),
+        t.width(),
+        t.height(),
+        t.width() * t.height(),
+        spot.texture.width(),
+        spot.texture.height(),
+        out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,307 @@
+//! From a UV-textured mesh to mesh colours.
+//!
+//! Each face's resolution comes from the texels its UV triangle covers: a
+//! face of resolution `R` owns about `R²/2` samples (its share of the
+//! shared vertices and edges plus its interior), so `R ≈ √(2 · A_texels ·
+//! density)`, rounded to the nearest power of two in log scale and capped.
+//! A sample budget (by default the texture's texel count) lowers the
+//! density until the total fits, then raises the faces furthest below
+//! their choice while the budget allows. Every sample takes the bilinearly
+//! filtered texture at its UV; a vertex or edge sample that has several
+//! UVs (it lies on a UV seam) takes the mean over its distinct UVs, which
+//! removes the seam.
+
+use glam::Vec2;
+
+use crate::structure::{
+    MeshColors, lattice_points, primitive_levels, samples_per_edge, samples_per_face,
+};
+use crate::texture::Texture;
+use crate::topology::Topology;
+use crate::{Error, MAX_LEVEL};
+
+/// How to choose resolutions when converting a texture.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// Samples per covered texel to aim for (1: the texture's density).
+    pub density: f64,
+    /// The highest face level (`R ≤ 2^max_level`).
+    pub max_level: u8,
+    /// At most this many samples; `None` means the texture's texel count.
+    pub max_samples: Option<usize>,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            density: 1.0,
+            max_level: 8,
+            max_samples: None,
+        }
+    }
+}
+
+fn texel_area(uv: &[Vec2; 3], texture: &Texture) -> f64 {
+    let (a, b, c) = (uv[0].as_dvec2(), uv[1].as_dvec2(), uv[2].as_dvec2());
+    0.5 * (b - a).perp_dot(c - a).abs() * texture.width() as f64 * texture.height() as f64
+}
+
+/// The level for a face covering `area` texels at `density`.
+fn level_for(area: f64, density: f64, max_level: u8) -> u8 {
+    let r = (2.0 * area * density).sqrt();
+    if r.is_nan() || r <= 1.0 {
+        return 0;
+    }
+    (r.log2().round() as i64).clamp(0, i64::from(max_level)) as u8
+}
+
+/// Total samples for these face levels on this topology.
+fn count(topology: &Topology, levels: &[u8]) -> u64 {
+    let (edge_level, _) = primitive_levels(topology, levels);
+    topology.vertex_count() as u64
+        + edge_level
+            .iter()
+            .map(|&n| u64::from(samples_per_edge(1 << n)))
+            .sum::<u64>()
+        + levels
+            .iter()
+            .map(|&n| u64::from(samples_per_face(1 << n)))
+            .sum::<u64>()
+}
+
+/// Face levels from the texel footprint of each face's UVs, within the
+/// sample budget.
+///
+/// # Errors
+/// [`Error::ChannelMismatch`] (one UV triple per face),
+/// [`Error::NonFinite`] for a NaN or infinite UV.
+pub fn choose_levels(
+    topology: &Topology,
+    corner_uvs: &[[Vec2; 3]],
+    texture: &Texture,
+    options: &Options,
+) -> Result<Vec<u8>, Error> {
+    if corner_uvs.len() != topology.faces().len() {
+        return Err(Error::ChannelMismatch {
+            what: "corner UVs (one triple per face)",
+            expected: topology.faces().len(),
+            got: corner_uvs.len(),
+        });
+    }
+    if let Some(i) = corner_uvs.iter().flatten().position(|uv| !uv.is_finite()) {
+        return Err(Error::NonFinite {
+            what: "uv",
+            index: i,
+        });
+    }
+    let max_level = options.max_level.min(MAX_LEVEL);
+    let areas: Vec<f64> = corner_uvs
+        .iter()
+        .map(|uv| texel_area(uv, texture))
+        .collect();
+    let levels_at =
+        |d: f64| -> Vec<u8> { areas.iter().map(|&a| level_for(a, d, max_level)).collect() };
+    let budget = options
+        .max_samples
+        .unwrap_or(texture.width() * texture.height()) as u64;
+    let mut levels = levels_at(options.density);
+    if count(topology, &levels) > budget {
+        // The count only grows with the density: bisect it.
+        let (mut lo, mut hi) = (0.0, options.density);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if count(topology, &levels_at(mid)) > budget {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        levels = levels_at(lo);
+        top_up(
+            topology,
+            &mut levels,
+            &levels_at(options.density),
+            &areas,
+            budget,
+        );
+    }
+    Ok(levels)
+}
+
+/// Spends what the bisection left of the budget: raises faces one level at
+/// a time, those furthest below their unconstrained level first, while the
+/// total stays within `budget` (the count changes only at the face and its
+/// three edges, so each step is O(1)).
+fn top_up(topology: &Topology, levels: &mut [u8], target: &[u8], areas: &[f64], budget: u64) {
+    let mut total = count(topology, levels);
+    let edge_count = |n: u8| u64::from(samples_per_edge(1 << n));
+    for _ in 0..=MAX_LEVEL {
+        let mut order: Vec<usize> = (0..levels.len())
+            .filter(|&f| levels[f] < target[f])
+            .collect();
+        // Largest texel area per current sample first.
+        order.sort_by(|&a, &b| {
+            let d = |f: usize| areas[f] / f64::from(1u32 << (2 * levels[f]));
+            d(b).total_cmp(&d(a))
+        });
+        let mut changed = false;
+        for f in order {
+            let (old, new) = (levels[f], levels[f] + 1);
+            let mut grow =
+                u64::from(samples_per_face(1 << new)) - u64::from(samples_per_face(1 << old));
+            for &e in &topology.face_edges[f] {
+                let other = topology.edge_faces[e as usize]
+                    .iter()
+                    .filter(|&&g| g != crate::NO_FACE && g as usize != f)
+                    .map(|&g| levels[g as usize])
+                    .min()
+                    .unwrap_or(u8::MAX);
+                grow += edge_count(new.min(other)) - edge_count(old.min(other));
+            }
+            if total + grow <= budget {
+                levels[f] = new;
+                total += grow;
+                changed = true;
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+}
+
+/// Converts a UV-textured mesh to mesh colours with as many channels as the
+/// texture. `corner_uvs[f][k]` is the UV of corner `k` of face `f`, in the
+/// [`Texture`] convention (`v = 0` is row 0).
+///
+/// # Errors
+/// As for [`choose_levels`].
+pub fn from_texture(
+    topology: Topology,
+    corner_uvs: &[[Vec2; 3]],
+    texture: &Texture,
+    options: &Options,
+) -> Result<MeshColors, Error> {
+    let levels = choose_levels(&topology, corner_uvs, texture, options)?;
+    let mut mc = MeshColors::with_levels(topology, levels, texture.channels())?;
+    fill(&mut mc, corner_uvs, texture)?;
+    Ok(mc)
+}
+
+/// Fills existing mesh colours from a texture (resolutions unchanged):
+/// each sample is the bilinear texture value at its UV, averaged over its
+/// distinct UVs on seams.
+///
+/// # Errors
+/// [`Error::ChannelMismatch`] for a texture with other channels or UVs
+/// not one triple per face; [`Error::NonFinite`].
+pub fn fill(mc: &mut MeshColors, corner_uvs: &[[Vec2; 3]], texture: &Texture) -> Result<(), Error> {
+    if texture.channels() != mc.channels() {
+        return Err(Error::ChannelMismatch {
+            what: "texture channels",
+            expected: mc.channels(),
+            got: texture.channels(),
+        });
+    }
+    if corner_uvs.len() != mc.face_count() {
+        return Err(Error::ChannelMismatch {
+            what: "corner UVs (one triple per face)",
+            expected: mc.face_count(),
+            got: corner_uvs.len(),
+        });
+    }
+    if let Some(i) = corner_uvs.iter().flatten().position(|uv| !uv.is_finite()) {
+        return Err(Error::NonFinite {
+            what: "uv",
+            index: i,
+        });
+    }
+    // Every (sample, UV) pair; a sample on a seam has several UVs.
+    let mut entries: Vec<(usize, [u32; 2])> =
+        Vec::with_capacity(mc.sample_count() + mc.sample_count() / 2);
+    for (f, uv) in corner_uvs.iter().enumerate() {
+        let r = mc.face_resolution(f);
+        let rf = f64::from(r);
+        for a in lattice_points(r) {
+            if let Some(i) = mc.lattice_index(f, a) {
+                let p = (0..3).fold(glam::DVec2::ZERO, |s, k| {
+                    s + f64::from(a[k]) / rf * uv[k].as_dvec2()
+                });
+                entries.push((i, [(p.x as f32).to_bits(), (p.y as f32).to_bits()]));
+            }
+        }
+    }
+    entries.sort_unstable();
+    entries.dedup();
+    let c = mc.channels();
+    let values = lookups(&entries, texture);
+    let mut sum = vec![0.0f64; c];
+    let mut start = 0;
+    while start < entries.len() {
+        let i = entries[start].0;
+        let mut end = start;
+        sum.fill(0.0);
+        while end < entries.len() && entries[end].0 == i {
+            for (s, &x) in sum.iter_mut().zip(&values[end * c..(end + 1) * c]) {
+                *s += f64::from(x);
+            }
+            end += 1;
+        }
+        let n = (end - start) as f64;
+        for (o, s) in mc.sample_mut(i).iter_mut().zip(&sum) {
+            *o = (s / n) as f32;
+        }
+        start = end;
+    }
+    Ok(())
+}
+
+/// The bilinear texture value at each entry's UV (on all threads with the
+/// `rayon` feature; each value depends only on its UV).
+fn lookups(entries: &[(usize, [u32; 2])], texture: &Texture) -> Vec<f32> {
+    let c = texture.channels();
+    let mut values = vec![0.0f32; entries.len() * c];
+    let one = |(e, out): (&(usize, [u32; 2]), &mut [f32])| {
+        texture.bilinear([f32::from_bits(e.1[0]), f32::from_bits(e.1[1])], out);
+    };
+    #[cfg(feature = "rayon")]
+    {
+        use rayon::prelude::*;
+        entries
+            .par_iter()
+            .zip(values.par_chunks_mut(c))
+            .for_each(one);
+    }
+    #[cfg(not(feature = "rayon"))]
+    entries.iter().zip(values.chunks_mut(c)).for_each(one);
+    values
+}
+
+/// Peak signal-to-noise ratio, in dB, of mesh colours (linear filter)
+/// against the bilinearly filtered texture at the given surface points
+/// `(face, barycentrics)`, for values in `[0, peak]`. Infinite when equal.
+pub fn psnr(
+    mc: &MeshColors,
+    corner_uvs: &[[Vec2; 3]],
+    texture: &Texture,
+    points: &[(u32, [f32; 3])],
+    peak: f64,
+) -> Result<f64, Error> {
+    let c = mc.channels();
+    let (mut got, mut want) = (vec![0.0f32; c], vec![0.0f32; c]);
+    let mut sse = 0.0f64;
+    for &(f, b) in points {
+        mc.linear(f as usize, b, &mut got)?;
+        let uv = corner_uvs.get(f as usize).ok_or(Error::MissingFace {
+            face: f as usize,
+            count: corner_uvs.len(),
+        })?;
+        let p = b[0] * uv[0] + b[1] * uv[1] + b[2] * uv[2];
+        texture.bilinear([p.x, p.y], &mut want);
+        for (g, w) in got.iter().zip(&want) {
+            sse += f64::from(g - w).powi(2);
+        }
+    }
+    let mse = sse / (points.len() * c).max(1) as f64;
+    Ok(10.0 * (peak * peak / mse).log10())
+}

@@ -1,0 +1,116 @@
+//! The one error type of this crate.
+
+/// Why mesh colours could not be built, edited, converted or read.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A face resolution is not a power of two or is above the cap.
+    #[error(
+        "face {face}: resolution {resolution} is not a power of two in 1..={max}",
+        max = 1u32 << crate::MAX_LEVEL
+    )]
+    BadResolution {
+        /// The face.
+        face: usize,
+        /// The resolution asked for.
+        resolution: u64,
+    },
+    /// A face names a vertex that does not exist.
+    #[error("face {face} references vertex {vertex}, but there are only {count} vertices")]
+    MissingVertex {
+        /// The face.
+        face: usize,
+        /// The vertex index it names.
+        vertex: u32,
+        /// The number of vertices.
+        count: usize,
+    },
+    /// A face uses the same vertex twice, so it has no area to colour.
+    #[error("face {face} repeats vertex {vertex}")]
+    DegenerateFace {
+        /// The face.
+        face: usize,
+        /// The repeated vertex.
+        vertex: u32,
+    },
+    /// More than two faces share an edge. Mesh colours need each edge to
+    /// have one or two sides; split such an edge (duplicate its vertices
+    /// for the extra faces) before colouring.
+    #[error("edge ({a}, {b}) is shared by faces {faces:?} (at most two allowed)")]
+    NonManifoldEdge {
+        /// The edge's smaller vertex.
+        a: u32,
+        /// The edge's larger vertex.
+        b: u32,
+        /// Three of the faces that share it.
+        faces: [usize; 3],
+    },
+    /// The number of resolutions does not match the number of faces.
+    #[error("{got} face resolutions for {faces} faces")]
+    ResolutionCount {
+        /// Resolutions given.
+        got: usize,
+        /// Faces in the mesh.
+        faces: usize,
+    },
+    /// Attribute data with the wrong number of channels or values.
+    #[error("{what}: expected {expected} values, got {got}")]
+    ChannelMismatch {
+        /// Which input.
+        what: &'static str,
+        /// The number expected.
+        expected: usize,
+        /// The number given.
+        got: usize,
+    },
+    /// A channel count of zero or above [`crate::MAX_CHANNELS`].
+    #[error("{0} channels (1..={max} supported)", max = crate::MAX_CHANNELS)]
+    BadChannels(usize),
+    /// A face index out of range.
+    #[error("face {face} does not exist (the mesh has {count})")]
+    MissingFace {
+        /// The face index.
+        face: usize,
+        /// The number of faces.
+        count: usize,
+    },
+    /// An operation that needs every face at resolution ≥ 2 met a face at 1.
+    #[error("face {face} has resolution 1 and cannot be split 1-to-4 without resampling")]
+    CannotSubdivide {
+        /// The face.
+        face: usize,
+    },
+    /// A texture with zero size or a data length that does not match.
+    #[error("texture {width}×{height}×{channels} needs {expected} values, got {got}")]
+    BadTexture {
+        /// Width.
+        width: usize,
+        /// Height.
+        height: usize,
+        /// Channels.
+        channels: usize,
+        /// Values needed.
+        expected: usize,
+        /// Values given.
+        got: usize,
+    },
+    /// A non-finite UV or position.
+    #[error("{what} {index} is not finite")]
+    NonFinite {
+        /// "uv" or "position".
+        what: &'static str,
+        /// The corner or vertex index.
+        index: usize,
+    },
+    /// A `.meshcolors` file that cannot be read.
+    #[error("invalid .meshcolors data at byte {offset}: {reason}")]
+    File {
+        /// Byte offset where the problem was found.
+        offset: u64,
+        /// What was wrong.
+        reason: String,
+    },
+    /// An I/O failure while writing or reading a `.meshcolors` stream.
+    #[error("I/O error: {0}")]
+    Io(String),
+}

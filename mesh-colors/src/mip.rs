@@ -1,0 +1,600 @@
+//! MIP-maps per face, edge and vertex (Sec. 4.2: Eq. 5, the six-neighbour
+//! edge rule, Eq. 6), trilinear filtering from a footprint, and
+//! anisotropic filtering from screen-space derivatives (Sec. 4.3).
+
+use crate::filter::{FINEST, Place, Store, check, edge_point, eval_at, lattice, place, triangle};
+use crate::structure::{MeshColors, interior_index, samples_per_face};
+use crate::topology::NO_FACE;
+use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
+
+/// Offset of level `l` within a face's levels: `Σ_{m<l} (2^m−1)(2^m−2)/2`.
+const fn face_level_offsets() -> [usize; MAX_LEVEL as usize + 2] {
+    let mut out = [0usize; MAX_LEVEL as usize + 2];
+    let mut l = 1;
+    while l < out.len() {
+        out[l] = out[l - 1] + samples_per_face(1 << (l - 1)) as usize;
+        l += 1;
+    }
+    out
+}
+const FACE_LEVEL_OFFSET: [usize; MAX_LEVEL as usize + 2] = face_level_offsets();
+
+/// Offset of level `l` within an edge's levels: `Σ_{m<l} (2^m − 1)`.
+#[inline]
+fn edge_level_offset(l: u8) -> usize {
+    (1usize << l) - 1 - l as usize
+}
+
+/// The hexagonal neighbours of a lattice point (Eq. 5's six colours).
+const HEX: [[i32; 3]; 6] = [
+    [1, -1, 0],
+    [-1, 1, 0],
+    [1, 0, -1],
+    [-1, 0, 1],
+    [0, 1, -1],
+    [0, -1, 1],
+];
+
+/// Mesh colours with every MIP level of every vertex, edge and face.
+///
+/// Level `l` of a face has resolution `2^l`, down to level 0 (its vertex
+/// colours). A vertex has levels `0..=` the finest of its faces, an edge
+/// `0..=` its own (the lowest of its faces, see [`MeshColors`]). Levels are
+/// stored one after the other per primitive, coarsest first, so one index
+/// per vertex, edge and face reaches all of them (Sec. 4.2). A query at
+/// level `l` reads each primitive at `min(l, its finest)`, so every level
+/// is one continuous colouring, identical on an edge from both sides.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MipMap {
+    pub(crate) colors: MeshColors,
+    pub(crate) vertex_offset: Vec<usize>,
+    pub(crate) edge_offset: Vec<usize>,
+    pub(crate) face_offset: Vec<usize>,
+    pub(crate) data: Vec<f32>,
+    /// A lookup cache: per face, every level's full lattice (vertex and
+    /// edge values copied in, interpolated where the edge is coarser), so
+    /// a lookup inside a face reads three values without branching. Slot
+    /// `l ≤ n_f` is the face seen at query level `l`; slot `n_f + 1` at any
+    /// level from the finest of its corners up (vertices keep refining
+    /// after a coarse face stops).
+    pub(crate) flat_offset: Vec<usize>,
+    pub(crate) flat: Vec<f32>,
+    /// Per face, the finest level of its three corners.
+    pub(crate) corner_level: Vec<u8>,
+}
+
+/// Lattice points of a face of resolution `r`: `(r + 1)(r + 2)/2`.
+const fn lattice_len(r: usize) -> usize {
+    (r + 1) * (r + 2) / 2
+}
+
+/// Offset of slot `s` within a face's cache: `Σ_{m<s} lattice_len(2^m)`.
+const fn flat_slot_offsets() -> [usize; MAX_LEVEL as usize + 3] {
+    let mut out = [0usize; MAX_LEVEL as usize + 3];
+    let mut l = 1;
+    while l < out.len() {
+        out[l] = out[l - 1] + lattice_len(1 << (l - 1));
+        l += 1;
+    }
+    out
+}
+const FLAT_SLOT_OFFSET: [usize; MAX_LEVEL as usize + 3] = flat_slot_offsets();
+
+/// Row-major index of lattice point `(i, j, ·)` of resolution `r`.
+#[inline(always)]
+fn lattice_row_index(r: u32, i: u32, j: u32) -> usize {
+    (i * (2 * r + 3 - i) / 2 + j) as usize
+}
+
+impl Store for MipMap {
+    #[inline]
+    fn colors(&self) -> &MeshColors {
+        &self.colors
+    }
+    #[inline]
+    fn vertex_at(&self, v: usize, level: u8) -> &[f32] {
+        let c = self.colors.channels;
+        let i = self.vertex_offset[v] + level as usize;
+        &self.data[i * c..(i + 1) * c]
+    }
+    #[inline]
+    fn edge_at(&self, e: usize, level: u8, s: u32) -> &[f32] {
+        let c = self.colors.channels;
+        let i = self.edge_offset[e] + edge_level_offset(level) + s as usize - 1;
+        &self.data[i * c..(i + 1) * c]
+    }
+    #[inline]
+    fn face_at(&self, f: usize, level: u8, idx: usize) -> &[f32] {
+        let c = self.colors.channels;
+        let i = self.face_offset[f] + FACE_LEVEL_OFFSET[level as usize] + idx;
+        &self.data[i * c..(i + 1) * c]
+    }
+}
+
+/// Writes `(centre + ½ Σ neighbours) / (1 + n/2)`: Eq. 5 for six
+/// neighbours, Eq. 6 for a vertex of valence `n`, and the edge rule (two
+/// on the edge, two from each face; one face on a boundary).
+fn combine(centre: &[f32], sum: &[f64], n: usize, out: &mut [f32]) {
+    let norm = 1.0 / (1.0 + 0.5 * n as f64);
+    for ((o, &c), &s) in out.iter_mut().zip(centre).zip(sum) {
+        *o = ((f64::from(c) + 0.5 * s) * norm) as f32;
+    }
+}
+
+impl MipMap {
+    /// Builds all MIP levels from the finest samples, level by level from
+    /// the top: faces by Eq. 5, edges from their two on-edge and (per face)
+    /// two off-edge neighbours, vertices by Eq. 6 with the nearest sample
+    /// of every edge at the finer level (interpolated, by the continuity
+    /// rule, on an edge coarser than that level). Sums are in `f64`.
+    pub fn new(colors: MeshColors) -> Self {
+        let mut mip = Self::zeroed(colors);
+        mip.copy_finest();
+        let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); mip.colors.topology.vertex_count];
+        for (e, &[a, b]) in mip.colors.topology.edges.iter().enumerate() {
+            vertex_edges[a as usize].push(e as u32);
+            vertex_edges[b as usize].push(e as u32);
+        }
+        let top = mip.colors.vertex_level.iter().copied().max().unwrap_or(0);
+        for l in (0..top).rev() {
+            mip.build_level(l, &vertex_edges);
+        }
+        mip.build_cache();
+        mip
+    }
+
+    /// The layout for `colors` with every value zero.
+    pub(crate) fn zeroed(colors: MeshColors) -> Self {
+        let c = colors.channels;
+        let mut next = 0usize;
+        let vertex_offset: Vec<usize> = colors
+            .vertex_level
+            .iter()
+            .map(|&n| {
+                let at = next;
+                next += n as usize + 1;
+                at
+            })
+            .collect();
+        let edge_offset: Vec<usize> = colors
+            .edge_level
+            .iter()
+            .map(|&n| {
+                let at = next;
+                next += edge_level_offset(n + 1);
+                at
+            })
+            .collect();
+        let face_offset: Vec<usize> = colors
+            .face_level
+            .iter()
+            .map(|&n| {
+                let at = next;
+                next += FACE_LEVEL_OFFSET[n as usize + 1];
+                at
+            })
+            .collect();
+        MipMap {
+            data: vec![0.0; next * c],
+            vertex_offset,
+            edge_offset,
+            face_offset,
+            colors,
+            flat_offset: Vec::new(),
+            flat: Vec::new(),
+            corner_level: Vec::new(),
+        }
+    }
+
+    /// The number of values (samples × channels) a pyramid of `colors`
+    /// holds, without building it.
+    pub(crate) fn len_for(colors: &MeshColors) -> u64 {
+        let v: u64 = colors.vertex_level.iter().map(|&n| u64::from(n) + 1).sum();
+        let e: u64 = colors
+            .edge_level
+            .iter()
+            .map(|&n| edge_level_offset(n + 1) as u64)
+            .sum();
+        let f: u64 = colors
+            .face_level
+            .iter()
+            .map(|&n| FACE_LEVEL_OFFSET[n as usize + 1] as u64)
+            .sum();
+        (v + e + f) * colors.channels as u64
+    }
+
+    /// The mesh colours (finest level) this pyramid was built from.
+    pub fn colors(&self) -> &MeshColors {
+        &self.colors
+    }
+
+    /// Gives the finest-level mesh colours back.
+    pub fn into_colors(self) -> MeshColors {
+        self.colors
+    }
+
+    /// Every level of every primitive, in the layout described on
+    /// [`MipMap`]: vertices, then edges, then faces.
+    pub fn data(&self) -> &[f32] {
+        &self.data
+    }
+
+    /// Replaces the MIP data (for example read from a file).
+    ///
+    /// # Errors
+    /// [`Error::ChannelMismatch`] if the length is not this layout's.
+    pub(crate) fn set_data(&mut self, data: Vec<f32>) -> Result<(), Error> {
+        if data.len() != self.data.len() {
+            return Err(Error::ChannelMismatch {
+                what: "MIP data",
+                expected: self.data.len(),
+                got: data.len(),
+            });
+        }
+        self.data = data;
+        self.build_cache();
+        Ok(())
+    }
+
+    /// Fills the lookup cache from the pyramid (see the `flat` field).
+    fn build_cache(&mut self) {
+        let mc = &self.colors;
+        let c = mc.channels;
+        let mut offsets = Vec::with_capacity(mc.face_level.len());
+        let mut next = 0;
+        for &n in &mc.face_level {
+            offsets.push(next);
+            next += FLAT_SLOT_OFFSET[n as usize + 2];
+        }
+        let corner_level: Vec<u8> = mc
+            .topology
+            .faces
+            .iter()
+            .map(|face| {
+                face.iter()
+                    .map(|&v| mc.vertex_level[v as usize])
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        let mut flat = vec![0.0f32; next * c];
+        for (f, (&n, &first)) in mc.face_level.iter().zip(&offsets).enumerate() {
+            for slot in 0..=n + 1 {
+                let (q, lf) = if slot <= n { (slot, slot) } else { (FINEST, n) };
+                let r = 1u32 << lf;
+                let base = first + FLAT_SLOT_OFFSET[slot as usize];
+                for i in 0..=r {
+                    for j in 0..=r - i {
+                        let at = (base + lattice_row_index(r, i, j)) * c;
+                        lattice(
+                            self,
+                            f,
+                            q,
+                            lf,
+                            [i, j, r - i - j],
+                            1.0,
+                            false,
+                            &mut flat[at..at + c],
+                        );
+                    }
+                }
+            }
+        }
+        self.flat_offset = offsets;
+        self.flat = flat;
+        self.corner_level = corner_level;
+    }
+
+    /// A lookup at query level `q` of a point inside face `f`, from the
+    /// cache when it holds that view of the face.
+    #[inline]
+    fn inside(&self, f: usize, at: Place, q: u8, out: &mut [f32]) {
+        let Place::Inside(bc) = at else {
+            eval_at(self, f, at, q, false, out);
+            return;
+        };
+        let n = self.colors.face_level[f];
+        let (slot, lf) = if q <= n {
+            (q, q)
+        } else if q >= self.corner_level[f] {
+            (n + 1, n)
+        } else {
+            eval_at(self, f, at, q, false, out);
+            return;
+        };
+        let r = 1u32 << lf;
+        let (pts, ws) = triangle(bc, r);
+        let c = self.colors.channels;
+        let base = self.flat_offset[f] + FLAT_SLOT_OFFSET[slot as usize];
+        out.fill(0.0);
+        for t in 0..3 {
+            let at = (base + lattice_row_index(r, pts[t][0], pts[t][1])) * c;
+            for (o, &x) in out.iter_mut().zip(&self.flat[at..at + c]) {
+                *o += ws[t] * x;
+            }
+        }
+    }
+
+    fn copy_finest(&mut self) {
+        let mc = &self.colors;
+        let c = mc.channels;
+        for v in 0..mc.topology.vertex_count {
+            let at = self.vertex_offset[v] + mc.vertex_level[v] as usize;
+            self.data[at * c..(at + 1) * c].copy_from_slice(&mc.samples[v * c..(v + 1) * c]);
+        }
+        for e in 0..mc.edge_level.len() {
+            let n = mc.edge_level[e];
+            let len = ((1usize << n) - 1) * c;
+            let at = (self.edge_offset[e] + edge_level_offset(n)) * c;
+            let from = mc.edge_offset[e] * c;
+            self.data[at..at + len].copy_from_slice(&mc.samples[from..from + len]);
+        }
+        for f in 0..mc.face_level.len() {
+            let n = mc.face_level[f];
+            let len = samples_per_face(1 << n) as usize * c;
+            let at = (self.face_offset[f] + FACE_LEVEL_OFFSET[n as usize]) * c;
+            let from = mc.face_offset[f] * c;
+            self.data[at..at + len].copy_from_slice(&mc.samples[from..from + len]);
+        }
+    }
+
+    /// Computes level `l` of every primitive finer than `l` from level
+    /// `l + 1` (all of which exists already).
+    fn build_level(&mut self, l: u8, vertex_edges: &[Vec<u32>]) {
+        let c = self.colors.channels;
+        let q = l + 1;
+        let mut writes: Vec<(usize, Vec<f32>)> = Vec::new();
+        let mut tmp = vec![0.0f32; c];
+        let mut sum = vec![0.0f64; c];
+        let mut val = vec![0.0f32; c];
+        let mc = &self.colors;
+        let accumulate = |sum: &mut [f64], tmp: &[f32]| {
+            for (s, &x) in sum.iter_mut().zip(tmp) {
+                *s += f64::from(x);
+            }
+        };
+        // Faces, Eq. 5.
+        let r = 1u32 << l;
+        for f in 0..mc.face_level.len() {
+            if mc.face_level[f] <= l || r < 3 {
+                continue;
+            }
+            for i in 1..r {
+                for j in 1..r - i {
+                    let k = r - i - j;
+                    let centre = [2 * i, 2 * j, 2 * k];
+                    sum.fill(0.0);
+                    for d in HEX {
+                        let a = [0, 1, 2].map(|m| (centre[m] as i32 + d[m]) as u32);
+                        tmp.fill(0.0);
+                        lattice(self, f, q, q, a, 1.0, false, &mut tmp);
+                        accumulate(&mut sum, &tmp);
+                    }
+                    let idx = interior_index(1 << q, centre[0], centre[1]);
+                    combine(self.face_at(f, q, idx), &sum, 6, &mut val);
+                    let at = self.face_offset[f]
+                        + FACE_LEVEL_OFFSET[l as usize]
+                        + interior_index(r, i, j);
+                    writes.push((at, val.clone()));
+                }
+            }
+        }
+        // Edges: the six-neighbour rule.
+        for e in 0..mc.edge_level.len() {
+            if mc.edge_level[e] <= l || r < 2 {
+                continue;
+            }
+            let r2 = 1u32 << q;
+            for s in 1..r {
+                sum.fill(0.0);
+                let mut n = 0;
+                for p in [2 * s - 1, 2 * s + 1] {
+                    accumulate(&mut sum, self.edge_at(e, q, p));
+                    n += 1;
+                }
+                for &f in &mc.topology.edge_faces[e] {
+                    if f == NO_FACE {
+                        continue;
+                    }
+                    let f = f as usize;
+                    let face = mc.topology.faces[f];
+                    let Some(k) = (0..3).find(|&k| mc.topology.face_edges[f][k] as usize == e)
+                    else {
+                        continue;
+                    };
+                    let (k1, m) = ((k + 1) % 3, (k + 2) % 3);
+                    let t = if face[k] < face[k1] {
+                        2 * s
+                    } else {
+                        r2 - 2 * s
+                    };
+                    let mut a = [0u32; 3];
+                    a[k] = r2 - t;
+                    a[k1] = t;
+                    for (dk, dk1) in [(1, 0), (0, 1)] {
+                        let mut b = a;
+                        b[k] -= dk;
+                        b[k1] -= dk1;
+                        b[m] += 1;
+                        tmp.fill(0.0);
+                        lattice(self, f, q, q, b, 1.0, false, &mut tmp);
+                        accumulate(&mut sum, &tmp);
+                        n += 1;
+                    }
+                }
+                combine(self.edge_at(e, q, 2 * s), &sum, n, &mut val);
+                let at = self.edge_offset[e] + edge_level_offset(l) + s as usize - 1;
+                writes.push((at, val.clone()));
+            }
+        }
+        // Vertices, Eq. 6.
+        for (v, edges) in vertex_edges.iter().enumerate() {
+            if mc.vertex_level[v] <= l {
+                continue;
+            }
+            sum.fill(0.0);
+            let r2 = 1u32 << q;
+            for &e in edges {
+                let e = e as usize;
+                let p = if mc.topology.edges[e][0] as usize == v {
+                    1
+                } else {
+                    r2 - 1
+                };
+                tmp.fill(0.0);
+                edge_point(self, e, q, q, p, 1.0, false, &mut tmp);
+                accumulate(&mut sum, &tmp);
+            }
+            combine(self.vertex_at(v, q), &sum, edges.len(), &mut val);
+            writes.push((self.vertex_offset[v] + l as usize, val.clone()));
+        }
+        for (at, v) in writes {
+            self.data[at * c..(at + 1) * c].copy_from_slice(&v);
+        }
+    }
+
+    /// Linear filtering at MIP level `level` (clamped per primitive to its
+    /// finest): the colouring of that level, continuous across edges.
+    ///
+    /// # Errors
+    /// [`Error::MissingFace`] or [`Error::ChannelMismatch`].
+    pub fn at_level(
+        &self,
+        face: usize,
+        b: [f32; 3],
+        level: u8,
+        out: &mut [f32],
+    ) -> Result<(), Error> {
+        check(&self.colors, face, out)?;
+        self.inside(face, place(&self.colors, face, b), level, out);
+        Ok(())
+    }
+
+    /// Trilinear MIP filtering: the level is `λ = −log2(footprint)`, where
+    /// `footprint` is the filter width in barycentric units (the fraction of
+    /// the face's edge a pixel covers); the two levels around `λ` are
+    /// filtered linearly and blended. Blending happens only when the two
+    /// levels differ for the primitive the point lies on, so points on an
+    /// edge get the same value from both faces.
+    ///
+    /// # Errors
+    /// As for [`MipMap::at_level`].
+    pub fn trilinear(
+        &self,
+        face: usize,
+        b: [f32; 3],
+        footprint: f32,
+        out: &mut [f32],
+    ) -> Result<(), Error> {
+        check(&self.colors, face, out)?;
+        self.trilinear_unchecked(face, b, level_of_footprint(footprint), out);
+        Ok(())
+    }
+
+    #[inline]
+    fn trilinear_unchecked(&self, face: usize, b: [f32; 3], lambda: f32, out: &mut [f32]) {
+        let mc = &self.colors;
+        let at = place(mc, face, b);
+        let top = match at {
+            Place::Vertex(v) => mc.vertex_level[v as usize],
+            Place::Edge(e, _) => mc.edge_level[e],
+            Place::Inside(_) => mc.face_level[face],
+        };
+        let l0 = lambda.floor();
+        let frac = lambda - l0;
+        let l0 = l0 as u8;
+        self.inside(face, at, l0, out);
+        if l0 >= top || frac == 0.0 {
+            return;
+        }
+        let c = mc.channels;
+        let mut fine = [0.0f32; MAX_CHANNELS];
+        self.inside(face, at, l0 + 1, &mut fine[..c]);
+        for (o, &x) in out.iter_mut().zip(&fine[..c]) {
+            *o = (1.0 - frac) * *o + frac * x;
+        }
+    }
+
+    /// Anisotropic filtering (Sec. 4.3) from the screen-space derivatives
+    /// of the barycentrics, `db_dx` and `db_dy`. Lengths are measured on
+    /// the equilateral triangle (where the sample lattice is regular). Up to
+    /// `max_samples` trilinear probes, spaced along the longer axis of the
+    /// pixel footprint and clamped into the face (mesh colours cannot reach
+    /// across faces), are averaged at the level of the shorter axis.
+    /// `max_samples` is capped at [`MAX_PROBES`].
+    ///
+    /// # Errors
+    /// As for [`MipMap::at_level`].
+    pub fn anisotropic(
+        &self,
+        face: usize,
+        b: [f32; 3],
+        db_dx: [f32; 3],
+        db_dy: [f32; 3],
+        max_samples: u32,
+        out: &mut [f32],
+    ) -> Result<(), Error> {
+        check(&self.colors, face, out)?;
+        let metric = |d: [f32; 3]| {
+            let (x, y) = (d[0] + 0.5 * d[1], d[1] * 0.866_025_4);
+            (x * x + y * y).sqrt()
+        };
+        let (lx, ly) = (metric(db_dx), metric(db_dy));
+        let (major, minor, axis) = if lx >= ly {
+            (lx, ly, db_dx)
+        } else {
+            (ly, lx, db_dy)
+        };
+        let max_n = max_samples.clamp(1, MAX_PROBES) as f32;
+        let n = if minor > 0.0 {
+            (major / minor).ceil().clamp(1.0, max_n)
+        } else {
+            max_n
+        };
+        let width = (major / n).max(minor);
+        let lambda = level_of_footprint(width);
+        let c = self.colors.channels;
+        if n <= 1.0 {
+            self.trilinear_unchecked(face, b, lambda, out);
+            return Ok(());
+        }
+        let mut acc = [0.0f32; MAX_CHANNELS];
+        let mut probe = [0.0f32; MAX_CHANNELS];
+        let (sum, probe) = (&mut acc[..c], &mut probe[..c]);
+        let count = n as u32;
+        for k in 0..count {
+            let t = (k as f32 + 0.5) / n - 0.5;
+            let p = [0, 1, 2].map(|m| (b[m] + t * axis[m]).max(0.0));
+            self.trilinear_unchecked(face, p, lambda, probe);
+            for (s, &x) in sum.iter_mut().zip(probe.iter()) {
+                *s += x;
+            }
+        }
+        for (o, &s) in out.iter_mut().zip(sum.iter()) {
+            *o = s / n;
+        }
+        Ok(())
+    }
+}
+
+/// The most probes an anisotropic lookup takes, whatever it is asked.
+pub const MAX_PROBES: u32 = 64;
+
+/// `λ = −log2(footprint)`, clamped to the levels that exist.
+#[inline]
+fn level_of_footprint(footprint: f32) -> f32 {
+    if footprint.is_nan() || footprint <= 0.0 {
+        return f32::from(MAX_LEVEL);
+    }
+    (-footprint.log2()).clamp(0.0, f32::from(MAX_LEVEL))
+}
+
+impl MeshColors {
+    /// The MIP pyramid of these colours (see [`MipMap::new`]).
+    pub fn mip_map(&self) -> MipMap {
+        MipMap::new(self.clone())
+    }
+}
+
+/// The query level that reads every primitive at its finest.
+pub const FINEST_LEVEL: u8 = FINEST;

@@ -1,0 +1,221 @@
+//! 3D painting (Sec. 5.1): brush strokes on the samples themselves, with
+//! no UV bookkeeping. A uniform grid over the samples' 3D positions finds
+//! the samples near the brush, so a stroke costs the samples in the grid
+//! cells it overlaps (a small multiple of the samples it touches when the
+//! cell size is about the brush radius), not the size of the mesh.
+
+use std::collections::HashMap;
+
+use glam::Vec3;
+
+use crate::Error;
+use crate::structure::MeshColors;
+
+/// How a brush combines its colour with a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Blend {
+    /// Replace the colour inside the radius (no falloff).
+    Set,
+    /// Move towards the brush colour by the falloff weight.
+    Mix,
+    /// Add the brush colour times the falloff weight (densities, masks).
+    Add,
+}
+
+/// A brush dab: a sphere with a smooth falloff `w = strength · (1 −
+/// (d/r)²)²`, which is 1 at the centre and reaches 0 with zero slope at
+/// the rim, so strokes leave no visible edge.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Brush<'a> {
+    /// The centre, in the mesh's space.
+    pub center: Vec3,
+    /// The radius; samples farther away are untouched.
+    pub radius: f32,
+    /// The colour, one value per channel.
+    pub color: &'a [f32],
+    /// Scales the falloff weight (1: full strength).
+    pub strength: f32,
+    /// How the colour is applied.
+    pub blend: Blend,
+}
+
+impl Brush<'_> {
+    /// The falloff weight at distance `d`.
+    pub fn weight(&self, d: f32) -> f32 {
+        let x = d / self.radius;
+        if x > 1.0 {
+            0.0
+        } else {
+            let s = 1.0 - x * x;
+            self.strength * s * s
+        }
+    }
+}
+
+/// What a stroke did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Stroke {
+    /// Samples within the radius (changed, unless the weight was zero).
+    pub touched: usize,
+    /// Samples whose distance was computed (the cost).
+    pub examined: usize,
+}
+
+/// A spatial index of the sample positions of one [`MeshColors`] on one
+/// set of vertex positions. Rebuild it after a topology edit, a resolution
+/// change or a vertex move.
+#[derive(Debug, Clone)]
+pub struct Painter {
+    cell: f32,
+    positions: Vec<Vec3>,
+    grid: HashMap<[i32; 3], Vec<u32>>,
+    channels: usize,
+}
+
+impl Painter {
+    /// Indexes the samples of `colors` on a mesh with vertex `positions`,
+    /// in grid cells of size `cell` (about the usual brush radius).
+    ///
+    /// # Errors
+    /// [`Error::ChannelMismatch`] if `positions` is shorter than the vertex
+    /// count, [`Error::NonFinite`] for a non-finite position or cell size.
+    pub fn new(colors: &MeshColors, positions: &[Vec3], cell: f32) -> Result<Self, Error> {
+        let t = colors.topology();
+        if positions.len() < t.vertex_count() {
+            return Err(Error::ChannelMismatch {
+                what: "vertex positions",
+                expected: t.vertex_count(),
+                got: positions.len(),
+            });
+        }
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "position",
+                index: i,
+            });
+        }
+        if !(cell.is_finite() && cell > 0.0) {
+            return Err(Error::NonFinite {
+                what: "cell size",
+                index: 0,
+            });
+        }
+        let sample_positions: Vec<Vec3> = colors
+            .sites()
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                s.position(t, positions)
+                    .map_or_else(|| positions[i], |p| p.as_vec3())
+            })
+            .collect();
+        let mut grid: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
+        for (i, p) in sample_positions.iter().enumerate() {
+            grid.entry(cell_of(*p, cell)).or_default().push(i as u32);
+        }
+        Ok(Self {
+            cell,
+            positions: sample_positions,
+            grid,
+            channels: colors.channels(),
+        })
+    }
+
+    /// The 3D position of every sample.
+    pub fn sample_positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// Calls `f(sample, distance)` for every sample within `radius` of
+    /// `center`; returns how many were examined.
+    pub fn for_each_within(
+        &self,
+        center: Vec3,
+        radius: f32,
+        mut f: impl FnMut(usize, f32),
+    ) -> usize {
+        let lo = cell_of(center - Vec3::splat(radius), self.cell);
+        let hi = cell_of(center + Vec3::splat(radius), self.cell);
+        let span = (0..3).fold(1u64, |s, k| {
+            s.saturating_mul((i64::from(hi[k]) - i64::from(lo[k]) + 1) as u64)
+        });
+        let mut examined = 0;
+        let mut visit = |list: &Vec<u32>| {
+            for &i in list {
+                examined += 1;
+                let d = self.positions[i as usize].distance(center);
+                if d <= radius {
+                    f(i as usize, d);
+                }
+            }
+        };
+        if span > self.grid.len() as u64 {
+            // A brush larger than the occupied grid: scan occupied cells.
+            for (c, list) in &self.grid {
+                if (0..3).all(|k| c[k] >= lo[k] && c[k] <= hi[k]) {
+                    visit(list);
+                }
+            }
+        } else {
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        if let Some(list) = self.grid.get(&[x, y, z]) {
+                            visit(list);
+                        }
+                    }
+                }
+            }
+        }
+        examined
+    }
+
+    /// Applies one brush dab to `colors` (the ones this painter indexed).
+    ///
+    /// # Errors
+    /// [`Error::ChannelMismatch`] if the brush colour or `colors` do not
+    /// match this painter; [`Error::NonFinite`] for a bad radius.
+    pub fn paint(&self, colors: &mut MeshColors, brush: &Brush<'_>) -> Result<Stroke, Error> {
+        if brush.color.len() != self.channels || colors.channels() != self.channels {
+            return Err(Error::ChannelMismatch {
+                what: "brush colour",
+                expected: self.channels,
+                got: brush.color.len(),
+            });
+        }
+        if colors.sample_count() != self.positions.len() {
+            return Err(Error::ChannelMismatch {
+                what: "samples indexed by this painter",
+                expected: self.positions.len(),
+                got: colors.sample_count(),
+            });
+        }
+        if !(brush.radius.is_finite() && brush.radius > 0.0 && brush.center.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "brush",
+                index: 0,
+            });
+        }
+        let mut touched = 0;
+        let examined = self.for_each_within(brush.center, brush.radius, |i, d| {
+            touched += 1;
+            let w = brush.weight(d);
+            let s = colors.sample_mut(i);
+            for (x, &c) in s.iter_mut().zip(brush.color) {
+                *x = match brush.blend {
+                    Blend::Set => c,
+                    Blend::Mix => *x + w * (c - *x),
+                    Blend::Add => *x + w * c,
+                };
+            }
+        });
+        Ok(Stroke { touched, examined })
+    }
+}
+
+fn cell_of(p: Vec3, cell: f32) -> [i32; 3] {
+    (p / cell)
+        .floor()
+        .to_array()
+        .map(|x| x.clamp(-1e9, 1e9) as i32)
+}

@@ -1,0 +1,378 @@
+//! The mesh colour structure (Sec. 3.1–3.2, Fig. 10): one sample array,
+//! an index into it per vertex, edge and face, and the rule that keeps
+//! edges between faces of different resolution continuous.
+
+use glam::DVec3;
+
+use crate::topology::{NO_FACE, Topology};
+use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
+
+/// Samples on one edge of resolution `r` (Eq. 2): `r − 1`.
+pub const fn samples_per_edge(r: u32) -> u32 {
+    r.saturating_sub(1)
+}
+
+/// Samples inside one face of resolution `r` (Eq. 3): `(r − 1)(r − 2)/2`.
+pub const fn samples_per_face(r: u32) -> u32 {
+    if r < 2 { 0 } else { (r - 1) * (r - 2) / 2 }
+}
+
+/// The barycentric position of sample `C_ij` of a face of resolution `r`
+/// (Eq. 4): `[i/r, j/r, 1 − (i + j)/r]`; weight `k` belongs to corner `k`.
+pub fn sample_position(r: u32, i: u32, j: u32) -> [f64; 3] {
+    let r = f64::from(r);
+    let (i, j) = (f64::from(i), f64::from(j));
+    [i / r, j / r, 1.0 - (i + j) / r]
+}
+
+/// The level `n` of a resolution `R = 2^n`, or the error naming the face.
+pub fn level_of(face: usize, resolution: u32) -> Result<u8, Error> {
+    if resolution == 0 || !resolution.is_power_of_two() || resolution > 1 << MAX_LEVEL {
+        return Err(Error::BadResolution {
+            face,
+            resolution: u64::from(resolution),
+        });
+    }
+    Ok(resolution.trailing_zeros() as u8)
+}
+
+/// Where one sample sits: a face that contains it and its barycentric
+/// coordinates there (weight `k` for corner `k`). Isolated vertices have
+/// `face == NO_FACE`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Site {
+    /// A face the sample lies on.
+    pub face: u32,
+    /// Its barycentric coordinates in that face.
+    pub barycentric: [f64; 3],
+}
+
+impl Site {
+    /// The 3D position of the site on a mesh with these vertex positions.
+    pub fn position(&self, topology: &Topology, positions: &[glam::Vec3]) -> Option<DVec3> {
+        let face = topology.faces.get(self.face as usize)?;
+        let mut p = DVec3::ZERO;
+        for (b, &v) in self.barycentric.iter().zip(face) {
+            p += *b * positions.get(v as usize)?.as_dvec3();
+        }
+        Some(p)
+    }
+}
+
+/// Colour (any number of `f32` channels) on the vertices, edges and faces
+/// of a triangle mesh, each face at its own resolution `R = 2^n`.
+///
+/// **Layout** (Fig. 10): one array of samples, vertex `v` at index `v`,
+/// then each edge's `R_e − 1` samples in canonical order (from its smaller
+/// vertex to its larger), then each face's `(R − 1)(R − 2)/2` samples, row
+/// by row: `C_ij` for `i = 1..R−1`, `j = 1..R−1−i`.
+///
+/// **Continuity rule for mixed resolutions** (Sec. 3.2): an edge stores its
+/// samples at the *lowest* resolution of its faces, `R_e = min(R_f)`. A face
+/// of higher resolution reads the edge values it needs between two stored
+/// samples by linear interpolation along the edge (the paper's "higher
+/// resolution edge colors are linearly interpolated from the lower
+/// resolution"), so both faces see one piecewise-linear function on the
+/// edge. Any lookup whose point lies on an edge (a barycentric ≤ 0) is
+/// evaluated from the edge's own samples and its canonical parameter
+/// alone, so the linear, nearest and MIP filters return bit-identical
+/// values from either face.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshColors {
+    pub(crate) topology: Topology,
+    pub(crate) channels: usize,
+    pub(crate) face_level: Vec<u8>,
+    pub(crate) edge_level: Vec<u8>,
+    pub(crate) vertex_level: Vec<u8>,
+    pub(crate) edge_offset: Vec<usize>,
+    pub(crate) face_offset: Vec<usize>,
+    pub(crate) samples: Vec<f32>,
+}
+
+impl MeshColors {
+    /// Mesh colours of `channels` channels, all zero, with face `f` at
+    /// resolution `resolutions[f]` (a power of two up to `2^MAX_LEVEL`).
+    ///
+    /// # Errors
+    /// [`Error::BadResolution`] naming the face, [`Error::ResolutionCount`],
+    /// [`Error::BadChannels`].
+    pub fn new(topology: Topology, resolutions: &[u32], channels: usize) -> Result<Self, Error> {
+        if resolutions.len() != topology.faces.len() {
+            return Err(Error::ResolutionCount {
+                got: resolutions.len(),
+                faces: topology.faces.len(),
+            });
+        }
+        let levels = resolutions
+            .iter()
+            .enumerate()
+            .map(|(f, &r)| level_of(f, r))
+            .collect::<Result<Vec<_>, _>>()?;
+        Self::with_levels(topology, levels, channels)
+    }
+
+    /// As [`MeshColors::new`] with the same resolution on every face.
+    ///
+    /// # Errors
+    /// As for [`MeshColors::new`].
+    pub fn uniform(topology: Topology, resolution: u32, channels: usize) -> Result<Self, Error> {
+        let r = vec![resolution; topology.faces.len()];
+        Self::new(topology, &r, channels)
+    }
+
+    /// Builds the layout for per-face levels (already checked).
+    pub(crate) fn with_levels(
+        topology: Topology,
+        levels: Vec<u8>,
+        channels: usize,
+    ) -> Result<Self, Error> {
+        if channels == 0 || channels > MAX_CHANNELS {
+            return Err(Error::BadChannels(channels));
+        }
+        if let Some(f) = levels.iter().position(|&n| n > MAX_LEVEL) {
+            return Err(Error::BadResolution {
+                face: f,
+                resolution: 1u64 << levels[f].min(63),
+            });
+        }
+        let (edge_level, vertex_level) = primitive_levels(&topology, &levels);
+        let mut next = topology.vertex_count;
+        let edge_offset = edge_level
+            .iter()
+            .map(|&n| {
+                let at = next;
+                next += samples_per_edge(1 << n) as usize;
+                at
+            })
+            .collect();
+        let face_offset = levels
+            .iter()
+            .map(|&n| {
+                let at = next;
+                next += samples_per_face(1 << n) as usize;
+                at
+            })
+            .collect();
+        Ok(Self {
+            topology,
+            channels,
+            face_level: levels,
+            edge_level,
+            vertex_level,
+            edge_offset,
+            face_offset,
+            samples: vec![0.0; next * channels],
+        })
+    }
+
+    /// The connectivity.
+    pub fn topology(&self) -> &Topology {
+        &self.topology
+    }
+
+    /// Channels per sample.
+    pub fn channels(&self) -> usize {
+        self.channels
+    }
+
+    /// The number of faces.
+    pub fn face_count(&self) -> usize {
+        self.face_level.len()
+    }
+
+    /// The number of samples (colours), `samples().len() / channels()`.
+    pub fn sample_count(&self) -> usize {
+        self.samples.len() / self.channels
+    }
+
+    /// Face `f`'s resolution `R`. The per-primitive accessors below panic
+    /// on an index out of range, like slice indexing; lookups return `Err`.
+    pub fn face_resolution(&self, f: usize) -> u32 {
+        1 << self.face_level[f]
+    }
+
+    /// Face `f`'s level `n` (`R = 2^n`).
+    pub fn face_level(&self, f: usize) -> u8 {
+        self.face_level[f]
+    }
+
+    /// Edge `e`'s resolution: the lowest of its faces (the continuity rule).
+    pub fn edge_resolution(&self, e: usize) -> u32 {
+        1 << self.edge_level[e]
+    }
+
+    /// All samples, `channels()` values each, in the layout described on
+    /// [`MeshColors`].
+    pub fn samples(&self) -> &[f32] {
+        &self.samples
+    }
+
+    /// All samples, mutable.
+    pub fn samples_mut(&mut self) -> &mut [f32] {
+        &mut self.samples
+    }
+
+    /// The index of vertex `v`'s sample (Fig. 10: the vertex index).
+    pub fn vertex_index(&self, v: usize) -> usize {
+        v
+    }
+
+    /// The index of edge `e`'s first sample; the `R_e − 1` samples follow
+    /// in canonical order.
+    pub fn edge_index(&self, e: usize) -> usize {
+        self.edge_offset[e]
+    }
+
+    /// The index of face `f`'s first interior sample; the rest follow.
+    pub fn face_index(&self, f: usize) -> usize {
+        self.face_offset[f]
+    }
+
+    /// Sample `i`'s values.
+    ///
+    /// # Panics
+    /// If `i >= sample_count()`, like slice indexing.
+    pub fn sample(&self, i: usize) -> &[f32] {
+        &self.samples[i * self.channels..(i + 1) * self.channels]
+    }
+
+    /// Sample `i`'s values, mutable.
+    ///
+    /// # Panics
+    /// If `i >= sample_count()`, like slice indexing.
+    pub fn sample_mut(&mut self, i: usize) -> &mut [f32] {
+        &mut self.samples[i * self.channels..(i + 1) * self.channels]
+    }
+
+    /// The sample index of lattice point `a = (a0, a1, a2)` (Eq. 4 with
+    /// `i = a0`, `j = a1`, `a0 + a1 + a2 = R`) of face `f` at its own
+    /// resolution, when a stored sample sits there; `None` for a point on
+    /// an edge of lower resolution that falls between two stored samples.
+    pub fn lattice_index(&self, f: usize, a: [u32; 3]) -> Option<usize> {
+        let n = *self.face_level.get(f)?;
+        let r = 1u32 << n;
+        if u64::from(a[0]) + u64::from(a[1]) + u64::from(a[2]) != u64::from(r) {
+            return None;
+        }
+        let face = self.topology.faces[f];
+        for k in 0..3 {
+            if a[k] == r {
+                return Some(face[k] as usize);
+            }
+        }
+        for m in 0..3 {
+            if a[m] == 0 {
+                let k = (m + 1) % 3;
+                let e = self.topology.face_edges[f][k] as usize;
+                let p = edge_param(face, k, a, r);
+                let d = n - self.edge_level[e];
+                if p & ((1 << d) - 1) != 0 {
+                    return None;
+                }
+                return Some(self.edge_offset[e] + (p >> d) as usize - 1);
+            }
+        }
+        Some(self.face_offset[f] + interior_index(r, a[0], a[1]))
+    }
+
+    /// One site per sample: a face containing it and its barycentrics.
+    pub fn sites(&self) -> Vec<Site> {
+        let mut sites = vec![
+            Site {
+                face: NO_FACE,
+                barycentric: [0.0; 3]
+            };
+            self.sample_count()
+        ];
+        for f in 0..self.face_count() {
+            let r = self.face_resolution(f);
+            for a in lattice_points(r) {
+                if let Some(i) = self.lattice_index(f, a)
+                    && sites[i].face == NO_FACE
+                {
+                    sites[i] = Site {
+                        face: f as u32,
+                        barycentric: sample_position(r, a[0], a[1]),
+                    };
+                }
+            }
+        }
+        sites
+    }
+
+    /// Sets every sample from a function of its 3D position, `f(p, out)`
+    /// writing `channels()` values.
+    ///
+    /// # Errors
+    /// [`Error::ChannelMismatch`] if `positions` has fewer entries than the
+    /// topology's vertices.
+    pub fn fill(
+        &mut self,
+        positions: &[glam::Vec3],
+        mut f: impl FnMut(DVec3, &mut [f32]),
+    ) -> Result<(), Error> {
+        if positions.len() < self.topology.vertex_count {
+            return Err(Error::ChannelMismatch {
+                what: "positions",
+                expected: self.topology.vertex_count,
+                got: positions.len(),
+            });
+        }
+        let sites = self.sites();
+        let c = self.channels;
+        for (i, site) in sites.iter().enumerate() {
+            let p = site
+                .position(&self.topology, positions)
+                .unwrap_or_else(|| positions[i].as_dvec3());
+            f(p, &mut self.samples[i * c..(i + 1) * c]);
+        }
+        Ok(())
+    }
+}
+
+/// Edge levels (minimum of the faces: the continuity rule) and vertex
+/// levels (maximum of the faces: the finest MIP level a vertex needs).
+pub(crate) fn primitive_levels(topology: &Topology, levels: &[u8]) -> (Vec<u8>, Vec<u8>) {
+    let edge_level = topology
+        .edge_faces
+        .iter()
+        .map(|fs| {
+            fs.iter()
+                .filter(|&&f| f != NO_FACE)
+                .map(|&f| levels[f as usize])
+                .min()
+                .unwrap_or(0)
+        })
+        .collect();
+    let mut vertex_level = vec![0u8; topology.vertex_count];
+    for (face, &n) in topology.faces.iter().zip(levels) {
+        for &v in face {
+            vertex_level[v as usize] = vertex_level[v as usize].max(n);
+        }
+    }
+    (edge_level, vertex_level)
+}
+
+/// The canonical position (in steps of `1/r` from the edge's smaller
+/// vertex) of lattice point `a` on local edge `k` of a face.
+#[inline]
+pub(crate) fn edge_param(face: [u32; 3], k: usize, a: [u32; 3], r: u32) -> u32 {
+    let t = a[(k + 1) % 3];
+    if face[k] < face[(k + 1) % 3] {
+        t
+    } else {
+        r - t
+    }
+}
+
+/// Row-major index of interior sample `C_ij` (`i, j ≥ 1`, `i + j ≤ r − 1`).
+#[inline]
+pub(crate) fn interior_index(r: u32, i: u32, j: u32) -> usize {
+    let (r, i, j) = (r as usize, i as usize, j as usize);
+    (i - 1) * (r - 1) - (i - 1) * i / 2 + (j - 1)
+}
+
+/// Every lattice point `(i, j, r − i − j)` of a face of resolution `r`.
+pub fn lattice_points(r: u32) -> impl Iterator<Item = [u32; 3]> {
+    (0..=r).flat_map(move |i| (0..=r - i).map(move |j| [i, j, r - i - j]))
+}
