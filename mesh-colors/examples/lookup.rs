@@ -14,8 +14,9 @@ use std::time::Instant;
 
 use mesh_colors::{Topology, convert};
 
-/// Lookups per measurement; the best of `REPEATS` interleaved runs is
-/// kept (the machine is shared, so the fastest run is the least disturbed).
+/// Lookups per measurement; the median of `REPEATS` interleaved runs is
+/// kept (the machine is shared; interleaving spreads load bursts over all
+/// filters alike, the median drops the disturbed runs).
 const POINTS: usize = 1_000_000;
 
 /// One mesh colour lookup: (point index, face, barycentrics, output).
@@ -118,7 +119,7 @@ fn main() {
             }
             acc
         };
-        let mut best = [f64::INFINITY; 6];
+        let mut times: [Vec<f64>; 6] = Default::default();
         for _ in 0..REPEATS {
             let passes: [&dyn Fn() -> f32; 6] = [
                 &|| pass_mc(&nearest),
@@ -131,10 +132,13 @@ fn main() {
             for (k, pass) in passes.iter().enumerate() {
                 let t = Instant::now();
                 black_box(pass());
-                best[k] = best[k].min(t.elapsed().as_secs_f64());
+                times[k].push(t.elapsed().as_secs_f64());
             }
         }
-        let rate = best.map(|t| POINTS as f64 / t / 1e6);
+        let rate = times.map(|mut t| {
+            t.sort_by(f64::total_cmp);
+            POINTS as f64 / t[t.len() / 2] / 1e6
+        });
         let [nearest, linear, mipr, aniso, bilinear, trilinear] = rate;
         for (filter, v) in [
             ("nearest", nearest),
