@@ -109,3 +109,20 @@ pub(crate) fn for_each_chunk_via<B: Default + Clone + Send, T: Send>(
         }
     }
 }
+
+/// The points `triangle(f)` makes for every face `f`, in face order, on all
+/// threads when `rayon` is on (the stable per-triangle modes).
+pub(crate) fn per_face<T: Send>(
+    faces: usize,
+    triangle: impl Fn(usize) -> Vec<T> + Sync + Send,
+) -> Vec<T> {
+    #[cfg(feature = "rayon")]
+    {
+        use rayon::prelude::*;
+        (0..faces).into_par_iter().flat_map_iter(triangle).collect()
+    }
+    #[cfg(not(feature = "rayon"))]
+    {
+        (0..faces).flat_map(triangle).collect()
+    }
+}

@@ -162,15 +162,7 @@ impl UniformSampler<'_> {
                 })
                 .collect()
         };
-        let faces = 0..self.mesh.indices.len();
-        #[cfg(feature = "rayon")]
-        let points = {
-            use rayon::prelude::*;
-            faces.into_par_iter().flat_map_iter(triangle).collect()
-        };
-        #[cfg(not(feature = "rayon"))]
-        let points = faces.flat_map(triangle).collect();
-        Ok(points)
+        Ok(crate::parallel::per_face(self.mesh.indices.len(), triangle))
     }
 }
 
