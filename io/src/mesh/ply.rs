@@ -480,7 +480,7 @@ pub fn write(path: &Path, data: &PlyData, format: Format) -> Result<()> {
 /// The `.ply` file as bytes; `path` names it in errors.
 ///
 /// # Errors
-/// As for [`write`], without the I/O.
+/// As for [`write()`], without the I/O.
 pub fn to_bytes(path: &Path, data: &PlyData, format: Format) -> Result<Vec<u8>> {
     let n = data.positions.len();
     let invalid = |what: String| Error::new(path, ErrorKind::InvalidInput(what));

@@ -50,7 +50,7 @@ pub fn write(
 /// The `.vtu` document as a string; `path` names it in errors.
 ///
 /// # Errors
-/// As for [`write`], without the I/O.
+/// As for [`write()`], without the I/O.
 pub fn to_string(
     path: &Path,
     mesh: &TetMesh,
