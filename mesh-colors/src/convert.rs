@@ -14,7 +14,7 @@
 use glam::Vec2;
 
 use crate::structure::{
-    MeshColors, lattice_points, primitive_levels, samples_per_edge, samples_per_face,
+    MeshColors, lattice_points, layout_sample_count, samples_per_edge, samples_per_face,
 };
 use crate::texture::Texture;
 use crate::topology::Topology;
@@ -55,20 +55,6 @@ fn level_for(area: f64, density: f64, max_level: u8) -> u8 {
     (r.log2().round() as i64).clamp(0, i64::from(max_level)) as u8
 }
 
-/// Total samples for these face levels on this topology.
-fn count(topology: &Topology, levels: &[u8]) -> u64 {
-    let (edge_level, _) = primitive_levels(topology, levels);
-    topology.vertex_count() as u64
-        + edge_level
-            .iter()
-            .map(|&n| u64::from(samples_per_edge(1 << n)))
-            .sum::<u64>()
-        + levels
-            .iter()
-            .map(|&n| u64::from(samples_per_face(1 << n)))
-            .sum::<u64>()
-}
-
 /// Face levels from the texel footprint of each face's UVs, within the
 /// sample budget.
 ///
@@ -105,12 +91,12 @@ pub fn choose_levels(
         .max_samples
         .unwrap_or(texture.width() * texture.height()) as u64;
     let mut levels = levels_at(options.density);
-    if count(topology, &levels) > budget {
+    if layout_sample_count(topology, &levels) > budget {
         // The count only grows with the density: bisect it.
         let (mut lo, mut hi) = (0.0, options.density);
         for _ in 0..40 {
             let mid = 0.5 * (lo + hi);
-            if count(topology, &levels_at(mid)) > budget {
+            if layout_sample_count(topology, &levels_at(mid)) > budget {
                 hi = mid;
             } else {
                 lo = mid;
@@ -133,7 +119,7 @@ pub fn choose_levels(
 /// total stays within `budget` (the count changes only at the face and its
 /// three edges, so each step is O(1)).
 fn top_up(topology: &Topology, levels: &mut [u8], target: &[u8], areas: &[f64], budget: u64) {
-    let mut total = count(topology, levels);
+    let mut total = layout_sample_count(topology, levels);
     let edge_count = |n: u8| u64::from(samples_per_edge(1 << n));
     for _ in 0..=MAX_LEVEL {
         let mut order: Vec<usize> = (0..levels.len())

@@ -23,7 +23,7 @@ use std::io::{Read, Write};
 use std::path::Path;
 
 use crate::mip::MipMap;
-use crate::structure::{MeshColors, primitive_levels, samples_per_edge, samples_per_face};
+use crate::structure::{MeshColors, layout_sample_count};
 use crate::topology::Topology;
 use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
 
@@ -218,16 +218,7 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(MeshColors, Option<MipMap>), Error> {
         bad(HEADER + 12 * face, e.to_string())
     })?;
     // The sample count from the layout, checked before allocating it.
-    let (edge_level, _) = primitive_levels(&topology, &levels);
-    let count = vertex_count as u64
-        + edge_level
-            .iter()
-            .map(|&n| u64::from(samples_per_edge(1 << n)))
-            .sum::<u64>()
-        + levels
-            .iter()
-            .map(|&n| u64::from(samples_per_face(1 << n)))
-            .sum::<u64>();
+    let count = layout_sample_count(&topology, &levels);
     let samples_at = levels_at + face_count;
     let sample_bytes = 4 * count * channels as u64;
     if sample_bytes > (bytes.len() - samples_at) as u64 {

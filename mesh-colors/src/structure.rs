@@ -353,6 +353,22 @@ pub(crate) fn primitive_levels(topology: &Topology, levels: &[u8]) -> (Vec<u8>, 
     (edge_level, vertex_level)
 }
 
+/// Total samples (Eq. 1–3 summed) for these face levels on this topology,
+/// without allocating them: the conversion's budget and the file reader's
+/// size check both need it.
+pub(crate) fn layout_sample_count(topology: &Topology, levels: &[u8]) -> u64 {
+    let (edge_level, _) = primitive_levels(topology, levels);
+    topology.vertex_count as u64
+        + edge_level
+            .iter()
+            .map(|&n| u64::from(samples_per_edge(1 << n)))
+            .sum::<u64>()
+        + levels
+            .iter()
+            .map(|&n| u64::from(samples_per_face(1 << n)))
+            .sum::<u64>()
+}
+
 /// The canonical position (in steps of `1/r` from the edge's smaller
 /// vertex) of lattice point `a` on local edge `k` of a face.
 #[inline]
