@@ -712,22 +712,9 @@ fn bad_input_is_an_error() {
     ));
 }
 
-/// The folder of `$TRILUX_DATA`, resolved against the workspace root.
-fn data_dir() -> Option<std::path::PathBuf> {
-    let given = std::path::PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let dir = if given.is_dir() {
-        given
-    } else {
-        root.join(given)
-    };
-    assert!(
-        dir.is_dir(),
-        "TRILUX_DATA={} is not a folder",
-        dir.display()
-    );
-    Some(dir)
-}
+#[path = "../../io/tests/support/data_dir.rs"]
+mod data_dir;
+use data_dir::data_dir;
 
 /// Each HDR image of `$TRILUX_DATA/hdr`, its luminance box-filtered to
 /// 64×32 (the sun stays thousands of times brighter than the sky), on a

@@ -4,22 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-/// The data folder named by `TRILUX_DATA` (a relative path is taken from
-/// the workspace root), or `None` when unset. A value that names no folder
-/// fails the test instead of skipping it.
-pub(crate) fn data_dir() -> Option<PathBuf> {
-    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let found = [given.clone(), workspace.join(&given)]
-        .into_iter()
-        .find(|p| p.is_dir());
-    assert!(
-        found.is_some(),
-        "TRILUX_DATA={} names no folder",
-        given.display()
-    );
-    found
-}
+mod data_dir;
+pub(crate) use data_dir::data_dir;
 
 /// A fresh scratch folder, unique even for tests running in parallel.
 pub(crate) fn scratch(name: &str) -> PathBuf {

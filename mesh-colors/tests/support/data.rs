@@ -5,7 +5,7 @@
 
 #![allow(dead_code, reason = "each user needs a subset")]
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use mesh_colors::{Texture, Wrap};
@@ -20,22 +20,9 @@ pub(crate) struct Textured {
     pub(crate) texture: Texture,
 }
 
-/// The folder of `$TRILUX_DATA`, resolved against the workspace root.
-pub(crate) fn data_dir() -> Option<PathBuf> {
-    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let dir = if given.is_dir() {
-        given
-    } else {
-        root.join(given)
-    };
-    assert!(
-        dir.is_dir(),
-        "TRILUX_DATA={} is not a folder",
-        dir.display()
-    );
-    Some(dir)
-}
+#[path = "../../../io/tests/support/data_dir.rs"]
+mod data_dir;
+pub(crate) use data_dir::data_dir;
 
 /// An RGB texture with sRGB-encoded values (as stored in the file: the
 /// values PSNR is usually quoted on) from a linear RGBA image.
