@@ -8,7 +8,7 @@ use sprs::CsMat;
 use crate::Error;
 use crate::coarse::{galerkin, restrict_by_selection, substituted};
 use crate::hierarchy::{Hierarchy, HierarchyOptions, Weights};
-use crate::krylov::{Monitor, Report, SolveOptions, bicgstab, cg, cg_monitored};
+use crate::krylov::{Monitor, Report, SolveOptions, bicgstab, cg, jacobi_cg_checked, nonzero};
 use crate::matrix::{check_square, check_vector, mul_vec, transpose};
 
 /// Which coarse systems the cascade solves.
@@ -107,6 +107,9 @@ pub struct Cascade {
     hierarchy: Hierarchy,
     /// `matrices[l - 1]` is level `l`'s matrix.
     matrices: Vec<CsMat<f64>>,
+    /// `Pᵀ` of each step, for Galerkin right-hand sides (empty for Eq. 17,
+    /// which restricts by selection).
+    restrict: Vec<CsMat<f64>>,
     options: CascadeOptions,
 }
 
@@ -142,9 +145,18 @@ impl Cascade {
             };
             matrices.push(coarse);
         }
+        let restrict = match options.system {
+            CoarseSystem::Substituted => Vec::new(),
+            CoarseSystem::Galerkin => hierarchy
+                .steps
+                .iter()
+                .map(|step| transpose(&step.interpolation))
+                .collect(),
+        };
         Ok(Self {
             hierarchy,
             matrices,
+            restrict,
             options: *options,
         })
     }
@@ -228,13 +240,13 @@ impl Cascade {
         // Right-hand sides and warm starts of every level, by selection.
         let mut rhs = vec![b.to_vec()];
         let mut start = vec![x.to_vec()];
-        for step in steps {
+        for (l, step) in steps.iter().enumerate() {
             let finer = &rhs[rhs.len() - 1];
-            rhs.push(match self.options.system {
-                CoarseSystem::Substituted => restrict_by_selection(finer, step),
-                CoarseSystem::Galerkin => {
+            rhs.push(match self.restrict.get(l) {
+                None => restrict_by_selection(finer, step),
+                Some(pt) => {
                     let mut coarse = vec![0.0; step.kept.len()];
-                    mul_vec(&transpose(&step.interpolation), finer, &mut coarse);
+                    mul_vec(pt, finer, &mut coarse);
                     coarse
                 }
             });
@@ -282,8 +294,7 @@ impl Cascade {
         if monitor(0, x).is_break() {
             let mut r = vec![0.0; n];
             let scale = crate::vector::norm(b);
-            let residual = crate::krylov::residual_into(m, b, x, &mut r)
-                / if scale > 0.0 { scale } else { 1.0 };
+            let residual = crate::krylov::residual_into(m, b, x, &mut r) / nonzero(scale);
             let finest = Report {
                 stop: crate::Stop::Interrupted,
                 iterations: 0,
@@ -296,7 +307,7 @@ impl Cascade {
                 finest,
             });
         }
-        let finest = cg_monitored(m, b, x, options, monitor)?;
+        let finest = jacobi_cg_checked(m, b, x, options, monitor)?;
         Ok(CascadeReport {
             start_level,
             fallbacks,

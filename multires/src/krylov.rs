@@ -158,8 +158,23 @@ pub fn cg_monitored(
     options: &SolveOptions,
     monitor: Monitor<'_>,
 ) -> Result<Report, Error> {
-    let jacobi = Jacobi::new(a)?;
-    pcg_monitored(a, b, x, &jacobi, options, monitor)
+    check_square(a)?;
+    jacobi_cg_checked(a, b, x, options, monitor)
+}
+
+/// [`cg_monitored`] for a matrix already checked by [`check_square`]
+/// (scanning every entry for NaN once per solve is enough).
+pub(crate) fn jacobi_cg_checked(
+    a: &CsMat<f64>,
+    b: &[f64],
+    x: &mut [f64],
+    options: &SolveOptions,
+    monitor: Monitor<'_>,
+) -> Result<Report, Error> {
+    let jacobi = Jacobi {
+        inverse: inverse_diagonal(a, true)?,
+    };
+    pcg_checked(a, b, x, &jacobi, options, monitor)
 }
 
 /// Conjugate gradients preconditioned by `m` (symmetric positive definite).
@@ -188,7 +203,20 @@ pub fn pcg_monitored(
     options: &SolveOptions,
     monitor: Monitor<'_>,
 ) -> Result<Report, Error> {
-    let n = check_square(a)?;
+    check_square(a)?;
+    pcg_checked(a, b, x, m, options, monitor)
+}
+
+/// [`pcg_monitored`] for a matrix already checked by [`check_square`].
+pub(crate) fn pcg_checked(
+    a: &CsMat<f64>,
+    b: &[f64],
+    x: &mut [f64],
+    m: &(impl Preconditioner + ?Sized),
+    options: &SolveOptions,
+    monitor: Monitor<'_>,
+) -> Result<Report, Error> {
+    let n = a.rows();
     check_vector("right-hand side", b, n)?;
     check_vector("start vector", x, n)?;
     options.check()?;
@@ -424,6 +452,6 @@ pub(crate) fn residual_into(a: &CsMat<f64>, b: &[f64], x: &[f64], r: &mut [f64])
 }
 
 /// `‖b‖`, or 1 for `b = 0` (then the residual is absolute).
-fn nonzero(v: f64) -> f64 {
+pub(crate) fn nonzero(v: f64) -> f64 {
     if v > 0.0 { v } else { 1.0 }
 }

@@ -15,7 +15,7 @@ use crate::coarse::galerkin;
 use crate::dense::Cholesky;
 use crate::graph::Graph;
 use crate::hierarchy::{Hierarchy, HierarchyOptions, Weights};
-use crate::krylov::{Monitor, Preconditioner, Report, SolveOptions, pcg_monitored};
+use crate::krylov::{Monitor, Preconditioner, Report, SolveOptions, pcg_checked};
 use crate::matrix::{check_square, inverse_diagonal, mul_vec, transpose};
 use crate::vector::{CHUNK, scale};
 
@@ -65,8 +65,7 @@ pub struct VCycle<'m> {
     fine_inverse_diagonal: Vec<f64>,
     /// Levels 1.. (Galerkin operators).
     levels: Vec<Level>,
-    /// `P_l` and `P_lᵀ` between level `l` and `l + 1`.
-    prolong: Vec<CsMat<f64>>,
+    /// `P_lᵀ` between level `l` and `l + 1` (`P_l` is the hierarchy's).
     restrict: Vec<CsMat<f64>>,
     coarsest: Option<Cholesky>,
     options: VCycleOptions,
@@ -95,29 +94,24 @@ impl<'m> VCycle<'m> {
         let fine_inverse_diagonal = damped_inverse_diagonal(m, options.damping)?;
         // Each level's graph is that of its Galerkin operator, so the
         // coarsening follows the couplings the operator really has.
+        // (Called only for the steps the hierarchy keeps.)
         let mut levels: Vec<Level> = Vec::new();
-        let mut failure = None;
         let hierarchy = Hierarchy::build(m, weights, &options.hierarchy, |_, step| {
             let finer = levels.last().map_or(m, |l| &l.matrix);
             let matrix = galerkin(finer, step);
             let graph = Graph::from_matrix(&matrix);
-            match damped_inverse_diagonal(&matrix, options.damping) {
-                Ok(inverse_diagonal) => levels.push(Level {
-                    matrix,
-                    inverse_diagonal,
-                }),
-                Err(e) => failure = Some(e),
-            }
-            failure.clone().map_or(Ok(graph), Err)
+            let inverse_diagonal = damped_inverse_diagonal(&matrix, options.damping)?;
+            levels.push(Level {
+                matrix,
+                inverse_diagonal,
+            });
+            Ok(graph)
         })?;
-        // The last step may have been rejected (too little coarsening).
-        levels.truncate(hierarchy.steps.len());
-        let prolong: Vec<CsMat<f64>> = hierarchy
+        let restrict: Vec<CsMat<f64>> = hierarchy
             .steps
             .iter()
-            .map(|s| s.interpolation.clone())
+            .map(|s| transpose(&s.interpolation))
             .collect();
-        let restrict: Vec<CsMat<f64>> = prolong.iter().map(transpose).collect();
         let last = levels.last().map_or(m, |l| &l.matrix);
         let coarsest = if last.rows() <= DENSE_LIMIT {
             Some(Cholesky::new(last)?)
@@ -128,7 +122,6 @@ impl<'m> VCycle<'m> {
             fine: m,
             fine_inverse_diagonal,
             levels,
-            prolong,
             restrict,
             coarsest,
             options: *options,
@@ -191,7 +184,7 @@ impl<'m> VCycle<'m> {
             let (a, inv) = self.matrix(l);
             let (fine, coarse) = work.z.split_at_mut(l + 1);
             let t = &mut work.t[l];
-            mul_vec(&self.prolong[l], &coarse[0], t);
+            mul_vec(&self.hierarchy.steps[l].interpolation, &coarse[0], t);
             let z = &mut fine[l];
             z.par_iter_mut().zip(&*t).for_each(|(z, c)| *z += c);
             self.smooth(a, inv, &work.r[l], z, t, self.options.sweeps);
@@ -256,7 +249,7 @@ impl<'m> VCycle<'m> {
     /// # Errors
     /// Those of [`crate::pcg`].
     pub fn solve(&self, b: &[f64], x: &mut [f64], options: &SolveOptions) -> Result<Report, Error> {
-        pcg_monitored(self.fine, b, x, self, options, &mut |_, _| {
+        self.solve_monitored(b, x, options, &mut |_, _| {
             std::ops::ControlFlow::Continue(())
         })
     }
@@ -272,7 +265,8 @@ impl<'m> VCycle<'m> {
         options: &SolveOptions,
         monitor: Monitor<'_>,
     ) -> Result<Report, Error> {
-        pcg_monitored(self.fine, b, x, self, options, monitor)
+        // The matrix was checked when the V-cycle was built.
+        pcg_checked(self.fine, b, x, self, options, monitor)
     }
 }
 
