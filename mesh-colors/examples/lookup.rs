@@ -36,16 +36,29 @@ fn main() {
     let mut speed_rows = Vec::new();
     let mut mesh_rows = Vec::new();
     for m in data::textured_meshes(&dir) {
-        let topology = Topology::new(m.positions.len(), &m.faces).expect("a manifold mesh");
         let t = Instant::now();
-        let mc = convert::from_texture(topology, &m.corner_uvs, &m.texture, &Default::default())
-            .expect("conversion");
+        let converted = Topology::new(m.positions.len(), &m.faces).and_then(|topology| {
+            convert::from_texture(topology, &m.corner_uvs, &m.texture, &Default::default())
+        });
+        let mc = match converted {
+            Ok(mc) => mc,
+            Err(e) => {
+                eprintln!("{}: skipped: {e}", m.name);
+                continue;
+            }
+        };
         let convert_ms = t.elapsed().as_secs_f64() * 1e3;
         let t = Instant::now();
         let mip = mc.mip_map();
         let mip_ms = t.elapsed().as_secs_f64() * 1e3;
         let points = data::surface_points(&m.positions, &m.faces, POINTS, 7);
-        let psnr = convert::psnr(&mc, &m.corner_uvs, &m.texture, &points, 1.0).expect("psnr");
+        let psnr = match convert::psnr(&mc, &m.corner_uvs, &m.texture, &points, 1.0) {
+            Ok(psnr) => psnr,
+            Err(e) => {
+                eprintln!("{}: skipped: {e}", m.name);
+                continue;
+            }
+        };
         let texels = m.texture.width() * m.texture.height();
         mesh_rows.push((
             m.name.clone(),
