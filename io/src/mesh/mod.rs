@@ -15,6 +15,19 @@ pub mod ply;
 /// A triangle mesh as plain data, with one index stream: attributes are
 /// per vertex, and a vertex that has several UVs or normals in the file
 /// (a seam) is split into several vertices.
+///
+/// # UV convention
+///
+/// Texture coordinates follow glTF: the origin is the top-left corner of
+/// the image and v grows downwards, so `uv * (width, height)` is a texel
+/// coordinate with row 0 the first row stored in the image file (the row
+/// [`Image::pixels`] starts with). OBJ and PLY files store v upwards:
+/// their readers in this crate turn it into `1 - v` and their writers
+/// turn it back, which is the only place a flip happens. glTF UVs are kept
+/// as stored. Values outside `[0, 1]` (tiling) are kept; the material's
+/// [`Wrap`] says what they mean. Flipping in `f32` is exact for the values
+/// a texture atlas usually holds (multiples of powers of two) and within
+/// 2^-24 otherwise.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriMesh {
     /// Vertex positions.
@@ -24,7 +37,8 @@ pub struct TriMesh {
     pub indices: Vec<[u32; 3]>,
     /// Per-vertex normals, when the file has them.
     pub normals: Option<Vec<Vec3>>,
-    /// Per-vertex texture coordinates, when the file has them.
+    /// Per-vertex texture coordinates, when the file has them; v down,
+    /// `v = 0` at image row 0 (see the [UV convention](#uv-convention)).
     pub uvs: Option<Vec<Vec2>>,
     /// Consecutive triangle ranges per object, group or material.
     pub objects: Vec<Object>,

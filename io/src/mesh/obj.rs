@@ -204,7 +204,8 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
                 if !(u.is_finite() && w.is_finite()) {
                     return Err(at.syntax("a finite texture coordinate", &text));
                 }
-                vt.push(Vec2::new(u, w));
+                // OBJ's v grows upwards; TriMesh's grows downwards (glTF).
+                vt.push(Vec2::new(u, 1.0 - w));
             }
             "vn" => {
                 let n = vec3(&at, &mut tokens, "a normal coordinate")?;
@@ -389,7 +390,8 @@ pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
         let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
     }
     for t in mesh.uvs.iter().flatten() {
-        let _ = writeln!(out, "vt {} {}", t.x, t.y);
+        // Back to OBJ's v-up convention (the reader's flip, undone).
+        let _ = writeln!(out, "vt {} {}", t.x, 1.0 - t.y);
     }
     for q in mesh.normals.iter().flatten() {
         let _ = writeln!(out, "vn {} {} {}", q.x, q.y, q.z);

@@ -25,7 +25,9 @@ pub struct PlyData {
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex colours, RGBA 8-bit (alpha 255 when the file has none).
     pub colors: Option<Vec<[u8; 4]>>,
-    /// Per-vertex texture coordinates.
+    /// Per-vertex texture coordinates in [`TriMesh`](super::TriMesh)'s
+    /// convention (v down, `v = 0` at image row 0): the file's `t` (v up)
+    /// is read as `1 - t` and written back as `1 - v`.
     pub uvs: Option<Vec<Vec2>>,
     /// Other per-vertex scalar properties, by name, written as `float`.
     pub scalars: Vec<(String, Vec<f32>)>,
@@ -404,9 +406,10 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
             ]);
         }
         if has_uv {
+            // PLY's t grows upwards (as OBJ's v); ours grows downwards.
             uvs.push(Vec2::new(
                 values[uv[0].unwrap_or(0)] as f32,
-                values[uv[1].unwrap_or(0)] as f32,
+                1.0 - values[uv[1].unwrap_or(0)] as f32,
             ));
         }
         for ((_, column), &i) in scalars.iter_mut().zip(&extra) {
@@ -561,7 +564,7 @@ pub fn to_bytes(path: &Path, data: &PlyData, format: Format) -> Result<Vec<u8>> 
                     let _ = write!(line, " {r} {g} {b} {a}");
                 }
                 if let Some(uvs) = &data.uvs {
-                    let _ = write!(line, " {} {}", uvs[i].x, uvs[i].y);
+                    let _ = write!(line, " {} {}", uvs[i].x, 1.0 - uvs[i].y);
                 }
                 for (_, column) in &data.scalars {
                     let _ = write!(line, " {}", column[i]);
@@ -587,7 +590,7 @@ pub fn to_bytes(path: &Path, data: &PlyData, format: Format) -> Result<Vec<u8>> 
                 }
                 if let Some(uvs) = &data.uvs {
                     out.extend_from_slice(&uvs[i].x.to_le_bytes());
-                    out.extend_from_slice(&uvs[i].y.to_le_bytes());
+                    out.extend_from_slice(&(1.0 - uvs[i].y).to_le_bytes());
                 }
                 for (_, column) in &data.scalars {
                     out.extend_from_slice(&column[i].to_le_bytes());
