@@ -138,6 +138,24 @@ pub(crate) fn shift_for(points: &[DVec3]) -> DVec3 {
     }
 }
 
+/// Reads a triangle mesh, choosing the format by extension (see
+/// [`TriMesh::read`]).
+///
+/// # Errors
+/// [`Error`] naming the file, the line, and what was wrong.
+pub fn read(path: impl AsRef<Path>) -> Result<TriMesh> {
+    TriMesh::read(path)
+}
+
+/// Writes a triangle mesh, choosing the format by extension (see
+/// [`TriMesh::write`]).
+///
+/// # Errors
+/// As for [`TriMesh::write`].
+pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
+    mesh.write(path)
+}
+
 impl TriMesh {
     /// The positions as the file has them, in `f64`: `origin + p`.
     pub fn absolute_positions(&self) -> Vec<DVec3> {
@@ -176,6 +194,36 @@ impl TriMesh {
             other => Err(Error::new(
                 path,
                 ErrorKind::UnknownExtension(other.to_string(), ".obj, .gltf, .glb, .ply"),
+            )),
+        }
+    }
+
+    /// Writes the mesh, choosing the format by extension: `.obj` (with its
+    /// `.mtl` and textures, see [`obj::write`]) or `.ply` (binary
+    /// little-endian with normals and UVs; objects and materials are not
+    /// part of PLY and are not written, see [`ply::write`]).
+    ///
+    /// # Errors
+    /// [`ErrorKind::UnknownExtension`] for other extensions; the writer's
+    /// errors.
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        match crate::error::extension(path).as_str() {
+            "obj" => obj::write(path, self),
+            "ply" => {
+                let data = ply::PlyData {
+                    positions: self.positions.clone(),
+                    origin: self.origin,
+                    triangles: self.indices.clone(),
+                    normals: self.normals.clone(),
+                    uvs: self.uvs.clone(),
+                    ..ply::PlyData::default()
+                };
+                ply::write(path, &data, ply::Format::BinaryLittleEndian)
+            }
+            other => Err(Error::new(
+                path,
+                ErrorKind::UnknownExtension(other.to_string(), ".obj, .ply"),
             )),
         }
     }

@@ -491,21 +491,42 @@ fn texture_map<'a>(at: &At<'_>, mut rest: &'a str) -> Result<TextureMap<'a>> {
     Ok(TextureMap { file, clamp })
 }
 
-/// Writes an `.obj` file: positions, UVs and normals when present, one
-/// `o` line per object, faces in the matching `v/vt/vn` form. Floats are
-/// written in shortest round-trip form.
+/// Writes an `.obj` file: positions (plus [`TriMesh::origin`], in `f64`),
+/// UVs (flipped back to OBJ's v up) and normals when present, one `o` line
+/// per object, faces in the matching `v/vt/vn` form. Floats are written in
+/// shortest round-trip form.
+///
+/// When the mesh has materials, their library is written beside it
+/// (`name.obj` → `name.mtl`, named by `mtllib`) with `Kd` and `map_Kd`,
+/// and each object with a material gets its `usemtl`. A texture file is
+/// referenced where it is (relative to the OBJ's folder when inside it); a
+/// decoded texture without a file (glTF's embedded images) is written as
+/// `name_<material>.png` beside the OBJ. MTL holds one wrap mode for both
+/// axes: `-clamp on` when both are [`Wrap::ClampToEdge`], repeat otherwise
+/// (MTL has no mirrored repeat). Materials without a name are written as
+/// `material_<index>`.
 ///
 /// # Errors
-/// [`ErrorKind::InvalidInput`] for an index out of range or attribute
-/// arrays of the wrong length; an I/O error.
-pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
+/// [`ErrorKind::InvalidInput`] for an index out of range, attribute
+/// arrays of the wrong length, objects that do not cover the triangles in
+/// order, a material index out of range, or a name that a `#` or a line
+/// break would cut; an I/O error.
+pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
+    let path = path.as_ref();
+    let invalid = |what: String| Error::new(path, ErrorKind::InvalidInput(what));
     let n = mesh.positions.len();
     let bad_len = |len: Option<usize>| len.is_some_and(|l| l != n);
-    if bad_len(mesh.uvs.as_ref().map(Vec::len)) || bad_len(mesh.normals.as_ref().map(Vec::len)) {
-        return Err(Error::new(
-            path,
-            ErrorKind::InvalidInput("UVs or normals do not match the positions".into()),
-        ));
+    if bad_len(mesh.uvs.as_ref().map(Vec::len)) {
+        return Err(invalid(format!(
+            "{} UVs for {n} positions",
+            mesh.uvs.as_ref().map_or(0, Vec::len)
+        )));
+    }
+    if bad_len(mesh.normals.as_ref().map(Vec::len)) {
+        return Err(invalid(format!(
+            "{} normals for {n} positions",
+            mesh.normals.as_ref().map_or(0, Vec::len)
+        )));
     }
     if let Some((t, _)) = mesh
         .indices
@@ -513,37 +534,54 @@ pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
         .enumerate()
         .find(|(_, tri)| tri.iter().any(|&i| i as usize >= n))
     {
-        return Err(Error::new(
-            path,
-            ErrorKind::InvalidInput(format!("triangle {t} references a missing vertex")),
-        ));
+        return Err(invalid(format!("triangle {t} references a missing vertex")));
     }
     let mut end = 0;
     for o in &mesh.objects {
         if o.triangles.start != end || o.triangles.end < o.triangles.start {
-            return Err(Error::new(
-                path,
-                ErrorKind::InvalidInput(format!(
-                    "object {:?} does not continue at triangle {end}",
-                    o.name
-                )),
-            ));
+            return Err(invalid(format!(
+                "object {:?} does not continue at triangle {end}",
+                o.name
+            )));
         }
         end = o.triangles.end;
+        if let Some(m) = o.material.filter(|&m| m >= mesh.materials.len()) {
+            return Err(invalid(format!(
+                "object {:?} uses material {m}, but there are {}",
+                o.name,
+                mesh.materials.len()
+            )));
+        }
+        check_name(path, "object", &o.name)?;
     }
     if !mesh.objects.is_empty() && end != mesh.indices.len() {
-        return Err(Error::new(
-            path,
-            ErrorKind::InvalidInput(format!(
-                "the objects cover {end} of {} triangles",
-                mesh.indices.len()
-            )),
-        ));
+        return Err(invalid(format!(
+            "the objects cover {end} of {} triangles",
+            mesh.indices.len()
+        )));
     }
+    if !mesh.origin.is_finite() {
+        return Err(invalid(format!("origin {} is not finite", mesh.origin)));
+    }
+    let names = material_names(path, mesh)?;
     let mut out = String::with_capacity(40 * n + 30 * mesh.indices.len());
     out.push_str("# written by trilux-io\n");
+    if !mesh.materials.is_empty() {
+        let library = path.with_extension("mtl");
+        write_mtl(path, &library, mesh, &names)?;
+        let file = library
+            .file_name()
+            .map(|f| f.to_string_lossy().into_owned());
+        let _ = writeln!(out, "mtllib {}", file.unwrap_or_default());
+    }
+    let shifted = mesh.origin != DVec3::ZERO;
     for p in &mesh.positions {
-        let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
+        if shifted {
+            let q = mesh.origin + p.as_dvec3();
+            let _ = writeln!(out, "v {} {} {}", q.x, q.y, q.z);
+        } else {
+            let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
+        }
     }
     for t in mesh.uvs.iter().flatten() {
         // Back to OBJ's v-up convention (the reader's flip, undone).
@@ -575,6 +613,9 @@ pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
         if !object.name.is_empty() {
             let _ = writeln!(out, "o {}", object.name);
         }
+        if let Some(m) = object.material {
+            let _ = writeln!(out, "usemtl {}", names[m]);
+        }
         for tri in &mesh.indices[object.triangles.clone()] {
             out.push('f');
             for &i in tri {
@@ -584,4 +625,81 @@ pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
         }
     }
     std::fs::write(path, out).map_err(|e| Error::io(path, e))
+}
+
+/// Refuses a name that the OBJ/MTL line pre-pass would cut (`#` starts a
+/// comment, a line break ends the statement).
+fn check_name(path: &Path, what: &str, name: &str) -> Result<()> {
+    if name.contains(['#', '\n', '\r']) || name.ends_with('\\') {
+        return Err(Error::new(
+            path,
+            ErrorKind::InvalidInput(format!(
+                "{what} name {name:?} cannot be written to OBJ (a '#', a line break or a \
+                 trailing backslash would cut it)"
+            )),
+        ));
+    }
+    Ok(())
+}
+
+/// The name each material is written under: its own, or
+/// `material_<index>` when empty or taken by an earlier one.
+fn material_names(path: &Path, mesh: &TriMesh) -> Result<Vec<String>> {
+    let mut names: Vec<String> = Vec::with_capacity(mesh.materials.len());
+    for (i, m) in mesh.materials.iter().enumerate() {
+        check_name(path, "material", &m.name)?;
+        let name = m.name.trim();
+        let name = if name.is_empty() || names.iter().any(|n| n == name) {
+            format!("material_{i}")
+        } else {
+            name.to_string()
+        };
+        names.push(name);
+    }
+    Ok(names)
+}
+
+/// Writes the material library of `mesh` to `library`, and the decoded
+/// textures that have no file beside `obj`.
+fn write_mtl(obj: &Path, library: &Path, mesh: &TriMesh, names: &[String]) -> Result<()> {
+    let folder = obj.parent().unwrap_or(Path::new(""));
+    let stem = obj
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut text = String::from("# written by trilux-io\n");
+    for (i, m) in mesh.materials.iter().enumerate() {
+        let [r, g, b] = m.diffuse;
+        let _ = writeln!(text, "newmtl {}\nKd {r} {g} {b}", names[i]);
+        let texture = match (&m.diffuse_texture, &m.diffuse_image) {
+            (Some(file), _) => Some(reference(folder, file)),
+            (None, Some(image)) => {
+                let name = format!("{stem}_{i}.png");
+                crate::image::write_png(folder.join(&name), image, crate::image::PngDepth::Eight)?;
+                Some(name)
+            }
+            (None, None) => None,
+        };
+        if let Some(texture) = texture {
+            check_name(library, "texture file", &texture)?;
+            let clamp = if m.wrap == [Wrap::ClampToEdge; 2] {
+                "-clamp on "
+            } else {
+                ""
+            };
+            let _ = writeln!(text, "map_Kd {clamp}{texture}");
+        }
+    }
+    std::fs::write(library, text).map_err(|e| Error::io(library, e))
+}
+
+/// How an MTL beside `folder` names `file`: relative when inside the
+/// folder, else absolute.
+fn reference(folder: &Path, file: &Path) -> String {
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let (folder_abs, file_abs) = (absolute(folder), absolute(file));
+    match file_abs.strip_prefix(&folder_abs) {
+        Ok(relative) => relative.to_string_lossy().into_owned(),
+        Err(_) => file_abs.to_string_lossy().into_owned(),
+    }
 }

@@ -34,6 +34,35 @@ pub struct TetMesh {
 /// rule) when it is positively oriented, `det[p1-p0, p2-p0, p3-p0] > 0`.
 const OUTWARD_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
 
+/// Reads a tetrahedral mesh, choosing the format by extension (see
+/// [`TetMesh::read`]).
+///
+/// # Errors
+/// [`Error`] naming the file, the line or byte, and what was wrong.
+pub fn read(path: impl AsRef<Path>) -> Result<TetMesh> {
+    TetMesh::read(path)
+}
+
+/// Writes a tetrahedral mesh, choosing the format by extension: `.node` or
+/// `.ele` (TetGen, both files), `.mesh` (MEDIT), `.vtu` (VTK, ASCII, no
+/// fields; [`vtu::write`] adds fields).
+///
+/// # Errors
+/// [`crate::ErrorKind::UnknownExtension`] for other extensions; the
+/// writer's errors.
+pub fn write(path: impl AsRef<Path>, mesh: &TetMesh) -> Result<()> {
+    let path = path.as_ref();
+    match crate::error::extension(path).as_str() {
+        "node" | "ele" => tetgen::write(path, mesh),
+        "mesh" => medit::write(path, mesh),
+        "vtu" => vtu::write(path, mesh, &[], &[], vtu::Encoding::Ascii),
+        other => Err(Error::new(
+            path,
+            ErrorKind::UnknownExtension(other.to_string(), ".node, .ele, .mesh, .vtu"),
+        )),
+    }
+}
+
 impl TetMesh {
     /// Reads a tetrahedral mesh, choosing the format by extension: `.node`
     /// or `.ele` (TetGen; the other file is found beside it), `.msh` (Gmsh
@@ -49,7 +78,7 @@ impl TetMesh {
             "mesh" => medit::read(path),
             other => Err(Error::new(
                 path,
-                ErrorKind::UnknownExtension(other.to_string(), ".node, .ele, .msh"),
+                ErrorKind::UnknownExtension(other.to_string(), ".node, .ele, .msh, .mesh"),
             )),
         }
     }

@@ -42,7 +42,8 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>> {
 /// truncated record, a non-finite coordinate, a tetrahedron referencing a
 /// missing node, numbering that is not consecutive, or a header count the
 /// file cannot hold.
-pub fn read(path: &Path) -> Result<TetMesh> {
+pub fn read(path: impl AsRef<Path>) -> Result<TetMesh> {
+    let path = path.as_ref();
     let node = read_bytes(&sibling(path, "node"))?;
     let ele = read_bytes(&sibling(path, "ele"))?;
     from_bytes(&node, &ele, path)
@@ -54,7 +55,8 @@ pub fn read(path: &Path) -> Result<TetMesh> {
 ///
 /// # Errors
 /// As for [`read`].
-pub fn from_bytes(node: &[u8], ele: &[u8], path: &Path) -> Result<TetMesh> {
+pub fn from_bytes(node: &[u8], ele: &[u8], path: impl AsRef<Path>) -> Result<TetMesh> {
+    let path = path.as_ref();
     parse_pair(node, ele, path).map(|(mesh, _)| mesh)
 }
 
@@ -76,7 +78,8 @@ fn parse_pair(node: &[u8], ele: &[u8], path: &Path) -> Result<(TetMesh, i64)> {
 ///
 /// # Errors
 /// As for [`read`], and for the `.face` file.
-pub fn read_all(path: &Path) -> Result<TetGenFiles> {
+pub fn read_all(path: impl AsRef<Path>) -> Result<TetGenFiles> {
+    let path = path.as_ref();
     let node = read_bytes(&sibling(path, "node"))?;
     let ele = read_bytes(&sibling(path, "ele"))?;
     let (mesh, first_index) = parse_pair(&node, &ele, path)?;
@@ -190,7 +193,9 @@ pub(crate) fn parse_nodes(data: &[u8], path: &Path) -> Result<(Vec<DVec3>, i64)>
     if declared == 0 {
         return Err(c.error_at(
             at,
-            ErrorKind::Unsupported("a .node file with 0 points (points in a .poly file)".into()),
+            ErrorKind::Unsupported(
+                "a .node file with 0 points (the points are in a .poly file)".into(),
+            ),
         ));
     }
     // Smallest record: "i x y z" plus attributes and markers, one byte and
