@@ -53,6 +53,10 @@ pub struct TriMesh {
     /// Per-vertex texture coordinates, when the file has them; v down,
     /// `v = 0` at image row 0 (see the [UV convention](#uv-convention)).
     pub uvs: Option<Vec<Vec2>>,
+    /// A second set of texture coordinates: glTF's `TEXCOORD_1` as stored
+    /// (lightmap or detail UVs; no texture transform applied), when the
+    /// file has it. OBJ and PLY have one set only.
+    pub uvs1: Option<Vec<Vec2>>,
     /// Consecutive triangle ranges per object, group or material.
     pub objects: Vec<Object>,
     /// Materials, indexed by [`Object::material`].
@@ -179,6 +183,7 @@ impl TriMesh {
                 let ply = ply::read(path)?;
                 Ok(TriMesh {
                     origin: ply.origin,
+                    uvs1: None,
                     objects: vec![Object {
                         name: String::new(),
                         triangles: 0..ply.triangles.len(),

@@ -344,6 +344,7 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
     let mesh = TriMesh {
         positions,
         origin,
+        uvs1: None,
         uvs: has_uv.then(|| {
             vertices
                 .iter()
