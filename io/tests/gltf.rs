@@ -201,7 +201,7 @@ impl Asset {
     /// Appends `bytes` (4-byte aligned) as a buffer view with an optional
     /// stride; returns its index.
     fn view(&mut self, bytes: &[u8], stride: Option<usize>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let stride = stride.map_or(String::new(), |s| format!(r#","byteStride":{s}"#));

@@ -218,7 +218,7 @@ fn hostile_and_broken_images_are_refused() {
         height: 2,
         pixels: vec![[0.0; 4]; 3],
     };
-    let err = image::write_png(&dir.join("w.png"), &wrong, PngDepth::Eight).unwrap_err();
+    let err = image::write_png(dir.join("w.png"), &wrong, PngDepth::Eight).unwrap_err();
     assert!(matches!(err.kind, ErrorKind::InvalidInput(_)), "{err}");
 }
 

@@ -82,7 +82,7 @@ const MTL: &[u8] =
 fn every_obj_feature() {
     let dir = scratch("features");
     write(&dir, "parts.mtl", MTL);
-    let mesh = obj::read(&write(&dir, "m.obj", FEATURES)).unwrap();
+    let mesh = obj::read(write(&dir, "m.obj", FEATURES)).unwrap();
     // The quad fans into two triangles; the last face reuses corners with
     // the same v/vt/vn, so only 4 vertices exist and v 9 9 9 is unused.
     assert_eq!(mesh.indices, vec![[0, 1, 2], [0, 2, 3], [0, 2, 3]]);
@@ -199,11 +199,11 @@ fn malformed_obj_files_name_the_line() {
         ),
     ];
     for (name, bytes, kind_ok, line) in cases {
-        let err = obj::read(&write(&dir, &format!("{name}.obj"), bytes)).unwrap_err();
+        let err = obj::read(write(&dir, &format!("{name}.obj"), bytes)).unwrap_err();
         assert!(kind_ok(&err.kind), "{name}: {err}");
         assert_eq!(err.location, Some(Location::Line(line)), "{name}: {err}");
     }
-    let err = obj::read(&write(&dir, "lib.obj", b"mtllib gone.mtl\nv 0 0 0\n")).unwrap_err();
+    let err = obj::read(write(&dir, "lib.obj", b"mtllib gone.mtl\nv 0 0 0\n")).unwrap_err();
     assert!(matches!(err.kind, ErrorKind::Io(_)));
     assert!(err.path.ends_with("gone.mtl"), "{err}");
     let err = TriMesh::read("mesh.stl").unwrap_err();
@@ -218,11 +218,11 @@ fn obj_writer_refuses_inconsistent_meshes() {
         indices: vec![[0, 1, 3]],
         ..TriMesh::default()
     };
-    let err = obj::write(&dir.join("a.obj"), &mesh).unwrap_err();
+    let err = obj::write(dir.join("a.obj"), &mesh).unwrap_err();
     assert!(matches!(err.kind, ErrorKind::InvalidInput(_)), "{err}");
     mesh.indices = vec![[0, 1, 2]];
     mesh.uvs = Some(vec![Vec2::ZERO]);
-    assert!(obj::write(&dir.join("b.obj"), &mesh).is_err());
+    assert!(obj::write(dir.join("b.obj"), &mesh).is_err());
 }
 
 use trilux_io::mesh::ply::{self, Format, PlyData};
@@ -402,7 +402,7 @@ fn malformed_ply_files() {
 fn obj_and_ply_uvs_are_flipped_to_v_down_once() {
     let dir = scratch("uv-convention");
     let text = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 1\nvt 1 1\nvt 0.25 0.75\nf 1/1 2/2 3/3\n";
-    let mesh = obj::read(&write(&dir, "uv.obj", text)).unwrap();
+    let mesh = obj::read(write(&dir, "uv.obj", text)).unwrap();
     let expected = vec![
         Vec2::new(0.0, 0.0),
         Vec2::new(1.0, 0.0),
@@ -561,7 +561,7 @@ vt 0 0\r\nvt 1 0\r\nvt 0 1\r\nusemtl a b\r\nf 1/1 2/2 3/3 # comment\r\n";
             "my lib.mtl",
             format!("newmtl a b\nKd 0 1 0\n{line}\n").as_bytes(),
         );
-        let result = obj::read(&write(&sub, "m.obj", obj_text));
+        let result = obj::read(write(&sub, "m.obj", obj_text));
         match expected {
             Some((file, wrap)) => {
                 let mesh = result.unwrap_or_else(|e| panic!("{line}: {e}"));
