@@ -460,3 +460,76 @@ fn sparse_accessors_over_zeros() {
         .unwrap_err();
     assert!(err.to_string().contains("sparse index 7"), "{err}");
 }
+
+/// The same textured triangle as an OBJ (v up) and as a glTF (v down),
+/// over a texture whose top row is red and bottom row blue: both files'
+/// UVs must land on the same texels. Without the OBJ reader's flip (or
+/// with a flip added to glTF) the corners would land on opposite rows.
+#[test]
+fn obj_and_gltf_uvs_land_on_the_same_texels() {
+    use trilux_io::image::{Image, PngDepth};
+    let dir = scratch("uv-agreement");
+    let texture = Image {
+        width: 1,
+        height: 2,
+        pixels: vec![[1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 1.0, 1.0]],
+    };
+    trilux_io::image::write_png(dir.join("tex.png"), &texture, PngDepth::Eight).unwrap();
+    let texel = |mesh: &TriMesh, i: usize| {
+        let uv = mesh.uvs.as_ref().unwrap()[i];
+        let image = mesh.materials[0]
+            .diffuse_image
+            .clone()
+            .unwrap_or_else(|| trilux_io::image::read(dir.join("tex.png")).unwrap());
+        let x = ((uv.x * image.width as f32) as u32).min(image.width - 1);
+        let y = ((uv.y * image.height as f32) as u32).min(image.height - 1);
+        image.pixels[(y * image.width + x) as usize]
+    };
+    // Corner 0 in the upper half of the picture, corners 1 and 2 in the
+    // lower half, as each format writes it.
+    std::fs::write(dir.join("t.mtl"), "newmtl m\nmap_Kd tex.png\n").unwrap();
+    std::fs::write(
+        dir.join("t.obj"),
+        "mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.75\nvt 0.5 0.25\nvt 0.2 0.1\nusemtl m\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let obj = TriMesh::read(dir.join("t.obj")).unwrap();
+    let mut a = Asset::default();
+    let p = a.view(
+        &bytes(
+            &[0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0],
+            f32::to_le_bytes,
+        ),
+        None,
+    );
+    a.accessor(&format!(
+        r#""bufferView":{p},"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]"#
+    ));
+    let t = a.view(
+        &bytes(&[0.5f32, 0.25, 0.5, 0.75, 0.2, 0.9], f32::to_le_bytes),
+        None,
+    );
+    a.accessor(&format!(
+        r#""bufferView":{t},"componentType":5126,"count":3,"type":"VEC2""#
+    ));
+    let gltf = a
+        .read(
+            &dir,
+            "t",
+            r#""attributes":{"POSITION":0,"TEXCOORD_0":1},"material":0"#,
+            r#","materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],
+"textures":[{"source":0}],"images":[{"uri":"tex.png"}]"#,
+        )
+        .unwrap();
+    let red = [1.0, 0.0, 0.0, 1.0];
+    let blue = [0.0, 0.0, 1.0, 1.0];
+    for (mesh, name) in [(&obj, "OBJ"), (&gltf, "glTF")] {
+        assert_eq!(texel(mesh, 0), red, "{name}");
+        assert_eq!(texel(mesh, 1), blue, "{name}");
+        assert_eq!(texel(mesh, 2), blue, "{name}");
+    }
+    for i in 0..3 {
+        let (u, v) = (obj.uvs.as_ref().unwrap()[i], gltf.uvs.as_ref().unwrap()[i]);
+        assert!((u - v).abs().max_element() < 1e-6, "corner {i}: {u} vs {v}");
+    }
+}
