@@ -533,3 +533,22 @@ fn obj_and_gltf_uvs_land_on_the_same_texels() {
         assert!((u - v).abs().max_element() < 1e-6, "corner {i}: {u} vs {v}");
     }
 }
+
+/// An accessor without a buffer view declaring 10^9 elements: refused
+/// with the number before anything is allocated.
+#[test]
+fn zero_filled_accessors_have_a_budget() {
+    let dir = scratch("gltf-budget");
+    let mut a = Asset::default();
+    let idx = a.view(&bytes(&[1u16], u16::to_le_bytes), None);
+    let val = a.view(&bytes(&[1.0f32, 0.0, 0.0], f32::to_le_bytes), None);
+    a.accessor(&format!(
+        r#""componentType":5126,"count":1000000000,"type":"VEC3","min":[0,0,0],"max":[1,1,0],
+"sparse":{{"count":1,"indices":{{"bufferView":{idx},"componentType":5123}},"values":{{"bufferView":{val}}}}}"#
+    ));
+    let err = a
+        .read(&dir, "huge", r#""attributes":{"POSITION":0}"#, "")
+        .unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::LimitExceeded(_)), "{err}");
+    assert!(err.to_string().contains("1000000000"), "{err}");
+}

@@ -79,10 +79,15 @@ pub fn from_bytes(bytes: &[u8], path: impl AsRef<Path>, options: Options) -> Res
 /// The extensions a file may require: what they change is decoded.
 const HONOURED_EXTENSIONS: &[&str] = &["KHR_mesh_quantization", "KHR_texture_transform"];
 
-/// The most values (components) one accessor may decode to: 2^28, 2 GiB as
-/// `f64`. An accessor backed by a buffer view is also bounded by the
-/// buffer; one without a view (zeros plus sparse values) only by this.
-pub const MAX_ACCESSOR_VALUES: u64 = 1 << 28;
+/// The most values (components) one accessor may decode to: 2^27, 1 GiB
+/// as the `f64` the decoder works in. An accessor backed by a buffer view
+/// is also bounded by its buffer.
+pub const MAX_ACCESSOR_VALUES: u64 = 1 << 27;
+
+/// The most elements an accessor without a buffer view (zeros, plus its
+/// sparse values) may declare: 2^24. Nothing in the file bounds its count,
+/// so a few bytes of JSON could otherwise ask for gigabytes.
+pub const MAX_ZERO_FILLED_ELEMENTS: u64 = 1 << 24;
 
 struct Reader<'a> {
     path: &'a Path,
@@ -262,6 +267,12 @@ impl Reader<'_> {
             return Err(self.error(ErrorKind::LimitExceeded(format!(
                 "accessor {index} ({what}) declares {count} elements, {values} values, more than \
                  the {MAX_ACCESSOR_VALUES} one accessor may decode to"
+            ))));
+        }
+        if accessor.view().is_none() && count as u64 > MAX_ZERO_FILLED_ELEMENTS {
+            return Err(self.error(ErrorKind::LimitExceeded(format!(
+                "accessor {index} ({what}) has no buffer view and declares {count} elements, more \
+                 than the {MAX_ZERO_FILLED_ELEMENTS} allowed for one filled with zeros"
             ))));
         }
         let kind = accessor.data_type();
