@@ -529,7 +529,7 @@ fn obj_written_with_materials_reads_back_with_them() {
 }
 
 /// MTL texture options are parsed, not taken for the file name; names
-/// keep their spaces; `-o`/`-s` other than the identity are refused.
+/// keep their spaces; `-s`/`-o` are applied to the UVs.
 #[test]
 fn mtl_texture_options() {
     use trilux_io::mesh::Wrap;
@@ -550,7 +550,10 @@ vt 0 0\r\nvt 1 0\r\nvt 0 1\r\nusemtl a b\r\nf 1/1 2/2 3/3 # comment\r\n";
             "map_Kd -clamp off -o 0 x.png",
             Some(("x.png", Wrap::Repeat)),
         ),
-        ("map_Kd -s 2 2 1 scaled.png", None),
+        (
+            "map_Kd -s 2 2 1 scaled.png",
+            Some(("scaled.png", Wrap::Repeat)),
+        ),
         ("map_Kd -unknown 3 f.png", None),
     ];
     for (k, (line, expected)) in cases.into_iter().enumerate() {
@@ -574,6 +577,25 @@ vt 0 0\r\nvt 1 0\r\nvt 0 1\r\nusemtl a b\r\nf 1/1 2/2 3/3 # comment\r\n";
                     "{line}"
                 );
                 assert_eq!(m.wrap, [wrap; 2], "{line}");
+                let uvs = mesh.uvs.unwrap();
+                if line.contains("-s 2 2") {
+                    // vt (1, 0) and (0, 1), v up, scaled by 2: (2, 0) and
+                    // (0, 2), i.e. (2, 1) and (0, -1) v down.
+                    assert_eq!(
+                        uvs,
+                        vec![
+                            Vec2::new(0.0, 1.0),
+                            Vec2::new(2.0, 1.0),
+                            Vec2::new(0.0, -1.0)
+                        ]
+                    );
+                } else {
+                    assert_eq!(
+                        uvs,
+                        vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::ZERO],
+                        "{line}"
+                    );
+                }
             }
             None => {
                 let err = result.unwrap_err();
@@ -582,4 +604,33 @@ vt 0 0\r\nvt 1 0\r\nvt 0 1\r\nusemtl a b\r\nf 1/1 2/2 3/3 # comment\r\n";
             }
         }
     }
+}
+
+/// A vertex shared by a triangle whose texture is shifted (`-o`) and one
+/// whose texture is not is split, so each triangle reads its own texels.
+#[test]
+fn mtl_offsets_split_shared_vertices() {
+    let dir = scratch("mtl-offset");
+    write(
+        &dir,
+        "m.mtl",
+        b"newmtl plain\nmap_Kd a.png\nnewmtl shifted\nmap_Kd -o 0.5 0.25 b.png\n",
+    );
+    let text =
+        b"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n\
+usemtl plain\nf 1/1 2/2 3/3\nusemtl shifted\nf 2/2 4/4 3/3\n";
+    let mesh = obj::read(write(&dir, "m.obj", text)).unwrap();
+    // Vertices 1 and 2 (0-based) are shared: split into copies.
+    assert_eq!(mesh.positions.len(), 6);
+    let uvs = mesh.uvs.as_ref().unwrap();
+    let uv_of = |t: usize, c: usize| uvs[mesh.indices[t][c] as usize];
+    assert_eq!(
+        uv_of(0, 1),
+        Vec2::new(1.0, 1.0),
+        "plain: vt (1, 0) is v-down (1, 1)"
+    );
+    // Shifted: vt (1, 0) + (0.5, 0.25) = (1.5, 0.25) v up = (1.5, 0.75) v down.
+    assert_eq!(uv_of(1, 0), Vec2::new(1.5, 0.75));
+    assert_eq!(mesh.positions[mesh.indices[1][0] as usize], Vec3::X);
+    assert!((mesh.area() - 1.0).abs() < 1e-12);
 }
