@@ -552,3 +552,24 @@ fn zero_filled_accessors_have_a_budget() {
     assert!(matches!(err.kind, ErrorKind::LimitExceeded(_)), "{err}");
     assert!(err.to_string().contains("1000000000"), "{err}");
 }
+
+/// A node translation to georeferenced coordinates (x ≈ 4·10^5,
+/// y ≈ 4.6·10^6) is applied in f64: the millimetre triangle keeps its
+/// area, and the shift is recorded in `origin`.
+#[test]
+fn far_node_translations_keep_the_triangles() {
+    let dir = scratch("gltf-far");
+    let (bin, json) = triangle(
+        "tri.bin",
+        44,
+        // Values the f32 of glTF's JSON holds exactly.
+        r#"{"mesh":0,"translation":[412345.5,4612345.5,231.0],"scale":[0.001,0.001,0.001]}"#,
+    );
+    std::fs::write(dir.join("tri.bin"), &bin).unwrap();
+    std::fs::write(dir.join("far.gltf"), json).unwrap();
+    let mesh = TriMesh::read(dir.join("far.gltf")).unwrap();
+    assert_ne!(mesh.origin, glam::DVec3::ZERO);
+    assert!((mesh.area() - 0.5e-6).abs() < 1e-9, "{}", mesh.area());
+    let first = mesh.absolute_positions()[0];
+    assert!((first - glam::DVec3::new(412_345.5, 4_612_345.5, 231.0)).length() < 1e-6);
+}

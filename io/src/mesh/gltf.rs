@@ -20,7 +20,7 @@
 
 use std::path::{Component, Path, PathBuf};
 
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use glam::{DVec3, Mat3, Mat4, Vec2, Vec3};
 use gltf::accessor::sparse::IndexType;
 use gltf::accessor::{Accessor, DataType, Dimensions};
 use gltf::mesh::Mode;
@@ -235,7 +235,7 @@ impl Reader<'_> {
                 )?;
             }
         }
-        Ok(parts.finish())
+        parts.finish(self.path)
     }
 
     /// Decodes accessor `accessor` (glTF 2.0 Sec. 3.6.2) to `f64`
@@ -406,22 +406,23 @@ impl Reader<'_> {
             &[F32, I8, U8, I16, U16],
         )?;
         let count = positions.len() / 3;
-        let base = parts.mesh.positions.len();
+        let base = parts.points.len();
         let normal_matrix = Mat3::from_mat4(global).inverse().transpose();
+        // In f64, so that a node translation far from the origin (a
+        // georeferenced tile) keeps the precision of the vertices; the
+        // shift is chosen once all primitives are in (TriMesh::origin).
+        let global64 = global.as_dmat4();
         for (i, p) in positions.chunks_exact(3).enumerate() {
-            let q = global.transform_point3(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32));
-            if !q.is_finite() {
-                let value = q
-                    .to_array()
-                    .into_iter()
-                    .find(|v| !v.is_finite())
-                    .unwrap_or(f32::NAN);
+            // The file's components are f32 (or integers); the decoder's
+            // f64 holds them exactly.
+            let q = global64.transform_point3(DVec3::new(p[0], p[1], p[2]));
+            if let Some(value) = q.to_array().into_iter().find(|v| !v.is_finite()) {
                 return Err(self.error(ErrorKind::NonFinite {
                     index: base + i,
-                    value: f64::from(value),
+                    value,
                 }));
             }
-            parts.mesh.positions.push(q);
+            parts.points.push(q);
         }
         let length_error = |what: &str, n: usize| {
             self.invalid(format!(
@@ -623,6 +624,9 @@ impl Reader<'_> {
 #[derive(Default)]
 struct Parts {
     mesh: TriMesh,
+    /// Positions with the node transforms applied, in f64 until the
+    /// global shift is known.
+    points: Vec<DVec3>,
     normals: Vec<Option<Vec3>>,
     uvs: Vec<Option<Vec2>>,
     uvs1: Vec<Option<Vec2>>,
@@ -630,20 +634,33 @@ struct Parts {
 
 impl Parts {
     /// The mesh, with an attribute when any primitive has it (zeros for
-    /// the vertices of those that do not).
-    fn finish(self) -> TriMesh {
+    /// the vertices of those that do not), positions relative to the
+    /// global shift.
+    fn finish(self, path: &Path) -> Result<TriMesh> {
         fn fill<T: Copy + Default>(values: Vec<Option<T>>) -> Option<Vec<T>> {
             values
                 .iter()
                 .any(Option::is_some)
                 .then(|| values.into_iter().map(Option::unwrap_or_default).collect())
         }
-        TriMesh {
+        let (origin, positions) = super::recenter(&self.points);
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::new(
+                path,
+                ErrorKind::OutOfRange(format!(
+                    "vertex {i} at {} is too far from the others for f32 positions",
+                    self.points[i]
+                )),
+            ));
+        }
+        Ok(TriMesh {
+            positions,
+            origin,
             normals: fill(self.normals),
             uvs: fill(self.uvs),
             uvs1: fill(self.uvs1),
             ..self.mesh
-        }
+        })
     }
 }
 

@@ -42,8 +42,9 @@ pub struct TriMesh {
     /// triangles instead of collapsing them. Shifted when the largest
     /// coordinate magnitude is at least 10^5 (CloudCompare's default; the
     /// `f32` step there is 1/128) or more than 2^12 times the mesh's size.
-    /// Writers add it back in `f64`. glTF stores `f32`, so its meshes keep
-    /// a zero origin.
+    /// Writers add it back in `f64`. glTF stores `f32` vertices, but its
+    /// node transforms may carry them far away (a georeferenced tile): the
+    /// reader applies them in `f64` and picks the shift the same way.
     pub origin: DVec3,
     /// Three 0-based vertex indices per triangle, counter-clockwise as the
     /// file orders them.
