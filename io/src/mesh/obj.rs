@@ -129,12 +129,18 @@ fn apply_uv_transforms(mesh: &mut TriMesh, transforms: &[Option<UvTransform>]) {
 
 /// The files an `mtllib` line names: the whole rest of the line when a
 /// file of that name exists (names with spaces), else its
-/// whitespace-separated words (the statement's list form).
+/// whitespace-separated words (the statement's list form). When none of
+/// the words exists either, the whole name, so that the error names what
+/// the line says.
 fn library_files(folder: &Path, names: &str) -> Vec<String> {
-    if folder.join(names).is_file() || !names.contains(char::is_whitespace) {
+    let words: Vec<String> = names.split_whitespace().map(str::to_string).collect();
+    if words.len() <= 1
+        || folder.join(names).is_file()
+        || !words.iter().any(|w| folder.join(w).is_file())
+    {
         return vec![names.to_string()];
     }
-    names.split_whitespace().map(str::to_string).collect()
+    words
 }
 
 /// Parses the contents of an `.obj` file; `path` names it in errors.
