@@ -506,6 +506,9 @@ impl Reader<'_> {
             None => parts.uvs1.extend(std::iter::repeat_n(None, count)),
         }
 
+        if let Some(a) = primitive.indices().filter(|a| a.normalized()) {
+            return Err(self.invalid(format!("index accessor {} marked normalized", a.index())));
+        }
         let raw: Vec<u32> = match primitive.indices() {
             Some(a) => self
                 .decode(&a, buffers, "indices", Dimensions::Scalar, &[U8, U16, U32])?
