@@ -497,6 +497,12 @@ impl Reader<'_> {
                 *uv = Vec2::new(cos * u - sin * v + ou, sin * u + cos * v + ov);
             }
         }
+        if let Some(bad) = uvs.iter().flatten().position(|uv| !uv.is_finite()) {
+            return Err(self.invalid(format!(
+                "a non-finite texture coordinate at vertex {} (TEXCOORD_{set}, after any texture transform)",
+                base + bad
+            )));
+        }
         match uvs {
             Some(uvs) => parts.uvs.extend(uvs.into_iter().map(Some)),
             None => parts.uvs.extend(std::iter::repeat_n(None, count)),
