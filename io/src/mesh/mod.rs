@@ -26,8 +26,8 @@ pub mod ply;
 /// turn it back, which is the only place a flip happens. glTF UVs are kept
 /// as stored. Values outside `[0, 1]` (tiling) are kept; the material's
 /// [`Wrap`] says what they mean. Flipping in `f32` is exact for the values
-/// a texture atlas usually holds (multiples of powers of two) and within
-/// 2^-24 otherwise.
+/// a texture atlas usually holds (multiples of powers of two) and
+/// otherwise within half an `f32` step of `max(1, |v|)`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriMesh {
     /// Vertex positions, relative to [`origin`](Self::origin): the point a
@@ -93,10 +93,13 @@ pub struct Material {
     pub wrap: [Wrap; 2],
 }
 
-/// Texture wrap mode (glTF sampler modes; OBJ/MTL textures repeat).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Texture wrap mode (glTF sampler modes; OBJ/MTL textures repeat unless
+/// `-clamp on`). The same enum, with the same meaning, is used by every
+/// trilux crate that has wrap modes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum Wrap {
     /// Tile the texture.
+    #[default]
     Repeat,
     /// Tile, mirroring every other copy.
     MirroredRepeat,
