@@ -6,6 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
+use trilux_io::image;
 use trilux_io::mesh::{TriMesh, gltf, obj, ply};
 use trilux_io::tet::{TetMesh, gmsh, medit, tetgen};
 
@@ -97,6 +98,21 @@ fn replay(target: &str, data: &[u8]) -> Option<()> {
                 check_tri(&mesh);
             }
         }
+        "image" => {
+            let Some((&pick, bytes)) = data.split_first() else {
+                return Some(());
+            };
+            let name = ["fuzz.png", "fuzz.jpg", "fuzz.hdr", "fuzz.exr"][usize::from(pick % 4)];
+            let options = image::ReadOptions {
+                max_dimension: 4096,
+                max_bytes: 64 << 20,
+                ..image::ReadOptions::default()
+            };
+            if let Ok(picture) = image::decode(bytes, name, options) {
+                let n = u64::from(picture.width) * u64::from(picture.height);
+                assert_eq!(picture.pixels.len() as u64, n);
+            }
+        }
         _ => return None,
     }
     Some(())
@@ -105,7 +121,7 @@ fn replay(target: &str, data: &[u8]) -> Option<()> {
 #[test]
 fn every_fuzz_target_replays_its_crashes_and_seeds() {
     let targets = targets();
-    assert!(targets.len() >= 6, "fuzz targets: {targets:?}");
+    assert!(targets.len() >= 7, "fuzz targets: {targets:?}");
     let mut crashes = 0;
     for target in &targets {
         let crash_files = files(&manifest().join("tests/fuzz-regressions").join(target));
