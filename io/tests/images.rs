@@ -333,3 +333,30 @@ fn exr_blocks_are_checked_against_the_budget() {
     assert!(matches!(err.kind, ErrorKind::LimitExceeded(_)), "{err}");
     assert!(err.to_string().contains("16777024×64"), "{err}");
 }
+
+/// A B44-compressed OpenEXR file on which the codec's decompression
+/// overflows (found by fuzzing): the panic inside the codec comes back as
+/// a codec error.
+#[test]
+fn a_codec_panic_is_an_error() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz-regressions/image");
+    let data = std::fs::read(dir.join("crash-cad39f76bdd3f9ffaed8ac4fdf5abf694d75a820")).unwrap();
+    let options = ReadOptions {
+        max_dimension: 4096,
+        max_bytes: 64 << 20,
+        ..ReadOptions::default()
+    };
+    // Overflow checks are on in test builds, as in the fuzzer.
+    if let Err(err) = image::decode(&data[1..], "b44.exr", options) {
+        assert!(
+            matches!(
+                err.kind,
+                ErrorKind::Codec {
+                    format: "OpenEXR",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+    }
+}
