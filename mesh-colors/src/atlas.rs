@@ -49,7 +49,7 @@ pub struct Atlas {
     /// The texture, `channels()` of the mesh colours.
     pub texture: Texture,
     /// `corner_uvs[f][k]`: the UV of corner `k` of face `f` ([`Texture`]
-    /// convention: `v = 0` is row 0; flip for OBJ).
+    /// convention: `v = 0` is row 0, as in `trilux-io`'s `TriMesh`).
     pub corner_uvs: Vec<[Vec2; 3]>,
 }
 
