@@ -38,7 +38,10 @@ pub struct CascadeOptions {
     pub hierarchy: HierarchyOptions,
     /// Which coarse systems.
     pub system: CoarseSystem,
-    /// The coarsest level's solve ("to convergence").
+    /// The coarsest level's solve ("to convergence"). Its
+    /// `require_convergence` is not used: a coarsest level that does not
+    /// converge hands over to the next finer one (reported in
+    /// [`CascadeReport::fallbacks`]).
     pub coarsest: SolveOptions,
     /// BiCGSTAB iterations on each intermediate level.
     pub intermediate_iterations: usize,
