@@ -8,6 +8,10 @@
 //! - [`cg`], [`bicgstab`], [`pcg`]: warm start, relative-residual
 //!   tolerance, iteration cap, and a [`Report`] that says whether they
 //!   converged, in how many iterations, with the true final residual.
+//!   Stopping short of the tolerance is an [`Error::NotConverged`]
+//!   carrying that report unless [`SolveOptions::require_convergence`] is
+//!   turned off; CG refuses non-symmetric matrices
+//!   ([`Error::NotSymmetric`]).
 //!   Mat-vecs and vector operations run in parallel with results that do
 //!   not depend on the number of threads.
 //! - [`Hierarchy`] (Sec. 4.1): per-vertex 32-bit codes (hashed random
@@ -32,12 +36,13 @@
 //!   operators, damped Jacobi, exact coarsest solve) preconditioning CG.
 //! - [`grid`]: the 7-point diffusion system on 3D grids, for tests and
 //!   benchmarks.
+//! - [`mtx`]: Matrix Market files, read and written.
 //!
 //! # Example
 //! ```
 //! use multires::{cg, grid, SolveOptions, VCycle, VCycleOptions, Weights};
 //! let p = grid::diffusion([20, 20, 20], 6.0)?;
-//! let options = SolveOptions { tolerance: 1e-8, max_iterations: 1_000 };
+//! let options = SolveOptions::new(1e-8, 1_000);
 //!
 //! let mut plain = vec![0.0; p.rhs.len()];
 //! let jacobi = cg(&p.matrix, &p.rhs, &mut plain, &options)?;
@@ -58,15 +63,24 @@ pub mod grid;
 pub mod hierarchy;
 pub mod krylov;
 pub mod matrix;
+pub mod mtx;
 pub mod vcycle;
 pub mod vector;
+
+/// The README's examples, compiled as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
 
 pub use cascade::{Cascade, CascadeOptions, CascadeReport, CoarseSystem};
 pub use error::Error;
 pub use graph::Graph;
-pub use hierarchy::{Coarsening, Hierarchy, HierarchyOptions, Weights};
+pub use hierarchy::{Coarsening, Hierarchy, HierarchyOptions, PositionList, Weights};
 pub use krylov::{
     Jacobi, Monitor, Preconditioner, Report, SolveOptions, Stop, bicgstab, bicgstab_monitored, cg,
     cg_monitored, pcg, pcg_monitored,
 };
+/// The `sprs` whose `CsMat` this crate's API takes, re-exported so that
+/// callers build matrices with the same version.
+pub use sprs;
 pub use vcycle::{VCycle, VCycleOptions};
