@@ -13,8 +13,8 @@ use std::process::ExitCode;
 
 use glam::Vec2;
 use mesh_colors::{Texture, Topology, atlas, convert, file};
-use trilux_io::image::{Image, PngDepth, linear_to_srgb, srgb_to_linear};
-use trilux_io::mesh::{Object, TriMesh};
+use trilux_io::image::{Image, linear_to_srgb, srgb_to_linear};
+use trilux_io::mesh::{Material, Object, TriMesh};
 
 fn main() -> ExitCode {
     // Errors print as the sentence their Display gives, not as Debug.
@@ -69,19 +69,6 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         }
         mesh.indices.push([base, base + 1, base + 2]);
     }
-    mesh.objects.push(Object {
-        name: "spot".into(),
-        triangles: 0..mesh.indices.len(),
-        material: None,
-    });
-    let obj = out.join("spot_atlas.obj");
-    trilux_io::mesh::obj::write(&obj, &mesh)?;
-    let text = std::fs::read_to_string(&obj)?;
-    std::fs::write(&obj, format!("mtllib spot_atlas.mtl\nusemtl atlas\n{text}"))?;
-    std::fs::write(
-        out.join("spot_atlas.mtl"),
-        "newmtl atlas\nKd 1 1 1\nmap_Kd spot_atlas.png\n",
-    )?;
     let t = &baked.texture;
     let image = Image {
         width: t.width() as u32,
@@ -99,11 +86,31 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
             })
             .collect(),
     };
-    trilux_io::image::write_png(&out.join("spot_atlas.png"), &image, PngDepth::Eight)?;
+    // The OBJ writer keeps the material: it writes the .mtl and the atlas
+    // as a PNG beside the OBJ.
+    mesh.materials.push(Material {
+        name: "atlas".into(),
+        diffuse: [1.0; 3],
+        diffuse_texture: None,
+        diffuse_image: Some(image),
+        wrap: Default::default(),
+    });
+    mesh.objects.push(Object {
+        name: "spot".into(),
+        triangles: 0..mesh.indices.len(),
+        material: Some(0),
+    });
+    let obj = out.join("spot_atlas.obj");
+    mesh.write(&obj)?;
 
     // Read both back as a user would, and compare with the source texture.
     let back = TriMesh::read(&obj)?;
-    let png = trilux_io::image::read(out.join("spot_atlas.png"))?;
+    let atlas_png = back
+        .materials
+        .first()
+        .and_then(|m| m.diffuse_texture.clone())
+        .ok_or_else(|| format!("{}: the written OBJ reads back without its texture", obj.display()))?;
+    let png = trilux_io::image::read(&atlas_png)?;
     let data = png
         .pixels
         .iter()
