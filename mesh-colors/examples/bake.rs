@@ -109,7 +109,12 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         .materials
         .first()
         .and_then(|m| m.diffuse_texture.clone())
-        .ok_or_else(|| format!("{}: the written OBJ reads back without its texture", obj.display()))?;
+        .ok_or_else(|| {
+            format!(
+                "{}: the written OBJ reads back without its texture",
+                obj.display()
+            )
+        })?;
     let png = trilux_io::image::read(&atlas_png)?;
     let data = png
         .pixels
