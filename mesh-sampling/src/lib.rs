@@ -79,5 +79,5 @@ pub use naive::NaiveSampler;
 pub use point::{SurfacePoint, uniform_barycentric};
 pub use projection::spherical_uvs;
 pub use rejection::RejectionSampler;
-pub use texture::{Channel, DensityTexture, Filter, Wrap};
+pub use texture::{Channel, DensityTexture, Filter, Wrap, luminance};
 pub use uniform::UniformSampler;
