@@ -9,7 +9,7 @@ use rand::distr::Distribution;
 
 use crate::layout::{Piece, PieceAlias};
 use crate::parallel::{BLOCK, unit};
-use crate::point::{Frame, uniform_barycentric};
+use crate::point::Frame;
 use crate::subdivision::{self, MAX_LEVEL, Merge, SubTriangle, Values};
 use crate::{DensityTexture, Error, Layout, MeshRef, SurfacePoint, SurfaceSampler};
 
@@ -461,8 +461,11 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         match piece.part.corner() {
             Some(corner) => linear_corner_barycentric(corner, xi1, xi2),
             None => {
-                let [_, a, b] = uniform_barycentric(xi1, xi2);
-                let (u, v) = piece.part.to_parent(f64::from(a), f64::from(b));
+                // The square-root map (Sec. 3.5) in the sub-triangle's own
+                // legs, kept in f64 up to the parent's barycentrics.
+                let s = xi1.sqrt();
+                let a = xi2 * s;
+                let (u, v) = piece.part.to_parent(a, s - a);
                 [(1.0 - u - v).max(0.0) as f32, u as f32, v as f32]
             }
         }
