@@ -152,7 +152,7 @@ fn load_meshes(filter: Option<&str>) -> Result<Vec<TestMesh>, String> {
             .into_owned();
         let (positions, uvs, indices) = match m.uvs {
             Some(uvs) => (m.positions, uvs, m.indices),
-            None => spherical_uvs(&m.positions, &m.indices),
+            None => spherical_uvs(&m.positions, &m.indices).map_err(|e| e.to_string())?,
         };
         out.push(TestMesh {
             name,
@@ -227,7 +227,8 @@ fn icosphere(levels: u32) -> TestMesh {
         }
         indices = next;
     }
-    let (positions, uvs, indices) = spherical_uvs(&positions, &indices);
+    let (positions, uvs, indices) =
+        spherical_uvs(&positions, &indices).expect("the icosphere is a valid mesh");
     TestMesh {
         name: "icosphere".into(),
         positions,
