@@ -548,8 +548,9 @@ fn measure_pair(
         ..Options::default()
     };
     // Its build is the inversion layout's (timed below): built once.
-    let (ms, no_table) =
-        build_n(1, || DensitySampler::<CdfBisection>::with_table(mesh, density, &inversion));
+    let (ms, no_table) = build_n(1, || {
+        DensitySampler::<CdfBisection>::with_table(mesh, density, &inversion)
+    });
     let no_table = no_table.map_err(|e| e.to_string())?;
     let bytes = no_table.memory_bytes();
     rows.push(row(
@@ -589,7 +590,9 @@ fn measure_pair(
         mode: Mode::Exact,
         ..Options::default()
     };
-    let (ms, exact) = build_n(1, || DensitySampler::with_options(mesh, density, &exact_options));
+    let (ms, exact) = build_n(1, || {
+        DensitySampler::with_options(mesh, density, &exact_options)
+    });
     let exact = exact.map_err(|e| e.to_string())?;
     rows.push(row(
         "exact",
@@ -642,7 +645,9 @@ fn print_summary(rows: &[Row]) {
         })
     };
     println!("\n## Density rate / uniform sampler rate (same mesh, same threads)\n");
-    println!("| mesh | density | threads | alias layout | inversion layout | speed-up over rejection |");
+    println!(
+        "| mesh | density | threads | alias layout | inversion layout | speed-up over rejection |"
+    );
     println!("|---|---|---:|---:|---:|---:|");
     let mut worst: [Option<(f64, &Row)>; 2] = [None, None];
     for r in rows.iter().filter(|r| r.method == "subdivision") {
@@ -684,7 +689,10 @@ fn print_summary(rows: &[Row]) {
         }
     }
     let mut worst_scaling: Option<(f64, &Row)> = None;
-    for r in rows.iter().filter(|r| r.method == "subdivision" && r.threads == 2) {
+    for r in rows
+        .iter()
+        .filter(|r| r.method == "subdivision" && r.threads == 2)
+    {
         if let Some(one) = find(&r.mesh, &r.density, "subdivision", 1) {
             let s = r.msamples_per_s / one.msamples_per_s;
             if worst_scaling.is_none_or(|(w, _)| s < w) {

@@ -809,7 +809,11 @@ fn collect_pieces(
         let base = pieces.len();
         face_start.extend(starts.iter().map(|&s| (base + s) as u32));
         let first = c * FACE_CHUNK;
-        let ends = starts.iter().skip(1).copied().chain(std::iter::once(parts.len()));
+        let ends = starts
+            .iter()
+            .skip(1)
+            .copied()
+            .chain(std::iter::once(parts.len()));
         for (k, (&start, end)) in starts.iter().zip(ends).enumerate() {
             let face = (first + k) as u32;
             pieces.extend(parts[start..end].iter().map(|&(part, value)| Piece {
@@ -845,7 +849,10 @@ fn capped_levels(wanted: &[(u8, Option<f32>)], budget: usize) -> Result<(Vec<u8>
             needed: count(0),
             budget,
         })?;
-    Ok((wanted.iter().map(|&(l, _)| l.min(cap)).collect(), count(cap)))
+    Ok((
+        wanted.iter().map(|&(l, _)| l.min(cap)).collect(),
+        count(cap),
+    ))
 }
 
 /// Sub-triangles of face `f` with their values (approximate mode: the
@@ -907,7 +914,11 @@ fn texture_pieces(
 /// density whose texels are at most that).
 fn round_up(x: f64) -> f32 {
     let y = x as f32;
-    if f64::from(y) < x { y.next_up().min(f32::MAX) } else { y.min(f32::MAX) }
+    if f64::from(y) < x {
+        y.next_up().min(f32::MAX)
+    } else {
+        y.min(f32::MAX)
+    }
 }
 
 /// The lowest expected acceptance a rejection step may have: 10⁻⁹ (a

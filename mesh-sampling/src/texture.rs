@@ -312,7 +312,10 @@ impl DensityTexture {
                 if i1.saturating_sub(i0) >= last {
                     return all;
                 }
-                let (a, b) = (i0.rem_euclid(n as i64) as usize, i1.rem_euclid(n as i64) as usize);
+                let (a, b) = (
+                    i0.rem_euclid(n as i64) as usize,
+                    i1.rem_euclid(n as i64) as usize,
+                );
                 if a <= b {
                     [Some((a, b)), None]
                 } else {
@@ -404,7 +407,8 @@ impl DensityTexture {
             // the value times the UV area, without visiting its cells.
             return f64::from(c) * 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
         }
-        if !(self.cells_to_integrate(uv) <= MAX_INTEGRATION_CELLS as f64) {
+        let cells = self.cells_to_integrate(uv);
+        if cells.is_nan() || cells > MAX_INTEGRATION_CELLS as f64 {
             return f64::NAN;
         }
         let scale = 1.0 / (self.width as f64 * self.height as f64);
@@ -635,8 +639,11 @@ impl Changes {
             let (mut row_a, mut row_d) = (0u32, 0u32);
             for x in 0..width {
                 let t = texels[y * width + x];
-                row_a = row_a.wrapping_add(u32::from(x + 1 < width && texels[y * width + x + 1] != t));
-                row_d = row_d.wrapping_add(u32::from(y + 1 < height && texels[(y + 1) * width + x] != t));
+                row_a =
+                    row_a.wrapping_add(u32::from(x + 1 < width && texels[y * width + x + 1] != t));
+                row_d = row_d.wrapping_add(u32::from(
+                    y + 1 < height && texels[(y + 1) * width + x] != t,
+                ));
                 let at = (y + 1) * stride + x + 1;
                 let above = sums[at - stride];
                 sums[at] = [above[0].wrapping_add(row_a), above[1].wrapping_add(row_d)];
@@ -913,11 +920,20 @@ mod tests {
         assert_eq!(t.range_over_box(lo, hi), (2.0, 2.0));
         assert_eq!(t.constant_over_box(lo, hi), Some(2.0));
         // Repeat: the box wraps from the right half into the left one.
-        assert_eq!(t.constant_over_box(DVec2::new(0.9, 0.1), DVec2::new(1.2, 0.3)), None);
-        assert_eq!(t.constant_over_box(DVec2::new(1.05, 0.1), DVec2::new(1.4, 0.3)), Some(2.0));
+        assert_eq!(
+            t.constant_over_box(DVec2::new(0.9, 0.1), DVec2::new(1.2, 0.3)),
+            None
+        );
+        assert_eq!(
+            t.constant_over_box(DVec2::new(1.05, 0.1), DVec2::new(1.4, 0.3)),
+            Some(2.0)
+        );
         for clamp in [Wrap::ClampToEdge, Wrap::MirroredRepeat] {
             let c = t.clone().with_wrap(clamp);
-            assert_eq!(c.constant_over_box(DVec2::new(-0.3, 0.1), DVec2::new(0.2, 0.3)), Some(2.0));
+            assert_eq!(
+                c.constant_over_box(DVec2::new(-0.3, 0.1), DVec2::new(0.2, 0.3)),
+                Some(2.0)
+            );
         }
         assert_eq!(
             t.range_over_box(lo, DVec2::new(0.6, 0.9)),

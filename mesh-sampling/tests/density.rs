@@ -268,7 +268,10 @@ fn subdivision_depth_follows_the_papers_rule() {
         uvs: Some(&uvs),
         ..MeshRef::new(&positions, &indices)
     };
-    for depth in [mesh_sampling::Depth::AtMostOneTexel, mesh_sampling::Depth::Nearest] {
+    for depth in [
+        mesh_sampling::Depth::AtMostOneTexel,
+        mesh_sampling::Depth::Nearest,
+    ] {
         let options = Options {
             depth,
             max_level: 13,
@@ -279,7 +282,9 @@ fn subdivision_depth_follows_the_papers_rule() {
         for (f, tri) in indices.iter().enumerate() {
             let p = tri.map(|i| uvs[i as usize].as_dvec2() * DVec2::new(w, h));
             let texels = 0.5 * (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
-            let longest = (0..3).map(|k| (p[(k + 1) % 3] - p[k]).length()).fold(0.0, f64::max);
+            let longest = (0..3)
+                .map(|k| (p[(k + 1) % 3] - p[k]).length())
+                .fold(0.0, f64::max);
             let mut by_edge = 0;
             while 2.0 * f64::from(1u32 << by_edge) < longest {
                 by_edge += 1;
@@ -298,7 +303,11 @@ fn subdivision_depth_follows_the_papers_rule() {
                 }
             };
             let expected = by_area.max(by_edge).min(13) as u8;
-            assert_eq!(s.level(f), expected, "{depth:?}, face {f}: {texels} texels, edge {longest}");
+            assert_eq!(
+                s.level(f),
+                expected,
+                "{depth:?}, face {f}: {texels} texels, edge {longest}"
+            );
         }
     }
 }
@@ -381,7 +390,8 @@ fn exact_mode_and_rejection_sample_the_same_distribution() {
     let mesh = mesh_ref(&m);
     let exact_points = DensitySampler::with_options(mesh, Density::Texture(&t), &exact())
         .unwrap()
-        .sample_n(9, N).unwrap();
+        .sample_n(9, N)
+        .unwrap();
     let rejection = RejectionSampler::new(mesh, &t).unwrap();
     let reject_points = rejection.sample_n(10, N).unwrap();
     let p = two_sample_p(
@@ -397,7 +407,8 @@ fn exact_mode_and_rejection_sample_the_same_distribution() {
     };
     let approximate = DensitySampler::with_options(mesh, Density::Texture(&t), &coarse)
         .unwrap()
-        .sample_n(11, N).unwrap();
+        .sample_n(11, N)
+        .unwrap();
     let p = two_sample_p(
         &texel_counts(&m, &t, &approximate),
         &texel_counts(&m, &t, &reject_points),
@@ -630,12 +641,24 @@ fn zero_area_triangles_are_never_sampled() {
     let t = noise(8, 8);
     for options in [Options::default(), exact()] {
         let sampler = DensitySampler::with_options(mesh, Density::Texture(&t), &options).unwrap();
-        assert!(sampler.sample_n(17, 10_000).unwrap().iter().all(|p| p.face == 0));
+        assert!(
+            sampler
+                .sample_n(17, 10_000)
+                .unwrap()
+                .iter()
+                .all(|p| p.face == 0)
+        );
         assert_eq!(sampler.pdf(1, [0.3, 0.3, 0.4]), 0.0);
     }
     let w = [1.0, 1.0];
     let sampler = DensitySampler::new(mesh, Density::PerFace(&w)).unwrap();
-    assert!(sampler.sample_n(18, 10_000).unwrap().iter().all(|p| p.face == 0));
+    assert!(
+        sampler
+            .sample_n(18, 10_000)
+            .unwrap()
+            .iter()
+            .all(|p| p.face == 0)
+    );
 }
 
 #[test]
@@ -803,7 +826,10 @@ use data_dir::data_dir;
 /// plane: the approximate mode against the from-scratch `p′` per texel,
 /// the exact mode against the exact integrals per triangle.
 #[test]
-#[cfg_attr(not(trilux_data), ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)")]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
 fn hdr_images_as_densities() {
     let dir = data_dir().expect("TRILUX_DATA names the data folder");
     let mut files: Vec<_> = std::fs::read_dir(dir.join("hdr"))
@@ -862,11 +888,15 @@ fn uniform_area(mesh: MeshRef<'_>) -> f64 {
 /// mapping; the approximate mode does near texel edges (that is the
 /// paper's approximation, documented).
 #[test]
-#[cfg_attr(not(trilux_data), ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)")]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
 fn bunny_checkerboard_exact_mode_never_lands_on_black() {
     let dir = data_dir().expect("TRILUX_DATA names the data folder");
     let bunny = trilux_io::mesh::TriMesh::read(dir.join("meshes/stanford-bunny.obj")).unwrap();
-    let (positions, uvs, indices) = mesh_sampling::spherical_uvs(&bunny.positions, &bunny.indices).unwrap();
+    let (positions, uvs, indices) =
+        mesh_sampling::spherical_uvs(&bunny.positions, &bunny.indices).unwrap();
     let mesh = MeshRef {
         uvs: Some(&uvs),
         ..MeshRef::new(&positions, &indices)

@@ -16,8 +16,11 @@ use mesh_sampling::{
     RejectionSampler, SurfaceSampler,
 };
 
+/// Positions, UVs and triangles.
+type Mesh = (Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>);
+
 /// An `n × n` grid over a bumpy unit square, UVs over `[lo, hi]²`.
-fn grid(n: u32, lo: f32, hi: f32) -> (Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>) {
+fn grid(n: u32, lo: f32, hi: f32) -> Mesh {
     let (mut positions, mut uvs, mut indices) = (Vec::new(), Vec::new(), Vec::new());
     for y in 0..=n {
         for x in 0..=n {
@@ -57,7 +60,9 @@ fn a_constant_density_over_tiled_uvs_is_one_piece_per_triangle() {
         ..MeshRef::new(&p, &i)
     };
     let t = DensityTexture::new(1024, 1024, vec![3.0; 1024 * 1024]).unwrap();
-    let area = mesh_sampling::UniformSampler::new(mesh).unwrap().total_area();
+    let area = mesh_sampling::UniformSampler::new(mesh)
+        .unwrap()
+        .total_area();
     for mode in [Mode::Approximate, Mode::Exact] {
         let options = Options {
             mode,
