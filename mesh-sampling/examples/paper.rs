@@ -1,12 +1,13 @@
 //! Šik & Křivánek 2013, Fig. 10 and Table 1: sampling rate, preprocessing
 //! time and memory of rejection sampling and of adaptive subdivision
-//! (without and with the lookup table, and our exact mode), per mesh and
-//! density texture, on one and two threads; then the issue's bar, and the
-//! comparison with trimesh and Open3D at N = 10⁷ on the bunny.
+//! (the inversion layout without and with the lookup table, the alias
+//! layout, and our exact mode) against the uniform sampler, per mesh and
+//! density texture, on one and two threads; then the ratios between them,
+//! and the comparison with trimesh and Open3D at N = 10⁷ on the bunny.
 //!
 //! ```text
 //! cargo run --release -p mesh-sampling --example paper -- [--json] [--mesh FILE]
-//!     [--density D] [--threads T] [--no-peers]
+//!     [--density D] [--threads T] [--no-peers] [--no-tiled] [--tiled-only]
 //! ```
 //!
 //! Meshes: every mesh in `$TRILUX_DATA/meshes` (those without UVs get
@@ -15,7 +16,7 @@
 //! `checker128` (black = 0), `perlin4`, `perlin16`, `perlin64`, and
 //! `hdr:<file>` for each image of `$TRILUX_DATA/hdr` (luminance, rows
 //! doubled to 1024²), or a generated `hdr:sun` without data. Rates are
-//! medians of five timed runs of about 0.2 s each; points are streamed
+//! medians of five timed runs of about 0.1 s each; points are streamed
 //! through [`SurfaceSampler::sample_stream`] and summed, so memory
 //! bandwidth for storing them is not what is measured (the peer comparison
 //! stores their positions, as the peers do).
@@ -28,7 +29,7 @@ use std::time::Instant;
 use discrete_sampling::CdfBisection;
 use glam::{Vec2, Vec3};
 use mesh_sampling::{
-    Density, DensitySampler, DensityTexture, MeshRef, Mode, Options, RejectionSampler,
+    Density, DensitySampler, DensityTexture, Layout, MeshRef, Mode, Options, RejectionSampler,
     SurfaceSampler, UniformSampler, spherical_uvs,
 };
 use rand::{Rng, SeedableRng};
@@ -37,7 +38,7 @@ use rand_pcg::Pcg64Mcg;
 const SIZE: usize = 1024;
 const RUNS: usize = 5;
 const BUILDS: usize = 3;
-const TARGET_S: f64 = 0.2;
+const TARGET_S: f64 = 0.1;
 const PEER_N: usize = 10_000_000;
 
 struct Args {
@@ -46,6 +47,7 @@ struct Args {
     density: Option<String>,
     threads: Vec<usize>,
     peers: bool,
+    tiled: bool,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -55,6 +57,7 @@ fn parse_args() -> Result<Args, String> {
         density: None,
         threads: vec![1, 2],
         peers: true,
+        tiled: true,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -62,6 +65,12 @@ fn parse_args() -> Result<Args, String> {
         match a.as_str() {
             "--json" => args.json = true,
             "--no-peers" => args.peers = false,
+            "--no-tiled" => args.tiled = false,
+            "--tiled-only" => {
+                args.tiled = true;
+                args.peers = false;
+                args.threads = Vec::new();
+            }
             "--mesh" => args.mesh = Some(value("--mesh")?),
             "--density" => args.density = Some(value("--density")?),
             "--threads" => {
@@ -75,7 +84,7 @@ fn parse_args() -> Result<Args, String> {
             }
             "-h" | "--help" => {
                 return Err(
-                    "usage: paper [--json] [--mesh FILE] [--density D] [--threads T] [--no-peers]"
+                    "usage: paper [--json] [--mesh FILE] [--density D] [--threads T] [--no-peers] [--no-tiled] [--tiled-only]"
                         .into(),
                 );
             }
@@ -151,7 +160,7 @@ fn load_meshes(filter: Option<&str>) -> Result<Vec<TestMesh>, String> {
             .into_owned();
         let (positions, uvs, indices) = match m.uvs {
             Some(uvs) => (m.positions, uvs, m.indices),
-            None => spherical_uvs(&m.positions, &m.indices),
+            None => spherical_uvs(&m.positions, &m.indices).map_err(|e| e.to_string())?,
         };
         out.push(TestMesh {
             name,
@@ -226,7 +235,8 @@ fn icosphere(levels: u32) -> TestMesh {
         }
         indices = next;
     }
-    let (positions, uvs, indices) = spherical_uvs(&positions, &indices);
+    let (positions, uvs, indices) =
+        spherical_uvs(&positions, &indices).expect("the icosphere is a valid mesh");
     TestMesh {
         name: "icosphere".into(),
         positions,
@@ -481,9 +491,14 @@ fn measure(run: impl Fn(usize) -> f64) -> f64 {
 
 /// Median build time (ms) of [`BUILDS`] builds, and the last build.
 fn build<T>(f: impl Fn() -> T) -> (f64, T) {
+    build_n(BUILDS, f)
+}
+
+/// Median build time (ms) of `n` builds, and the last build.
+fn build_n<T>(n: usize, f: impl Fn() -> T) -> (f64, T) {
     let mut times = Vec::new();
     let mut last = None;
-    for _ in 0..BUILDS {
+    for _ in 0..n.max(1) {
         let start = Instant::now();
         let built = f();
         times.push(start.elapsed().as_secs_f64() * 1e3);
@@ -528,8 +543,14 @@ fn measure_pair(
         m.indices.len(),
     )];
     let density = Density::Texture(texture);
-    let (ms, no_table) =
-        build(|| DensitySampler::<CdfBisection>::with_table(mesh, density, &Options::default()));
+    let inversion = Options {
+        layout: Layout::Inversion,
+        ..Options::default()
+    };
+    // Its build is the inversion layout's (timed below): built once.
+    let (ms, no_table) = build_n(1, || {
+        DensitySampler::<CdfBisection>::with_table(mesh, density, &inversion)
+    });
     let no_table = no_table.map_err(|e| e.to_string())?;
     let bytes = no_table.memory_bytes();
     rows.push(row(
@@ -541,11 +562,11 @@ fn measure_pair(
         no_table.pieces(),
     ));
     drop(no_table);
-    let (ms, table) = build(|| DensitySampler::new(mesh, density));
+    let (ms, table) = build(|| DensitySampler::with_options(mesh, density, &inversion));
     let table = table.map_err(|e| e.to_string())?;
     let bytes = table.memory_bytes();
     rows.push(row(
-        "subdivision",
+        "subdivision-inversion",
         rate(&table),
         ms,
         bytes as f64 / 1e6,
@@ -553,11 +574,25 @@ fn measure_pair(
         table.pieces(),
     ));
     drop(table);
+    let (ms, alias) = build(|| DensitySampler::new(mesh, density));
+    let alias = alias.map_err(|e| e.to_string())?;
+    let bytes = alias.memory_bytes();
+    rows.push(row(
+        "subdivision",
+        rate(&alias),
+        ms,
+        bytes as f64 / 1e6,
+        1.0,
+        alias.pieces(),
+    ));
+    drop(alias);
     let exact_options = Options {
         mode: Mode::Exact,
         ..Options::default()
     };
-    let (ms, exact) = build(|| DensitySampler::with_options(mesh, density, &exact_options));
+    let (ms, exact) = build_n(1, || {
+        DensitySampler::with_options(mesh, density, &exact_options)
+    });
     let exact = exact.map_err(|e| e.to_string())?;
     rows.push(row(
         "exact",
@@ -600,86 +635,89 @@ fn print_markdown(rows: &[Row]) {
     }
 }
 
-/// The issue's bar, from the rows of this run.
-fn print_bar(rows: &[Row]) {
-    println!("\n## Bar\n");
+/// The ratios that matter, from the rows of this run: each density's
+/// rate against the uniform sampler's on the same mesh and thread count
+/// (both layouts), against rejection, and two threads against one.
+fn print_summary(rows: &[Row]) {
     let find = |mesh: &str, density: &str, method: &str, threads: usize| {
         rows.iter().find(|r| {
             r.mesh == mesh && r.density == density && r.method == method && r.threads == threads
         })
     };
-    let mut worst_uniform: Option<(f64, &Row)> = None;
-    let mut worst_rejection: Option<(f64, &Row)> = None;
-    let mut worst_scaling: Option<(f64, &Row)> = None;
+    println!("\n## Density rate / uniform sampler rate (same mesh, same threads)\n");
+    println!(
+        "| mesh | density | threads | alias layout | inversion layout | speed-up over rejection |"
+    );
+    println!("|---|---|---:|---:|---:|---:|");
+    let mut worst: [Option<(f64, &Row)>; 2] = [None, None];
     for r in rows.iter().filter(|r| r.method == "subdivision") {
-        if let Some(u) = find(&r.mesh, "uniform", "subdivision", r.threads) {
-            let ratio = r.msamples_per_s / u.msamples_per_s;
-            if worst_uniform.is_none_or(|(w, _)| ratio < w) {
-                worst_uniform = Some((ratio, r));
+        let Some(u) = find(&r.mesh, "-", "uniform-sampler", r.threads) else {
+            continue;
+        };
+        let alias = r.msamples_per_s / u.msamples_per_s;
+        let inversion = find(&r.mesh, &r.density, "subdivision-inversion", r.threads)
+            .map(|i| i.msamples_per_s / u.msamples_per_s);
+        let rejection = find(&r.mesh, &r.density, "rejection", r.threads)
+            .map(|j| r.msamples_per_s / j.msamples_per_s);
+        println!(
+            "| {} | {} | {} | {:.0}% | {} | {} |",
+            r.mesh,
+            r.density,
+            r.threads,
+            100.0 * alias,
+            inversion.map_or("-".into(), |x| format!("{:.0}%", 100.0 * x)),
+            rejection.map_or("-".into(), |x| format!("{x:.1}×")),
+        );
+        for (slot, ratio) in worst.iter_mut().zip([Some(alias), inversion]) {
+            if let Some(ratio) = ratio
+                && slot.is_none_or(|(w, _)| ratio < w)
+            {
+                *slot = Some((ratio, r));
             }
         }
-        if let Some(rej) = find(&r.mesh, &r.density, "rejection", r.threads) {
-            let margin = (r.msamples_per_s / rej.msamples_per_s) / (0.5 * r.max_over_mean);
-            if worst_rejection.is_none_or(|(w, _)| margin < w) {
-                worst_rejection = Some((margin, r));
-            }
+    }
+    println!();
+    for (name, w) in ["alias", "inversion"].iter().zip(worst) {
+        if let Some((ratio, r)) = w {
+            println!(
+                "- Lowest density rate with the {name} layout: {:.0}% of the uniform sampler's ({}, {}, {} thread(s))",
+                100.0 * ratio,
+                r.mesh,
+                r.density,
+                r.threads
+            );
         }
-        if r.threads == 2
-            && let Some(one) = find(&r.mesh, &r.density, "subdivision", 1)
-        {
+    }
+    let mut worst_scaling: Option<(f64, &Row)> = None;
+    for r in rows
+        .iter()
+        .filter(|r| r.method == "subdivision" && r.threads == 2)
+    {
+        if let Some(one) = find(&r.mesh, &r.density, "subdivision", 1) {
             let s = r.msamples_per_s / one.msamples_per_s;
             if worst_scaling.is_none_or(|(w, _)| s < w) {
                 worst_scaling = Some((s, r));
             }
         }
     }
-    let verdict = |ok: bool| if ok { "met" } else { "MISSED" };
-    if let Some((ratio, r)) = worst_uniform {
-        println!(
-            "- Rate with any density / rate with the uniform density: worst {:.0}% ({}, {}, {} thread(s)); bar 65%: {}",
-            100.0 * ratio,
-            r.mesh,
-            r.density,
-            r.threads,
-            verdict(ratio >= 0.65)
-        );
-    }
-    if let Some((margin, r)) = worst_rejection {
-        let rej = find(&r.mesh, &r.density, "rejection", r.threads).expect("found above");
-        println!(
-            "- Speed-up over rejection / (max/mean ÷ 2): worst {:.2} ({}, {}: {:.1}× at max/mean {:.1}); bar 1: {}",
-            margin,
-            r.mesh,
-            r.density,
-            r.msamples_per_s / rej.msamples_per_s,
-            r.max_over_mean,
-            verdict(margin >= 1.0)
-        );
-    }
-    let bunny = rows
-        .iter()
-        .find(|r| r.mesh.contains("bunny"))
-        .map(|r| r.mesh.clone());
-    let rng = rows.iter().find(|r| r.method == "rng" && r.threads == 1);
-    if let (Some(b), Some(rng)) = (bunny, rng)
-        && let Some(s) = find(&b, "uniform", "subdivision", 1)
-    {
-        let cost = rng.msamples_per_s / s.msamples_per_s;
-        println!(
-            "- One thread, uniform density, {b}: {:.1} ns per point, {:.1} ns for its three random u64: {:.2}×; bar 3×: {}",
-            1e3 / s.msamples_per_s,
-            1e3 / rng.msamples_per_s,
-            cost,
-            verdict(cost <= 3.0)
-        );
-    }
     if let Some((s, r)) = worst_scaling {
         println!(
-            "- Two threads / one thread: worst {:.2}× ({}, {}); bar 1.8×: {}",
-            s,
-            r.mesh,
-            r.density,
-            verdict(s >= 1.8)
+            "- Two threads / one thread (alias layout): lowest {s:.2}× ({}, {})",
+            r.mesh, r.density
+        );
+    }
+    let rng = rows.iter().find(|r| r.method == "rng" && r.threads == 1);
+    if let Some(rng) = rng
+        && let Some(u) = rows
+            .iter()
+            .find(|r| r.method == "uniform-sampler" && r.threads == 1 && r.mesh.contains("bunny"))
+    {
+        println!(
+            "- One thread, {}: {:.1} ns per uniform point, {:.1} ns for its three random u64 ({:.2}×)",
+            u.mesh,
+            1e3 / u.msamples_per_s,
+            1e3 / rng.msamples_per_s,
+            rng.msamples_per_s / u.msamples_per_s
         );
     }
 }
@@ -695,7 +733,7 @@ fn peers(m: &TestMesh, file: &Path, threads: &[usize], json: bool) -> Result<(),
             (0..3)
                 .map(|seed| {
                     let start = Instant::now();
-                    black_box(uniform.sample_positions(seed, PEER_N));
+                    black_box(uniform.sample_positions(seed, PEER_N).unwrap());
                     start.elapsed().as_secs_f64()
                 })
                 .collect()
@@ -753,13 +791,89 @@ fn peers(m: &TestMesh, file: &Path, threads: &[usize], json: bool) -> Result<(),
     }
     println!();
     for (peer, r) in &peer_rates {
-        for (t, ours) in &ours {
-            let x = ours / r;
+        if let Some((_, ours)) = ours.iter().find(|(t, _)| *t == 1) {
+            println!("- one thread against {peer} (one thread): {:.1}×", ours / r);
+        }
+    }
+    Ok(())
+}
+
+/// A 64 × 64 grid (8,192 triangles) over a bumpy square, its UVs
+/// spanning `[lo, hi]²`.
+fn tiled_grid(lo: f32, hi: f32) -> TestMesh {
+    let n = 64u32;
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    for y in 0..=n {
+        for x in 0..=n {
+            let (s, t) = (x as f32 / n as f32, y as f32 / n as f32);
+            let z = 0.1 * (7.0 * s).sin() * (5.0 * t).cos();
+            positions.push(Vec3::new(s, t, z));
+            uvs.push(Vec2::new(lo + (hi - lo) * s, lo + (hi - lo) * t));
+        }
+    }
+    let at = |x: u32, y: u32| y * (n + 1) + x;
+    let mut indices = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            indices.push([at(x, y), at(x + 1, y), at(x, y + 1)]);
+            indices.push([at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)]);
+        }
+    }
+    TestMesh {
+        name: format!("grid UV [{lo}, {hi}]²"),
+        positions,
+        uvs,
+        indices,
+    }
+}
+
+/// Tiled UVs: the same mesh with UVs in `[0, 1]²` and in `[−8, 8]²` (the
+/// texture tiled 256 times), with a constant and a noise density:
+/// preprocessing time against the uniform sampler's build, pieces, memory.
+fn print_tiled(textures: &[(String, DensityTexture)]) -> Result<(), String> {
+    println!("\n## Tiled UVs (64 × 64 grid, 8,192 triangles, 1024² textures, default options)\n");
+    println!(
+        "| UVs | density | uniform sampler build ms | density build ms | ratio | pieces | memory MB | rejection build ms |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|");
+    let mut noise_ms = Vec::new();
+    for (lo, hi) in [(0.0, 1.0), (-8.0, 8.0)] {
+        let m = tiled_grid(lo, hi);
+        let mesh = m.mesh();
+        let (uniform_ms, _) = build(|| UniformSampler::new(mesh));
+        for (name, texture) in textures
+            .iter()
+            .filter(|(n, _)| n == "uniform" || n == "perlin16")
+        {
+            let (ms, sampler) = build(|| DensitySampler::new(mesh, Density::Texture(texture)));
+            let sampler = sampler.map_err(|e| format!("{}, {name}: {e}", m.name))?;
+            // Rejection integrates exactly: O(1) per face on a constant
+            // footprint, one step per texel cell otherwise.
+            let rejection = if name == "uniform" {
+                let (ms, r) = build(|| RejectionSampler::new(mesh, texture));
+                r.map_err(|e| e.to_string())?;
+                format!("{ms:.1}")
+            } else {
+                "-".into()
+            };
+            if name != "uniform" {
+                noise_ms.push(ms);
+            }
             println!(
-                "- {t} thread(s) vs {peer}: {x:.1}×; bar 15×: {}",
-                if x >= 15.0 { "met" } else { "MISSED" }
+                "| [{lo}, {hi}]² | {name} | {uniform_ms:.1} | {ms:.1} | {:.2}× | {} | {:.1} | {rejection} |",
+                ms / uniform_ms,
+                sampler.pieces(),
+                sampler.memory_bytes() as f64 / 1e6,
             );
         }
+    }
+    if let [unit, tiled] = noise_ms[..] {
+        println!(
+            "\n- Noise density, UVs in [−8, 8]² against [0, 1]²: {:.2}× the preprocessing time (piece budget {})",
+            tiled / unit,
+            mesh_sampling::DEFAULT_MAX_PIECES
+        );
     }
     Ok(())
 }
@@ -790,6 +904,28 @@ fn run() -> Result<(), String> {
         rows.push(rng_row);
     }
     for m in &meshes {
+        for &t in &args.threads {
+            let uniform = UniformSampler::new(m.mesh()).map_err(|e| e.to_string())?;
+            let (ms, _) = build(|| UniformSampler::new(m.mesh()));
+            let r = pool(t)?.install(|| rate(&uniform));
+            let row = Row {
+                mesh: m.name.clone(),
+                triangles: m.indices.len(),
+                density: "-".into(),
+                method: "uniform-sampler",
+                threads: t,
+                msamples_per_s: r,
+                preprocess_ms: ms,
+                memory_mb: uniform.memory_bytes() as f64 / 1e6,
+                max_over_mean: 1.0,
+                acceptance: 1.0,
+                pieces: m.indices.len(),
+            };
+            if args.json {
+                println!("{}", row.json());
+            }
+            rows.push(row);
+        }
         for (name, texture) in &textures {
             for &t in &args.threads {
                 eprintln!("{} / {name} / {t} thread(s)…", m.name);
@@ -803,10 +939,14 @@ fn run() -> Result<(), String> {
             }
         }
     }
-    if !args.json {
+    if !args.json && !rows.is_empty() {
         println!("# mesh-sampling: Šik & Křivánek 2013, Fig. 10 and Table 1\n");
         print_markdown(&rows);
-        print_bar(&rows);
+        print_summary(&rows);
+    }
+    if args.tiled {
+        let all = densities(None)?;
+        print_tiled(&all)?;
     }
     if args.peers
         && let Some(bunny) = meshes.iter().find(|m| m.name.contains("bunny"))

@@ -135,4 +135,61 @@ pub enum Error {
     /// A subdivision option out of range.
     #[error("invalid option: {0}")]
     InvalidOption(String),
+    /// Even one piece per triangle exceeds the piece budget.
+    #[error(
+        "the density needs at least {needed} pieces, more than the budget of {budget} \
+         (Options::max_pieces)"
+    )]
+    TooManyPieces {
+        /// Pieces needed at the coarsest subdivision.
+        needed: u128,
+        /// The budget.
+        budget: usize,
+    },
+    /// A call would return more points than [`MAX_POINTS`](crate::MAX_POINTS).
+    #[error(
+        "{requested} points is too large a count: at most {budget} points are returned at \
+         once (use sample_stream for more, or a lower rate)"
+    )]
+    TooManyPoints {
+        /// The number of points asked for (or an upper bound of it).
+        requested: f64,
+        /// The budget, [`MAX_POINTS`](crate::MAX_POINTS).
+        budget: usize,
+    },
+    /// The exact integral of the density over the mesh would visit too
+    /// many texel cells (UV footprints that tile a varying texture many
+    /// times).
+    #[error(
+        "integrating the density exactly over the mesh would visit {cells} texel cells, more \
+         than the budget of {budget}: its UVs tile the texture too many times for the exact \
+         mode or rejection sampling (use the approximate mode)"
+    )]
+    IntegrationTooLarge {
+        /// Cells to visit.
+        cells: f64,
+        /// The budget, [`MAX_INTEGRATION_CELLS`](crate::MAX_INTEGRATION_CELLS).
+        budget: u64,
+    },
+    /// A rejection sampler would accept too few of its proposals to
+    /// finish in reasonable time.
+    #[error(
+        "the sampler would accept only {acceptance:e} of its proposals, below the minimum of \
+         {minimum:e}: the density's maximum is too far above its mean on this mesh (use the \
+         approximate mode)"
+    )]
+    AcceptanceTooLow {
+        /// The expected fraction of proposals accepted.
+        acceptance: f64,
+        /// The minimum, [`MIN_ACCEPTANCE`](crate::MIN_ACCEPTANCE).
+        minimum: f64,
+    },
+    /// A triangle index that does not exist.
+    #[error("there is no triangle {face}: the mesh has {count}")]
+    NoSuchFace {
+        /// The index given.
+        face: usize,
+        /// The number of triangles.
+        count: usize,
+    },
 }
