@@ -57,6 +57,8 @@
 #![forbid(unsafe_code)]
 
 mod batch;
+#[cfg(feature = "blue-noise")]
+mod blue_noise;
 mod density;
 mod error;
 mod mesh;
@@ -71,6 +73,11 @@ mod texture;
 mod uniform;
 
 pub use batch::SurfaceSampler;
+#[cfg(feature = "blue-noise")]
+pub use blue_noise::{
+    BlueNoiseOptions, BlueNoiseTarget, SurfaceArea, blue_noise, max_poisson_radius,
+    nearest_neighbour_distances, relative_radius, relative_radius_with_density,
+};
 pub use density::{Density, DensitySampler, Mode, Options};
 pub use error::Error;
 pub use mesh::MeshRef;
