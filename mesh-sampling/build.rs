@@ -1,5 +1,6 @@
-//! Real-data tests run when `TRILUX_DATA` names the data folder; without it
-//! they are compiled as ignored, so a test summary shows them as skipped.
+//! Sets `cfg(trilux_data)` when `TRILUX_DATA` names the real-data folder,
+//! so that the tests needing it show as ignored (not passed) without it.
+
 fn main() {
     println!("cargo::rustc-check-cfg=cfg(trilux_data)");
     println!("cargo::rerun-if-env-changed=TRILUX_DATA");

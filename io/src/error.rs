@@ -77,6 +77,10 @@ pub enum ErrorKind {
         /// The offending value.
         value: f64,
     },
+    /// A value the file holds cannot be represented (a coordinate too far
+    /// from the others for `f32`, an id beyond `u32`).
+    #[error("{0}")]
+    OutOfRange(String),
     /// A valid file that uses a feature this crate does not read.
     #[error("unsupported: {0}")]
     Unsupported(String),

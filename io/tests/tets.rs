@@ -87,12 +87,14 @@ fn tetgen_round_trip_is_exact() {
         ],
         tets: vec![[0, 1, 2, 3], [3, 2, 1, 0]],
         regions: vec![7, -2],
+        attributes: vec![vec![7.0, -2.0]],
     };
     let path = dir.join("m.node");
     tetgen::write(&path, &mesh).unwrap();
     assert_eq!(TetMesh::read(&path).unwrap(), mesh);
     let plain = TetMesh {
         regions: Vec::new(),
+        attributes: Vec::new(),
         ..mesh
     };
     tetgen::write(&path, &plain).unwrap();
@@ -333,9 +335,9 @@ fn malformed_files_name_the_problem_and_the_line() {
             1,
         ),
         (
-            "fractional-region",
+            "nan-attribute",
             node,
-            b"1 4 1\n1 1 2 3 4 0.5\n",
+            b"1 4 1\n1 1 2 3 4 nan\n",
             |k| matches!(k, ErrorKind::Syntax { .. }),
             2,
         ),

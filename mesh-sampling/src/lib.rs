@@ -44,11 +44,11 @@
 //! let mesh = MeshRef { uvs: Some(&uvs), ..MeshRef::new(&positions, &indices) };
 //!
 //! let uniform = UniformSampler::new(mesh)?;
-//! assert!(uniform.sample_n(1, 1000).iter().all(|p| (p.pdf - 1.0).abs() < 1e-6));
+//! assert!(uniform.sample_n(1, 1000).unwrap().iter().all(|p| (p.pdf - 1.0).abs() < 1e-6));
 //!
 //! let texture = DensityTexture::new(2, 2, vec![1.0, 1.0, 1.0, 9.0])?;
 //! let sampler = DensitySampler::new(mesh, Density::Texture(&texture))?;
-//! let points = sampler.sample_n(2, 10_000); // same on any number of threads
+//! let points = sampler.sample_n(2, 10_000).unwrap(); // same on any number of threads
 //! let p = points[0];
 //! assert!((sampler.pdf(p.face as usize, p.barycentric) - p.pdf).abs() < 1e-6); // for MIS
 //! # Ok::<(), mesh_sampling::Error>(())
@@ -61,6 +61,7 @@ mod batch;
 mod blue_noise;
 mod density;
 mod error;
+mod layout;
 mod mesh;
 mod multi;
 mod naive;
@@ -78,13 +79,15 @@ pub use blue_noise::{
     BlueNoiseOptions, BlueNoiseTarget, SurfaceArea, blue_noise, max_poisson_radius,
     nearest_neighbour_distances, relative_radius, relative_radius_with_density,
 };
-pub use density::{Density, DensitySampler, Mode, Options};
+pub use density::{DEFAULT_MAX_PIECES, Density, DensitySampler, Depth, Mode, Options};
 pub use error::Error;
+pub use layout::Layout;
 pub use mesh::MeshRef;
 pub use multi::{MeshPoint, MultiDensitySampler, MultiMeshSampler};
 pub use naive::NaiveSampler;
+pub use parallel::MAX_POINTS;
 pub use point::{SurfacePoint, uniform_barycentric};
 pub use projection::spherical_uvs;
 pub use rejection::RejectionSampler;
-pub use texture::{Channel, DensityTexture, Filter, Wrap};
+pub use texture::{Channel, DensityTexture, Filter, Wrap, luminance};
 pub use uniform::UniformSampler;

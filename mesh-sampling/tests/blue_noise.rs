@@ -92,7 +92,7 @@ fn rho_pair<S: SurfaceSampler + SurfaceArea>(sampler: &S, n: usize, seed: u64) -
     )
     .unwrap();
     assert_eq!(blue.len(), n);
-    let random = sampler.sample_n(seed + 1, n);
+    let random = sampler.sample_n(seed + 1, n).unwrap();
     (
         relative_radius(&positions(&blue), area),
         relative_radius(&positions(&random), area),
@@ -184,7 +184,7 @@ fn density_counts_follow_the_density_and_spacing_scales_as_inverse_sqrt() {
     // own density; independent points from the same density are not.
     let pdf: Vec<f32> = points.iter().map(|p| p.pdf).collect();
     let blue = relative_radius_with_density(&xyz, &pdf);
-    let random = sampler.sample_n(6, n);
+    let random = sampler.sample_n(6, n).unwrap();
     let random_pdf: Vec<f32> = random.iter().map(|p| p.pdf).collect();
     let random = relative_radius_with_density(&positions(&random), &random_pdf);
     eprintln!("density-adaptive ρ: blue {blue:.3}, random {random:.4}");
@@ -205,7 +205,7 @@ fn progressive_prefixes_are_spread() {
     let xyz = positions(&points);
     for prefix in [n / 4, n / 16, n] {
         let rho = relative_radius(&xyz[..prefix], 1.0);
-        let random = relative_radius(&positions(&s.sample_n(9, prefix)), 1.0);
+        let random = relative_radius(&positions(&s.sample_n(9, prefix).unwrap()), 1.0);
         eprintln!("prefix {prefix}: ρ {rho:.3} (random {random:.3})");
         assert!(rho > RHO_BLUE && random < RHO_BLUE);
     }

@@ -196,6 +196,7 @@ fn finish(parts: Parts, c: &Cursor<'_>) -> Result<TetMesh> {
         positions: parts.positions,
         tets,
         regions,
+        attributes: Vec::new(),
     })
 }
 

@@ -157,6 +157,7 @@ pub fn from_bytes(data: &[u8], path: &Path) -> Result<TetMesh> {
         positions,
         tets,
         regions,
+        attributes: Vec::new(),
     })
 }
 

@@ -22,6 +22,12 @@ pub struct TetMesh {
     /// One region tag per tetrahedron (TetGen's region attribute, Gmsh's
     /// physical tag), or empty when the file has none.
     pub regions: Vec<i32>,
+    /// The real-valued per-tetrahedron attributes a TetGen `.ele` file
+    /// stores, one column per attribute: `attributes[k][t]` is attribute
+    /// `k` of tetrahedron `t`. [`regions`](Self::regions) is the first
+    /// column when all its values are integers (TetGen's region tags),
+    /// and empty otherwise. Empty for the other formats.
+    pub attributes: Vec<Vec<f64>>,
 }
 
 /// The faces of tetrahedron `(0, 1, 2, 3)` with outward normals (right-hand
@@ -144,6 +150,7 @@ mod tests {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
             tets: vec![[0, 1, 2, 3]],
             regions: Vec::new(),
+            attributes: Vec::new(),
         }
     }
 

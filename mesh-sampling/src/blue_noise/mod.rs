@@ -168,7 +168,7 @@ pub fn blue_noise<S: SurfaceSampler + SurfaceArea>(
         )));
     }
     let m = m_f as usize;
-    let candidates = spatially_sorted(sampler.sample_n(seed, m));
+    let candidates = spatially_sorted(sampler.sample_n(seed, m)?);
     let order = select(&candidates, n, options);
     Ok(order.into_iter().map(|i| candidates[i as usize]).collect())
 }
@@ -351,7 +351,7 @@ mod tests {
         let sampler = DensitySampler::new(mesh, Density::Texture(&texture)).unwrap();
         let n = 4000;
         let options = BlueNoiseOptions::default();
-        let candidates = sampler.sample_n(3, 5 * n);
+        let candidates = sampler.sample_n(3, 5 * n).unwrap();
         let chi_square = |kept: &[u32]| {
             let mut counts = [0.0f64; 4];
             for &k in kept {
