@@ -140,9 +140,8 @@ pub(crate) fn eliminate(
         let Some(k) = heap.pop() else { break };
         removed.push(k);
         for &(i, w) in lists.of(k as usize) {
-            if heap.contains(i) {
-                heap.decrease(i, f64::from(w));
-            }
+            // −∞ − w stays −∞: removed neighbours need no test.
+            heap.decrease(i, f64::from(w));
         }
     }
     let survivors = (0..points.len() as u32)
