@@ -82,7 +82,7 @@ fn run() -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     let (positions, uvs, indices): (Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>) = match m.uvs {
         Some(uvs) => (m.positions, uvs, m.indices),
-        None => spherical_uvs(&m.positions, &m.indices),
+        None => spherical_uvs(&m.positions, &m.indices).map_err(|e| e.to_string())?,
     };
     let mesh = MeshRef {
         uvs: Some(&uvs),

@@ -79,7 +79,7 @@ pub use blue_noise::{
     BlueNoiseOptions, BlueNoiseTarget, SurfaceArea, blue_noise, max_poisson_radius,
     nearest_neighbour_distances, relative_radius, relative_radius_with_density,
 };
-pub use density::{DEFAULT_MAX_PIECES, Density, DensitySampler, Depth, Mode, Options};
+pub use density::{DEFAULT_MAX_PIECES, MIN_ACCEPTANCE, Density, DensitySampler, Depth, Mode, Options};
 pub use error::Error;
 pub use layout::Layout;
 pub use mesh::MeshRef;
@@ -89,5 +89,5 @@ pub use parallel::MAX_POINTS;
 pub use point::{SurfacePoint, uniform_barycentric};
 pub use projection::spherical_uvs;
 pub use rejection::RejectionSampler;
-pub use texture::{Channel, DensityTexture, Filter, Wrap, luminance};
+pub use texture::{Channel, DensityTexture, Filter, MAX_INTEGRATION_CELLS, Wrap, luminance};
 pub use uniform::UniformSampler;

@@ -246,7 +246,7 @@ fn visit<V, C>(
     let hi = values.iter().copied().fold(0.0f32, f32::max);
     if hi == lo || hi - lo <= tolerance * hi {
         let merged = match merge {
-            Merge::Mean => values.iter().map(|&v| f64::from(v)).sum::<f64>() as f32 * 0.25,
+            Merge::Mean => (values.iter().map(|&v| f64::from(v)).sum::<f64>() * 0.25) as f32,
             Merge::Max => hi,
         };
         out.truncate(start);

@@ -13,6 +13,13 @@ use glam::DVec2;
 
 use crate::Error;
 
+/// The most texel cells an exact integral visits: 2³⁰ (about a minute of
+/// work). [`DensityTexture::integral`] returns NaN beyond it, and the
+/// samplers that integrate exactly ([`Mode::Exact`](crate::Mode::Exact),
+/// [`RejectionSampler`](crate::RejectionSampler)) refuse a mesh whose
+/// footprints add up to more with [`Error::IntegrationTooLarge`].
+pub const MAX_INTEGRATION_CELLS: u64 = 1 << 30;
+
 /// What happens outside `[0, 1]²`, with glTF's sampler semantics (the
 /// same enum, with the same meaning, as in `trilux-io` and `mesh-colors`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -134,11 +141,11 @@ impl DensityTexture {
         channels: usize,
         channel: Channel,
     ) -> Result<Self, Error> {
-        let needed = match channel {
-            Channel::Index(c) => c + 1,
-            Channel::Luminance => 3,
+        let enough = match channel {
+            Channel::Index(c) => c < channels,
+            Channel::Luminance => channels >= 3,
         };
-        if channels < needed {
+        if !enough {
             return Err(Error::InvalidChannel { channel, channels });
         }
         if !data.len().is_multiple_of(channels) {
@@ -305,10 +312,7 @@ impl DensityTexture {
                 if i1.saturating_sub(i0) >= last {
                     return all;
                 }
-                let (a, b) = (
-                    i0.rem_euclid(n as i64) as usize,
-                    i1.rem_euclid(n as i64) as usize,
-                );
+                let (a, b) = (i0.rem_euclid(n as i64) as usize, i1.rem_euclid(n as i64) as usize);
                 if a <= b {
                     [Some((a, b)), None]
                 } else {
@@ -389,12 +393,19 @@ impl DensityTexture {
 
     /// The exact integral of the filtered density over the UV triangle
     /// `uv`, in UV area (the unit square has area 1).
+    ///
+    /// Constant footprints cost O(1); others one clipping step per texel
+    /// cell of the triangle's bounding box ([`cells_to_integrate`](Self::cells_to_integrate)),
+    /// and beyond [`MAX_INTEGRATION_CELLS`] the answer is NaN (not computed).
     pub fn integral(&self, uv: [DVec2; 3]) -> f64 {
         let (lo, hi) = (uv[0].min(uv[1]).min(uv[2]), uv[0].max(uv[1]).max(uv[2]));
         if let Some(c) = self.constant_over_box(lo, hi) {
             // Constant over the footprint (say a tiled constant region):
             // the value times the UV area, without visiting its cells.
             return f64::from(c) * 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
+        }
+        if !(self.cells_to_integrate(uv) <= MAX_INTEGRATION_CELLS as f64) {
+            return f64::NAN;
         }
         let scale = 1.0 / (self.width as f64 * self.height as f64);
         let tri = uv.map(|p| self.to_cells(p));
@@ -403,6 +414,18 @@ impl DensityTexture {
             sum += integrate_piece(piece, |p| self.in_cell(cell, p));
         });
         sum * scale
+    }
+
+    /// The texel cells [`integral`](Self::integral) visits for the UV
+    /// triangle `uv`: 0 if the density is constant over its bounding box,
+    /// else the cells of that box (NaN or infinite for non-finite UVs).
+    pub fn cells_to_integrate(&self, uv: [DVec2; 3]) -> f64 {
+        let (lo, hi) = (uv[0].min(uv[1]).min(uv[2]), uv[0].max(uv[1]).max(uv[2]));
+        if self.constant_over_box(lo, hi).is_some() {
+            return 0.0;
+        }
+        let (a, b) = (self.to_cells(lo).floor(), self.to_cells(hi).ceil());
+        ((b.x - a.x).max(1.0)) * ((b.y - a.y).max(1.0))
     }
 
     /// The maximum of the filtered density over the UV box `[lo, hi]`,
@@ -459,7 +482,12 @@ impl DensityTexture {
         match self.filter {
             Filter::Nearest => self.texel(cell.0, cell.1),
             Filter::Bilinear => {
-                let (fx, fy) = (p.x - cell.0 as f64, p.y - cell.1 as f64);
+                // In [0, 1] inside the cell; clamped for coordinates so
+                // far out (beyond 2⁶³) that the cell index saturated.
+                let (fx, fy) = (
+                    (p.x - cell.0 as f64).clamp(0.0, 1.0),
+                    (p.y - cell.1 as f64).clamp(0.0, 1.0),
+                );
                 let x0 = self.wrap_index(cell.0, self.width);
                 let x1 = self.wrap_index(cell.0.saturating_add(1), self.width);
                 let row0 = self.wrap_index(cell.1, self.height) * self.width;
@@ -592,59 +620,50 @@ impl Pyramid {
 /// texture has fewer than 2³² texels.
 #[derive(Debug, Clone, PartialEq)]
 struct Changes {
-    /// `(width + 1) × (height + 1)`: changes between `(x, y)` and
-    /// `(x + 1, y)` summed over `x' < x, y' < y`.
-    across: Vec<u32>,
-    /// The same for `(x, y)` and `(x, y + 1)`.
-    down: Vec<u32>,
+    /// `(width + 1) × (height + 1)` pairs: changes between `(x, y)` and
+    /// `(x + 1, y)` summed over `x' < x, y' < y`, and the same for
+    /// `(x, y)` and `(x, y + 1)` (side by side: one cache line per corner).
+    sums: Vec<[u32; 2]>,
     width: usize,
 }
 
 impl Changes {
     fn new(width: usize, height: usize, texels: &[f32]) -> Self {
         let stride = width + 1;
-        let mut across = vec![0u32; stride * (height + 1)];
-        let mut down = vec![0u32; stride * (height + 1)];
+        let mut sums = vec![[0u32; 2]; stride * (height + 1)];
         for y in 0..height {
             let (mut row_a, mut row_d) = (0u32, 0u32);
             for x in 0..width {
                 let t = texels[y * width + x];
-                row_a =
-                    row_a.wrapping_add(u32::from(x + 1 < width && texels[y * width + x + 1] != t));
-                row_d = row_d.wrapping_add(u32::from(
-                    y + 1 < height && texels[(y + 1) * width + x] != t,
-                ));
+                row_a = row_a.wrapping_add(u32::from(x + 1 < width && texels[y * width + x + 1] != t));
+                row_d = row_d.wrapping_add(u32::from(y + 1 < height && texels[(y + 1) * width + x] != t));
                 let at = (y + 1) * stride + x + 1;
-                across[at] = across[at - stride].wrapping_add(row_a);
-                down[at] = down[at - stride].wrapping_add(row_d);
+                let above = sums[at - stride];
+                sums[at] = [above[0].wrapping_add(row_a), above[1].wrapping_add(row_d)];
             }
         }
-        Self {
-            across,
-            down,
-            width,
-        }
+        Self { sums, width }
     }
 
     fn memory_bytes(&self) -> usize {
-        (self.across.len() + self.down.len()) * size_of::<u32>()
+        self.sums.len() * size_of::<[u32; 2]>()
     }
 
-    /// The sum of `table` over texels `x0..x1` × `y0..y1` (exclusive ends).
-    fn sum(&self, table: &[u32], (x0, x1): (usize, usize), (y0, y1): (usize, usize)) -> u32 {
+    /// The sum of table `k` over texels `x0..x1` × `y0..y1` (exclusive ends).
+    fn sum(&self, k: usize, (x0, x1): (usize, usize), (y0, y1): (usize, usize)) -> u32 {
         let s = self.width + 1;
-        table[y1 * s + x1]
-            .wrapping_sub(table[y0 * s + x1])
-            .wrapping_sub(table[y1 * s + x0])
-            .wrapping_add(table[y0 * s + x0])
+        let t = &self.sums;
+        t[y1 * s + x1][k]
+            .wrapping_sub(t[y0 * s + x1][k])
+            .wrapping_sub(t[y1 * s + x0][k])
+            .wrapping_add(t[y0 * s + x0][k])
     }
 
     /// Whether texels `x0..=x1` × `y0..=y1` are all equal.
     fn constant(&self, (x0, x1): (usize, usize), (y0, y1): (usize, usize)) -> bool {
         // Horizontal pairs starting at x0..x1 − 1 and vertical pairs
         // starting at y0..y1 − 1: those inside the block.
-        self.sum(&self.across, (x0, x1), (y0, y1 + 1)) == 0
-            && self.sum(&self.down, (x0, x1 + 1), (y0, y1)) == 0
+        self.sum(0, (x0, x1), (y0, y1 + 1)) == 0 && self.sum(1, (x0, x1 + 1), (y0, y1)) == 0
     }
 }
 
@@ -894,20 +913,11 @@ mod tests {
         assert_eq!(t.range_over_box(lo, hi), (2.0, 2.0));
         assert_eq!(t.constant_over_box(lo, hi), Some(2.0));
         // Repeat: the box wraps from the right half into the left one.
-        assert_eq!(
-            t.constant_over_box(DVec2::new(0.9, 0.1), DVec2::new(1.2, 0.3)),
-            None
-        );
-        assert_eq!(
-            t.constant_over_box(DVec2::new(1.05, 0.1), DVec2::new(1.4, 0.3)),
-            Some(2.0)
-        );
+        assert_eq!(t.constant_over_box(DVec2::new(0.9, 0.1), DVec2::new(1.2, 0.3)), None);
+        assert_eq!(t.constant_over_box(DVec2::new(1.05, 0.1), DVec2::new(1.4, 0.3)), Some(2.0));
         for clamp in [Wrap::ClampToEdge, Wrap::MirroredRepeat] {
             let c = t.clone().with_wrap(clamp);
-            assert_eq!(
-                c.constant_over_box(DVec2::new(-0.3, 0.1), DVec2::new(0.2, 0.3)),
-                Some(2.0)
-            );
+            assert_eq!(c.constant_over_box(DVec2::new(-0.3, 0.1), DVec2::new(0.2, 0.3)), Some(2.0));
         }
         assert_eq!(
             t.range_over_box(lo, DVec2::new(0.6, 0.9)),
