@@ -3,6 +3,7 @@
 # Open3D's sample_points_uniformly, timed by peers.py (next to this file).
 #
 #   bash mesh-sampling/bench/peers.sh MESH.obj N REPEATS
+#   PEER_SCRIPT=blue_noise_peer.py bash mesh-sampling/bench/peers.sh ARGS...
 #
 # stdout carries only the results, one JSON object per peer and line (the
 # Rust benchmark parses it); all set-up chatter goes to stderr. The first
@@ -13,7 +14,8 @@
 # installed is reported as {"peer": "...", "error": "..."} by peers.py, and
 # the other one still runs.
 set -u
-[ $# -eq 3 ] || { echo "usage: $0 MESH.obj N REPEATS" >&2; exit 2; }
+script="${PEER_SCRIPT:-peers.py}" # another peer script in this folder
+[ "$script" != peers.py ] || [ $# -eq 3 ] || { echo "usage: $0 MESH.obj N REPEATS" >&2; exit 2; }
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 venv="${CARGO_TARGET_DIR:-$(cd "$here/../.." && pwd)/target}/peers-venv"
 py="$venv/bin/python"
@@ -48,4 +50,4 @@ if ! "$py" -c 'import open3d' 2>/dev/null; then
     fi
 fi
 
-exec "$py" "$here/peers.py" "$@" 1>&3 3>&-
+exec "$py" "$here/$script" "$@" 1>&3 3>&-

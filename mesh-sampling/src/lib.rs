@@ -77,6 +77,8 @@ pub use glam;
 pub use rand;
 
 mod batch;
+#[cfg(feature = "blue-noise")]
+mod blue_noise;
 mod density;
 mod error;
 mod layout;
@@ -92,6 +94,11 @@ mod texture;
 mod uniform;
 
 pub use batch::SurfaceSampler;
+#[cfg(feature = "blue-noise")]
+pub use blue_noise::{
+    BlueNoiseOptions, BlueNoiseTarget, SurfaceArea, blue_noise, max_poisson_radius,
+    nearest_neighbour_distances, relative_radius, relative_radius_with_density,
+};
 pub use density::{
     DEFAULT_MAX_PIECES, Density, DensitySampler, Depth, MIN_ACCEPTANCE, Mode, Options,
 };
