@@ -26,6 +26,9 @@
 //!   constant over a triangle's UV footprint is one piece, found in O(1)
 //!   from the texture's tables, so tiled UVs stay cheap, and
 //!   [`Options::max_pieces`] bounds the subdivision before it is built.
+//! - **Blue noise** ([`blue_noise`], feature `blue-noise`): Poisson-disk
+//!   points that keep their distance, following any sampler's density, by
+//!   weighted sample elimination (Yuksel 2015).
 //! - **Weights**: [`Density::PerFace`] and [`Density::PerVertex`] (linear
 //!   over each triangle), both sampled exactly.
 //!
