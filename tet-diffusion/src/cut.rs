@@ -115,8 +115,8 @@ pub const RHO: f64 = 0.1;
 impl Object {
     /// Cuts the object: removes every tet whose four vertices lie on the
     /// cut side, removes orphaned vertices, keeps each remaining tet's
-    /// original id, then relaxes the remaining cut-side vertices toward
-    /// the cross-section for `relax_sweeps` sweeps, `x ← x + ρ (x′ − x)`
+    /// original id, then relaxes the remaining cut-side vertices that were
+    /// inside the object toward the cross-section for `relax_sweeps` sweeps, `x ← x + ρ (x′ − x)`
     /// with `ρ = 0.1` and `x′` the mean of the one-ring — never across the
     /// cut, and never making a tet's smallest dihedral angle drop below
     /// 0.5° (or below its current value, if already smaller). The matrix
@@ -162,7 +162,13 @@ impl Object {
         let removed_vertices = n - old_of_new.len();
         let mut new_mesh =
             TetMesh::with_original(positions.clone(), tets.clone(), original.clone())?;
-        let (moved, sweeps) = relax(&new_mesh, cut, &mut positions, relax_sweeps);
+        // Only vertices inside the object before the cut move: the object's
+        // own surface keeps its shape.
+        let inside: Vec<bool> = old_of_new
+            .iter()
+            .map(|&v| mesh.boundary_index(v).is_none())
+            .collect();
+        let (moved, sweeps) = relax(&new_mesh, cut, &inside, &mut positions, relax_sweeps);
         if moved > 0 {
             new_mesh = TetMesh::with_original(positions, tets, original)?;
         }
@@ -183,9 +189,15 @@ impl Object {
 /// The paper's relaxation, one vertex at a time in ascending order (so
 /// each move is checked against its neighbours' current positions).
 /// Returns (vertices moved at least once, sweeps done).
-fn relax(mesh: &TetMesh, cut: &Cut, positions: &mut [DVec3], sweeps: usize) -> (usize, usize) {
+fn relax(
+    mesh: &TetMesh,
+    cut: &Cut,
+    inside: &[bool],
+    positions: &mut [DVec3],
+    sweeps: usize,
+) -> (usize, usize) {
     let movable: Vec<usize> = (0..positions.len())
-        .filter(|&v| cut.side(positions[v]) > 0.0)
+        .filter(|&v| inside[v] && cut.side(positions[v]) > 0.0)
         .collect();
     let mut moved = vec![false; positions.len()];
     let mut done = 0;
