@@ -453,6 +453,21 @@ impl Object {
         Ok(())
     }
 
+    /// Re-assembles the three matrices from the mesh and the media (all
+    /// rows; what a cut does after rebuilding the mesh) and returns the
+    /// time it took, ms.
+    pub fn reassemble(&mut self) -> f64 {
+        let start = Instant::now();
+        self.matrices = assembly::assemble(
+            &self.mesh,
+            &self.geometry,
+            &self.coefficients,
+            self.boundary_factor(),
+        );
+        self.assembly_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.assembly_ms
+    }
+
     /// Time of the last full matrix assembly, ms.
     pub fn assembly_ms(&self) -> f64 {
         self.assembly_ms
