@@ -9,7 +9,8 @@
 //! `area (1 + δ_ab) / 12`), and numerical quadrature (collapsed
 //! Gauss–Legendre, 27 points per tet and 9 per boundary triangle, exact for
 //! these integrands) evaluating the coefficients and basis functions at
-//! every point, as Arbree et al. do.
+//! every point, as Arbree et al. do (their material varies inside a tet;
+//! ours is constant per tet, and the quadrature still samples it per point).
 //!
 //! **The exact relation.** TransCut's matrix is
 //! `M = 4 (K + lumped(Mμ) + lumped(B) / (2A))` and its right-hand side
@@ -161,15 +162,24 @@ pub(crate) fn assemble(
                 let tet = mesh.tets()[t];
                 let a = tet.iter().position(|&v| v as usize == i).unwrap_or(0);
                 let c = mesh.corners(t);
+                let (kappa, mu) = (coefficients.kappa[t], coefficients.mu[t]);
                 let (k, m) = match how {
-                    Integration::ClosedForm => closed_form_row(&c, a),
-                    Integration::Quadrature => quadrature_row(&c, a, &tet_rule),
+                    Integration::ClosedForm => {
+                        let (k, m) = closed_form_row(&c, a);
+                        (
+                            kappa.map(|x| k.map(|k| x * k)),
+                            mu.map(|x| m.map(|m| x * m)),
+                        )
+                    }
+                    // The material is sampled at every quadrature point (it
+                    // is constant per tet here; Arbree et al.'s varies).
+                    Integration::Quadrature => quadrature_row(&c, a, &tet_rule, |_| (kappa, mu)),
                 };
                 for b in 0..4 {
                     let e = &mut out[at(tet[b])];
                     for ch in 0..3 {
-                        e[ch] += coefficients.kappa[t][ch] * k[b];
-                        e[3 + ch] += coefficients.mu[t][ch] * m[b];
+                        e[ch] += k[ch][b];
+                        e[3 + ch] += m[ch][b];
                     }
                 }
             }
@@ -223,21 +233,33 @@ fn closed_form_row(c: &[DVec3; 4], a: usize) -> ([f64; 4], [f64; 4]) {
     (k, m)
 }
 
-/// Row `a` of the element stiffness and mass by quadrature: the basis
-/// gradients from the inverse Jacobian, the basis values at every point.
-fn quadrature_row(c: &[DVec3; 4], a: usize, rule: &[([f64; 4], f64)]) -> ([f64; 4], [f64; 4]) {
+/// Row `a` of the element stiffness and mass by quadrature, per channel:
+/// the basis gradients from the inverse Jacobian, the basis values and the
+/// coefficients `(κ, μa)` at every point.
+fn quadrature_row(
+    c: &[DVec3; 4],
+    a: usize,
+    rule: &[([f64; 4], f64)],
+    material: impl Fn(DVec3) -> ([f64; 3], [f64; 3]),
+) -> ([[f64; 4]; 3], [[f64; 4]; 3]) {
     let jac = DMat3::from_cols(c[1] - c[0], c[2] - c[0], c[3] - c[0]);
     let det = jac.determinant();
     let inv = jac.inverse();
     let g123 = [inv.row(0), inv.row(1), inv.row(2)];
     let grad = [-(g123[0] + g123[1] + g123[2]), g123[0], g123[1], g123[2]];
-    let mut k = [0.0; 4];
-    let mut m = [0.0; 4];
+    let mut k = [[0.0; 4]; 3];
+    let mut m = [[0.0; 4]; 3];
     for (bary, w) in rule {
         let dv = w * det;
+        let x = c[0] * bary[0] + c[1] * bary[1] + c[2] * bary[2] + c[3] * bary[3];
+        let (kappa, mu) = material(x);
         for b in 0..4 {
-            k[b] += dv * grad[a].dot(grad[b]);
-            m[b] += dv * bary[a] * bary[b];
+            let stiffness = dv * grad[a].dot(grad[b]);
+            let mass = dv * bary[a] * bary[b];
+            for ch in 0..3 {
+                k[ch][b] += kappa[ch] * stiffness;
+                m[ch][b] += mu[ch] * mass;
+            }
         }
     }
     (k, m)

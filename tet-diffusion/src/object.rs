@@ -219,16 +219,7 @@ impl Object {
     /// Recomputes everything that depends on the mesh: geometry, matrices,
     /// shadows, visibility, `q` and `b`.
     pub(crate) fn rebuild(&mut self) {
-        self.geometry = Geometry::new(&self.mesh);
-        self.coefficients = self.coefficients_of_media();
-        let start = Instant::now();
-        self.matrices = assembly::assemble(
-            &self.mesh,
-            &self.geometry,
-            &self.coefficients,
-            self.boundary_factor(),
-        );
-        self.assembly_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.reassemble();
         let lights: Vec<Light> = self.lights.drain(..).map(|l| l.light).collect();
         self.shadows = None;
         for light in lights {
@@ -453,11 +444,13 @@ impl Object {
         Ok(())
     }
 
-    /// Re-assembles the three matrices from the mesh and the media (all
-    /// rows; what a cut does after rebuilding the mesh) and returns the
-    /// time it took, ms.
+    /// Re-computes the cotangent weights and re-assembles the three
+    /// matrices from the mesh and the media (what a cut does after
+    /// rebuilding the mesh) and returns the time it took, ms.
     pub fn reassemble(&mut self) -> f64 {
         let start = Instant::now();
+        self.geometry = Geometry::new(&self.mesh);
+        self.coefficients = self.coefficients_of_media();
         self.matrices = assembly::assemble(
             &self.mesh,
             &self.geometry,
