@@ -43,6 +43,11 @@ use tet_diffusion::multires::{
 use tet_diffusion::sprs::CsMat;
 use tet_diffusion::{Cut, Integration, Light, Medium, Object, Stroke, TetMesh};
 
+/// A solve of channel `c` into `x` with an iteration cap and an optional
+/// monitor.
+type SolveFn<'a> =
+    dyn Fn(usize, &mut [f64], usize, Option<&mut dyn FnMut(usize, &[f64]) -> ControlFlow<()>>) + 'a;
+
 struct Args {
     json: bool,
     export: Option<PathBuf>,
@@ -97,11 +102,11 @@ fn main() {
             std::process::exit(1);
         }
     };
-    if let Some(d) = &args.export {
-        if let Err(e) = std::fs::create_dir_all(d) {
-            eprintln!("transcut: cannot create {}: {e}", d.display());
-            std::process::exit(1);
-        }
+    if let Some(d) = &args.export
+        && let Err(e) = std::fs::create_dir_all(d)
+    {
+        eprintln!("transcut: cannot create {}: {e}", d.display());
+        std::process::exit(1);
     }
     let mut table = String::from(
         "| mesh | #tets | #levels | T_b ms | T_m ms | T_s ms/channel | T_cut ms | T_paint ms | P1 quad ms | quad / T_m | max diff vs P1 | peak MB |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
@@ -149,13 +154,14 @@ fn list(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
                     .unwrap_or_default()
                     .to_string_lossy()
                     .to_string();
-                if by_stem.contains_key(&stem) {
-                    eprintln!(
+                match by_stem.entry(stem) {
+                    std::collections::btree_map::Entry::Occupied(_) => eprintln!(
                         "transcut: skipping {} (same mesh as the .node file)",
                         f.display()
-                    );
-                } else {
-                    by_stem.insert(stem, f.clone());
+                    ),
+                    std::collections::btree_map::Entry::Vacant(e) => {
+                        e.insert(f.clone());
+                    }
                 }
             }
         }
@@ -321,13 +327,7 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
     let norms: [f64; 3] = std::array::from_fn(|c| multires::vector::norm(&reference[c]));
     // Iterations to 1% error for a solver, found with a monitor, then timed
     // without it.
-    let to_one_percent = |solve: &dyn Fn(
-        usize,
-        &mut [f64],
-        usize,
-        Option<&mut dyn FnMut(usize, &[f64]) -> ControlFlow<()>>,
-    )|
-     -> (usize, f64) {
+    let to_one_percent = |solve: &SolveFn<'_>| -> (usize, f64) {
         let mut total_iterations = 0;
         let mut times = Vec::new();
         let mut counts = [0usize; 3];

@@ -9,6 +9,11 @@
 //! `M` is symmetric bit for bit, and re-assembling some rows (painting)
 //! gives exactly the values of a full assembly.
 
+#![expect(
+    clippy::needless_range_loop,
+    reason = "RGB loops index several per-channel arrays by one channel index"
+)]
+
 use rayon::prelude::*;
 use sprs::CsMat;
 

@@ -70,7 +70,7 @@ pub enum Error {
     /// An argument is NaN, infinite or outside its range.
     #[error("{what} is {value}: {need}")]
     BadArgument {
-        /// Which argument (for example "sigma_s_prime[1] of tetrahedron 12").
+        /// Which argument (for example `sigma_s_prime[1] of tetrahedron 12`).
         what: String,
         /// Its value.
         value: f64,

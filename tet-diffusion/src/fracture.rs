@@ -4,6 +4,11 @@
 //! them apart for display with rigid transforms, and merge two pieces back
 //! into exactly the object they came from.
 
+#![expect(
+    clippy::needless_range_loop,
+    reason = "RGB loops index several per-channel arrays by one channel index"
+)]
+
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;

@@ -441,7 +441,7 @@ fn orient(t: usize, tet: &mut [u32; 4], positions: &[DVec3]) -> Result<bool, Err
         .map(|&[a, b]| p[a].distance_squared(p[b]))
         .fold(0.0, f64::max)
         .sqrt();
-    if !(det.abs() > 1e-12 * longest.powi(3)) {
+    if det.is_nan() || det.abs() <= 1e-12 * longest.powi(3) {
         return Err(Error::DegenerateTet {
             tet: t,
             vertices: *tet,
@@ -508,7 +508,10 @@ fn neighbors(vertex_tets: &Csr, tets: &[[u32; 4]]) -> Csr {
 
 /// Face adjacency and the outward boundary triangles, by sorting the
 /// faces' sorted vertex triples.
-fn faces(tets: &[[u32; 4]]) -> Result<(Vec<[u32; 4]>, Vec<[u32; 3]>), Error> {
+/// Face adjacency per tet and the outward boundary triangles.
+type Faces = (Vec<[u32; 4]>, Vec<[u32; 3]>);
+
+fn faces(tets: &[[u32; 4]]) -> Result<Faces, Error> {
     let mut keys: Vec<([u32; 3], u32)> = tets
         .par_iter()
         .enumerate()

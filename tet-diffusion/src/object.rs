@@ -1,6 +1,11 @@
 //! A translucent object: a tet mesh, its materials and lights, TransCut's
 //! three RGB systems, and their solution `φ`.
 
+#![expect(
+    clippy::needless_range_loop,
+    reason = "RGB loops index several per-channel arrays by one channel index"
+)]
+
 use std::time::Instant;
 
 use glam::{DAffine3, DVec3};

@@ -149,7 +149,7 @@ fn close_to_the_p1_solution() {
     let fem = o.fem_reference(Integration::ClosedForm).consistent(a);
     let p1 = o.fem_reference(Integration::ClosedForm);
     let mesh = o.mesh();
-    for c in 0..3 {
+    for (c, system) in fem.iter().enumerate() {
         let mut q = vec![0.0; mesh.vertex_count()];
         for (k, &v) in mesh.boundary_vertices().iter().enumerate() {
             q[v as usize] = o.incident()[k][c];
@@ -157,7 +157,7 @@ fn close_to_the_p1_solution() {
         let b = p1.load(&q, a, o.fdr());
         let mut x = vec![0.0; b.len()];
         let r = multires::cg(
-            &fem[c],
+            system,
             &b,
             &mut x,
             &SolveOptions {
