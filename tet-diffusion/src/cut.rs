@@ -160,8 +160,7 @@ impl Object {
         let original: Vec<u32> = keep.iter().map(|&t| mesh.original_ids()[t]).collect();
         let removed_tets = mesh.tets().len() - keep.len();
         let removed_vertices = n - old_of_new.len();
-        let mut new_mesh =
-            TetMesh::with_original(positions.clone(), tets.clone(), original.clone())?;
+        let mut new_mesh = TetMesh::with_original(positions.clone(), tets, original)?;
         // Only vertices inside the object before the cut move: the object's
         // own surface keeps its shape.
         let inside: Vec<bool> = old_of_new
@@ -170,7 +169,8 @@ impl Object {
             .collect();
         let (moved, sweeps) = relax(&new_mesh, cut, &inside, &mut positions, relax_sweeps);
         if moved > 0 {
-            new_mesh = TetMesh::with_original(positions, tets, original)?;
+            // Every move kept its tets positively oriented: same topology.
+            new_mesh.move_vertices(positions);
         }
         let phi = std::array::from_fn(|c| old_of_new.iter().map(|&v| self.phi[c][v]).collect());
         self.mesh = new_mesh;

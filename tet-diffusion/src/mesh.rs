@@ -217,6 +217,15 @@ impl TetMesh {
         self.boundary_index = boundary_index;
     }
 
+    /// Moves the vertices without changing the topology (the caller keeps
+    /// every tet positively oriented), and updates the boundary areas and
+    /// normals.
+    pub(crate) fn move_vertices(&mut self, positions: Vec<DVec3>) {
+        debug_assert_eq!(positions.len(), self.positions.len());
+        self.positions = positions;
+        self.boundary_attributes();
+    }
+
     /// Vertex positions, in mesh units.
     pub fn positions(&self) -> &[DVec3] {
         &self.positions

@@ -362,3 +362,21 @@ fn warns_when_the_mesh_cannot_resolve_the_material() {
         Object::homogeneous(ball(4, 2.0), 1.0, Medium::measured("marble").unwrap(), 1.3).unwrap();
     assert!(o.warnings().is_empty());
 }
+
+#[test]
+fn manufactured_solution_after_a_cut() {
+    // The cut surface (flat, relaxed) is a boundary like any other.
+    let whole = manufactured_error(ball(12, 3.0), 0.2, 1.0);
+    let mut o = Object::homogeneous(ball(12, 3.0), 1.0, grey(0.2, 1.0), 1.3).unwrap();
+    o.cut(
+        &tet_diffusion::Cut::Plane {
+            point: DVec3::new(0.0, 0.0, 0.7),
+            normal: DVec3::new(0.3, 0.0, 1.0),
+        },
+        5,
+    )
+    .unwrap();
+    let cut = manufactured_error(o.mesh().clone(), 0.2, 1.0);
+    eprintln!("manufactured: whole {whole:.2e}, cut {cut:.2e}");
+    assert!(cut < 3.0 * whole, "{cut} vs {whole}");
+}
