@@ -23,12 +23,14 @@
 //!   solved to a residual of 10⁻¹⁰;
 //! - T_cut: a plane cut through the centre with 5 relaxation sweeps, the
 //!   rebuild (mesh, matrices, shadows) and the warm-started three-channel
-//!   re-solve to a relative residual of 10⁻³;
+//!   re-solve to a relative residual of 10⁻³, with V-cycle-PCG (hierarchy
+//!   rebuilt) and with Jacobi-PCG (`--json` gives the faster);
 //! - T_paint: a 10-point ketchup stroke, the rows it changes, and the
-//!   warm-started three-channel re-solve to 10⁻³;
+//!   warm-started three-channel re-solve to 10⁻³, both ways;
 //! - P1 quad: the P1 matrices by 27-point quadrature;
 //! - max diff: `max_i |φ_i − φ_P1,i| / max_i φ_P1,i` over the boundary
-//!   vertices, red channel, both solved to 10⁻¹⁰.
+//!   vertices, red channel, both solved to 10⁻¹⁰; L2 diff:
+//!   `‖φ − φ_P1‖ / ‖φ_P1‖` over all vertices.
 
 use std::fmt::Write as _;
 use std::io::Write as _;
@@ -41,7 +43,7 @@ use tet_diffusion::multires::{
     self, Cascade, CascadeOptions, SolveOptions, VCycle, VCycleOptions, Weights,
 };
 use tet_diffusion::sprs::CsMat;
-use tet_diffusion::{Cut, Integration, Light, Medium, Object, Stroke, TetMesh};
+use tet_diffusion::{Cut, Integration, Light, Medium, Method, Object, Stroke, TetMesh};
 
 /// A solve of channel `c` into `x` with an iteration cap and an optional
 /// monitor.
@@ -109,7 +111,7 @@ fn main() {
         std::process::exit(1);
     }
     let mut table = String::from(
-        "| mesh | #tets | #levels | T_b ms | T_m ms | T_s ms/channel | T_cut ms | T_paint ms | P1 quad ms | quad / T_m | max diff vs P1 | peak MB |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "| mesh | #tets | #levels | T_b ms | T_m ms | T_s ms/channel | T_cut ms (V-cycle / Jacobi) | T_paint ms (V-cycle / Jacobi) | P1 quad ms | quad / T_m | max diff vs P1 | L2 diff vs P1 | peak MB |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     let mut solvers = String::from(
         "| mesh | solver | build ms | iterations to 1% (per channel) | 3-channel solve ms | build + solve ms | speed-up vs Jacobi-PCG |\n|---|---|---:|---:|---:|---:|---:|\n",
@@ -181,10 +183,11 @@ struct Row {
     tb: f64,
     tm: f64,
     ts: f64,
-    tcut: f64,
-    tpaint: f64,
+    tcut: [f64; 2],
+    tpaint: [f64; 2],
     quad: f64,
     diff: f64,
+    diff_l2: f64,
     solver: &'static str,
     peak_mb: f64,
     solvers: String,
@@ -193,18 +196,21 @@ struct Row {
 impl Row {
     fn markdown(&self) -> String {
         format!(
-            "| {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.1}× | {:.2}% | {:.0} |\n",
+            "| {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.0} / {:.0} | {:.0} / {:.0} | {:.0} | {:.1}× | {:.2}% | {:.2}% | {:.0} |\n",
             self.mesh,
             self.tets,
             self.levels,
             self.tb,
             self.tm,
             self.ts,
-            self.tcut,
-            self.tpaint,
+            self.tcut[0],
+            self.tcut[1],
+            self.tpaint[0],
+            self.tpaint[1],
             self.quad,
             self.quad / self.tm,
             100.0 * self.diff,
+            100.0 * self.diff_l2,
             self.peak_mb
         )
     }
@@ -218,8 +224,8 @@ impl Row {
             self.tb,
             self.tm,
             self.ts,
-            self.tcut,
-            self.tpaint,
+            self.tcut[0].min(self.tcut[1]),
+            self.tpaint[0].min(self.tpaint[1]),
             self.quad,
             self.diff,
             self.solver,
@@ -433,11 +439,17 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
             .iter()
             .map(|&i| x[i as usize].abs())
             .fold(0.0, f64::max);
-        mesh.boundary_vertices()
+        let max = mesh
+            .boundary_vertices()
             .iter()
             .map(|&i| (reference[0][i as usize] - x[i as usize]).abs() / peak)
-            .fold(0.0, f64::max)
+            .fold(0.0, f64::max);
+        (
+            max,
+            relative_error(&reference[0], &x, multires::vector::norm(&x)),
+        )
     };
+    let (diff, diff_l2) = diff;
     if let Some(dir) = &args.export {
         write_mtx(&dir.join(format!("{name}.A.mtx")), &matrices[0]).map_err(|e| e.to_string())?;
         write_vector(&dir.join(format!("{name}.b.mtx")), &rhs[0]).map_err(|e| e.to_string())?;
@@ -445,26 +457,34 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
             .map_err(|e| e.to_string())?;
     }
     drop(vcycle);
-    // T_cut: cut, rebuild, warm re-solve (from the reference φ).
+    // T_cut: cut, rebuild, warm re-solve (from the reference φ), with the
+    // V-cycle (built after the cut) and with Jacobi-PCG (no build).
     object
         .set_phi(reference.clone())
         .map_err(|e| e.to_string())?;
     object.settings.tolerance = 1e-3;
     let center = object.mesh().positions().iter().sum::<DVec3>() / positions.len() as f64;
-    let t = Instant::now();
-    object
-        .cut(
-            &Cut::Plane {
-                point: center,
-                normal: DVec3::new(1.0, 0.0, 0.2),
-            },
-            5,
-        )
-        .map_err(|e| e.to_string())?;
-    object.solve().map_err(|e| e.to_string())?;
-    let tcut = ms(t);
+    let plane = Cut::Plane {
+        point: center,
+        normal: DVec3::new(1.0, 0.0, 0.2),
+    };
+    let mut tcut = [0.0; 2];
+    let mut cut_objects = Vec::new();
+    for (k, method) in [Method::VCyclePcg, Method::JacobiPcg]
+        .into_iter()
+        .enumerate()
+    {
+        let mut o = object.clone();
+        o.settings.method = method;
+        let t = Instant::now();
+        o.cut(&plane, 5).map_err(|e| e.to_string())?;
+        o.solve().map_err(|e| e.to_string())?;
+        tcut[k] = ms(t);
+        cut_objects.push(o);
+    }
+    drop(object);
     // T_paint: a stroke across the top of what is left, then a warm re-solve.
-    let (lo, hi) = object.mesh().positions().iter().fold(
+    let (lo, hi) = cut_objects[0].mesh().positions().iter().fold(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
         |(lo, hi), &p| (lo.min(p), hi.max(p)),
     );
@@ -485,10 +505,13 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
         medium: Medium::measured("ketchup").map_err(|e| e.to_string())?,
         strength: 0.8,
     };
-    let t = Instant::now();
-    object.paint(&stroke).map_err(|e| e.to_string())?;
-    object.solve().map_err(|e| e.to_string())?;
-    let tpaint = ms(t);
+    let mut tpaint = [0.0; 2];
+    for (k, o) in cut_objects.iter_mut().enumerate() {
+        let t = Instant::now();
+        o.paint(&stroke).map_err(|e| e.to_string())?;
+        o.solve().map_err(|e| e.to_string())?;
+        tpaint[k] = ms(t);
+    }
     Ok(Row {
         mesh: name.to_owned(),
         tets,
@@ -500,6 +523,7 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
         tpaint,
         quad,
         diff,
+        diff_l2,
         solver: "V-cycle-PCG",
         peak_mb: peak_mb(),
         solvers,

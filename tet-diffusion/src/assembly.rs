@@ -17,7 +17,7 @@
 use rayon::prelude::*;
 use sprs::CsMat;
 
-use crate::mesh::{EDGES, TetMesh, dihedral, edge_index, volume6};
+use crate::mesh::{EDGES, TetMesh, edge_index, volume6};
 
 /// Per-tet geometry: volume and the geometric part of Eq. 10.
 #[derive(Debug, Clone)]
@@ -56,14 +56,25 @@ impl Geometry {
 }
 
 /// Volume and Eq. 10's geometric weights of one tet.
+///
+/// For edge `(i, j)` with opposite edge `kl`, `E = x_l − x_k`,
+/// `a = x_i − x_k`, `b = x_j − x_k`: the components of `a` and `b`
+/// orthogonal to `E` span the dihedral angle `θ_kl`, so
+/// `|kl| cot θ_kl = (|E|² a·b − (a·E)(b·E)) / 6V` (their cross product has
+/// length `|(a × b)·E| / |E| = 6V / |kl|`): the cotangent without
+/// trigonometry or square roots.
 pub(crate) fn tet_geometry(c: &[glam::DVec3; 4]) -> (f64, [f64; 6]) {
+    let v6 = volume6(c);
+    let scale = -1.0 / (6.0 * v6);
     let weights = std::array::from_fn(|e| {
-        let [a, b] = EDGES[e];
+        let [i, j] = EDGES[e];
         let [k, l] = EDGES[5 - e];
-        let (_, cot) = dihedral(c[k], c[l], c[a], c[b]);
-        -(c[k].distance(c[l])) * cot / 6.0
+        let edge = c[l] - c[k];
+        let (a, b) = (c[i] - c[k], c[j] - c[k]);
+        // −(1/6) |kl| cot θ_kl
+        scale * (edge.length_squared() * a.dot(b) - a.dot(edge) * b.dot(edge))
     });
-    (volume6(c) / 6.0, weights)
+    (v6 / 6.0, weights)
 }
 
 /// Per-tet coefficients in mesh units: `κ_t` (units) and `μa_t`
@@ -228,6 +239,23 @@ mod tests {
     use super::*;
     use crate::mesh::tests::cube;
     use glam::DVec3;
+
+    #[test]
+    fn eq10_matches_the_dihedral_cotangent() {
+        let c = [
+            DVec3::new(0.1, 0.0, 0.2),
+            DVec3::new(1.3, 0.1, 0.0),
+            DVec3::new(0.2, 0.9, 0.1),
+            DVec3::new(0.3, 0.4, 1.1),
+        ];
+        let (_, w) = tet_geometry(&c);
+        for (e, [i, j]) in EDGES.iter().enumerate() {
+            let [k, l] = EDGES[5 - e];
+            let (_, cot) = crate::mesh::dihedral(c[k], c[l], c[*i], c[*j]);
+            let expected = -c[k].distance(c[l]) * cot / 6.0;
+            assert!((w[e] - expected).abs() < 1e-12, "{e}: {} {expected}", w[e]);
+        }
+    }
 
     #[test]
     fn eq10_matches_the_face_normal_form() {

@@ -200,6 +200,7 @@ fn radical_inverse(k: u32) -> f64 {
 }
 
 /// The boundary surface for shadow rays.
+#[derive(Clone)]
 pub(crate) struct Shadows {
     bvh: Bvh2,
     triangles: Vec<Triangle>,

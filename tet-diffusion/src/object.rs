@@ -91,12 +91,13 @@ pub(crate) struct Lineage {
 }
 
 /// A translucent object ready to light, solve, shade, cut, paint and
-/// fracture.
+/// fracture. `Clone` copies everything, the solution and the traced
+/// shadows included (to try an edit and keep the original).
 ///
 /// Lengths are in the mesh's unit; `length_unit_mm` says how many
 /// millimetres one unit is (1000 for a mesh in metres), because the
 /// materials are in mm⁻¹. `φ` is per vertex and per RGB channel.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Object {
     pub(crate) mesh: TetMesh,
     pub(crate) length_unit_mm: f64,
