@@ -59,7 +59,7 @@
 //! # Ok::<(), tet_diffusion::Error>(())
 //! ```
 
-pub mod assembly;
+mod assembly;
 pub mod cut;
 mod error;
 pub mod fem;

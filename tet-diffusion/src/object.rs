@@ -405,13 +405,14 @@ impl Object {
         self.media.get(id as usize)
     }
 
-    /// TransCut's matrix `M` of channel `c` (0 red, 1 green, 2 blue), mesh
-    /// units.
+    /// TransCut's matrix `M` of channel `c` (0 red, 1 green, 2 blue; larger
+    /// values read blue), mesh units.
     pub fn matrix(&self, c: usize) -> &CsMat<f64> {
         &self.matrices[c.min(2)]
     }
 
-    /// The right-hand side `b` (Eq. 12) of channel `c`.
+    /// The right-hand side `b` (Eq. 12) of channel `c` (as for
+    /// [`matrix`](Self::matrix)).
     pub fn rhs(&self, c: usize) -> &[f64] {
         &self.rhs[c.min(2)]
     }
@@ -421,8 +422,8 @@ impl Object {
         &self.q
     }
 
-    /// The fluence `φ` of channel `c` per vertex (the last solution; the
-    /// warm start of the next solve).
+    /// The fluence `φ` of channel `c` (as for [`matrix`](Self::matrix)) per
+    /// vertex: the last solution, and the warm start of the next solve.
     pub fn phi(&self, c: usize) -> &[f64] {
         &self.phi[c.min(2)]
     }
