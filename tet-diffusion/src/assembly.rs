@@ -103,30 +103,38 @@ pub(crate) fn pattern(mesh: &TetMesh) -> (Vec<usize>, Vec<usize>) {
     (indptr, indices)
 }
 
+/// Index in [`EDGES`] of the local edge between corners `a` and `b`
+/// (either order; the diagonal entries are unused).
+const EDGE_OF: [[usize; 4]; 4] = [[0, 0, 1, 2], [0, 0, 3, 4], [1, 3, 0, 5], [2, 4, 5, 0]];
+
 /// Row `i` of the three systems into `out` (one `[r, g, b]` per stored
-/// entry of the row, whose columns are `cols`): Eq. 13–14.
+/// entry of the row, which starts at `mesh.row_start(i)` in the value
+/// array): Eq. 13–14. The tets around `i` are visited in ascending order
+/// and each adds its three edges and its volume term in a fixed order, so
+/// a row has the same bits whether assembled alone or with all others.
 pub(crate) fn row(
     mesh: &TetMesh,
     geometry: &Geometry,
     coefficients: &Coefficients,
     boundary: f64,
     i: usize,
-    cols: &[usize],
     out: &mut [[f64; 3]],
 ) {
     out.fill([0.0; 3]);
-    let diag = cols.partition_point(|&j| j < i);
-    for &t in mesh.vertex_tets(i) {
+    let start = mesh.row_start(i);
+    let diag = mesh.one_ring(i).partition_point(|&j| (j as usize) < i);
+    let diag_slot = (start + diag) as u32;
+    for (&t, slots) in mesh.vertex_tets(i).iter().zip(mesh.vertex_slots(i)) {
         let t = t as usize;
-        let tet = mesh.tets()[t];
-        let a = tet.iter().position(|&v| v as usize == i).unwrap_or(0);
+        let a = slots.iter().position(|&s| s == diag_slot).unwrap_or(0);
         let kappa = coefficients.kappa[t];
-        for (b, &j) in tet.iter().enumerate() {
+        let g = &geometry.weights[t];
+        for (b, &slot) in slots.iter().enumerate() {
             if b == a {
                 continue;
             }
-            let g = geometry.weights[t][edge_index(a.min(b), a.max(b))];
-            let pos = cols.partition_point(|&c| c < j as usize);
+            let g = g[EDGE_OF[a][b]];
+            let pos = slot as usize - start;
             for c in 0..3 {
                 // M_ij = 4 w_ij (Eq. 14); M_ii = −4 Σ_j w_ij + … (Eq. 13).
                 let w = 4.0 * kappa[c] * g;
@@ -160,31 +168,30 @@ pub(crate) fn assemble(
     let n = mesh.vertex_count();
     let (indptr, indices) = pattern(mesh);
     let boundary = 2.0 / (3.0 * a);
-    let chunks: Vec<Vec<[f64; 3]>> = (0..n.div_ceil(ROWS))
-        .into_par_iter()
-        .map(|k| {
-            let (lo, hi) = (k * ROWS, ((k + 1) * ROWS).min(n));
-            let mut values = vec![[0.0; 3]; indptr[hi] - indptr[lo]];
-            for i in lo..hi {
-                let (s, e) = (indptr[i] - indptr[lo], indptr[i + 1] - indptr[lo]);
-                row(
-                    mesh,
-                    geometry,
-                    coefficients,
-                    boundary,
-                    i,
-                    &indices[indptr[i]..indptr[i + 1]],
-                    &mut values[s..e],
-                );
-            }
-            values
-        })
-        .collect();
-    let values: Vec<[f64; 3]> = chunks.concat();
-    [0, 1, 2].map(|c| {
-        let data: Vec<f64> = values.par_iter().map(|v| v[c]).collect();
-        CsMat::new((n, n), indptr.clone(), indices.clone(), data)
-    })
+    let mut values = vec![[0.0; 3]; indices.len()];
+    // Disjoint blocks of whole rows, filled in parallel.
+    let mut blocks = Vec::with_capacity(n.div_ceil(ROWS));
+    let mut rest = values.as_mut_slice();
+    for k in 0..n.div_ceil(ROWS) {
+        let (lo, hi) = (k * ROWS, ((k + 1) * ROWS).min(n));
+        let (block, tail) = rest.split_at_mut(indptr[hi] - indptr[lo]);
+        blocks.push((lo, hi, block));
+        rest = tail;
+    }
+    blocks.into_par_iter().for_each(|(lo, hi, block)| {
+        for i in lo..hi {
+            let (s, e) = (indptr[i] - indptr[lo], indptr[i + 1] - indptr[lo]);
+            row(mesh, geometry, coefficients, boundary, i, &mut block[s..e]);
+        }
+    });
+    let data: [Vec<f64>; 3] = [0, 1, 2].map(|c| values.par_iter().map(|v| v[c]).collect());
+    drop(values);
+    let [r, g, b] = data;
+    [
+        CsMat::new((n, n), indptr.clone(), indices.clone(), r),
+        CsMat::new((n, n), indptr.clone(), indices.clone(), g),
+        CsMat::new((n, n), indptr, indices, b),
+    ]
 }
 
 /// Re-assembles the given rows of the three matrices in place.
@@ -197,23 +204,22 @@ pub(crate) fn reassemble_rows(
     matrices: &mut [CsMat<f64>; 3],
 ) {
     let boundary = 2.0 / (3.0 * a);
-    let indptr: Vec<usize> = matrices[0].indptr().raw_storage().to_vec();
-    let indices = matrices[0].indices().to_vec();
     let updates: Vec<(usize, Vec<[f64; 3]>)> = rows
         .par_iter()
         .map(|&i| {
             let i = i as usize;
-            let cols = &indices[indptr[i]..indptr[i + 1]];
-            let mut out = vec![[0.0; 3]; cols.len()];
-            row(mesh, geometry, coefficients, boundary, i, cols, &mut out);
+            let len = mesh.one_ring(i).len() + 1;
+            let mut out = vec![[0.0; 3]; len];
+            row(mesh, geometry, coefficients, boundary, i, &mut out);
             (i, out)
         })
         .collect();
     for (c, m) in matrices.iter_mut().enumerate() {
         let data = m.data_mut();
         for (i, out) in &updates {
+            let start = mesh.row_start(*i);
             for (k, v) in out.iter().enumerate() {
-                data[indptr[*i] + k] = v[c];
+                data[start + k] = v[c];
             }
         }
     }

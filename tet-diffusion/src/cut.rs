@@ -5,6 +5,7 @@
 //! start.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use crate::error::finite_vec;
 use crate::mesh::{POOR_DIHEDRAL_DEGREES, dihedral_angles, volume6};
@@ -130,8 +131,9 @@ impl Object {
         cut.check()?;
         let mesh = &self.mesh;
         let n = mesh.vertex_count();
-        let side: Vec<f64> = mesh.positions().iter().map(|&x| cut.side(x)).collect();
+        let side: Vec<f64> = mesh.positions().par_iter().map(|&x| cut.side(x)).collect();
         let keep: Vec<usize> = (0..mesh.tets().len())
+            .into_par_iter()
             .filter(|&t| mesh.tets()[t].iter().any(|&v| side[v as usize] <= 0.0))
             .collect();
         if keep.is_empty() {
@@ -152,15 +154,10 @@ impl Object {
                 old_of_new.push(v);
             }
         }
-        let mut positions: Vec<DVec3> = old_of_new.iter().map(|&v| mesh.positions()[v]).collect();
-        let tets: Vec<[u32; 4]> = keep
-            .iter()
-            .map(|&t| mesh.tets()[t].map(|v| new_index[v as usize]))
-            .collect();
-        let original: Vec<u32> = keep.iter().map(|&t| mesh.original_ids()[t]).collect();
         let removed_tets = mesh.tets().len() - keep.len();
         let removed_vertices = n - old_of_new.len();
-        let mut new_mesh = TetMesh::with_original(positions.clone(), tets, original)?;
+        let mut new_mesh = mesh.subset(&keep, &new_index, &old_of_new)?;
+        let mut positions = new_mesh.positions().to_vec();
         // Only vertices inside the object before the cut move: the object's
         // own surface keeps its shape.
         let inside: Vec<bool> = old_of_new

@@ -50,6 +50,12 @@ pub struct TetMesh {
     reoriented: usize,
     vertex_tets: Csr,
     neighbors: Csr,
+    /// Parallel to `vertex_tets.items`: for vertex `i` and its tet `t`,
+    /// entry `b` is the position in the matrix's value array (CSR, rows =
+    /// vertex + one-ring ascending) of `(i, tets[t][b])`, the diagonal
+    /// where `tets[t][b] == i`. Fixed per mesh: every assembly, paint and
+    /// rebuild reuses it instead of searching the rows.
+    slots: Vec<[u32; 4]>,
     tet_neighbors: Vec<[u32; 4]>,
     boundary: Vec<[u32; 3]>,
     boundary_vertices: Vec<u32>,
@@ -170,6 +176,7 @@ impl TetMesh {
         debug_assert!(tets.iter().flatten().all(|&v| (v as usize) < n));
         let vertex_tets = vertex_tets(n, &tets);
         let neighbors = neighbors(&vertex_tets, &tets);
+        let slots = slots(&vertex_tets, &neighbors, &tets)?;
         let (tet_neighbors, boundary) = faces(&tets)?;
         let mut mesh = Self {
             positions,
@@ -178,6 +185,67 @@ impl TetMesh {
             reoriented,
             vertex_tets,
             neighbors,
+            slots,
+            tet_neighbors,
+            boundary,
+            boundary_vertices: Vec::new(),
+            boundary_index: Vec::new(),
+            vertex_area: Vec::new(),
+            vertex_normal: Vec::new(),
+        };
+        mesh.boundary_attributes();
+        Ok(mesh)
+    }
+
+    /// The sub-mesh of the tets `keep` (ascending), with vertex `v` of
+    /// this mesh renumbered `new_index[v]` and `old_of_new` its inverse.
+    /// What a cut leaves: the tets are already validated and oriented and
+    /// their face adjacency is known, so only what the removal changes is
+    /// recomputed (no re-validation, no sort of the faces). Equal to
+    /// building the sub-mesh from scratch with [`with_original`](Self::with_original).
+    pub(crate) fn subset(
+        &self,
+        keep: &[usize],
+        new_index: &[u32],
+        old_of_new: &[usize],
+    ) -> Result<Self, Error> {
+        let positions: Vec<DVec3> = old_of_new.par_iter().map(|&v| self.positions[v]).collect();
+        let tets: Vec<[u32; 4]> = keep
+            .par_iter()
+            .map(|&t| self.tets[t].map(|v| new_index[v as usize]))
+            .collect();
+        let original: Vec<u32> = keep.par_iter().map(|&t| self.original[t]).collect();
+        let mut new_tet = vec![NONE; self.tets.len()];
+        for (k, &t) in keep.iter().enumerate() {
+            new_tet[t] = k as u32;
+        }
+        let tet_neighbors: Vec<[u32; 4]> = keep
+            .par_iter()
+            .map(|&t| {
+                self.tet_neighbors[t].map(|o| if o == NONE { NONE } else { new_tet[o as usize] })
+            })
+            .collect();
+        // Ordered by (tet, local face), as `faces` orders them.
+        let mut boundary = Vec::new();
+        for (t, adjacent) in tet_neighbors.iter().enumerate() {
+            for (k, &o) in adjacent.iter().enumerate() {
+                if o == NONE {
+                    boundary.push(OUTWARD_FACES[k].map(|l| tets[t][l]));
+                }
+            }
+        }
+        let n = positions.len();
+        let vertex_tets = vertex_tets(n, &tets);
+        let neighbors = neighbors(&vertex_tets, &tets);
+        let slots = slots(&vertex_tets, &neighbors, &tets)?;
+        let mut mesh = Self {
+            positions,
+            tets,
+            original,
+            reoriented: 0,
+            vertex_tets,
+            neighbors,
+            slots,
             tet_neighbors,
             boundary,
             boundary_vertices: Vec::new(),
@@ -261,6 +329,19 @@ impl TetMesh {
     /// The tetrahedra containing vertex `v`, ascending.
     pub fn vertex_tets(&self, v: usize) -> &[u32] {
         self.vertex_tets.row(v)
+    }
+
+    /// The matrix slots of vertex `v`'s tets (see the field `slots`), in
+    /// the order of [`vertex_tets`](Self::vertex_tets).
+    pub(crate) fn vertex_slots(&self, v: usize) -> &[[u32; 4]] {
+        &self.slots[self.vertex_tets.offsets[v]..self.vertex_tets.offsets[v + 1]]
+    }
+
+    /// Start of row `v` in the matrix's value array: the entries before
+    /// it are the one-rings of the vertices before it plus their
+    /// diagonals.
+    pub(crate) fn row_start(&self, v: usize) -> usize {
+        self.neighbors.offsets[v] + v
     }
 
     /// Number of edges.
@@ -526,6 +607,55 @@ fn neighbors(vertex_tets: &Csr, tets: &[[u32; 4]]) -> Csr {
         items.extend_from_slice(&block);
     }
     Csr { offsets, items }
+}
+
+/// The matrix slot of each (vertex, tet, corner), see `TetMesh::slots`;
+/// per block of vertices in parallel.
+fn slots(vertex_tets: &Csr, neighbors: &Csr, tets: &[[u32; 4]]) -> Result<Vec<[u32; 4]>, Error> {
+    const BLOCK: usize = 1024;
+    let n = vertex_tets.offsets.len() - 1;
+    let nnz = neighbors.items.len() + n;
+    if nnz >= NONE as usize {
+        return Err(Error::TooLarge {
+            what: "matrix entries",
+            count: nnz,
+        });
+    }
+    let mut slots = vec![[0u32; 4]; vertex_tets.items.len()];
+    let mut chunks = Vec::with_capacity(n.div_ceil(BLOCK));
+    let mut rest = slots.as_mut_slice();
+    for b in 0..n.div_ceil(BLOCK) {
+        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
+        let len = vertex_tets.offsets[hi] - vertex_tets.offsets[lo];
+        let (chunk, tail) = rest.split_at_mut(len);
+        chunks.push((lo, hi, chunk));
+        rest = tail;
+    }
+    chunks.into_par_iter().for_each(|(lo, hi, chunk)| {
+        let mut k = 0;
+        for i in lo..hi {
+            let ring = neighbors.row(i);
+            let start = neighbors.offsets[i] + i;
+            let diag = start + ring.partition_point(|&j| (j as usize) < i);
+            for &t in vertex_tets.row(i) {
+                chunk[k] = tets[t as usize].map(|j| {
+                    let j = j as usize;
+                    let slot = match j.cmp(&i) {
+                        std::cmp::Ordering::Equal => diag,
+                        std::cmp::Ordering::Less => {
+                            start + ring.partition_point(|&c| (c as usize) < j)
+                        }
+                        std::cmp::Ordering::Greater => {
+                            start + 1 + ring.partition_point(|&c| (c as usize) < j)
+                        }
+                    };
+                    slot as u32
+                });
+                k += 1;
+            }
+        }
+    });
+    Ok(slots)
 }
 
 /// Face adjacency and the outward boundary triangles, by sorting the

@@ -12,6 +12,7 @@ use glam::{DAffine3, DVec3};
 use multires::{
     Cascade, CascadeOptions, Report, SolveOptions, VCycle, VCycleOptions, Weights, cg, pcg,
 };
+use rayon::prelude::*;
 use sprs::CsMat;
 
 use crate::assembly::{self, Coefficients, Geometry};
@@ -243,7 +244,8 @@ impl Object {
         let (kappa, mu) = self
             .mesh
             .original_ids()
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .map(|&id| self.tet_coefficients(id))
             .unzip();
         Coefficients { kappa, mu }
