@@ -108,8 +108,7 @@ pub(crate) fn pattern(mesh: &TetMesh) -> (Vec<usize>, Vec<usize>) {
 const EDGE_OF: [[usize; 4]; 4] = [[0, 0, 1, 2], [0, 0, 3, 4], [1, 3, 0, 5], [2, 4, 5, 0]];
 
 /// Row `i` of the three systems into `out` (one `[r, g, b]` per stored
-/// entry of the row, which starts at `mesh.row_start(i)` in the value
-/// array): Eq. 13–14. The tets around `i` are visited in ascending order
+/// entry of the row): Eq. 13–14. The tets around `i` are visited in ascending order
 /// and each adds its three edges and its volume term in a fixed order, so
 /// a row has the same bits whether assembled alone or with all others.
 pub(crate) fn row(
@@ -121,9 +120,8 @@ pub(crate) fn row(
     out: &mut [[f64; 3]],
 ) {
     out.fill([0.0; 3]);
-    let start = mesh.row_start(i);
     let diag = mesh.one_ring(i).partition_point(|&j| (j as usize) < i);
-    let diag_slot = (start + diag) as u32;
+    let diag_slot = diag as u32;
     for (&t, slots) in mesh.vertex_tets(i).iter().zip(mesh.vertex_slots(i)) {
         let t = t as usize;
         let a = slots.iter().position(|&s| s == diag_slot).unwrap_or(0);
@@ -134,7 +132,7 @@ pub(crate) fn row(
                 continue;
             }
             let g = g[EDGE_OF[a][b]];
-            let pos = slot as usize - start;
+            let pos = slot as usize;
             for c in 0..3 {
                 // M_ij = 4 w_ij (Eq. 14); M_ii = −4 Σ_j w_ij + … (Eq. 13).
                 let w = 4.0 * kappa[c] * g;

@@ -51,9 +51,9 @@ pub struct TetMesh {
     vertex_tets: Csr,
     neighbors: Csr,
     /// Parallel to `vertex_tets.items`: for vertex `i` and its tet `t`,
-    /// entry `b` is the position in the matrix's value array (CSR, rows =
-    /// vertex + one-ring ascending) of `(i, tets[t][b])`, the diagonal
-    /// where `tets[t][b] == i`. Fixed per mesh: every assembly, paint and
+    /// entry `b` is the position of column `tets[t][b]` within row `i` of
+    /// the matrix (CSR, columns = the vertex and its one-ring, ascending),
+    /// the diagonal where `tets[t][b] == i`. Fixed per mesh: every assembly, paint and
     /// rebuild reuses it instead of searching the rows.
     slots: Vec<[u32; 4]>,
     tet_neighbors: Vec<[u32; 4]>,
@@ -175,8 +175,7 @@ impl TetMesh {
         }
         debug_assert!(tets.iter().flatten().all(|&v| (v as usize) < n));
         let vertex_tets = vertex_tets(n, &tets);
-        let neighbors = neighbors(&vertex_tets, &tets);
-        let slots = slots(&vertex_tets, &neighbors, &tets)?;
+        let (neighbors, slots) = neighbors(&vertex_tets, &tets);
         let (tet_neighbors, boundary) = faces(&tets)?;
         let mut mesh = Self {
             positions,
@@ -236,8 +235,7 @@ impl TetMesh {
         }
         let n = positions.len();
         let vertex_tets = vertex_tets(n, &tets);
-        let neighbors = neighbors(&vertex_tets, &tets);
-        let slots = slots(&vertex_tets, &neighbors, &tets)?;
+        let (neighbors, slots) = neighbors(&vertex_tets, &tets);
         let mut mesh = Self {
             positions,
             tets,
@@ -331,8 +329,9 @@ impl TetMesh {
         self.vertex_tets.row(v)
     }
 
-    /// The matrix slots of vertex `v`'s tets (see the field `slots`), in
-    /// the order of [`vertex_tets`](Self::vertex_tets).
+    /// The positions within row `v` of the matrix of the corners of `v`'s
+    /// tets (see the field `slots`), in the order of
+    /// [`vertex_tets`](Self::vertex_tets).
     pub(crate) fn vertex_slots(&self, v: usize) -> &[[u32; 4]] {
         &self.slots[self.vertex_tets.offsets[v]..self.vertex_tets.offsets[v + 1]]
     }
@@ -567,20 +566,29 @@ fn vertex_tets(n: usize, tets: &[[u32; 4]]) -> Csr {
     Csr { offsets, items }
 }
 
-/// The one-rings, ascending, built per block of vertices in parallel:
+/// The one-rings, ascending, and the row positions of each vertex's tet
+/// corners (`TetMesh::slots`), built per block of vertices in parallel:
 /// each vertex's neighbours are gathered from its tets, deduplicated with
-/// a per-thread stamp array (no sort of the ~90 repeats) and sorted.
-fn neighbors(vertex_tets: &Csr, tets: &[[u32; 4]]) -> Csr {
+/// a per-thread stamp array (no sort of the ~90 repeats) and sorted; a
+/// second per-thread array then gives each neighbour's position in the row
+/// without a search.
+fn neighbors(vertex_tets: &Csr, tets: &[[u32; 4]]) -> (Csr, Vec<[u32; 4]>) {
     const BLOCK: usize = 1024;
     let n = vertex_tets.offsets.len() - 1;
-    let blocks: Vec<(Vec<u32>, Vec<usize>)> = (0..n.div_ceil(BLOCK))
+    type Block = (Vec<u32>, Vec<usize>, Vec<[u32; 4]>);
+    let blocks: Vec<Block> = (0..n.div_ceil(BLOCK))
         .into_par_iter()
+        // Few inits: each allocates two arrays of n entries.
+        .with_min_len(8)
         .map_init(
-            || vec![u32::MAX; n],
-            |stamp, b| {
+            || (vec![u32::MAX; n], vec![0u32; n]),
+            |(stamp, position), b| {
+                let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
                 let mut items = Vec::new();
-                let mut lens = Vec::with_capacity(BLOCK);
-                for i in b * BLOCK..((b + 1) * BLOCK).min(n) {
+                let mut lens = Vec::with_capacity(hi - lo);
+                let mut slots =
+                    Vec::with_capacity(vertex_tets.offsets[hi] - vertex_tets.offsets[lo]);
+                for i in lo..hi {
                     let start = items.len();
                     for &t in vertex_tets.row(i) {
                         for v in tets[t as usize] {
@@ -590,72 +598,35 @@ fn neighbors(vertex_tets: &Csr, tets: &[[u32; 4]]) -> Csr {
                             }
                         }
                     }
-                    items[start..].sort_unstable();
-                    lens.push(items.len() - start);
+                    let ring = &mut items[start..];
+                    ring.sort_unstable();
+                    // Row i holds the ring with i inserted in order.
+                    let split = ring.partition_point(|&j| (j as usize) < i);
+                    for (k, &j) in ring.iter().enumerate() {
+                        position[j as usize] = (k + usize::from(k >= split)) as u32;
+                    }
+                    position[i] = split as u32;
+                    for &t in vertex_tets.row(i) {
+                        slots.push(tets[t as usize].map(|v| position[v as usize]));
+                    }
+                    lens.push(ring.len());
                 }
-                (items, lens)
+                (items, lens, slots)
             },
         )
         .collect();
     let mut offsets = Vec::with_capacity(n + 1);
     offsets.push(0);
     let mut items = Vec::with_capacity(blocks.iter().map(|b| b.0.len()).sum());
-    for (block, lens) in blocks {
+    let mut slots = Vec::with_capacity(vertex_tets.items.len());
+    for (block, lens, block_slots) in blocks {
         for len in lens {
             offsets.push(offsets[offsets.len() - 1] + len);
         }
         items.extend_from_slice(&block);
+        slots.extend_from_slice(&block_slots);
     }
-    Csr { offsets, items }
-}
-
-/// The matrix slot of each (vertex, tet, corner), see `TetMesh::slots`;
-/// per block of vertices in parallel.
-fn slots(vertex_tets: &Csr, neighbors: &Csr, tets: &[[u32; 4]]) -> Result<Vec<[u32; 4]>, Error> {
-    const BLOCK: usize = 1024;
-    let n = vertex_tets.offsets.len() - 1;
-    let nnz = neighbors.items.len() + n;
-    if nnz >= NONE as usize {
-        return Err(Error::TooLarge {
-            what: "matrix entries",
-            count: nnz,
-        });
-    }
-    let mut slots = vec![[0u32; 4]; vertex_tets.items.len()];
-    let mut chunks = Vec::with_capacity(n.div_ceil(BLOCK));
-    let mut rest = slots.as_mut_slice();
-    for b in 0..n.div_ceil(BLOCK) {
-        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
-        let len = vertex_tets.offsets[hi] - vertex_tets.offsets[lo];
-        let (chunk, tail) = rest.split_at_mut(len);
-        chunks.push((lo, hi, chunk));
-        rest = tail;
-    }
-    chunks.into_par_iter().for_each(|(lo, hi, chunk)| {
-        let mut k = 0;
-        for i in lo..hi {
-            let ring = neighbors.row(i);
-            let start = neighbors.offsets[i] + i;
-            let diag = start + ring.partition_point(|&j| (j as usize) < i);
-            for &t in vertex_tets.row(i) {
-                chunk[k] = tets[t as usize].map(|j| {
-                    let j = j as usize;
-                    let slot = match j.cmp(&i) {
-                        std::cmp::Ordering::Equal => diag,
-                        std::cmp::Ordering::Less => {
-                            start + ring.partition_point(|&c| (c as usize) < j)
-                        }
-                        std::cmp::Ordering::Greater => {
-                            start + 1 + ring.partition_point(|&c| (c as usize) < j)
-                        }
-                    };
-                    slot as u32
-                });
-                k += 1;
-            }
-        }
-    });
-    Ok(slots)
+    (Csr { offsets, items }, slots)
 }
 
 /// Face adjacency and the outward boundary triangles, by sorting the
@@ -751,6 +722,71 @@ pub(crate) mod tests {
             }
         }
         (p, tets)
+    }
+
+    #[test]
+    fn subset_equals_a_mesh_built_from_scratch() {
+        let (p, t) = cube(4, 1.0);
+        let mesh = TetMesh::new(&p, &t).unwrap();
+        // Keep the tets with their centre below a slanted plane.
+        let keep: Vec<usize> = (0..mesh.tets().len())
+            .filter(|&k| {
+                let c = mesh.tet_center(k);
+                c.x + 0.7 * c.y + 0.3 * c.z < 0.9
+            })
+            .collect();
+        let mut new_index = vec![NONE; p.len()];
+        for &k in &keep {
+            for &v in &mesh.tets()[k] {
+                new_index[v as usize] = 0;
+            }
+        }
+        let mut old_of_new = Vec::new();
+        for (v, slot) in new_index.iter_mut().enumerate() {
+            if *slot == 0 {
+                *slot = old_of_new.len() as u32;
+                old_of_new.push(v);
+            }
+        }
+        assert!(old_of_new.len() < p.len() && keep.len() < t.len());
+        let sub = mesh.subset(&keep, &new_index, &old_of_new).unwrap();
+        let scratch = TetMesh::with_original(
+            old_of_new.iter().map(|&v| p[v]).collect(),
+            keep.iter()
+                .map(|&k| mesh.tets()[k].map(|v| new_index[v as usize]))
+                .collect(),
+            keep.iter().map(|&k| k as u32).collect(),
+        )
+        .unwrap();
+        assert_eq!(sub.positions(), scratch.positions());
+        assert_eq!(sub.tets(), scratch.tets());
+        assert_eq!(sub.original_ids(), scratch.original_ids());
+        assert_eq!(scratch.reoriented(), 0);
+        assert_eq!(sub.vertex_tets, scratch.vertex_tets);
+        assert_eq!(sub.neighbors, scratch.neighbors);
+        assert_eq!(sub.slots, scratch.slots);
+        assert_eq!(sub.tet_neighbors(), scratch.tet_neighbors());
+        assert_eq!(sub.boundary(), scratch.boundary());
+        assert_eq!(sub.boundary_vertices(), scratch.boundary_vertices());
+        assert_eq!(sub.vertex_areas(), scratch.vertex_areas());
+        assert_eq!(sub.vertex_normals(), scratch.vertex_normals());
+    }
+
+    #[test]
+    fn slots_point_at_the_columns() {
+        let (p, t) = cube(3, 1.0);
+        let mesh = TetMesh::new(&p, &t).unwrap();
+        for i in 0..mesh.vertex_count() {
+            let ring = mesh.one_ring(i);
+            let split = ring.partition_point(|&j| (j as usize) < i);
+            let mut cols: Vec<u32> = ring.to_vec();
+            cols.insert(split, i as u32);
+            for (&k, slots) in mesh.vertex_tets(i).iter().zip(mesh.vertex_slots(i)) {
+                for (b, &s) in slots.iter().enumerate() {
+                    assert_eq!(cols[s as usize], mesh.tets()[k as usize][b]);
+                }
+            }
+        }
     }
 
     #[test]
