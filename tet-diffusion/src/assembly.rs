@@ -166,24 +166,34 @@ pub(crate) fn assemble(
     let n = mesh.vertex_count();
     let (indptr, indices) = pattern(mesh);
     let boundary = 2.0 / (3.0 * a);
-    let mut values = vec![[0.0; 3]; indices.len()];
-    // Disjoint blocks of whole rows, filled in parallel.
+    let nnz = indices.len();
+    let mut data = [vec![0.0; nnz], vec![0.0; nnz], vec![0.0; nnz]];
+    // Disjoint blocks of whole rows, filled in parallel; each row goes
+    // through a small buffer straight into the three value arrays.
     let mut blocks = Vec::with_capacity(n.div_ceil(ROWS));
-    let mut rest = values.as_mut_slice();
+    let [mut r, mut g, mut b] = data.each_mut().map(|d| d.as_mut_slice());
     for k in 0..n.div_ceil(ROWS) {
         let (lo, hi) = (k * ROWS, ((k + 1) * ROWS).min(n));
-        let (block, tail) = rest.split_at_mut(indptr[hi] - indptr[lo]);
-        blocks.push((lo, hi, block));
-        rest = tail;
+        let len = indptr[hi] - indptr[lo];
+        let (rb, rt) = r.split_at_mut(len);
+        let (gb, gt) = g.split_at_mut(len);
+        let (bb, bt) = b.split_at_mut(len);
+        blocks.push((lo, hi, [rb, gb, bb]));
+        (r, g, b) = (rt, gt, bt);
     }
-    blocks.into_par_iter().for_each(|(lo, hi, block)| {
+    blocks.into_par_iter().for_each(|(lo, hi, mut block)| {
+        let mut out = Vec::new();
         for i in lo..hi {
             let (s, e) = (indptr[i] - indptr[lo], indptr[i + 1] - indptr[lo]);
-            row(mesh, geometry, coefficients, boundary, i, &mut block[s..e]);
+            out.resize(e - s, [0.0; 3]);
+            row(mesh, geometry, coefficients, boundary, i, &mut out);
+            for (c, values) in block.iter_mut().enumerate() {
+                for (x, v) in values[s..e].iter_mut().zip(&out) {
+                    *x = v[c];
+                }
+            }
         }
     });
-    let data: [Vec<f64>; 3] = [0, 1, 2].map(|c| values.par_iter().map(|v| v[c]).collect());
-    drop(values);
     let [r, g, b] = data;
     [
         CsMat::new((n, n), indptr.clone(), indices.clone(), r),

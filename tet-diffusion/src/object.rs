@@ -461,6 +461,13 @@ impl Object {
     /// rebuilding the mesh) and returns the time it took, ms.
     pub fn reassemble(&mut self) -> f64 {
         let start = Instant::now();
+        // Free the old arrays first: they are not read, and keeping them
+        // while the new ones are built would double the peak memory.
+        self.matrices = std::array::from_fn(|_| CsMat::zero((0, 0)));
+        self.geometry = Geometry {
+            volume: Vec::new(),
+            weights: Vec::new(),
+        };
         self.geometry = Geometry::new(&self.mesh);
         self.coefficients = self.coefficients_of_media();
         self.matrices = assembly::assemble(
