@@ -293,6 +293,43 @@ mod tests {
     }
 
     #[test]
+    fn many_blocks_one_and_two_threads_agree_bit_for_bit() {
+        // 2197 vertices: several row blocks and one-ring blocks.
+        let (p, t) = cube(12, 1.0);
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    let mesh = TetMesh::new(&p, &t).unwrap();
+                    let g = Geometry::new(&mesh);
+                    let nt = t.len();
+                    let coefficients = Coefficients {
+                        kappa: (0..nt)
+                            .map(|k| [0.3 + 0.01 * (k % 7) as f64, 0.2, 0.1])
+                            .collect(),
+                        mu: (0..nt).map(|k| [0.05 * (k % 3) as f64, 0.1, 0.0]).collect(),
+                    };
+                    let m = assemble(&mesh, &g, &coefficients, 2.6);
+                    // Every row again on its own: the same bits.
+                    let mut out = Vec::new();
+                    for i in 0..mesh.vertex_count() {
+                        let (s, e) = (m[0].indptr().index(i), m[0].indptr().index(i + 1));
+                        out.resize(e - s, [0.0; 3]);
+                        row(&mesh, &g, &coefficients, 2.0 / (3.0 * 2.6), i, &mut out);
+                        for c in 0..3 {
+                            let alone: Vec<f64> = out.iter().map(|v| v[c]).collect();
+                            assert_eq!(&m[c].data()[s..e], alone.as_slice());
+                        }
+                    }
+                    m.map(|mc| mc.data().to_vec())
+                })
+        };
+        assert_eq!(run(1), run(2));
+    }
+
+    #[test]
     fn symmetric_positive_definite_and_row_sums() {
         let (p, t) = cube(4, 2.0);
         let mesh = TetMesh::new(&p, &t).unwrap();
