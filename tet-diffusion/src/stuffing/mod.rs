@@ -1,0 +1,1 @@
+//! Isosurface stuffing (Labelle & Shewchuk 2007) with generalized winding numbers.
