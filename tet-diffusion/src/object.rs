@@ -524,12 +524,11 @@ impl Object {
     /// [`Error::Solver`] for an error of `multires`.
     pub fn solve(&mut self) -> Result<SolveReport, Error> {
         let s = self.settings;
-        let options = SolveOptions {
-            tolerance: s.tolerance,
-            max_iterations: s.max_iterations,
-        };
-        let positions: Vec<[f64; 3]> = self.mesh.positions().iter().map(|p| p.to_array()).collect();
-        let weights = Weights::Positions(&positions);
+        // Convergence is checked below, per channel, so that the error can
+        // name the channel.
+        let options = SolveOptions::new(s.tolerance, s.max_iterations).allow_unconverged();
+        let positions = self.mesh.positions();
+        let weights = Weights::Points(&positions);
         let mut hierarchy_ms = 0.0;
         let mut solve_ms = 0.0;
         let mut levels = 1;

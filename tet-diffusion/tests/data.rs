@@ -1,8 +1,8 @@
 //! Real TetGen meshes from `$TRILUX_DATA/tets`.
 
 mod common;
-
-use std::path::PathBuf;
+#[path = "../../io/tests/support/data_dir.rs"]
+mod data_dir;
 
 use common::*;
 use tet_diffusion::glam::DVec3;
@@ -10,7 +10,7 @@ use tet_diffusion::multires::{self, SolveOptions};
 use tet_diffusion::{Cut, Integration, Light, Medium, Object, TetMesh};
 
 fn read(name: &str, scale: f64) -> TetMesh {
-    let dir = PathBuf::from(std::env::var_os("TRILUX_DATA").expect("TRILUX_DATA is set"));
+    let dir = data_dir::data_dir().expect("TRILUX_DATA is set");
     let file = trilux_io::tet::TetMesh::read(dir.join("tets").join(name)).unwrap();
     let p: Vec<DVec3> = file.positions.iter().map(|p| *p * scale).collect();
     TetMesh::new(&p, &file.tets).unwrap()
@@ -66,16 +66,7 @@ fn bunny_matches_p1_and_cuts_cleanly() {
     }
     let b = p1.load(&qv, a, o.fdr());
     let mut x = vec![0.0; b.len()];
-    let r = multires::cg(
-        &system[0],
-        &b,
-        &mut x,
-        &SolveOptions {
-            tolerance: 1e-10,
-            max_iterations: 20_000,
-        },
-    )
-    .unwrap();
+    let r = multires::cg(&system[0], &b, &mut x, &SolveOptions::new(1e-10, 20_000)).unwrap();
     assert!(r.converged());
     let l2 = rel_l2(mesh, o.phi(0), &x);
     eprintln!("bunny_50k: relative L2 difference to P1 {l2:.2e}");

@@ -156,16 +156,7 @@ fn close_to_the_p1_solution() {
         }
         let b = p1.load(&q, a, o.fdr());
         let mut x = vec![0.0; b.len()];
-        let r = multires::cg(
-            system,
-            &b,
-            &mut x,
-            &SolveOptions {
-                tolerance: 1e-10,
-                max_iterations: 10_000,
-            },
-        )
-        .unwrap();
+        let r = multires::cg(system, &b, &mut x, &SolveOptions::new(1e-10, 10_000)).unwrap();
         assert!(r.converged());
         let l2 = rel_l2(mesh, o.phi(c), &x);
         eprintln!("channel {c}: relative L2 difference to P1 {l2:.2e}");
