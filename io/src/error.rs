@@ -26,10 +26,10 @@ impl fmt::Display for Location {
 #[non_exhaustive]
 pub enum ErrorKind {
     /// The file could not be opened, read or written.
-    #[error("{0}")]
+    #[error("could not read or write the file: {0}")]
     Io(#[source] std::io::Error),
     /// The extension names no format this crate reads or writes.
-    #[error("unknown extension {0:?} (expected one of {1})")]
+    #[error("the extension {0:?} names no format known here (expected one of {1})")]
     UnknownExtension(String, &'static str),
     /// The data ends before a declared record or section does.
     #[error("the file ends early: expected {0}")]
@@ -70,15 +70,19 @@ pub enum ErrorKind {
         count: usize,
     },
     /// A coordinate is NaN or infinite.
-    #[error("node {index} has a non-finite coordinate ({value})")]
+    #[error("point {index} (0-based) has a non-finite coordinate ({value})")]
     NonFinite {
         /// The node's position in the file (0-based).
         index: usize,
         /// The offending value.
         value: f64,
     },
+    /// A value the file holds cannot be represented (a coordinate too far
+    /// from the others for `f32`, an id beyond `u32`).
+    #[error("{0}")]
+    OutOfRange(String),
     /// A valid file that uses a feature this crate does not read.
-    #[error("unsupported: {0}")]
+    #[error("the file uses {0}, which this reader does not support")]
     Unsupported(String),
     /// A codec (PNG, JPEG, HDR, EXR) could not decode or encode the data;
     /// its own error is the source.
@@ -92,7 +96,7 @@ pub enum ErrorKind {
     },
     /// The file asks for more than the reader allows (image dimensions or
     /// memory), refused before decoding.
-    #[error("limit exceeded: {0}")]
+    #[error("refused before allocating: {0}")]
     LimitExceeded(String),
     /// A URI in the file points outside its folder (absolute, `..`, or a
     /// remote scheme), refused unless the caller allows it.
@@ -100,7 +104,7 @@ pub enum ErrorKind {
     OutsideFolder(String),
     /// What the caller asked to write is inconsistent (a field of the wrong
     /// length, a tetrahedron referencing a missing node).
-    #[error("invalid input: {0}")]
+    #[error("cannot write this data: {0}")]
     InvalidInput(String),
 }
 
@@ -126,9 +130,12 @@ impl fmt::Display for Error {
 }
 
 impl std::error::Error for Error {
+    /// The I/O error or the codec's own error (PNG, JPEG, HDR, EXR, glTF
+    /// JSON), whose own `source()` continues the chain.
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match &self.kind {
             ErrorKind::Io(e) => Some(e),
+            ErrorKind::Codec { source, .. } => Some(source.as_ref()),
             _ => None,
         }
     }

@@ -31,7 +31,10 @@ pub struct ReadOptions {
     pub raw: bool,
     /// The largest width and height accepted.
     pub max_dimension: u32,
-    /// The most memory a decoder may allocate, in bytes.
+    /// The most memory reading may take, in bytes: the decoder's buffers,
+    /// and separately the conversion to linear `f32` RGBA (32 bytes per
+    /// pixel at its peak), checked from the header before either
+    /// allocates. 4 GiB by default.
     pub max_bytes: u64,
 }
 
@@ -102,7 +105,8 @@ pub fn read(path: impl AsRef<Path>) -> Result<Image> {
 ///
 /// # Errors
 /// As for [`read`].
-pub fn read_with(path: &Path, options: ReadOptions) -> Result<Image> {
+pub fn read_with(path: impl AsRef<Path>, options: ReadOptions) -> Result<Image> {
+    let path = path.as_ref();
     format_of(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     decode(&bytes, path, options)
@@ -113,21 +117,68 @@ pub fn read_with(path: &Path, options: ReadOptions) -> Result<Image> {
 ///
 /// # Errors
 /// As for [`read`].
-pub fn decode(bytes: &[u8], name: &Path, options: ReadOptions) -> Result<Image> {
+pub fn decode(bytes: &[u8], name: impl AsRef<Path>, options: ReadOptions) -> Result<Image> {
+    let name = name.as_ref();
     let format = format_of(name)?;
     let mut limits = Limits::default();
     limits.max_image_width = Some(options.max_dimension);
     limits.max_image_height = Some(options.max_dimension);
     limits.max_alloc = Some(options.max_bytes);
+    // The header's size, checked against the budget of the f32 RGBA
+    // conversion before the decoder allocates anything.
+    let mut probe = ImageReader::with_format(IoCursor::new(bytes), format);
+    probe.limits(limits.clone());
+    let (width, height) = probe
+        .into_dimensions()
+        .map_err(|e| codec_error(name, format, e))?;
+    check_conversion_budget(name, width, height, options)?;
     let mut reader = ImageReader::with_format(IoCursor::new(bytes), format);
     reader.limits(limits);
     let image = reader.decode().map_err(|e| codec_error(name, format, e))?;
+    // A decoder may report other dimensions than its header (it should
+    // not); the budget is checked on what came out as well.
+    check_conversion_budget(name, image.width(), image.height(), options)?;
     Ok(to_linear(image, options.raw))
+}
+
+/// Bytes per pixel at the peak of the conversion to linear RGBA: the
+/// codec's `f32` RGBA buffer and our `[f32; 4]` pixels.
+const CONVERSION_BYTES_PER_PIXEL: u64 = 32;
+
+fn check_conversion_budget(
+    name: &Path,
+    width: u32,
+    height: u32,
+    options: ReadOptions,
+) -> Result<()> {
+    if width > options.max_dimension || height > options.max_dimension {
+        return Err(Error::new(
+            name,
+            ErrorKind::LimitExceeded(format!(
+                "the image is {width}×{height} pixels, more than the {} a side allowed",
+                options.max_dimension
+            )),
+        ));
+    }
+    let needed = u64::from(width) * u64::from(height) * CONVERSION_BYTES_PER_PIXEL;
+    if needed > options.max_bytes {
+        return Err(Error::new(
+            name,
+            ErrorKind::LimitExceeded(format!(
+                "converting the {width}×{height} image to f32 RGBA needs {needed} bytes, \
+                 more than the budget of {} bytes (ReadOptions::max_bytes)",
+                options.max_bytes
+            )),
+        ));
+    }
+    Ok(())
 }
 
 fn codec_error(path: &Path, format: ImageFormat, e: ImageError) -> Error {
     let kind = match e {
-        ImageError::Limits(l) => ErrorKind::LimitExceeded(l.to_string()),
+        ImageError::Limits(l) => ErrorKind::LimitExceeded(format!(
+            "{l} (the limits are ReadOptions::max_dimension and max_bytes)"
+        )),
         ImageError::IoError(io) => ErrorKind::Io(io),
         other => ErrorKind::Codec {
             format: format_name(format),
@@ -161,13 +212,20 @@ fn to_linear(image: DynamicImage, raw: bool) -> Image {
         image,
         DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
     );
-    let rgba = image.to_rgba32f();
+    // Converted in place where it already is f32 RGBA; otherwise the
+    // decoded buffer is freed once converted, so the peak stays within
+    // CONVERSION_BYTES_PER_PIXEL.
+    let rgba = match image {
+        DynamicImage::ImageRgba32F(buffer) => buffer,
+        other => other.to_rgba32f(),
+    };
     let (width, height) = rgba.dimensions();
     let decode = !raw && !float_source;
     let pixels = rgba
-        .pixels()
+        .into_raw()
+        .chunks_exact(4)
         .map(|p| {
-            let mut px = p.0;
+            let mut px = [p[0], p[1], p[2], p[3]];
             if decode {
                 for c in &mut px[..3] {
                     *c = srgb_to_linear(*c);
@@ -183,12 +241,21 @@ fn to_linear(image: DynamicImage, raw: bool) -> Image {
     }
 }
 
+/// The Rec. 709 (sRGB primaries) luminance of a linear RGB colour:
+/// `0.2126 r + 0.7152 g + 0.0722 b` (ITU-R BT.709-6, item 3.2). The same
+/// function, with the same name and test values, exists in every trilux
+/// crate that needs it.
+pub fn luminance(rgb: [f32; 3]) -> f32 {
+    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+}
+
 impl Image {
-    /// Rec. 709 luminance of each pixel (for density textures and maps).
+    /// [`luminance`] of each pixel, row-major (for density textures and
+    /// maps); alpha is ignored.
     pub fn luminance(&self) -> Vec<f32> {
         self.pixels
             .iter()
-            .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+            .map(|p| luminance([p[0], p[1], p[2]]))
             .collect()
     }
 
@@ -209,13 +276,33 @@ impl Image {
     }
 }
 
+/// Writes an image, choosing the format by extension: `.png` (8-bit,
+/// sRGB-encoded, see [`write_png`]) or `.exr` (f32, linear, see
+/// [`write_exr`]).
+///
+/// # Errors
+/// [`ErrorKind::UnknownExtension`] for other extensions; the writer's
+/// errors.
+pub fn write(path: impl AsRef<Path>, image: &Image) -> Result<()> {
+    let path = path.as_ref();
+    match crate::error::extension(path).as_str() {
+        "png" => write_png(path, image, PngDepth::Eight),
+        "exr" => write_exr(path, image, ExrPrecision::F32),
+        other => Err(Error::new(
+            path,
+            ErrorKind::UnknownExtension(other.to_string(), ".png, .exr"),
+        )),
+    }
+}
+
 /// Writes a PNG: colour sRGB-encoded (values above 1 are clipped; tone map
 /// first), alpha linear.
 ///
 /// # Errors
 /// [`ErrorKind::InvalidInput`] for a pixel count that does not match the
 /// size; codec and I/O errors.
-pub fn write_png(path: &Path, image: &Image, depth: PngDepth) -> Result<()> {
+pub fn write_png(path: impl AsRef<Path>, image: &Image, depth: PngDepth) -> Result<()> {
+    let path = path.as_ref();
     image.check(path)?;
     // sRGB-encode colour, keep alpha linear; image's conversion to 8 or
     // 16 bits then clamps to [0, 1], scales and rounds.
@@ -248,7 +335,8 @@ pub fn write_png(path: &Path, image: &Image, depth: PngDepth) -> Result<()> {
 /// # Errors
 /// [`ErrorKind::InvalidInput`] for a pixel count that does not match the
 /// size; codec and I/O errors.
-pub fn write_exr(path: &Path, image: &Image, precision: ExrPrecision) -> Result<()> {
+pub fn write_exr(path: impl AsRef<Path>, image: &Image, precision: ExrPrecision) -> Result<()> {
+    let path = path.as_ref();
     use exr::prelude::f16;
     image.check(path)?;
     let (w, h) = (image.width as usize, image.height as usize);

@@ -35,6 +35,10 @@
 
 #![forbid(unsafe_code)]
 
+/// The vector types of every public position, normal and UV (`Vec3`,
+/// `DVec3`, `Vec2`): this crate speaks glam 0.34.
+pub use glam;
+
 mod base64;
 mod error;
 pub mod image;

@@ -18,11 +18,12 @@ fn canonical(f: [u32; 3]) -> [u32; 3] {
 }
 
 #[test]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
 fn real_tetgen_meshes_match_the_data_readme() {
-    let Some(data) = data_dir() else {
-        eprintln!("skipped: TRILUX_DATA is not set, so the real tet meshes are not tested");
-        return;
-    };
+    let data = data_dir().expect("TRILUX_DATA names the data folder");
     // name, nodes, tets, boundary triangles, total volume (data README).
     let expected = [
         ("sphere_20k", 3_626, 19_443, 1_938, 4.15274),
@@ -64,11 +65,12 @@ fn real_tetgen_meshes_match_the_data_readme() {
 }
 
 #[test]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
 fn real_gmsh_41_equals_the_tetgen_pair() {
-    let Some(data) = data_dir() else {
-        eprintln!("skipped: TRILUX_DATA is not set, so the real Gmsh file is not tested");
-        return;
-    };
+    let data = data_dir().expect("TRILUX_DATA names the data folder");
     let tets = data.join("tets");
     let from_msh = TetMesh::read(tets.join("bunny_500k.msh")).unwrap();
     let from_tetgen = TetMesh::read(tets.join("bunny_500k.ele")).unwrap();
@@ -87,12 +89,14 @@ fn tetgen_round_trip_is_exact() {
         ],
         tets: vec![[0, 1, 2, 3], [3, 2, 1, 0]],
         regions: vec![7, -2],
+        attributes: vec![vec![7.0, -2.0]],
     };
     let path = dir.join("m.node");
     tetgen::write(&path, &mesh).unwrap();
     assert_eq!(TetMesh::read(&path).unwrap(), mesh);
     let plain = TetMesh {
         regions: Vec::new(),
+        attributes: Vec::new(),
         ..mesh
     };
     tetgen::write(&path, &plain).unwrap();
@@ -333,9 +337,9 @@ fn malformed_files_name_the_problem_and_the_line() {
             1,
         ),
         (
-            "fractional-region",
+            "nan-attribute",
             node,
-            b"1 4 1\n1 1 2 3 4 0.5\n",
+            b"1 4 1\n1 1 2 3 4 nan\n",
             |k| matches!(k, ErrorKind::Syntax { .. }),
             2,
         ),
@@ -424,11 +428,12 @@ fn medit_reads_blocks_in_any_order_and_round_trips() {
 }
 
 #[test]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
 fn real_mesh_through_medit_and_back() {
-    let Some(data) = data_dir() else {
-        eprintln!("skipped: TRILUX_DATA is not set, so no real mesh goes through MEDIT");
-        return;
-    };
+    let data = data_dir().expect("TRILUX_DATA names the data folder");
     let mesh = TetMesh::read(data.join("tets/bunny_50k.node")).unwrap();
     let dir = scratch("medit-real");
     let path = dir.join("bunny.mesh");

@@ -35,7 +35,8 @@ pub struct Options {
 /// [`Error`]: an unreadable or invalid file, a URI outside the folder, a
 /// buffer shorter than its accessors, a non-finite position, an index out
 /// of range, or a texture that does not decode.
-pub fn read(path: &Path) -> Result<TriMesh> {
+pub fn read(path: impl AsRef<Path>) -> Result<TriMesh> {
+    let path = path.as_ref();
     read_with(path, Options::default())
 }
 
@@ -43,7 +44,8 @@ pub fn read(path: &Path) -> Result<TriMesh> {
 ///
 /// # Errors
 /// As for [`read`].
-pub fn read_with(path: &Path, options: Options) -> Result<TriMesh> {
+pub fn read_with(path: impl AsRef<Path>, options: Options) -> Result<TriMesh> {
+    let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     from_bytes(&bytes, path, options)
 }
@@ -53,7 +55,8 @@ pub fn read_with(path: &Path, options: Options) -> Result<TriMesh> {
 ///
 /// # Errors
 /// As for [`read`].
-pub fn from_bytes(bytes: &[u8], path: &Path, options: Options) -> Result<TriMesh> {
+pub fn from_bytes(bytes: &[u8], path: impl AsRef<Path>, options: Options) -> Result<TriMesh> {
+    let path = path.as_ref();
     let folder = path.parent().unwrap_or(Path::new("."));
     Reader {
         path,

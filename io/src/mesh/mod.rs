@@ -3,7 +3,7 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::image::Image;
@@ -15,16 +15,43 @@ pub mod ply;
 /// A triangle mesh as plain data, with one index stream: attributes are
 /// per vertex, and a vertex that has several UVs or normals in the file
 /// (a seam) is split into several vertices.
+///
+/// # UV convention
+///
+/// Texture coordinates follow glTF: the origin is the top-left corner of
+/// the image and v grows downwards, so `uv * (width, height)` is a texel
+/// coordinate with row 0 the first row stored in the image file (the row
+/// [`Image::pixels`] starts with). OBJ and PLY files store v upwards:
+/// their readers in this crate turn it into `1 - v` and their writers
+/// turn it back, which is the only place a flip happens. glTF UVs are kept
+/// as stored. Values outside `[0, 1]` (tiling) are kept; the material's
+/// [`Wrap`] says what they mean. Flipping in `f32` is exact for the values
+/// a texture atlas usually holds (multiples of powers of two) and within
+/// 2^-24 otherwise.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriMesh {
-    /// Vertex positions.
+    /// Vertex positions, relative to [`origin`](Self::origin): the point a
+    /// file puts vertex `i` at is `origin + positions[i].as_dvec3()`.
     pub positions: Vec<Vec3>,
+    /// The global shift (as CloudCompare calls it) that keeps the
+    /// precision of a file whose coordinates are far from zero: zero for
+    /// ordinary files, and otherwise the centre of the bounding box (whole
+    /// units when the mesh is at least one unit across). The readers
+    /// parse coordinates in `f64` and subtract it before storing `f32`, so
+    /// a georeferenced scan at x ≈ 4·10^5, y ≈ 4.6·10^6 keeps millimetre
+    /// triangles instead of collapsing them. Shifted when the largest
+    /// coordinate magnitude is at least 10^5 (CloudCompare's default; the
+    /// `f32` step there is 1/128) or more than 2^12 times the mesh's size.
+    /// Writers add it back in `f64`. glTF stores `f32`, so its meshes keep
+    /// a zero origin.
+    pub origin: DVec3,
     /// Three 0-based vertex indices per triangle, counter-clockwise as the
     /// file orders them.
     pub indices: Vec<[u32; 3]>,
     /// Per-vertex normals, when the file has them.
     pub normals: Option<Vec<Vec3>>,
-    /// Per-vertex texture coordinates, when the file has them.
+    /// Per-vertex texture coordinates, when the file has them; v down,
+    /// `v = 0` at image row 0 (see the [UV convention](#uv-convention)).
     pub uvs: Option<Vec<Vec2>>,
     /// Consecutive triangle ranges per object, group or material.
     pub objects: Vec<Object>,
@@ -72,7 +99,72 @@ pub enum Wrap {
     ClampToEdge,
 }
 
+/// The largest coordinate magnitude kept without a shift (CloudCompare's
+/// default threshold).
+const SHIFT_ABOVE: f64 = 1e5;
+/// A shift also happens when the coordinates are this many times larger
+/// than the bounding box: the `f32` step would exceed 2^-12 of the size.
+const SHIFT_RATIO: f64 = 4096.0;
+
+/// The global shift for points with coordinates `points` (see
+/// [`TriMesh::origin`]) and the points relative to it as `f32`.
+pub(crate) fn recenter(points: &[DVec3]) -> (DVec3, Vec<Vec3>) {
+    let origin = shift_for(points);
+    let relative = points.iter().map(|&p| (p - origin).as_vec3()).collect();
+    (origin, relative)
+}
+
+/// The origin [`recenter`] uses: zero unless the coordinates are far from
+/// it relative to the box.
+pub(crate) fn shift_for(points: &[DVec3]) -> DVec3 {
+    let Some(first) = points.first() else {
+        return DVec3::ZERO;
+    };
+    let (lo, hi) = points
+        .iter()
+        .fold((*first, *first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let magnitude = lo.abs().max(hi.abs()).max_element();
+    let extent = (hi - lo).max_element();
+    // A single point (zero extent) shifts only beyond the absolute bound.
+    let far = magnitude >= SHIFT_ABOVE || (extent > 0.0 && magnitude > SHIFT_RATIO * extent);
+    if !far || !magnitude.is_finite() {
+        return DVec3::ZERO;
+    }
+    let center = 0.5 * (lo + hi);
+    if extent >= 1.0 {
+        center.round()
+    } else {
+        center
+    }
+}
+
+/// Reads a triangle mesh, choosing the format by extension (see
+/// [`TriMesh::read`]).
+///
+/// # Errors
+/// [`Error`] naming the file, the line, and what was wrong.
+pub fn read(path: impl AsRef<Path>) -> Result<TriMesh> {
+    TriMesh::read(path)
+}
+
+/// Writes a triangle mesh, choosing the format by extension (see
+/// [`TriMesh::write`]).
+///
+/// # Errors
+/// As for [`TriMesh::write`].
+pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
+    mesh.write(path)
+}
+
 impl TriMesh {
+    /// The positions as the file has them, in `f64`: `origin + p`.
+    pub fn absolute_positions(&self) -> Vec<DVec3> {
+        self.positions
+            .iter()
+            .map(|p| self.origin + p.as_dvec3())
+            .collect()
+    }
+
     /// Reads a triangle mesh, choosing the format by extension: `.obj`,
     /// `.gltf`, `.glb` (URIs confined to the file's folder), `.ply`.
     ///
@@ -86,6 +178,7 @@ impl TriMesh {
             "ply" => {
                 let ply = ply::read(path)?;
                 Ok(TriMesh {
+                    origin: ply.origin,
                     objects: vec![Object {
                         name: String::new(),
                         triangles: 0..ply.triangles.len(),
@@ -101,6 +194,36 @@ impl TriMesh {
             other => Err(Error::new(
                 path,
                 ErrorKind::UnknownExtension(other.to_string(), ".obj, .gltf, .glb, .ply"),
+            )),
+        }
+    }
+
+    /// Writes the mesh, choosing the format by extension: `.obj` (with its
+    /// `.mtl` and textures, see [`obj::write`]) or `.ply` (binary
+    /// little-endian with normals and UVs; objects and materials are not
+    /// part of PLY and are not written, see [`ply::write`]).
+    ///
+    /// # Errors
+    /// [`ErrorKind::UnknownExtension`] for other extensions; the writer's
+    /// errors.
+    pub fn write(&self, path: impl AsRef<Path>) -> Result<()> {
+        let path = path.as_ref();
+        match crate::error::extension(path).as_str() {
+            "obj" => obj::write(path, self),
+            "ply" => {
+                let data = ply::PlyData {
+                    positions: self.positions.clone(),
+                    origin: self.origin,
+                    triangles: self.indices.clone(),
+                    normals: self.normals.clone(),
+                    uvs: self.uvs.clone(),
+                    ..ply::PlyData::default()
+                };
+                ply::write(path, &data, ply::Format::BinaryLittleEndian)
+            }
+            other => Err(Error::new(
+                path,
+                ErrorKind::UnknownExtension(other.to_string(), ".obj, .ply"),
             )),
         }
     }

@@ -1,7 +1,13 @@
 //! Wavefront OBJ: `v`, `vt`, `vn`, `f` (all four index forms, negative
 //! indices, polygons fan-triangulated), `o`, `g`, `usemtl`, `mtllib` (with
-//! `newmtl`, `Kd`, `map_Kd`). Lines, points, smoothing groups and
-//! free-form geometry are skipped.
+//! `newmtl`, `Kd`, `map_Kd` and its options). Lines, points, smoothing
+//! groups and free-form geometry are skipped.
+//!
+//! OBJ and MTL share one line pre-pass: a leading UTF-8 byte-order mark
+//! is dropped, `\r\n` is a line end, a `#` starts a comment wherever it
+//! is, and a `\` at the end of a line continues it. File names (`mtllib`,
+//! `map_Kd`) are the rest of the line after the options, spaces included.
+//! `vt` v coordinates are flipped to [`TriMesh`]'s v-down convention.
 //!
 //! Our own reader rather than `tobj`: errors must name the line, NaN and
 //! infinite coordinates must be refused, and unused vertices must not
@@ -12,7 +18,7 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 use super::{Material, Object, TriMesh, Wrap};
 use crate::error::{Error, ErrorKind, Location, Result};
@@ -30,20 +36,33 @@ const DEFAULT_DIFFUSE: [f32; 3] = [0.8, 0.8, 0.8];
 /// [`Error`] with the file and line: a malformed number, a NaN or infinite
 /// coordinate, a face with fewer than 3 vertices, a face index out of
 /// range, or an unreadable file (a missing material library included).
-pub fn read(path: &Path) -> Result<TriMesh> {
+pub fn read(path: impl AsRef<Path>) -> Result<TriMesh> {
+    let path = path.as_ref();
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let (mut mesh, libraries) = parse(&data, path)?;
     let folder = path.parent().unwrap_or(Path::new("."));
-    for library in libraries {
-        let lib_path = folder.join(&library);
-        let text = std::fs::read(&lib_path).map_err(|e| Error::io(&lib_path, e))?;
-        for found in parse_mtl(&text, &lib_path, folder)? {
-            if let Some(m) = mesh.materials.iter_mut().find(|m| m.name == found.name) {
-                *m = found;
+    for names in libraries {
+        for library in library_files(folder, &names) {
+            let lib_path = folder.join(&library);
+            let text = std::fs::read(&lib_path).map_err(|e| Error::io(&lib_path, e))?;
+            for found in parse_mtl(&text, &lib_path, folder)? {
+                if let Some(m) = mesh.materials.iter_mut().find(|m| m.name == found.name) {
+                    *m = found;
+                }
             }
         }
     }
     Ok(mesh)
+}
+
+/// The files an `mtllib` line names: the whole rest of the line when a
+/// file of that name exists (names with spaces), else its
+/// whitespace-separated words (the statement's list form).
+fn library_files(folder: &Path, names: &str) -> Vec<String> {
+    if folder.join(names).is_file() || !names.contains(char::is_whitespace) {
+        return vec![names.to_string()];
+    }
+    names.split_whitespace().map(str::to_string).collect()
 }
 
 /// Parses the contents of an `.obj` file; `path` names it in errors.
@@ -52,8 +71,8 @@ pub fn read(path: &Path) -> Result<TriMesh> {
 ///
 /// # Errors
 /// As for [`read`], without the files.
-pub fn from_bytes(data: &[u8], path: &Path) -> Result<TriMesh> {
-    parse(data, path).map(|(mesh, _)| mesh)
+pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<TriMesh> {
+    parse(data, path.as_ref()).map(|(mesh, _)| mesh)
 }
 
 /// One line's location for errors.
@@ -79,20 +98,28 @@ impl At<'_> {
     }
 }
 
-/// Splits the data into lines (joining `\` continuations) with their
-/// 1-based numbers.
-fn lines(data: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
+/// The line pre-pass shared by OBJ and MTL: splits the data into logical
+/// lines with the 1-based number of their first physical line. Drops a
+/// leading UTF-8 byte-order mark, `\r` before `\n`, and comments (from a
+/// `#` wherever it starts to the end of the line); joins lines ending in
+/// `\`; trims surrounding whitespace. Empty lines are skipped.
+pub(crate) fn lines(data: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
+    let data = data.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(data);
     let mut number = 0;
     let mut pending: Option<(usize, String)> = None;
     let mut raw = data.split(|&b| b == b'\n');
     std::iter::from_fn(move || {
         loop {
             let Some(bytes) = raw.next() else {
-                return pending.take();
+                return pending.take().filter(|(_, text)| !text.trim().is_empty());
             };
             number += 1;
+            let bytes = match bytes.iter().position(|&b| b == b'#') {
+                Some(hash) => &bytes[..hash],
+                None => bytes,
+            };
             let text = String::from_utf8_lossy(bytes);
-            let text = text.trim_end_matches('\r');
+            let text = text.trim_end();
             let (first, mut joined) = pending.take().unwrap_or((number, String::new()));
             if let Some(head) = text.strip_suffix('\\') {
                 joined.push_str(head);
@@ -101,9 +128,26 @@ fn lines(data: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
                 continue;
             }
             joined.push_str(text);
-            return Some((first, joined));
+            let trimmed = joined.trim();
+            if trimmed.is_empty() {
+                continue;
+            }
+            return Some((first, trimmed.to_string()));
         }
     })
+}
+
+/// The rest of `line` after its first word, trimmed: a name that may
+/// contain spaces.
+fn rest_of(line: &str) -> &str {
+    let line = line.trim_start();
+    let end = line.find(char::is_whitespace).unwrap_or(line.len());
+    line[end..].trim()
+}
+
+fn number64(at: &At<'_>, token: Option<&str>, what: &str) -> Result<f64> {
+    let token = token.ok_or_else(|| at.error(ErrorKind::Truncated(what.to_string())))?;
+    token.parse::<f64>().map_err(|_| at.syntax(what, token))
 }
 
 fn number(at: &At<'_>, token: Option<&str>, what: &str) -> Result<f32> {
@@ -144,8 +188,9 @@ fn resolve(
 }
 
 /// The mesh and the material libraries named by `mtllib`.
+/// The mesh and the rest of each `mtllib` line.
 fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
-    let mut v: Vec<Vec3> = Vec::new();
+    let mut v: Vec<DVec3> = Vec::new();
     let mut vt: Vec<Vec2> = Vec::new();
     let mut vn: Vec<Vec3> = Vec::new();
     let mut keys: HashMap<(u32, u32, u32), u32> = HashMap::new();
@@ -179,19 +224,19 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
         };
         match keyword {
             "v" => {
-                let p = vec3(&at, &mut tokens, "a vertex coordinate")?;
-                if !p.is_finite() {
-                    let value = p
-                        .to_array()
-                        .into_iter()
-                        .find(|x| !x.is_finite())
-                        .unwrap_or(f32::NAN);
+                // f64, so that far-from-origin files keep their precision
+                // until the shift (TriMesh::origin) is known.
+                let mut p = [0.0f64; 3];
+                for slot in &mut p {
+                    *slot = number64(&at, tokens.next(), "a vertex coordinate")?;
+                }
+                if let Some(value) = p.into_iter().find(|x| !x.is_finite()) {
                     return Err(at.error(ErrorKind::NonFinite {
                         index: v.len(),
-                        value: f64::from(value),
+                        value,
                     }));
                 }
-                v.push(p);
+                v.push(DVec3::from(p));
             }
             "vt" => {
                 let u = number(&at, tokens.next(), "a texture coordinate")?;
@@ -204,7 +249,8 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
                 if !(u.is_finite() && w.is_finite()) {
                     return Err(at.syntax("a finite texture coordinate", &text));
                 }
-                vt.push(Vec2::new(u, w));
+                // OBJ's v grows upwards; TriMesh's grows downwards (glTF).
+                vt.push(Vec2::new(u, 1.0 - w));
             }
             "vn" => {
                 let n = vec3(&at, &mut tokens, "a normal coordinate")?;
@@ -248,7 +294,7 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
             }
             "usemtl" => {
                 close(&mut objects, &name, material, indices.len());
-                let wanted = tokens.collect::<Vec<_>>().join(" ");
+                let wanted = rest_of(&text).to_string();
                 material = Some(match materials.iter().position(|m| m.name == wanted) {
                     Some(i) => i,
                     None => {
@@ -263,12 +309,19 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
                     }
                 });
             }
-            "mtllib" => libraries.extend(tokens.map(str::to_string)),
+            "mtllib" => {
+                let names = rest_of(&text);
+                if names.is_empty() {
+                    return Err(at.error(ErrorKind::Truncated(
+                        "a material library file name after mtllib".into(),
+                    )));
+                }
+                libraries.push(names.to_string());
+            }
             // Smoothing groups, lines, points, free-form geometry: skipped.
             "s" | "l" | "p" | "vp" | "cstype" | "deg" | "curv" | "curv2" | "surf" | "parm"
             | "trim" | "hole" | "end" | "bmat" | "step" | "con" | "mg" | "lod" | "shadow_obj"
             | "trace_obj" | "ctech" | "stech" | "bevel" | "c_interp" | "d_interp" => {}
-            k if k.starts_with('#') => {}
             other => return Err(at.syntax("an OBJ keyword", other)),
         }
     }
@@ -276,8 +329,21 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
 
     let has_uv = vertices.iter().any(|k| k.1 != NONE);
     let has_normal = vertices.iter().any(|k| k.2 != NONE);
+    let used: Vec<DVec3> = vertices.iter().map(|k| v[k.0 as usize]).collect();
+    let (origin, positions) = super::recenter(&used);
+    if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(Error::new(
+            path,
+            ErrorKind::OutOfRange(format!(
+                "vertex {} at {} is too far from the others for f32 positions",
+                vertices[i].0 + 1,
+                used[i]
+            )),
+        ));
+    }
     let mesh = TriMesh {
-        positions: vertices.iter().map(|k| v[k.0 as usize]).collect(),
+        positions,
+        origin,
         uvs: has_uv.then(|| {
             vertices
                 .iter()
@@ -297,8 +363,13 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
     Ok((mesh, libraries))
 }
 
-/// Parses an MTL library: `newmtl`, `Kd`, `map_Kd` (the last token is the
-/// file; options before it are skipped).
+/// Parses an MTL library: `newmtl`, `Kd`, `map_Kd` (options parsed, the
+/// rest of the line is the file, spaces included). `-clamp on` makes the
+/// texture [`Wrap::ClampToEdge`]; `-o`/`-s` other than the identity are
+/// refused (a shifted or scaled texture read as unshifted would be a
+/// silently wrong mesh); the other options (`-bm`, `-blendu`, `-blendv`,
+/// `-boost`, `-cc`, `-imfchan`, `-mm`, `-t`, `-texres`, `-type`) do not
+/// affect a diffuse colour lookup and are skipped.
 fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<Vec<Material>> {
     let mut materials: Vec<Material> = Vec::new();
     for (line, text) in lines(data) {
@@ -306,7 +377,7 @@ fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<Vec<Material>> {
         let mut tokens = text.split_whitespace();
         match tokens.next() {
             Some("newmtl") => materials.push(Material {
-                name: tokens.collect::<Vec<_>>().join(" "),
+                name: rest_of(&text).to_string(),
                 diffuse: DEFAULT_DIFFUSE,
                 diffuse_texture: None,
                 diffuse_image: None,
@@ -320,13 +391,14 @@ fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<Vec<Material>> {
                 current.diffuse = kd.to_array();
             }
             Some("map_Kd") => {
-                let file = tokens
-                    .last()
-                    .ok_or_else(|| at.error(ErrorKind::Truncated("a texture file".into())))?;
+                let map = texture_map(&at, rest_of(&text))?;
                 let current = materials
                     .last_mut()
                     .ok_or_else(|| at.syntax("newmtl before map_Kd", &text))?;
-                current.diffuse_texture = Some(folder.join(file));
+                current.diffuse_texture = Some(folder.join(map.file));
+                if map.clamp {
+                    current.wrap = [Wrap::ClampToEdge; 2];
+                }
             }
             _ => {}
         }
@@ -334,21 +406,127 @@ fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<Vec<Material>> {
     Ok(materials)
 }
 
-/// Writes an `.obj` file: positions, UVs and normals when present, one
-/// `o` line per object, faces in the matching `v/vt/vn` form. Floats are
-/// written in shortest round-trip form.
+/// A `map_*` statement: the file and the options that matter.
+#[derive(Debug, PartialEq)]
+struct TextureMap<'a> {
+    file: &'a str,
+    clamp: bool,
+}
+
+/// Parses `[options] file name` of a `map_*` statement (MTL spec, "Texture
+/// map statements"): each option takes a fixed number of arguments, `-o`,
+/// `-s` and `-t` one to three numbers.
+fn texture_map<'a>(at: &At<'_>, mut rest: &'a str) -> Result<TextureMap<'a>> {
+    let mut clamp = false;
+    // The next word of `rest` and what follows it.
+    fn word(rest: &str) -> (&str, &str) {
+        let rest = rest.trim_start();
+        let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
+        (&rest[..end], &rest[end..])
+    }
+    loop {
+        let (option, after) = word(rest);
+        if !option.starts_with('-') || option.len() < 2 {
+            break;
+        }
+        let mut args = |min: usize, max: usize, numeric: bool| -> Result<Vec<&'a str>> {
+            let mut taken = Vec::new();
+            let mut tail = after;
+            while taken.len() < max {
+                let (w, next) = word(tail);
+                let is_number = w.parse::<f64>().is_ok();
+                if w.is_empty() || (numeric && !is_number) || (taken.len() >= min && !is_number) {
+                    break;
+                }
+                taken.push(w);
+                tail = next;
+            }
+            if taken.len() < min {
+                return Err(at.syntax(&format!("{min} argument(s) after {option}"), after.trim()));
+            }
+            rest = tail;
+            Ok(taken)
+        };
+        match option {
+            "-blendu" | "-blendv" | "-cc" | "-imfchan" | "-type" => {
+                args(1, 1, false)?;
+            }
+            "-clamp" => {
+                clamp = args(1, 1, false)?[0].eq_ignore_ascii_case("on");
+            }
+            "-bm" | "-boost" | "-texres" => {
+                args(1, 1, true)?;
+            }
+            "-mm" => {
+                args(2, 2, true)?;
+            }
+            "-t" => {
+                args(1, 3, true)?;
+            }
+            "-o" | "-s" => {
+                let identity = if option == "-o" { 0.0 } else { 1.0 };
+                let values = args(1, 3, true)?;
+                if values
+                    .iter()
+                    .any(|v| v.parse::<f64>().ok() != Some(identity))
+                {
+                    return Err(at.error(ErrorKind::Unsupported(format!(
+                        "texture option {option} {} (a shifted or scaled texture)",
+                        values.join(" ")
+                    ))));
+                }
+            }
+            other => {
+                return Err(at.syntax(
+                    "a texture map option (-blendu, -bm, -clamp, -o, -s, ...)",
+                    other,
+                ));
+            }
+        }
+    }
+    let file = rest.trim();
+    if file.is_empty() {
+        return Err(at.error(ErrorKind::Truncated("a texture file name".into())));
+    }
+    Ok(TextureMap { file, clamp })
+}
+
+/// Writes an `.obj` file: positions (plus [`TriMesh::origin`], in `f64`),
+/// UVs (flipped back to OBJ's v up) and normals when present, one `o` line
+/// per object, faces in the matching `v/vt/vn` form. Floats are written in
+/// shortest round-trip form.
+///
+/// When the mesh has materials, their library is written beside it
+/// (`name.obj` → `name.mtl`, named by `mtllib`) with `Kd` and `map_Kd`,
+/// and each object with a material gets its `usemtl`. A texture file is
+/// referenced where it is (relative to the OBJ's folder when inside it); a
+/// decoded texture without a file (glTF's embedded images) is written as
+/// `name_<material>.png` beside the OBJ. MTL holds one wrap mode for both
+/// axes: `-clamp on` when both are [`Wrap::ClampToEdge`], repeat otherwise
+/// (MTL has no mirrored repeat). Materials without a name are written as
+/// `material_<index>`.
 ///
 /// # Errors
-/// [`ErrorKind::InvalidInput`] for an index out of range or attribute
-/// arrays of the wrong length; an I/O error.
-pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
+/// [`ErrorKind::InvalidInput`] for an index out of range, attribute
+/// arrays of the wrong length, objects that do not cover the triangles in
+/// order, a material index out of range, or a name that a `#` or a line
+/// break would cut; an I/O error.
+pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
+    let path = path.as_ref();
+    let invalid = |what: String| Error::new(path, ErrorKind::InvalidInput(what));
     let n = mesh.positions.len();
     let bad_len = |len: Option<usize>| len.is_some_and(|l| l != n);
-    if bad_len(mesh.uvs.as_ref().map(Vec::len)) || bad_len(mesh.normals.as_ref().map(Vec::len)) {
-        return Err(Error::new(
-            path,
-            ErrorKind::InvalidInput("UVs or normals do not match the positions".into()),
-        ));
+    if bad_len(mesh.uvs.as_ref().map(Vec::len)) {
+        return Err(invalid(format!(
+            "{} UVs for {n} positions",
+            mesh.uvs.as_ref().map_or(0, Vec::len)
+        )));
+    }
+    if bad_len(mesh.normals.as_ref().map(Vec::len)) {
+        return Err(invalid(format!(
+            "{} normals for {n} positions",
+            mesh.normals.as_ref().map_or(0, Vec::len)
+        )));
     }
     if let Some((t, _)) = mesh
         .indices
@@ -356,40 +534,58 @@ pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
         .enumerate()
         .find(|(_, tri)| tri.iter().any(|&i| i as usize >= n))
     {
-        return Err(Error::new(
-            path,
-            ErrorKind::InvalidInput(format!("triangle {t} references a missing vertex")),
-        ));
+        return Err(invalid(format!("triangle {t} references a missing vertex")));
     }
     let mut end = 0;
     for o in &mesh.objects {
         if o.triangles.start != end || o.triangles.end < o.triangles.start {
-            return Err(Error::new(
-                path,
-                ErrorKind::InvalidInput(format!(
-                    "object {:?} does not continue at triangle {end}",
-                    o.name
-                )),
-            ));
+            return Err(invalid(format!(
+                "object {:?} does not continue at triangle {end}",
+                o.name
+            )));
         }
         end = o.triangles.end;
+        if let Some(m) = o.material.filter(|&m| m >= mesh.materials.len()) {
+            return Err(invalid(format!(
+                "object {:?} uses material {m}, but there are {}",
+                o.name,
+                mesh.materials.len()
+            )));
+        }
+        check_name(path, "object", &o.name)?;
     }
     if !mesh.objects.is_empty() && end != mesh.indices.len() {
-        return Err(Error::new(
-            path,
-            ErrorKind::InvalidInput(format!(
-                "the objects cover {end} of {} triangles",
-                mesh.indices.len()
-            )),
-        ));
+        return Err(invalid(format!(
+            "the objects cover {end} of {} triangles",
+            mesh.indices.len()
+        )));
     }
+    if !mesh.origin.is_finite() {
+        return Err(invalid(format!("origin {} is not finite", mesh.origin)));
+    }
+    let names = material_names(path, mesh)?;
     let mut out = String::with_capacity(40 * n + 30 * mesh.indices.len());
     out.push_str("# written by trilux-io\n");
+    if !mesh.materials.is_empty() {
+        let library = path.with_extension("mtl");
+        write_mtl(path, &library, mesh, &names)?;
+        let file = library
+            .file_name()
+            .map(|f| f.to_string_lossy().into_owned());
+        let _ = writeln!(out, "mtllib {}", file.unwrap_or_default());
+    }
+    let shifted = mesh.origin != DVec3::ZERO;
     for p in &mesh.positions {
-        let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
+        if shifted {
+            let q = mesh.origin + p.as_dvec3();
+            let _ = writeln!(out, "v {} {} {}", q.x, q.y, q.z);
+        } else {
+            let _ = writeln!(out, "v {} {} {}", p.x, p.y, p.z);
+        }
     }
     for t in mesh.uvs.iter().flatten() {
-        let _ = writeln!(out, "vt {} {}", t.x, t.y);
+        // Back to OBJ's v-up convention (the reader's flip, undone).
+        let _ = writeln!(out, "vt {} {}", t.x, 1.0 - t.y);
     }
     for q in mesh.normals.iter().flatten() {
         let _ = writeln!(out, "vn {} {} {}", q.x, q.y, q.z);
@@ -417,6 +613,9 @@ pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
         if !object.name.is_empty() {
             let _ = writeln!(out, "o {}", object.name);
         }
+        if let Some(m) = object.material {
+            let _ = writeln!(out, "usemtl {}", names[m]);
+        }
         for tri in &mesh.indices[object.triangles.clone()] {
             out.push('f');
             for &i in tri {
@@ -426,4 +625,81 @@ pub fn write(path: &Path, mesh: &TriMesh) -> Result<()> {
         }
     }
     std::fs::write(path, out).map_err(|e| Error::io(path, e))
+}
+
+/// Refuses a name that the OBJ/MTL line pre-pass would cut (`#` starts a
+/// comment, a line break ends the statement).
+fn check_name(path: &Path, what: &str, name: &str) -> Result<()> {
+    if name.contains(['#', '\n', '\r']) || name.ends_with('\\') {
+        return Err(Error::new(
+            path,
+            ErrorKind::InvalidInput(format!(
+                "{what} name {name:?} cannot be written to OBJ (a '#', a line break or a \
+                 trailing backslash would cut it)"
+            )),
+        ));
+    }
+    Ok(())
+}
+
+/// The name each material is written under: its own, or
+/// `material_<index>` when empty or taken by an earlier one.
+fn material_names(path: &Path, mesh: &TriMesh) -> Result<Vec<String>> {
+    let mut names: Vec<String> = Vec::with_capacity(mesh.materials.len());
+    for (i, m) in mesh.materials.iter().enumerate() {
+        check_name(path, "material", &m.name)?;
+        let name = m.name.trim();
+        let name = if name.is_empty() || names.iter().any(|n| n == name) {
+            format!("material_{i}")
+        } else {
+            name.to_string()
+        };
+        names.push(name);
+    }
+    Ok(names)
+}
+
+/// Writes the material library of `mesh` to `library`, and the decoded
+/// textures that have no file beside `obj`.
+fn write_mtl(obj: &Path, library: &Path, mesh: &TriMesh, names: &[String]) -> Result<()> {
+    let folder = obj.parent().unwrap_or(Path::new(""));
+    let stem = obj
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut text = String::from("# written by trilux-io\n");
+    for (i, m) in mesh.materials.iter().enumerate() {
+        let [r, g, b] = m.diffuse;
+        let _ = writeln!(text, "newmtl {}\nKd {r} {g} {b}", names[i]);
+        let texture = match (&m.diffuse_texture, &m.diffuse_image) {
+            (Some(file), _) => Some(reference(folder, file)),
+            (None, Some(image)) => {
+                let name = format!("{stem}_{i}.png");
+                crate::image::write_png(folder.join(&name), image, crate::image::PngDepth::Eight)?;
+                Some(name)
+            }
+            (None, None) => None,
+        };
+        if let Some(texture) = texture {
+            check_name(library, "texture file", &texture)?;
+            let clamp = if m.wrap == [Wrap::ClampToEdge; 2] {
+                "-clamp on "
+            } else {
+                ""
+            };
+            let _ = writeln!(text, "map_Kd {clamp}{texture}");
+        }
+    }
+    std::fs::write(library, text).map_err(|e| Error::io(library, e))
+}
+
+/// How an MTL beside `folder` names `file`: relative when inside the
+/// folder, else absolute.
+fn reference(folder: &Path, file: &Path) -> String {
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    let (folder_abs, file_abs) = (absolute(folder), absolute(file));
+    match file_abs.strip_prefix(&folder_abs) {
+        Ok(relative) => relative.to_string_lossy().into_owned(),
+        Err(_) => file_abs.to_string_lossy().into_owned(),
+    }
 }

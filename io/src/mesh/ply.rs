@@ -8,16 +8,39 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::text::Cursor;
 
-/// A point cloud or triangle mesh with per-vertex attributes.
+/// A point cloud or triangle mesh with per-vertex attributes: what
+/// [`read`] returns and [`write`] takes. For sampled points, fill
+/// `positions` and whichever of `normals`, `uvs`, `face_ids` and `scalars`
+/// the samples have:
+///
+/// ```
+/// use trilux_io::glam::Vec3;
+/// use trilux_io::mesh::ply::{self, Format, PlyData};
+///
+/// let cloud = PlyData {
+///     positions: vec![Vec3::ZERO, Vec3::X],
+///     face_ids: Some(vec![0, 7]),
+///     ..PlyData::default()
+/// };
+/// let path = std::env::temp_dir().join("trilux-io-doc-points.ply");
+/// ply::write(&path, &cloud, Format::default())?; // binary little-endian
+/// assert_eq!(ply::read(&path)?, cloud);
+/// # Ok::<(), trilux_io::Error>(())
+/// ```
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PlyData {
-    /// Vertex positions.
+    /// Vertex positions, relative to `origin`.
     pub positions: Vec<Vec3>,
+    /// The global shift of far-from-origin coordinates, as
+    /// [`TriMesh::origin`](super::TriMesh::origin): the reader parses
+    /// coordinates in `f64` and keeps `origin + positions[i]`; the writer
+    /// writes `double` coordinates when it is not zero.
+    pub origin: DVec3,
     /// Triangles (0-based); empty for a point cloud. Polygons read from a
     /// file are fan-triangulated.
     pub triangles: Vec<[u32; 3]>,
@@ -25,19 +48,27 @@ pub struct PlyData {
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex colours, RGBA 8-bit (alpha 255 when the file has none).
     pub colors: Option<Vec<[u8; 4]>>,
-    /// Per-vertex texture coordinates.
+    /// Per-vertex texture coordinates in [`TriMesh`](super::TriMesh)'s
+    /// convention (v down, `v = 0` at image row 0): the file's `t` (v up)
+    /// is read as `1 - t` and written back as `1 - v`.
     pub uvs: Option<Vec<Vec2>>,
+    /// Per-vertex triangle indices (the face a sampled point lies on),
+    /// stored as the integer property `face_id`.
+    pub face_ids: Option<Vec<u32>>,
     /// Other per-vertex scalar properties, by name, written as `float`.
     pub scalars: Vec<(String, Vec<f32>)>,
 }
 
 /// How to write the data section.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum Format {
     /// Text, one element per line.
     Ascii,
     /// Binary little-endian: compact, and what most tools write.
+    #[default]
     BinaryLittleEndian,
+    /// Binary big-endian (older SGI and Java tools).
+    BinaryBigEndian,
 }
 
 /// The scalar types of the format, by size.
@@ -66,6 +97,10 @@ impl Scalar {
             b"double" | b"float64" => Scalar::F64,
             _ => return None,
         })
+    }
+
+    fn is_float(self) -> bool {
+        matches!(self, Scalar::F32 | Scalar::F64)
     }
 
     fn size(self) -> usize {
@@ -119,7 +154,8 @@ struct Element {
 /// (binary data): a malformed header, a missing `x y z`, a truncated
 /// element, a non-finite coordinate, a face with fewer than 3 vertices or
 /// referencing a missing vertex, or a count the file cannot hold.
-pub fn read(path: &Path) -> Result<PlyData> {
+pub fn read(path: impl AsRef<Path>) -> Result<PlyData> {
+    let path = path.as_ref();
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     from_bytes(&data, path)
 }
@@ -128,7 +164,8 @@ pub fn read(path: &Path) -> Result<PlyData> {
 ///
 /// # Errors
 /// As for [`read`].
-pub fn from_bytes(data: &[u8], path: &Path) -> Result<PlyData> {
+pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<PlyData> {
+    let path = path.as_ref();
     let mut c = Cursor::new(data, path, None);
     c.keyword("ply")?;
     c.keyword("format")?;
@@ -312,6 +349,17 @@ impl DataReader<'_> {
         Ok(n as usize)
     }
 
+    /// The offset where the next record starts. ASCII records may be
+    /// preceded by whitespace; a binary record never is, and its first
+    /// byte may well be 0x0a or 0x20 (a float's low byte), so nothing is
+    /// skipped there.
+    fn record_start(&mut self) -> usize {
+        if self.ascii {
+            self.c.skip_space();
+        }
+        self.c.offset()
+    }
+
     fn located(&self, at: usize, kind: ErrorKind) -> Error {
         if self.ascii {
             self.c.error_at(at, kind)
@@ -331,7 +379,10 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
     let (Some(x), Some(y), Some(z)) = (find(&["x"]), find(&["y"]), find(&["z"])) else {
         return Err(Error::new(
             r.c.path(),
-            ErrorKind::Truncated("vertex properties x, y and z".into()),
+            ErrorKind::Syntax {
+                expected: "vertex properties x, y and z".into(),
+                found: "a vertex element without them".into(),
+            },
         ));
     };
     let normal = [find(&["nx"]), find(&["ny"]), find(&["nz"])];
@@ -345,7 +396,10 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
         find(&["s", "u", "texture_u"]),
         find(&["t", "v", "texture_v"]),
     ];
-    let known: Vec<usize> = [Some(x), Some(y), Some(z), alpha]
+    // An integer `face_id` is a sampled point's triangle; a float one is
+    // kept as an ordinary scalar.
+    let face_id = find(&["face_id"]).filter(|&i| !element.properties[i].kind.is_float());
+    let known: Vec<usize> = [Some(x), Some(y), Some(z), alpha, face_id]
         .into_iter()
         .chain(normal)
         .chain(color)
@@ -360,37 +414,33 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
     let has_normal = normal.iter().all(Option::is_some);
     let has_color = color.iter().all(Option::is_some);
     let has_uv = uv.iter().all(Option::is_some);
-    out.positions.reserve(n);
+    let mut points: Vec<DVec3> = Vec::with_capacity(n);
     let mut normals = Vec::with_capacity(if has_normal { n } else { 0 });
     let mut colors = Vec::with_capacity(if has_color { n } else { 0 });
     let mut uvs = Vec::with_capacity(if has_uv { n } else { 0 });
+    let mut face_ids = Vec::with_capacity(if face_id.is_some() { n } else { 0 });
     let mut scalars: Vec<(String, Vec<f32>)> = extra
         .iter()
         .map(|&i| (element.properties[i].name.clone(), Vec::with_capacity(n)))
         .collect();
     let mut values = vec![0.0f64; element.properties.len()];
     let to_u8 = |v: f64, kind: Scalar| {
-        if matches!(kind, Scalar::F32 | Scalar::F64) {
+        if kind.is_float() {
             (v.clamp(0.0, 1.0) * 255.0).round() as u8
         } else {
             v.clamp(0.0, 255.0) as u8
         }
     };
     for index in 0..n {
-        r.c.skip_space();
-        let at = r.c.offset();
+        let at = r.record_start();
         for (slot, p) in values.iter_mut().zip(&element.properties) {
             *slot = r.property(p)?;
         }
-        let p = Vec3::new(values[x] as f32, values[y] as f32, values[z] as f32);
-        if !p.is_finite() {
-            let value = [values[x], values[y], values[z]]
-                .into_iter()
-                .find(|v| !(*v as f32).is_finite())
-                .unwrap_or(f64::NAN);
+        let p = DVec3::new(values[x], values[y], values[z]);
+        if let Some(value) = p.to_array().into_iter().find(|v| !v.is_finite()) {
             return Err(r.located(at, ErrorKind::NonFinite { index, value }));
         }
-        out.positions.push(p);
+        points.push(p);
         if has_normal {
             normals.push(Vec3::from(normal.map(|i| values[i.unwrap_or(0)] as f32)));
         }
@@ -404,18 +454,45 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
             ]);
         }
         if has_uv {
+            // PLY's t grows upwards (as OBJ's v); ours grows downwards.
             uvs.push(Vec2::new(
                 values[uv[0].unwrap_or(0)] as f32,
-                values[uv[1].unwrap_or(0)] as f32,
+                1.0 - values[uv[1].unwrap_or(0)] as f32,
             ));
+        }
+        if let Some(i) = face_id {
+            let v = values[i];
+            if !(0.0..=f64::from(u32::MAX)).contains(&v) {
+                return Err(r.located(
+                    at,
+                    ErrorKind::Syntax {
+                        expected: format!("a face_id from 0 to {} at vertex {index}", u32::MAX),
+                        found: v.to_string(),
+                    },
+                ));
+            }
+            face_ids.push(v as u32);
         }
         for ((_, column), &i) in scalars.iter_mut().zip(&extra) {
             column.push(values[i] as f32);
         }
     }
+    let (origin, positions) = super::recenter(&points);
+    if let Some(index) = positions.iter().position(|p| !p.is_finite()) {
+        let value = points[index].max_element();
+        return Err(Error::new(
+            r.c.path(),
+            ErrorKind::OutOfRange(format!(
+                "vertex {index} is at {value}, too far from the other vertices for f32 positions"
+            )),
+        ));
+    }
+    out.origin = origin;
+    out.positions = positions;
     out.normals = has_normal.then_some(normals);
     out.colors = has_color.then_some(colors);
     out.uvs = has_uv.then_some(uvs);
+    out.face_ids = face_id.map(|_| face_ids);
     out.scalars = scalars;
     Ok(())
 }
@@ -427,8 +504,7 @@ fn read_faces(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -> R
         .position(|p| p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index"));
     let mut polygon: Vec<u32> = Vec::new();
     for _ in 0..element.count {
-        r.c.skip_space();
-        let at = r.c.offset();
+        let at = r.record_start();
         for (i, p) in element.properties.iter().enumerate() {
             if Some(i) != indices {
                 r.property(p)?;
@@ -467,33 +543,105 @@ fn read_faces(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -> R
     Ok(())
 }
 
-/// Writes `data` as a `.ply` file.
+/// Writes `data` as a `.ply` file: `float` coordinates (`double` when
+/// [`PlyData::origin`] is not zero, with the origin added back), then
+/// normals `nx ny nz`, colours `red green blue alpha` (uchar), texture
+/// coordinates `s t` (v up, as PLY tools expect), `uint face_id`, and the
+/// extra scalars as `float`; faces as `list uchar int vertex_indices`.
 ///
 /// # Errors
-/// [`ErrorKind::InvalidInput`] for attribute arrays of the wrong length or
-/// triangles referencing missing vertices; an I/O error.
-pub fn write(path: &Path, data: &PlyData, format: Format) -> Result<()> {
+/// [`ErrorKind::InvalidInput`] for attribute arrays of the wrong length,
+/// a scalar name PLY cannot hold, or triangles referencing missing
+/// vertices; an I/O error.
+pub fn write(path: impl AsRef<Path>, data: &PlyData, format: Format) -> Result<()> {
+    let path = path.as_ref();
     let bytes = to_bytes(path, data, format)?;
     std::fs::write(path, bytes).map_err(|e| Error::io(path, e))
+}
+
+/// Appends one value in the format's encoding.
+trait Encode: Copy + std::fmt::Display {
+    fn le(self, out: &mut Vec<u8>);
+    fn be(self, out: &mut Vec<u8>);
+}
+
+macro_rules! encode {
+    ($($t:ty),*) => {$(
+        impl Encode for $t {
+            fn le(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_le_bytes());
+            }
+            fn be(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_be_bytes());
+            }
+        }
+    )*};
+}
+encode!(u8, i32, u32, f32, f64);
+
+/// Writes values in one of the three encodings.
+struct Sink {
+    out: Vec<u8>,
+    format: Format,
+    /// Whether the current ASCII line has a value yet.
+    started: bool,
+}
+
+impl Sink {
+    fn put<T: Encode>(&mut self, value: T) {
+        match self.format {
+            Format::Ascii => {
+                if self.started {
+                    self.out.push(b' ');
+                }
+                let _ = write!(AsciiOut(&mut self.out), "{value}");
+                self.started = true;
+            }
+            Format::BinaryLittleEndian => value.le(&mut self.out),
+            Format::BinaryBigEndian => value.be(&mut self.out),
+        }
+    }
+
+    fn end_record(&mut self) {
+        if self.format == Format::Ascii {
+            self.out.push(b'\n');
+            self.started = false;
+        }
+    }
+}
+
+/// `fmt::Write` into a byte vector.
+struct AsciiOut<'a>(&'a mut Vec<u8>);
+
+impl std::fmt::Write for AsciiOut<'_> {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        self.0.extend_from_slice(s.as_bytes());
+        Ok(())
+    }
 }
 
 /// The `.ply` file as bytes; `path` names it in errors.
 ///
 /// # Errors
 /// As for [`write()`], without the I/O.
-pub fn to_bytes(path: &Path, data: &PlyData, format: Format) -> Result<Vec<u8>> {
+pub fn to_bytes(path: impl AsRef<Path>, data: &PlyData, format: Format) -> Result<Vec<u8>> {
+    let path = path.as_ref();
     let n = data.positions.len();
     let invalid = |what: String| Error::new(path, ErrorKind::InvalidInput(what));
     let lengths = [
         ("normals", data.normals.as_ref().map(Vec::len)),
         ("colors", data.colors.as_ref().map(Vec::len)),
         ("uvs", data.uvs.as_ref().map(Vec::len)),
+        ("face ids", data.face_ids.as_ref().map(Vec::len)),
     ];
     for (name, len) in lengths {
         if let Some(len) = len.filter(|&l| l != n) {
             return Err(invalid(format!("{len} {name} for {n} vertices")));
         }
     }
+    let reserved = [
+        "x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha", "s", "t", "face_id",
+    ];
     for (name, column) in &data.scalars {
         if column.len() != n {
             return Err(invalid(format!(
@@ -501,9 +649,14 @@ pub fn to_bytes(path: &Path, data: &PlyData, format: Format) -> Result<Vec<u8>> 
                 column.len()
             )));
         }
-        if name.is_empty() || name.contains(char::is_whitespace) {
+        if name.is_empty() || !name.chars().all(|c| c.is_ascii_graphic()) {
             return Err(invalid(format!(
-                "scalar name {name:?} is not a PLY property name"
+                "scalar name {name:?} is not a PLY property name (printable ASCII, no spaces)"
+            )));
+        }
+        if reserved.contains(&name.as_str()) {
+            return Err(invalid(format!(
+                "scalar name {name:?} is taken by a standard vertex property"
             )));
         }
     }
@@ -515,15 +668,23 @@ pub fn to_bytes(path: &Path, data: &PlyData, format: Format) -> Result<Vec<u8>> 
     {
         return Err(invalid(format!("triangle {t} references a missing vertex")));
     }
+    if !data.origin.is_finite() {
+        return Err(invalid(format!("origin {} is not finite", data.origin)));
+    }
+    let shifted = data.origin != DVec3::ZERO;
 
     let mut header = String::from("ply\n");
     header.push_str(match format {
         Format::Ascii => "format ascii 1.0\n",
         Format::BinaryLittleEndian => "format binary_little_endian 1.0\n",
+        Format::BinaryBigEndian => "format binary_big_endian 1.0\n",
     });
     header.push_str("comment written by trilux-io\n");
     let _ = writeln!(header, "element vertex {n}");
-    header.push_str("property float x\nproperty float y\nproperty float z\n");
+    let coordinate = if shifted { "double" } else { "float" };
+    for axis in ["x", "y", "z"] {
+        let _ = writeln!(header, "property {coordinate} {axis}");
+    }
     if data.normals.is_some() {
         header.push_str("property float nx\nproperty float ny\nproperty float nz\n");
     }
@@ -535,6 +696,9 @@ pub fn to_bytes(path: &Path, data: &PlyData, format: Format) -> Result<Vec<u8>> 
     if data.uvs.is_some() {
         header.push_str("property float s\nproperty float t\n");
     }
+    if data.face_ids.is_some() {
+        header.push_str("property uint face_id\n");
+    }
     for (name, _) in &data.scalars {
         let _ = writeln!(header, "property float {name}");
     }
@@ -544,62 +708,51 @@ pub fn to_bytes(path: &Path, data: &PlyData, format: Format) -> Result<Vec<u8>> 
     }
     header.push_str("end_header\n");
 
-    let mut out = header.into_bytes();
-    match format {
-        Format::Ascii => {
-            let mut line = String::new();
-            for i in 0..n {
-                line.clear();
-                let p = data.positions[i];
-                let _ = write!(line, "{} {} {}", p.x, p.y, p.z);
-                if let Some(normals) = &data.normals {
-                    let q = normals[i];
-                    let _ = write!(line, " {} {} {}", q.x, q.y, q.z);
-                }
-                if let Some(colors) = &data.colors {
-                    let [r, g, b, a] = colors[i];
-                    let _ = write!(line, " {r} {g} {b} {a}");
-                }
-                if let Some(uvs) = &data.uvs {
-                    let _ = write!(line, " {} {}", uvs[i].x, uvs[i].y);
-                }
-                for (_, column) in &data.scalars {
-                    let _ = write!(line, " {}", column[i]);
-                }
-                line.push('\n');
-                out.extend_from_slice(line.as_bytes());
-            }
-            for t in &data.triangles {
-                out.extend_from_slice(format!("3 {} {} {}\n", t[0], t[1], t[2]).as_bytes());
-            }
+    let mut sink = Sink {
+        out: header.into_bytes(),
+        format,
+        started: false,
+    };
+    for i in 0..n {
+        let p = data.positions[i];
+        if shifted {
+            let q = data.origin + p.as_dvec3();
+            [q.x, q.y, q.z].into_iter().for_each(|v| sink.put(v));
+        } else {
+            [p.x, p.y, p.z].into_iter().for_each(|v| sink.put(v));
         }
-        Format::BinaryLittleEndian => {
-            for i in 0..n {
-                let mut floats = data.positions[i].to_array().to_vec();
-                if let Some(normals) = &data.normals {
-                    floats.extend(normals[i].to_array());
-                }
-                for f in floats {
-                    out.extend_from_slice(&f.to_le_bytes());
-                }
-                if let Some(colors) = &data.colors {
-                    out.extend_from_slice(&colors[i]);
-                }
-                if let Some(uvs) = &data.uvs {
-                    out.extend_from_slice(&uvs[i].x.to_le_bytes());
-                    out.extend_from_slice(&uvs[i].y.to_le_bytes());
-                }
-                for (_, column) in &data.scalars {
-                    out.extend_from_slice(&column[i].to_le_bytes());
-                }
-            }
-            for t in &data.triangles {
-                out.push(3);
-                for &i in t {
-                    out.extend_from_slice(&(i as i32).to_le_bytes());
-                }
-            }
+        if let Some(normals) = &data.normals {
+            normals[i].to_array().into_iter().for_each(|v| sink.put(v));
         }
+        if let Some(colors) = &data.colors {
+            colors[i].into_iter().for_each(|v| sink.put(v));
+        }
+        if let Some(uvs) = &data.uvs {
+            // Back to PLY's v-up convention (the reader's flip, undone).
+            sink.put(uvs[i].x);
+            sink.put(1.0 - uvs[i].y);
+        }
+        if let Some(ids) = &data.face_ids {
+            sink.put(ids[i]);
+        }
+        for (_, column) in &data.scalars {
+            sink.put(column[i]);
+        }
+        sink.end_record();
     }
-    Ok(out)
+    for t in &data.triangles {
+        sink.put(3u8);
+        for &i in t {
+            // `i < n`, and a vertex count beyond i32::MAX cannot be
+            // written as PLY's `int` indices.
+            let index = i32::try_from(i).map_err(|_| {
+                invalid(format!(
+                    "vertex index {i} does not fit the int vertex_indices of PLY"
+                ))
+            })?;
+            sink.put(index);
+        }
+        sink.end_record();
+    }
+    Ok(sink.out)
 }

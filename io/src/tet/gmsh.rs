@@ -76,7 +76,8 @@ struct Parts {
 /// [`Error`] with the file and line (or byte offset in binary sections): an
 /// unsupported version, a malformed, truncated or out-of-range record, a
 /// non-finite coordinate, or a tetrahedron that references a missing node.
-pub fn read(path: &Path) -> Result<TetMesh> {
+pub fn read(path: impl AsRef<Path>) -> Result<TetMesh> {
+    let path = path.as_ref();
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     from_bytes(&data, path)
 }
@@ -86,7 +87,8 @@ pub fn read(path: &Path) -> Result<TetMesh> {
 ///
 /// # Errors
 /// As for [`read`].
-pub fn from_bytes(data: &[u8], path: &Path) -> Result<TetMesh> {
+pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<TetMesh> {
+    let path = path.as_ref();
     let mut c = Cursor::new(data, path, None);
     c.keyword("$MeshFormat")?;
     let (at, version) = c.expect_token("the format version")?;
@@ -196,6 +198,7 @@ fn finish(parts: Parts, c: &Cursor<'_>) -> Result<TetMesh> {
         positions: parts.positions,
         tets,
         regions,
+        attributes: Vec::new(),
     })
 }
 

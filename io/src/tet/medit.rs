@@ -38,7 +38,8 @@ const SKIPPED: [(&str, u64, u64); 17] = [
 /// [`Error`] with the file and line: a malformed or truncated record, a
 /// non-finite coordinate, a tetrahedron referencing a missing node, a
 /// dimension other than 3, or an unknown keyword.
-pub fn read(path: &Path) -> Result<TetMesh> {
+pub fn read(path: impl AsRef<Path>) -> Result<TetMesh> {
+    let path = path.as_ref();
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     from_bytes(&data, path)
 }
@@ -47,7 +48,8 @@ pub fn read(path: &Path) -> Result<TetMesh> {
 ///
 /// # Errors
 /// As for [`read`].
-pub fn from_bytes(data: &[u8], path: &Path) -> Result<TetMesh> {
+pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<TetMesh> {
+    let path = path.as_ref();
     let mut c = Cursor::new(data, path, Some(b'#'));
     c.keyword("MeshVersionFormatted")?;
     let (at, version) = c.expect_token("the format version")?;
@@ -157,6 +159,7 @@ pub fn from_bytes(data: &[u8], path: &Path) -> Result<TetMesh> {
         positions,
         tets,
         regions,
+        attributes: Vec::new(),
     })
 }
 
@@ -166,7 +169,8 @@ pub fn from_bytes(data: &[u8], path: &Path) -> Result<TetMesh> {
 ///
 /// # Errors
 /// [`Error`] for a tetrahedron referencing a missing node, or an I/O error.
-pub fn write(path: &Path, mesh: &TetMesh) -> Result<()> {
+pub fn write(path: impl AsRef<Path>, mesh: &TetMesh) -> Result<()> {
+    let path = path.as_ref();
     mesh.check_indices(path)?;
     let mut text = String::with_capacity(64 * mesh.positions.len() + 40 * mesh.tets.len());
     text.push_str("MeshVersionFormatted 2\nDimension 3\n");

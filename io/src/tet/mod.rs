@@ -22,11 +22,46 @@ pub struct TetMesh {
     /// One region tag per tetrahedron (TetGen's region attribute, Gmsh's
     /// physical tag), or empty when the file has none.
     pub regions: Vec<i32>,
+    /// The real-valued per-tetrahedron attributes a TetGen `.ele` file
+    /// stores, one column per attribute: `attributes[k][t]` is attribute
+    /// `k` of tetrahedron `t`. [`regions`](Self::regions) is the first
+    /// column when all its values are integers (TetGen's region tags),
+    /// and empty otherwise. Empty for the other formats.
+    pub attributes: Vec<Vec<f64>>,
 }
 
 /// The faces of tetrahedron `(0, 1, 2, 3)` with outward normals (right-hand
 /// rule) when it is positively oriented, `det[p1-p0, p2-p0, p3-p0] > 0`.
 const OUTWARD_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+
+/// Reads a tetrahedral mesh, choosing the format by extension (see
+/// [`TetMesh::read`]).
+///
+/// # Errors
+/// [`Error`] naming the file, the line or byte, and what was wrong.
+pub fn read(path: impl AsRef<Path>) -> Result<TetMesh> {
+    TetMesh::read(path)
+}
+
+/// Writes a tetrahedral mesh, choosing the format by extension: `.node` or
+/// `.ele` (TetGen, both files), `.mesh` (MEDIT), `.vtu` (VTK, ASCII, no
+/// fields; [`vtu::write`] adds fields).
+///
+/// # Errors
+/// [`crate::ErrorKind::UnknownExtension`] for other extensions; the
+/// writer's errors.
+pub fn write(path: impl AsRef<Path>, mesh: &TetMesh) -> Result<()> {
+    let path = path.as_ref();
+    match crate::error::extension(path).as_str() {
+        "node" | "ele" => tetgen::write(path, mesh),
+        "mesh" => medit::write(path, mesh),
+        "vtu" => vtu::write(path, mesh, &[], &[], vtu::Encoding::Ascii),
+        other => Err(Error::new(
+            path,
+            ErrorKind::UnknownExtension(other.to_string(), ".node, .ele, .mesh, .vtu"),
+        )),
+    }
+}
 
 impl TetMesh {
     /// Reads a tetrahedral mesh, choosing the format by extension: `.node`
@@ -43,7 +78,7 @@ impl TetMesh {
             "mesh" => medit::read(path),
             other => Err(Error::new(
                 path,
-                ErrorKind::UnknownExtension(other.to_string(), ".node, .ele, .msh"),
+                ErrorKind::UnknownExtension(other.to_string(), ".node, .ele, .msh, .mesh"),
             )),
         }
     }
@@ -144,6 +179,7 @@ mod tests {
             positions: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z],
             tets: vec![[0, 1, 2, 3]],
             regions: Vec::new(),
+            attributes: Vec::new(),
         }
     }
 

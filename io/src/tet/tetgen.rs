@@ -42,7 +42,8 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>> {
 /// truncated record, a non-finite coordinate, a tetrahedron referencing a
 /// missing node, numbering that is not consecutive, or a header count the
 /// file cannot hold.
-pub fn read(path: &Path) -> Result<TetMesh> {
+pub fn read(path: impl AsRef<Path>) -> Result<TetMesh> {
+    let path = path.as_ref();
     let node = read_bytes(&sibling(path, "node"))?;
     let ele = read_bytes(&sibling(path, "ele"))?;
     from_bytes(&node, &ele, path)
@@ -54,18 +55,21 @@ pub fn read(path: &Path) -> Result<TetMesh> {
 ///
 /// # Errors
 /// As for [`read`].
-pub fn from_bytes(node: &[u8], ele: &[u8], path: &Path) -> Result<TetMesh> {
+pub fn from_bytes(node: &[u8], ele: &[u8], path: impl AsRef<Path>) -> Result<TetMesh> {
+    let path = path.as_ref();
     parse_pair(node, ele, path).map(|(mesh, _)| mesh)
 }
 
 /// The mesh of a `.node` and an `.ele` file, and the first node index.
 fn parse_pair(node: &[u8], ele: &[u8], path: &Path) -> Result<(TetMesh, i64)> {
     let (positions, first_index) = parse_nodes(node, &sibling(path, "node"))?;
-    let (tets, regions) = parse_elements(ele, &sibling(path, "ele"), first_index, positions.len())?;
+    let (tets, attributes) =
+        parse_elements(ele, &sibling(path, "ele"), first_index, positions.len())?;
     let mesh = TetMesh {
         positions,
         tets,
-        regions,
+        regions: region_tags(&attributes),
+        attributes,
     };
     Ok((mesh, first_index))
 }
@@ -74,7 +78,8 @@ fn parse_pair(node: &[u8], ele: &[u8], path: &Path) -> Result<(TetMesh, i64)> {
 ///
 /// # Errors
 /// As for [`read`], and for the `.face` file.
-pub fn read_all(path: &Path) -> Result<TetGenFiles> {
+pub fn read_all(path: impl AsRef<Path>) -> Result<TetGenFiles> {
+    let path = path.as_ref();
     let node = read_bytes(&sibling(path, "node"))?;
     let ele = read_bytes(&sibling(path, "ele"))?;
     let (mesh, first_index) = parse_pair(&node, &ele, path)?;
@@ -188,7 +193,9 @@ pub(crate) fn parse_nodes(data: &[u8], path: &Path) -> Result<(Vec<DVec3>, i64)>
     if declared == 0 {
         return Err(c.error_at(
             at,
-            ErrorKind::Unsupported("a .node file with 0 points (points in a .poly file)".into()),
+            ErrorKind::Unsupported(
+                "a .node file with 0 points (the points are in a .poly file)".into(),
+            ),
         ));
     }
     // Smallest record: "i x y z" plus attributes and markers, one byte and
@@ -223,13 +230,33 @@ pub(crate) fn parse_nodes(data: &[u8], path: &Path) -> Result<(Vec<DVec3>, i64)>
     Ok((positions, first_index))
 }
 
-/// Parses a `.ele` file: tetrahedra (0-based) and region tags.
+/// The region tags of [`TetMesh::regions`]: the first attribute column
+/// when every value of it is an integer in `i32`'s range, else none.
+fn region_tags(attributes: &[Vec<f64>]) -> Vec<i32> {
+    let Some(first) = attributes.first() else {
+        return Vec::new();
+    };
+    let range = f64::from(i32::MIN)..=f64::from(i32::MAX);
+    if first.iter().all(|v| v.fract() == 0.0 && range.contains(v)) {
+        first.iter().map(|&v| v as i32).collect()
+    } else {
+        Vec::new()
+    }
+}
+
+/// How many attribute columns are kept in memory; more are read and
+/// skipped (their values still have to parse). A budget, since the header
+/// sets the allocation.
+const MAX_ATTRIBUTES: u64 = 64;
+
+/// Parses a `.ele` file: tetrahedra (0-based) and their attributes, one
+/// column per attribute.
 pub(crate) fn parse_elements(
     data: &[u8],
     path: &Path,
     first_index: i64,
     node_count: usize,
-) -> Result<(Vec<[u32; 4]>, Vec<i32>)> {
+) -> Result<(Vec<[u32; 4]>, Vec<Vec<f64>>)> {
     let mut c = Cursor::new(data, path, Some(b'#'));
     let declared = c.u64("the number of tetrahedra")?;
     let (at, per_tok) = c.expect_token("the number of nodes per tetrahedron")?;
@@ -244,8 +271,16 @@ pub(crate) fn parse_elements(
         declared,
         min_record_bytes(1 + per_tet, attributes),
     )?;
+    if attributes > MAX_ATTRIBUTES {
+        return Err(c.error_at(
+            0,
+            ErrorKind::LimitExceeded(format!(
+                "{attributes} attributes per tetrahedron (at most {MAX_ATTRIBUTES} are read)"
+            )),
+        ));
+    }
     let mut tets = Vec::with_capacity(count);
-    let mut regions = Vec::with_capacity(if attributes > 0 { count } else { 0 });
+    let mut columns: Vec<Vec<f64>> = (0..attributes).map(|_| Vec::with_capacity(count)).collect();
     for k in 0..count {
         record_index(&mut c, first_index + k as i64, "tetrahedron")?;
         let mut tet = [0u32; 4];
@@ -255,26 +290,24 @@ pub(crate) fn parse_elements(
         // Quadratic tetrahedra: the six edge nodes follow the corners.
         skip_tokens(&mut c, per_tet - 4, "an edge node")?;
         tets.push(tet);
-        if attributes > 0 {
+        for column in &mut columns {
             let at = {
                 c.skip_space();
                 c.offset()
             };
-            let value = c.f64("a region attribute")?;
-            if value.fract() != 0.0 || !(f64::from(i32::MIN)..=f64::from(i32::MAX)).contains(&value)
-            {
+            let value = c.f64("a tetrahedron attribute")?;
+            if !value.is_finite() {
                 return Err(c.syntax(
                     at,
-                    "an integer region attribute",
+                    "a finite tetrahedron attribute",
                     value.to_string().as_bytes(),
                 ));
             }
-            regions.push(value as i32);
-            skip_tokens(&mut c, attributes - 1, "a tetrahedron attribute")?;
+            column.push(value);
         }
     }
     expect_end(&mut c, "tetrahedron")?;
-    Ok((tets, regions))
+    Ok((tets, columns))
 }
 
 /// Parses a `.face` file: triangles (0-based).
@@ -307,27 +340,69 @@ pub(crate) fn parse_faces(
     Ok(faces)
 }
 
-/// Writes `<name>.node` and `<name>.ele` (1-based, TetGen's default; one
-/// region attribute per tetrahedron when the mesh has regions).
+/// Writes `<name>.node` and `<name>.ele` (1-based, TetGen's default). The
+/// `.ele` attributes are [`TetMesh::attributes`] when there are any
+/// (then [`TetMesh::regions`], if given, must equal the first column), else
+/// one region attribute per tetrahedron when the mesh has regions.
 /// Coordinates are written in Rust's shortest round-trip form, so reading
 /// them back gives the same bits.
 ///
 /// # Errors
 /// [`Error`] for a tetrahedron referencing a missing node, or an I/O error.
-pub fn write(path: &Path, mesh: &TetMesh) -> Result<()> {
+pub fn write(path: impl AsRef<Path>, mesh: &TetMesh) -> Result<()> {
+    let path = path.as_ref();
     let node_path = sibling(path, "node");
     let ele_path = sibling(path, "ele");
     mesh.check_indices(&ele_path)?;
     if !mesh.regions.is_empty() && mesh.regions.len() != mesh.tets.len() {
         return Err(Error::new(
             &ele_path,
-            ErrorKind::Unsupported(format!(
+            ErrorKind::InvalidInput(format!(
                 "{} region tags for {} tetrahedra",
                 mesh.regions.len(),
                 mesh.tets.len()
             )),
         ));
     }
+    let columns: Vec<Vec<f64>> = if mesh.attributes.is_empty() {
+        (!mesh.regions.is_empty())
+            .then(|| mesh.regions.iter().map(|&r| f64::from(r)).collect())
+            .into_iter()
+            .collect()
+    } else {
+        if let Some(k) = mesh
+            .attributes
+            .iter()
+            .position(|c| c.len() != mesh.tets.len())
+        {
+            return Err(Error::new(
+                &ele_path,
+                ErrorKind::InvalidInput(format!(
+                    "attribute {k} has {} values for {} tetrahedra",
+                    mesh.attributes[k].len(),
+                    mesh.tets.len()
+                )),
+            ));
+        }
+        let first = &mesh.attributes[0];
+        if !mesh.regions.is_empty()
+            && mesh
+                .regions
+                .iter()
+                .zip(first)
+                .any(|(&r, &a)| f64::from(r) != a)
+        {
+            return Err(Error::new(
+                &ele_path,
+                ErrorKind::InvalidInput(
+                    "the region tags differ from the first attribute column, and the .ele file \
+                     holds only one of them"
+                        .into(),
+                ),
+            ));
+        }
+        mesh.attributes.clone()
+    };
     let mut text = String::with_capacity(mesh.positions.len() * 64);
     text.push_str("# written by trilux-io; 1-based\n");
     let _ = writeln!(text, "{} 3 0 0", mesh.positions.len());
@@ -337,7 +412,7 @@ pub fn write(path: &Path, mesh: &TetMesh) -> Result<()> {
     write_text(&node_path, &text)?;
 
     text.clear();
-    let attributes = usize::from(!mesh.regions.is_empty());
+    let attributes = columns.len();
     text.push_str("# written by trilux-io; 1-based\n");
     let _ = writeln!(text, "{} 4 {attributes}", mesh.tets.len());
     for (i, t) in mesh.tets.iter().enumerate() {
@@ -350,8 +425,8 @@ pub fn write(path: &Path, mesh: &TetMesh) -> Result<()> {
             t[2] + 1,
             t[3] + 1
         );
-        if let Some(r) = mesh.regions.get(i) {
-            let _ = write!(text, " {r}");
+        for column in &columns {
+            let _ = write!(text, " {}", column[i]);
         }
         text.push('\n');
     }

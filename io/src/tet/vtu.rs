@@ -37,12 +37,13 @@ const VTK_TETRA: u8 = 10;
 /// [`ErrorKind::InvalidInput`] for a field of the wrong length or a
 /// tetrahedron referencing a missing node; an I/O error.
 pub fn write(
-    path: &Path,
+    path: impl AsRef<Path>,
     mesh: &TetMesh,
     point_fields: &[Field<'_>],
     cell_fields: &[Field<'_>],
     encoding: Encoding,
 ) -> Result<()> {
+    let path = path.as_ref();
     let text = to_string(path, mesh, point_fields, cell_fields, encoding)?;
     std::fs::write(path, text).map_err(|e| Error::io(path, e))
 }
@@ -52,12 +53,13 @@ pub fn write(
 /// # Errors
 /// As for [`write()`], without the I/O.
 pub fn to_string(
-    path: &Path,
+    path: impl AsRef<Path>,
     mesh: &TetMesh,
     point_fields: &[Field<'_>],
     cell_fields: &[Field<'_>],
     encoding: Encoding,
 ) -> Result<String> {
+    let path = path.as_ref();
     mesh.check_indices(path)?;
     for (fields, expected, what) in [
         (point_fields, mesh.positions.len(), "nodes"),
