@@ -695,7 +695,7 @@ fn peers(m: &TestMesh, file: &Path, threads: &[usize], json: bool) -> Result<(),
             (0..3)
                 .map(|seed| {
                     let start = Instant::now();
-                    black_box(uniform.sample_positions(seed, PEER_N));
+                    black_box(uniform.sample_positions(seed, PEER_N).unwrap());
                     start.elapsed().as_secs_f64()
                 })
                 .collect()

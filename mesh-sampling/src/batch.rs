@@ -4,8 +4,8 @@
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::SurfacePoint;
-use crate::parallel::{for_each_chunk, for_each_chunk_via, stream};
+use crate::parallel::{check_points, for_each_chunk, for_each_chunk_via, stream};
+use crate::{Error, SurfacePoint};
 
 /// A sampler of points on a mesh, with batch APIs whose output depends
 /// only on the seed, never on the number of threads: points come in
@@ -21,10 +21,15 @@ pub trait SurfaceSampler: Distribution<SurfacePoint> + Sync {
     }
 
     /// `n` points from `seed`.
-    fn sample_n(&self, seed: u64, n: usize) -> Vec<SurfacePoint> {
+    ///
+    /// # Errors
+    /// [`Error::TooManyPoints`] if `n` exceeds [`MAX_POINTS`](crate::MAX_POINTS)
+    /// (checked before allocating; stream them instead).
+    fn sample_n(&self, seed: u64, n: usize) -> Result<Vec<SurfacePoint>, Error> {
+        check_points(n as f64)?;
         let mut out = vec![SurfacePoint::default(); n];
         for_each_chunk(seed, &mut out, |rng, chunk| self.sample_into(rng, chunk));
-        out
+        Ok(out)
     }
 
     /// The positions of the points of [`sample_n`](Self::sample_n), as
@@ -32,7 +37,11 @@ pub trait SurfaceSampler: Distribution<SurfacePoint> + Sync {
     /// output of trimesh's `sample_surface` or Open3D's
     /// `sample_points_uniformly`), which for 10⁷ points is also faster to
     /// allocate and write.
-    fn sample_positions(&self, seed: u64, n: usize) -> Vec<[f32; 3]> {
+    ///
+    /// # Errors
+    /// [`Error::TooManyPoints`] if `n` exceeds [`MAX_POINTS`](crate::MAX_POINTS).
+    fn sample_positions(&self, seed: u64, n: usize) -> Result<Vec<[f32; 3]>, Error> {
+        check_points(n as f64)?;
         // Zeroed arrays come from the allocator as zero pages, written once.
         let mut out = vec![[0.0f32; 3]; n];
         for_each_chunk_via(
@@ -41,7 +50,7 @@ pub trait SurfaceSampler: Distribution<SurfacePoint> + Sync {
             |rng, chunk| self.sample_into(rng, chunk),
             |p: &SurfacePoint| p.position.to_array(),
         );
-        out
+        Ok(out)
     }
 
     /// The points of [`sample_n`](Self::sample_n), handed chunk by chunk

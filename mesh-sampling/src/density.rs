@@ -7,10 +7,11 @@ use glam::{DVec2, Vec2};
 use rand::Rng;
 use rand::distr::Distribution;
 
+use crate::layout::{Piece, PieceAlias};
 use crate::parallel::{BLOCK, unit};
 use crate::point::{Frame, uniform_barycentric};
-use crate::subdivision::{self, MAX_LEVEL, Merge, SubTriangle};
-use crate::{DensityTexture, Error, MeshRef, SurfacePoint, SurfaceSampler};
+use crate::subdivision::{self, MAX_LEVEL, Merge, SubTriangle, Values};
+use crate::{DensityTexture, Error, Layout, MeshRef, SurfacePoint, SurfaceSampler};
 
 /// Where the density comes from.
 #[derive(Debug, Clone, Copy)]
@@ -38,11 +39,45 @@ pub enum Mode {
     Exact,
 }
 
+/// How the subdivision depth of a triangle follows the texels it covers
+/// (Šik & Křivánek 2013, Sec. 3.4: "each triangle is subdivided so that its
+/// sub-triangles are smaller than a texel").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Depth {
+    /// The level `L` with `4^L` nearest to the texel count `T` of the
+    /// triangle (in log scale): sub-triangles of half a texel to two.
+    #[default]
+    Nearest,
+    /// The paper's rule: the smallest `L` with `T / 4^L ≤ 1`, so every
+    /// sub-triangle covers at most one texel. Up to four times the pieces
+    /// of [`Nearest`](Self::Nearest).
+    AtMostOneTexel,
+}
+
 /// How finely a texture density is subdivided and merged.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
     /// Approximate (the paper) or exact.
     pub mode: Mode,
+    /// How a piece is drawn: the alias table with inlined records
+    /// (default, one cache miss a draw) or the order-preserving inversion
+    /// method.
+    pub layout: Layout,
+    /// The depth rule by texel count (both rules also subdivide until no
+    /// sub-triangle edge spans more than two texels).
+    pub depth: Depth,
+    /// The most sub-triangles the subdivision may make before merging,
+    /// `Σ 4^L` over the triangles whose texture footprint is not constant
+    /// (a constant one is one piece). Computed before anything is built;
+    /// when the depths ask for more, the deepest triangles are capped at
+    /// a common level until the sum fits (coarser where it must: each
+    /// capped sub-triangle takes the density at its barycenter, and the
+    /// exact mode stays exact, with a lower acceptance). Default
+    /// `1 << 22` (4,194,304: about 200 MB of tables), four sub-triangles
+    /// per texel of a 1024² texture; the error
+    /// [`Error::TooManyPieces`] only when even one piece per triangle
+    /// exceeds it.
+    pub max_pieces: usize,
     /// The deepest subdivision level, at most 13 (`4^13` sub-triangles for
     /// one triangle). Default 11: a triangle spanning a 2048² texture.
     pub max_level: u8,
@@ -63,6 +98,9 @@ impl Default for Options {
     fn default() -> Self {
         Self {
             mode: Mode::Approximate,
+            layout: Layout::Alias,
+            depth: Depth::Nearest,
+            max_pieces: DEFAULT_MAX_PIECES,
             max_level: 11,
             extra_levels: 0,
             merge_tolerance: 0.0,
@@ -70,13 +108,14 @@ impl Default for Options {
     }
 }
 
-/// One entry of the discrete distribution: a sub-triangle (or linear
-/// component) of a face, with its density value (exact mode: its bound).
-#[derive(Debug, Clone, Copy, Default)]
-struct Piece {
-    face: u32,
-    part: SubTriangle,
-    value: f32,
+/// The default of [`Options::max_pieces`].
+pub const DEFAULT_MAX_PIECES: usize = 1 << 22;
+
+/// The structure a piece is drawn from.
+#[derive(Debug, Clone)]
+enum Table<S> {
+    Alias(PieceAlias),
+    Inversion(S),
 }
 
 /// Draws points on a mesh with probability density proportional to a
@@ -88,9 +127,12 @@ struct Piece {
 /// subdivided along their length too), the density is looked up at each
 /// sub-triangle's
 /// barycenter, and four siblings of equal value merge into their parent.
-/// A sub-triangle costs a CDF entry, its triangle and a 32-bit code of its
-/// level and position (Fig. 4), decoded in O(1). `S` is the 1D sampler
-/// that picks a sub-triangle: the guide table by default,
+/// A sub-triangle costs its triangle, a 32-bit code of its level and
+/// position (Fig. 4, decoded in O(1)) and its value, plus its share of the
+/// table it is drawn from ([`Layout`]): by default an alias table whose
+/// columns hold the records themselves (one cache miss per draw). With
+/// [`Layout::Inversion`], `S` is the 1D sampler over the CDF that picks a
+/// sub-triangle: the guide table by default,
 /// [`CdfBisection`](discrete_sampling::CdfBisection) for the paper's
 /// "without table" variant.
 ///
@@ -112,7 +154,7 @@ struct Piece {
 /// let texture = DensityTexture::new(2, 1, vec![0.0, 1.0])?
 ///     .with_filter(mesh_sampling::Filter::Nearest);
 /// let sampler = DensitySampler::new(mesh, Density::Texture(&texture))?;
-/// for p in sampler.sample_n(1, 1000) {
+/// for p in sampler.sample_n(1, 1000).unwrap() {
 ///     assert!(p.position.x >= 0.5);
 ///     assert!((p.pdf - 2.0).abs() < 1e-4); // density 1 over half the area
 /// }
@@ -124,7 +166,7 @@ pub struct DensitySampler<'a, S = GuideTable> {
     density: Density<'a>,
     mode: Mode,
     pieces: Vec<Piece>,
-    table: S,
+    table: Table<S>,
     /// Pieces of face `f`: `face_start[f]..face_start[f + 1]`.
     face_start: Vec<u32>,
     /// Subdivision depth of each face (texture densities).
@@ -162,16 +204,20 @@ impl<'a> DensitySampler<'a, GuideTable> {
 impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
     /// Validates the mesh and the density, subdivides (in parallel with
     /// the `rayon` feature; the result does not depend on the thread
-    /// count) and builds the table of type `S`:
+    /// count) and builds the table `options.layout` names; with
+    /// [`Layout::Inversion`] it is of type `S`:
     /// `DensitySampler::<CdfBisection>::with_table(…)` is the paper's
-    /// variant without the lookup table.
+    /// variant without the lookup table (`S` is not used by the alias
+    /// layout).
     ///
     /// # Errors
     /// The mesh's errors ([`MeshRef::validate`]); [`Error::MissingUvs`] or
     /// [`Error::NonFiniteUv`] for a texture density;
     /// [`Error::WeightLength`], [`Error::InvalidWeight`] for weights;
-    /// [`Error::InvalidOption`]; [`Error::ZeroDensity`] when the density
-    /// is zero on every triangle of non-zero area.
+    /// [`Error::InvalidOption`]; [`Error::TooManyPieces`] when one piece
+    /// per triangle already exceeds [`Options::max_pieces`];
+    /// [`Error::ZeroDensity`] when the density is zero on every triangle
+    /// of non-zero area.
     pub fn with_table(
         mesh: MeshRef<'a>,
         density: Density<'a>,
@@ -194,9 +240,12 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         let (per_face, face_level, exact_mass) = match density {
             Density::Texture(texture) => {
                 let uvs = texture_uvs(&mesh)?;
-                let levels: Vec<u8> = map_faces(faces, |f| {
-                    face_level(texture, face_uvs(uvs, mesh.indices[f]), options)
+                let wanted: Vec<(u8, bool)> = map_faces(faces, |f| {
+                    let uv = face_uvs(uvs, mesh.indices[f]);
+                    let constant = uv_constant(texture, uv).is_some() || mesh.area(f) <= 0.0;
+                    (face_level(texture, uv, options), constant)
                 });
+                let levels = capped_levels(&wanted, options.max_pieces)?;
                 let build = |f: usize| texture_pieces(&mesh, uvs, texture, levels[f], options, f);
                 let per_face = map_faces(faces, build);
                 let exact = (options.mode == Mode::Exact).then(|| {
@@ -251,8 +300,12 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
             .map(|p| f64::from(p.value) * areas[p.face as usize] * piece_fraction(p.part))
             .collect();
         let proposal_mass: f64 = masses.iter().sum();
-        let table =
-            S::from_weights(&masses).map_err(|_| Error::ZeroDensity { triangles: faces })?;
+        let zero = Error::ZeroDensity { triangles: faces };
+        let table = match options.layout {
+            Layout::Alias => Table::Alias(PieceAlias::new(&pieces, &masses).ok_or(zero)?),
+            Layout::Inversion => Table::Inversion(S::from_weights(&masses).map_err(|_| zero)?),
+        };
+        drop(masses);
         let mass = exact_mass.unwrap_or(proposal_mass);
         if mass.is_nan() || mass <= 0.0 {
             return Err(Error::ZeroDensity { triangles: faces });
@@ -309,11 +362,23 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         self.acceptance
     }
 
+    /// The layout pieces are drawn from.
+    pub fn layout(&self) -> Layout {
+        match self.table {
+            Table::Alias(_) => Layout::Alias,
+            Table::Inversion(_) => Layout::Inversion,
+        }
+    }
+
     /// Heap memory of the sampler (pieces, table, face index and frames), not
     /// counting the mesh and texture it borrows.
     pub fn memory_bytes(&self) -> usize {
+        let table = match &self.table {
+            Table::Alias(a) => a.memory_bytes(),
+            Table::Inversion(t) => t.memory_bytes(),
+        };
         self.pieces.len() * size_of::<Piece>()
-            + self.table.memory_bytes()
+            + table
             + self.face_start.len() * size_of::<u32>()
             + self.face_level.len()
             + self.frames.len() * size_of::<Frame>()
@@ -322,11 +387,15 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
     /// The density (w.r.t. area, normalised over the mesh) this sampler
     /// draws from, at barycentrics `barycentric` of triangle `face`: what a
     /// path tracer needs for multiple importance sampling when a ray hits
-    /// the mesh. 0 outside the mesh or on a zero-area triangle.
+    /// the mesh. 0 for a triangle that does not exist, a zero-area
+    /// triangle, or barycentrics that are NaN or infinite.
     pub fn pdf(&self, face: usize, barycentric: [f32; 3]) -> f32 {
         let Some(range) = self.face_range(face) else {
             return 0.0;
         };
+        if !barycentric.iter().all(|b| b.is_finite()) {
+            return 0.0;
+        }
         let [b0, b1, b2] = barycentric.map(f64::from);
         let value = match self.density {
             Density::PerFace(w) => {
@@ -421,6 +490,35 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         }
     }
 
+    /// One piece drawn from the table (one `u64` of `rng`).
+    #[inline]
+    fn piece<R: Rng + ?Sized>(&self, rng: &mut R) -> Piece {
+        match &self.table {
+            Table::Alias(alias) => alias.piece(rng.next_u64()),
+            Table::Inversion(table) => self.pieces[table.sample_rng(rng)],
+        }
+    }
+
+    /// Fills `out` with pieces (one `u64` of `rng` each): the variates
+    /// first, then the searches, then the records, each in a pass of its
+    /// own so that the loads of independent draws overlap.
+    #[inline]
+    fn pieces_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [Piece]) {
+        match &self.table {
+            Table::Alias(alias) => alias.fill(rng, out),
+            Table::Inversion(table) => {
+                let mut picks = [0usize; BLOCK];
+                for block in out.chunks_mut(BLOCK) {
+                    let picks = &mut picks[..block.len()];
+                    table.sample_into(rng, picks);
+                    for (piece, &k) in block.iter_mut().zip(picks.iter()) {
+                        *piece = self.pieces[k];
+                    }
+                }
+            }
+        }
+    }
+
     fn exact_texture(&self) -> Option<&DensityTexture> {
         match (self.density, self.mode) {
             (Density::Texture(t), Mode::Exact) => Some(t),
@@ -443,7 +541,10 @@ impl<S: DiscreteSampler + Sync> DensitySampler<'_, S> {
     /// total_mass()`.
     ///
     /// # Errors
-    /// [`Error::InvalidDensity`] for a negative, NaN or infinite rate.
+    /// [`Error::InvalidDensity`] for a negative, NaN or infinite rate;
+    /// [`Error::TooManyPoints`] when the count could exceed
+    /// [`MAX_POINTS`](crate::MAX_POINTS) (the rate times the proposal mass,
+    /// plus one per triangle), checked before allocating.
     pub fn sample_stable(
         &self,
         seed: u64,
@@ -452,6 +553,9 @@ impl<S: DiscreteSampler + Sync> DensitySampler<'_, S> {
         if !(points_per_unit_mass >= 0.0 && points_per_unit_mass.is_finite()) {
             return Err(Error::InvalidDensity(points_per_unit_mass));
         }
+        let faces = self.mesh.indices.len() as f64;
+        let proposal_mass = self.total_mass() / self.acceptance;
+        crate::parallel::check_points(points_per_unit_mass * proposal_mass + faces)?;
         let texture = self.exact_texture();
         let triangle = |face: usize| -> Vec<SurfacePoint> {
             let Some(range) = self.face_range(face) else {
@@ -507,16 +611,12 @@ impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {
     /// the table's batch search, then their records, then the points; in
     /// exact mode, blocks of proposals of which the accepted are kept.
     fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
-        let mut picks = [0usize; BLOCK];
         let mut pieces = [Piece::default(); BLOCK];
         if let Some(texture) = self.exact_texture() {
             // Proposals in blocks, the accepted ones kept in order.
             let mut filled = 0;
             while filled < out.len() {
-                self.table.sample_into(rng, &mut picks);
-                for (piece, &k) in pieces.iter_mut().zip(&picks) {
-                    *piece = self.pieces[k];
-                }
+                self.pieces_into(rng, &mut pieces);
                 for &piece in &pieces {
                     let xi1 = unit(rng.next_u64());
                     let bary = self.place(piece, xi1, unit(rng.next_u64()));
@@ -532,11 +632,7 @@ impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {
         }
         for block in out.chunks_mut(BLOCK) {
             let n = block.len();
-            self.table.sample_into(rng, &mut picks[..n]);
-            // Gathered in a pass of their own: independent loads overlap.
-            for (piece, &k) in pieces.iter_mut().zip(&picks[..n]) {
-                *piece = self.pieces[k];
-            }
+            self.pieces_into(rng, &mut pieces[..n]);
             for (slot, &piece) in block.iter_mut().zip(&pieces) {
                 let xi1 = unit(rng.next_u64());
                 let bary = self.place(piece, xi1, unit(rng.next_u64()));
@@ -549,7 +645,7 @@ impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {
 impl<S: DiscreteSampler + Sync> Distribution<SurfacePoint> for DensitySampler<'_, S> {
     fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
         loop {
-            let piece = self.pieces[self.table.sample_rng(rng)];
+            let piece = self.piece(rng);
             let xi1 = unit(rng.next_u64());
             let bary = self.place(piece, xi1, unit(rng.next_u64()));
             let Some(texture) = self.exact_texture() else {
@@ -642,9 +738,12 @@ fn face_level(texture: &DensityTexture, uv: [DVec2; 3], options: &Options) -> u8
     let longest = (0..3)
         .map(|k| (t[(k + 1) % 3] - t[k]).length())
         .fold(0.0f64, f64::max);
-    // 4^L ≈ texels and 2^L ≥ longest / 2.
+    // 4^L ≈ texels (or ≥ texels) and 2^L ≥ longest / 2.
     let by_area = if texels > 1.0 {
-        (texels.log2() / 2.0).round()
+        match options.depth {
+            Depth::Nearest => (texels.log2() / 2.0).round(),
+            Depth::AtMostOneTexel => (texels.log2() / 2.0).ceil(),
+        }
     } else {
         0.0
     };
@@ -653,8 +752,37 @@ fn face_level(texture: &DensityTexture, uv: [DVec2; 3], options: &Options) -> u8
     } else {
         0.0
     };
+    // NaN (an infinite footprint) and huge values end at MAX_LEVEL.
     let level = by_area.max(by_edge).min(f64::from(MAX_LEVEL)) as u8;
     (level.saturating_add(options.extra_levels)).min(options.max_level)
+}
+
+/// The density's value if it is constant over the UV triangle's bounding
+/// box (O(1), whatever the footprint's size).
+fn uv_constant(texture: &DensityTexture, uv: [DVec2; 3]) -> Option<f32> {
+    let (lo, hi) = (uv[0].min(uv[1]).min(uv[2]), uv[0].max(uv[1]).max(uv[2]));
+    texture.constant_over_box(lo, hi)
+}
+
+/// The levels to build: each face's wanted level, capped at the deepest
+/// common level `C` for which `Σ 4^min(L, C)` over the faces that are not
+/// constant (plus one per constant face) stays within `budget`.
+fn capped_levels(wanted: &[(u8, bool)], budget: usize) -> Result<Vec<u8>, Error> {
+    let count = |cap: u8| -> u128 {
+        wanted
+            .iter()
+            .map(|&(l, constant)| if constant { 1 } else { 1u128 << (2 * l.min(cap)) })
+            .sum()
+    };
+    let deepest = wanted.iter().map(|w| w.0).max().unwrap_or(0);
+    let cap = (0..=deepest)
+        .rev()
+        .find(|&c| count(c) <= budget as u128)
+        .ok_or(Error::TooManyPieces {
+            needed: count(0),
+            budget,
+        })?;
+    Ok(wanted.iter().map(|&(l, _)| l.min(cap)).collect())
 }
 
 /// Sub-triangles of face `f` with their values (approximate mode: the
@@ -674,25 +802,30 @@ fn texture_pieces(
     let [a, b, c] = face_uvs(uvs, mesh.indices[f]);
     let at = |(u, v): (f64, f64)| a + (b - a) * u + (c - a) * v;
     let mut out = Vec::new();
+    // A node whose UV box is constant is one piece (its subtree would
+    // merge into it): found from the texture's tables in O(1).
+    let constant = |s: SubTriangle| uv_constant(texture, s.corners().map(at));
     match options.mode {
         Mode::Approximate => {
-            let value = |s: SubTriangle| texture.eval(at(s.barycenter())) as f32;
-            subdivision::build(
-                level,
-                options.merge_tolerance,
-                Merge::Mean,
-                &value,
-                &mut out,
-            );
+            let values = Values {
+                leaf: |s: SubTriangle| texture.eval(at(s.barycenter())) as f32,
+                constant,
+            };
+            let tolerance = options.merge_tolerance;
+            subdivision::build(level, tolerance, Merge::Mean, &values, &mut out);
         }
         Mode::Exact => {
             // The maximum over the sub-triangle's UV bounding box, rounded
             // up to f32 so that it stays a bound.
-            let value = |s: SubTriangle| {
-                let [p, q, r] = s.corners().map(at);
-                round_up(texture.max_over_box(p.min(q).min(r), p.max(q).max(r)))
+            let values = Values {
+                leaf: |s: SubTriangle| {
+                    let [p, q, r] = s.corners().map(at);
+                    round_up(texture.max_over_box(p.min(q).min(r), p.max(q).max(r)))
+                },
+                constant,
             };
-            subdivision::build(level, options.merge_tolerance, Merge::Max, &value, &mut out);
+            let tolerance = options.merge_tolerance;
+            subdivision::build(level, tolerance, Merge::Max, &values, &mut out);
         }
     }
     out.retain(|&(_, v)| v > 0.0);

@@ -135,4 +135,34 @@ pub enum Error {
     /// A subdivision option out of range.
     #[error("invalid option: {0}")]
     InvalidOption(String),
+    /// Even one piece per triangle exceeds the piece budget.
+    #[error(
+        "the density needs at least {needed} pieces, more than the budget of {budget} \
+         (Options::max_pieces)"
+    )]
+    TooManyPieces {
+        /// Pieces needed at the coarsest subdivision.
+        needed: u128,
+        /// The budget.
+        budget: usize,
+    },
+    /// A call would return more points than [`MAX_POINTS`](crate::MAX_POINTS).
+    #[error(
+        "{requested} points is too large a count: at most {budget} points are returned at \
+         once (use sample_stream for more, or a lower rate)"
+    )]
+    TooManyPoints {
+        /// The number of points asked for (or an upper bound of it).
+        requested: f64,
+        /// The budget, [`MAX_POINTS`](crate::MAX_POINTS).
+        budget: usize,
+    },
+    /// A triangle index that does not exist.
+    #[error("there is no triangle {face}: the mesh has {count}")]
+    NoSuchFace {
+        /// The index given.
+        face: usize,
+        /// The number of triangles.
+        count: usize,
+    },
 }

@@ -44,11 +44,11 @@
 //! let mesh = MeshRef { uvs: Some(&uvs), ..MeshRef::new(&positions, &indices) };
 //!
 //! let uniform = UniformSampler::new(mesh)?;
-//! assert!(uniform.sample_n(1, 1000).iter().all(|p| (p.pdf - 1.0).abs() < 1e-6));
+//! assert!(uniform.sample_n(1, 1000).unwrap().iter().all(|p| (p.pdf - 1.0).abs() < 1e-6));
 //!
 //! let texture = DensityTexture::new(2, 2, vec![1.0, 1.0, 1.0, 9.0])?;
 //! let sampler = DensitySampler::new(mesh, Density::Texture(&texture))?;
-//! let points = sampler.sample_n(2, 10_000); // same on any number of threads
+//! let points = sampler.sample_n(2, 10_000).unwrap(); // same on any number of threads
 //! let p = points[0];
 //! assert!((sampler.pdf(p.face as usize, p.barycentric) - p.pdf).abs() < 1e-6); // for MIS
 //! # Ok::<(), mesh_sampling::Error>(())
@@ -59,6 +59,7 @@
 mod batch;
 mod density;
 mod error;
+mod layout;
 mod mesh;
 mod multi;
 mod naive;
@@ -71,13 +72,15 @@ mod texture;
 mod uniform;
 
 pub use batch::SurfaceSampler;
-pub use density::{Density, DensitySampler, Mode, Options};
+pub use density::{DEFAULT_MAX_PIECES, Density, DensitySampler, Depth, Mode, Options};
 pub use error::Error;
+pub use layout::Layout;
 pub use mesh::MeshRef;
 pub use multi::{MeshPoint, MultiDensitySampler, MultiMeshSampler};
 pub use naive::NaiveSampler;
+pub use parallel::MAX_POINTS;
 pub use point::{SurfacePoint, uniform_barycentric};
 pub use projection::spherical_uvs;
 pub use rejection::RejectionSampler;
-pub use texture::{Channel, DensityTexture, Filter, Wrap};
+pub use texture::{Channel, DensityTexture, Filter, Wrap, luminance};
 pub use uniform::UniformSampler;

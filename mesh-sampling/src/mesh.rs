@@ -76,15 +76,21 @@ impl<'a> MeshRef<'a> {
         Ok(())
     }
 
-    /// The corners of triangle `face`.
+    /// The corners of triangle `face`; `None` if there is no such
+    /// triangle or it names a vertex that does not exist.
     #[inline]
-    pub fn corners(&self, face: usize) -> [Vec3; 3] {
-        self.indices[face].map(|i| self.positions[i as usize])
+    pub fn corners(&self, face: usize) -> Option<[Vec3; 3]> {
+        let [a, b, c] = *self.indices.get(face)?;
+        let p = |i: u32| self.positions.get(i as usize).copied();
+        Some([p(a)?, p(b)?, p(c)?])
     }
 
-    /// The area of triangle `face`, computed in `f64`.
+    /// The area of triangle `face`, computed in `f64`; 0 where
+    /// [`corners`](Self::corners) is `None`.
     pub fn area(&self, face: usize) -> f64 {
-        let [a, b, c] = self.corners(face).map(Vec3::as_dvec3);
-        0.5 * (b - a).cross(c - a).length()
+        self.corners(face).map_or(0.0, |corners| {
+            let [a, b, c] = corners.map(Vec3::as_dvec3);
+            0.5 * (b - a).cross(c - a).length()
+        })
     }
 }

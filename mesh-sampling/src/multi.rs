@@ -120,7 +120,8 @@ impl<'a> MultiMeshSampler<'a> {
 
     /// The point for uniform variates `u = [u0, u1]`: `u0` picks the mesh
     /// and, through its remapped remainder, the triangle and the first
-    /// barycentric variate.
+    /// barycentric variate. Variates outside `[0, 1)` are clamped into it,
+    /// NaN counting as 0.
     pub fn sample_u(&self, u: [f64; 2]) -> MeshPoint {
         let (mesh, rest) = self.top.sample_remapped(u[0]);
         let mut point = self.meshes[mesh].sample_u([rest, u[1]]);
@@ -129,7 +130,10 @@ impl<'a> MultiMeshSampler<'a> {
     }
 
     /// `n` points from `seed`, the same on any number of threads.
-    pub fn sample_n(&self, seed: u64, n: usize) -> Vec<MeshPoint> {
+    ///
+    /// # Errors
+    /// [`Error::TooManyPoints`] if `n` exceeds [`MAX_POINTS`](crate::MAX_POINTS).
+    pub fn sample_n(&self, seed: u64, n: usize) -> Result<Vec<MeshPoint>, Error> {
         sample_points(self, seed, n)
     }
 }
@@ -225,7 +229,10 @@ impl<'a> MultiDensitySampler<'a> {
     }
 
     /// `n` points from `seed`, the same on any number of threads.
-    pub fn sample_n(&self, seed: u64, n: usize) -> Vec<MeshPoint> {
+    ///
+    /// # Errors
+    /// [`Error::TooManyPoints`] if `n` exceeds [`MAX_POINTS`](crate::MAX_POINTS).
+    pub fn sample_n(&self, seed: u64, n: usize) -> Result<Vec<MeshPoint>, Error> {
         sample_points(self, seed, n)
     }
 }
@@ -245,12 +252,13 @@ fn sample_points(
     sampler: &(impl Distribution<MeshPoint> + Sync),
     seed: u64,
     n: usize,
-) -> Vec<MeshPoint> {
+) -> Result<Vec<MeshPoint>, Error> {
+    crate::parallel::check_points(n as f64)?;
     let mut out = vec![MeshPoint::default(); n];
     for_each_chunk(seed, &mut out, |rng, chunk| {
         for slot in chunk {
             *slot = sampler.sample(rng);
         }
     });
-    out
+    Ok(out)
 }

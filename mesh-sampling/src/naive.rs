@@ -6,7 +6,7 @@
 use rand::distr::Distribution;
 
 use crate::parallel::unit;
-use crate::point::uniform_barycentric;
+use crate::point::{Frame, uniform_barycentric};
 use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 
 /// Draws a triangle uniformly among those of non-zero area, then a uniform
@@ -66,7 +66,9 @@ impl Distribution<SurfacePoint> for NaiveSampler<'_> {
         let x = unit(rng.next_u64()) * self.faces.len() as f64;
         let k = (x as usize).min(self.faces.len() - 1);
         let bary = uniform_barycentric(x - k as f64, unit(rng.next_u64()));
-        SurfacePoint::on(&self.mesh, self.faces[k], bary, self.densities[k])
+        let face = self.faces[k];
+        let frame = Frame::new(&self.mesh, face as usize);
+        SurfacePoint::in_frame(&self.mesh, &frame, face, bary, self.densities[k])
     }
 }
 

@@ -5,6 +5,27 @@
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 
+/// The most points a call returns in one `Vec`: 2²⁷ = 134,217,728 (9.7 GB
+/// of [`SurfacePoint`](crate::SurfacePoint), 1.6 GB of positions). Counts
+/// from arguments are checked against it before anything is allocated, so
+/// that a huge count is an [`Error::TooManyPoints`](crate::Error::TooManyPoints),
+/// not an aborted process. [`SurfaceSampler::sample_stream`](crate::SurfaceSampler::sample_stream)
+/// has no limit: it holds one chunk per thread at a time.
+pub const MAX_POINTS: usize = 1 << 27;
+
+/// `Ok` if `requested` points (a count or an upper bound of one, NaN
+/// counting as too many) fit in [`MAX_POINTS`].
+pub(crate) fn check_points(requested: f64) -> Result<(), crate::Error> {
+    if requested <= MAX_POINTS as f64 {
+        Ok(())
+    } else {
+        Err(crate::Error::TooManyPoints {
+            requested,
+            budget: MAX_POINTS,
+        })
+    }
+}
+
 /// Points per chunk (and per random stream).
 pub(crate) const CHUNK: usize = 1 << 14;
 

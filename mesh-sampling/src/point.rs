@@ -2,7 +2,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::MeshRef;
+use crate::{Error, MeshRef};
 
 /// A point on the surface, with everything a renderer or scatterer needs.
 ///
@@ -29,9 +29,13 @@ pub struct SurfacePoint {
 }
 
 /// Barycentrics of a uniform point in a triangle from two uniform variates
-/// (Šik & Křivánek 2013, Sec. 3.5: `u = 1 − √ξ₁`, `v = ξ₂ √ξ₁`).
+/// (Šik & Křivánek 2013, Sec. 3.5: `u = 1 − √ξ₁`, `v = ξ₂ √ξ₁`). Variates
+/// are clamped into `[0, 1]`, NaN counting as 0, so the point is always in
+/// the closed triangle.
 #[inline]
+#[expect(clippy::manual_clamp, reason = "max maps NaN to 0; clamp keeps NaN")]
 pub fn uniform_barycentric(xi1: f64, xi2: f64) -> [f32; 3] {
+    let (xi1, xi2) = (xi1.max(0.0).min(1.0), xi2.max(0.0).min(1.0));
     let s = xi1.sqrt();
     let b0 = 1.0 - s;
     let b1 = xi2 * s;
@@ -40,18 +44,49 @@ pub fn uniform_barycentric(xi1: f64, xi2: f64) -> [f32; 3] {
 
 impl SurfacePoint {
     /// The point at `barycentric` on triangle `face` of `mesh`, with the
-    /// given density.
+    /// given density (barycentrics are used as given: NaN ones give a NaN
+    /// position).
     ///
-    /// # Panics
-    /// If `face` is not a triangle of `mesh`.
-    pub fn on(mesh: &MeshRef<'_>, face: u32, barycentric: [f32; 3], pdf: f32) -> Self {
-        Self::in_frame(
+    /// # Errors
+    /// [`Error::NoSuchFace`] if `face` is not a triangle of `mesh`, or
+    /// [`Error::IndexOutOfRange`] if it names a vertex (or normal or UV)
+    /// that does not exist.
+    pub fn on(
+        mesh: &MeshRef<'_>,
+        face: u32,
+        barycentric: [f32; 3],
+        pdf: f32,
+    ) -> Result<Self, Error> {
+        let f = face as usize;
+        let Some(tri) = mesh.indices.get(f) else {
+            return Err(Error::NoSuchFace {
+                face: f,
+                count: mesh.indices.len(),
+            });
+        };
+        let count = [
+            Some(mesh.positions.len()),
+            mesh.normals.map(<[Vec3]>::len),
+            mesh.uvs.map(<[Vec2]>::len),
+        ]
+        .into_iter()
+        .flatten()
+        .min()
+        .unwrap_or(0);
+        if let Some(&vertex) = tri.iter().find(|&&i| i as usize >= count) {
+            return Err(Error::IndexOutOfRange {
+                triangle: f,
+                vertex,
+                count,
+            });
+        }
+        Ok(Self::in_frame(
             mesh,
-            &Frame::new(mesh, face as usize),
+            &Frame::new(mesh, f),
             face,
             barycentric,
             pdf,
-        )
+        ))
     }
 
     /// [`on`](Self::on) with the triangle's frame at hand: the samplers
@@ -98,8 +133,9 @@ pub(crate) struct Frame {
 }
 
 impl Frame {
+    /// The frame of a triangle of a validated mesh (all zero otherwise).
     pub(crate) fn new(mesh: &MeshRef<'_>, face: usize) -> Self {
-        let [a, b, c] = mesh.corners(face);
+        let [a, b, c] = mesh.corners(face).unwrap_or_default();
         Self {
             origin: a,
             e1: b - a,

@@ -67,9 +67,11 @@ impl<'a> RejectionSampler<'a> {
         1.0 / self.norm
     }
 
-    /// The density (w.r.t. area) at barycentrics of `face`.
+    /// The density (w.r.t. area) at barycentrics of `face`: 0 for a
+    /// triangle that does not exist, a zero-area triangle, or barycentrics
+    /// that are NaN or infinite.
     pub fn pdf(&self, face: usize, barycentric: [f32; 3]) -> f32 {
-        if self.uniform.pdf(face) == 0.0 {
+        if self.uniform.pdf(face) == 0.0 || !barycentric.iter().all(|b| b.is_finite()) {
             return 0.0;
         }
         let tri = self.uniform.mesh().indices[face];

@@ -167,37 +167,62 @@ pub(crate) enum Merge {
     Max,
 }
 
-/// Subdivides one triangle to `depth`, evaluates `value` on every leaf,
-/// and merges four siblings into their parent when their values are
-/// equal, or within `tolerance` relative to the largest, recursively.
-/// Appends the surviving sub-triangles with their values to `out` in
-/// depth-first order; zero values are kept (the caller drops them after
-/// merging, so zeros still merge).
-pub(crate) fn build(
+/// What the build evaluates: the value of a leaf, and, for a node above
+/// the leaves, its value if the density is constant over all of it (then
+/// its subtree would merge into it anyway, and is not visited).
+pub(crate) struct Values<V, C> {
+    /// The value of a leaf.
+    pub(crate) leaf: V,
+    /// `Some(value)` when the node is known to be constant.
+    pub(crate) constant: C,
+}
+
+/// Subdivides one triangle to `depth`, evaluates the leaves, and merges
+/// four siblings into their parent when their values are equal, or within
+/// `tolerance` relative to the largest, recursively. A node found constant
+/// by `values.constant` is emitted whole, which gives the same result
+/// without visiting its leaves. Appends the surviving sub-triangles with
+/// their values to `out` in depth-first order; zero values are kept (the
+/// caller drops them after merging, so zeros still merge).
+pub(crate) fn build<V, C>(
     depth: u8,
     tolerance: f32,
     merge: Merge,
-    value: &impl Fn(SubTriangle) -> f32,
+    values: &Values<V, C>,
     out: &mut Vec<(SubTriangle, f32)>,
-) {
-    visit(SubTriangle::ROOT, depth, tolerance, merge, value, out);
+) where
+    V: Fn(SubTriangle) -> f32,
+    C: Fn(SubTriangle) -> Option<f32>,
+{
+    visit(SubTriangle::ROOT, depth, tolerance, merge, values, out);
 }
 
-fn visit(
+fn visit<V, C>(
     node: SubTriangle,
     depth: u8,
     tolerance: f32,
     merge: Merge,
-    value: &impl Fn(SubTriangle) -> f32,
+    values: &Values<V, C>,
     out: &mut Vec<(SubTriangle, f32)>,
-) {
+) where
+    V: Fn(SubTriangle) -> f32,
+    C: Fn(SubTriangle) -> Option<f32>,
+{
     if node.level() == depth {
-        out.push((node, value(node)));
+        out.push((node, (values.leaf)(node)));
+        return;
+    }
+    // Worth asking only above subtrees of 16 leaves or more (and at the
+    // root, where a constant face ends in one lookup).
+    if (node.level() == 0 || depth - node.level() >= 2)
+        && let Some(c) = (values.constant)(node)
+    {
+        out.push((node, c));
         return;
     }
     let start = out.len();
     for child in node.children() {
-        visit(child, depth, tolerance, merge, value, out);
+        visit(child, depth, tolerance, merge, values, out);
     }
     // Four leaves, all direct children, means no child was split.
     if out.len() != start + 4 {
@@ -271,10 +296,51 @@ mod tests {
         }
     }
 
+    fn leaves_only(
+        leaf: impl Fn(SubTriangle) -> f32,
+    ) -> Values<impl Fn(SubTriangle) -> f32, impl Fn(SubTriangle) -> Option<f32>> {
+        Values {
+            leaf,
+            constant: |_| None,
+        }
+    }
+
+    #[test]
+    fn a_constant_node_is_emitted_whole_as_merging_would() {
+        // Constant on the first level-1 child, varying elsewhere.
+        let first = SubTriangle::ROOT.children()[0];
+        let inside = |s: SubTriangle| {
+            let (u, v) = s.barycenter();
+            SubTriangle::locate(1, u, v) == first
+        };
+        let leaf = |s: SubTriangle| if inside(s) { 7.0 } else { (s.key(4) % 5) as f32 };
+        let mut full = Vec::new();
+        build(4, 0.0, Merge::Mean, &leaves_only(leaf), &mut full);
+        let asked = std::cell::Cell::new(0);
+        let inside_leaves = std::cell::Cell::new(0);
+        let values = Values {
+            leaf: |s: SubTriangle| {
+                inside_leaves.set(inside_leaves.get() + usize::from(inside(s)));
+                leaf(s)
+            },
+            constant: |s: SubTriangle| {
+                asked.set(asked.get() + 1);
+                (s == first).then_some(7.0)
+            },
+        };
+        let mut fast = Vec::new();
+        build(4, 0.0, Merge::Mean, &values, &mut fast);
+        assert_eq!(fast, full);
+        assert_eq!(inside_leaves.get(), 0, "the constant child was subdivided");
+        // The root, its four children, and the level-2 nodes of the three
+        // varying ones (level 3 nodes have only 4 leaves: not asked).
+        assert_eq!(asked.get(), 1 + 4 + 12);
+    }
+
     #[test]
     fn equal_siblings_merge_recursively_and_unequal_ones_do_not() {
         let mut out = Vec::new();
-        build(4, 0.0, Merge::Mean, &|_| 2.0, &mut out);
+        build(4, 0.0, Merge::Mean, &leaves_only(|_| 2.0), &mut out);
         assert_eq!(out, vec![(SubTriangle::ROOT, 2.0)]);
         // A value that depends on the first level-1 child only.
         out.clear();
@@ -287,20 +353,20 @@ mod tests {
                 5.0
             }
         };
-        build(3, 0.0, Merge::Mean, &value, &mut out);
+        build(3, 0.0, Merge::Mean, &leaves_only(value), &mut out);
         // 16 leaves in the first child, three merged level-1 siblings.
         assert_eq!(out.len(), 16 + 3);
         assert!(out.windows(2).all(|w| w[0].0.key(3) < w[1].0.key(3)));
         out.clear();
         // 0.7 merges 1 with 3 (into 2), then 2 with 5: the mean keeps the
         // mass, the maximum keeps the bound.
-        build(3, 0.7, Merge::Mean, &value, &mut out);
+        build(3, 0.7, Merge::Mean, &leaves_only(value), &mut out);
         assert_eq!(out, vec![(SubTriangle::ROOT, 4.25)]);
         out.clear();
-        build(3, 0.7, Merge::Max, &value, &mut out);
+        build(3, 0.7, Merge::Max, &leaves_only(value), &mut out);
         assert_eq!(out, vec![(SubTriangle::ROOT, 5.0)]);
         out.clear();
-        build(3, 0.5, Merge::Mean, &value, &mut out);
+        build(3, 0.5, Merge::Mean, &leaves_only(value), &mut out);
         assert_eq!(out.len(), 16 + 3, "0.5 merges nothing");
     }
 }

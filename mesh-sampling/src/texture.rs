@@ -1,5 +1,6 @@
 //! A density texture: one non-negative value per texel, filtered bilinearly
-//! (or nearest), repeated or clamped outside `[0, 1]²`.
+//! (or nearest), repeated, mirrored or clamped outside `[0, 1]²` (glTF's
+//! sampler wrap modes).
 //!
 //! Besides point lookups it answers the two questions exact sampling needs:
 //! the exact integral of the filtered density over a UV triangle, and its
@@ -12,14 +13,27 @@ use glam::DVec2;
 
 use crate::Error;
 
-/// What happens outside `[0, 1]²`.
+/// What happens outside `[0, 1]²`, with glTF's sampler semantics (the
+/// same enum, with the same meaning, as in `trilux-io` and `mesh-colors`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Wrap {
-    /// The texture tiles the plane (tiled UV maps).
+    /// The texture tiles the plane (tiled UV maps): texel `x` is texel
+    /// `x mod W`.
     #[default]
     Repeat,
+    /// The texture tiles the plane, every other copy mirrored: texel
+    /// columns run `0 … W−1, W−1 … 0, 0 …`.
+    MirroredRepeat,
     /// The edge texels extend outwards.
-    Clamp,
+    ClampToEdge,
+}
+
+/// Rec. 709 luminance `0.2126 R + 0.7152 G + 0.0722 B` of linear RGB (the
+/// same function, with the same name, in every trilux crate that needs
+/// one).
+#[inline]
+pub fn luminance(rgb: [f32; 3]) -> f32 {
+    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
 }
 
 /// How the density between texel centres is reconstructed.
@@ -37,15 +51,20 @@ pub enum Filter {
 pub enum Channel {
     /// One channel, by index.
     Index(usize),
-    /// Rec. 709 luminance `0.2126 R + 0.7152 G + 0.0722 B` of the first
-    /// three channels (for HDR luminaires: sample by emitted power).
+    /// Rec. 709 [`luminance`] of the first three channels (for HDR
+    /// luminaires: sample by emitted power).
     Luminance,
 }
 
 /// A density texture. Texel `(x, y)` covers `u ∈ [x/W, (x+1)/W)`,
-/// `v ∈ [y/H, (y+1)/H)`, and row 0 is the first row of the data: images
-/// stored top row first (PNG, EXR, HDR) match glTF's UV convention; for
-/// OBJ's (v up) use [`flip_rows`](Self::flip_rows).
+/// `v ∈ [y/H, (y+1)/H)`, and row 0 is the first row of the data: glTF's UV
+/// convention (v grows downwards), the one `trilux-io`'s `TriMesh` uses,
+/// so the rows of an image as stored (PNG, EXR, HDR) are used as they are.
+///
+/// Besides the texels it keeps a min/max pyramid (two thirds more memory),
+/// so that the range of the density over any UV box is known in O(1):
+/// the density sampler uses it to stop subdividing where the density is
+/// constant, without visiting the texels there.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DensityTexture {
     width: usize,
@@ -54,6 +73,8 @@ pub struct DensityTexture {
     wrap: Wrap,
     filter: Filter,
     max: f32,
+    pyramid: Pyramid,
+    changes: Changes,
 }
 
 impl DensityTexture {
@@ -86,6 +107,8 @@ impl DensityTexture {
             });
         }
         let max = texels.iter().copied().fold(0.0f32, f32::max);
+        let pyramid = Pyramid::new(width, height, &texels);
+        let changes = Changes::new(width, height, &texels);
         Ok(Self {
             width,
             height,
@@ -93,6 +116,8 @@ impl DensityTexture {
             wrap: Wrap::default(),
             filter: Filter::default(),
             max,
+            pyramid,
+            changes,
         })
     }
 
@@ -126,7 +151,7 @@ impl DensityTexture {
             .chunks_exact(channels)
             .map(|p| match channel {
                 Channel::Index(c) => p[c],
-                Channel::Luminance => 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2],
+                Channel::Luminance => luminance([p[0], p[1], p[2]]),
             })
             .collect();
         Self::new(width, height, texels)
@@ -146,7 +171,7 @@ impl DensityTexture {
         self
     }
 
-    /// The same texture upside down (for OBJ-style UVs, v pointing up).
+    /// The same texture upside down (row 0 becomes the last row).
     #[must_use]
     pub fn flip_rows(mut self) -> Self {
         let w = self.width;
@@ -155,6 +180,8 @@ impl DensityTexture {
             let (top, bottom) = self.texels.split_at_mut((h - 1 - y) * w);
             top[y * w..(y + 1) * w].swap_with_slice(&mut bottom[..w]);
         }
+        self.pyramid = Pyramid::new(w, h, &self.texels);
+        self.changes = Changes::new(w, h, &self.texels);
         self
     }
 
@@ -189,12 +216,124 @@ impl DensityTexture {
         &self.texels
     }
 
-    /// Heap memory used, in bytes.
+    /// Heap memory used (texels and the min/max pyramid), in bytes.
     pub fn memory_bytes(&self) -> usize {
         self.texels.len() * size_of::<f32>()
+            + self.pyramid.memory_bytes()
+            + self.changes.memory_bytes()
     }
 
-    /// Column or row `i` wrapped or clamped into `0..n`.
+    /// The smallest and largest value the filtered density takes over the
+    /// UV box `[lo, hi]`, or bounds of them (`min` may be lower, `max`
+    /// higher, never the other way); exact, `(c, c)`, when the density is
+    /// constant `c` over the box. O(1): a few table lookups per wrapped
+    /// piece of the box, whatever its size.
+    pub fn range_over_box(&self, lo: DVec2, hi: DVec2) -> (f32, f32) {
+        let (xs, ys) = self.texel_spans(lo, hi);
+        if let Some(c) = self.constant_over(&xs, &ys) {
+            return (c, c);
+        }
+        let (mut min, mut max) = (f32::INFINITY, 0.0f32);
+        for &x in xs.iter().flatten() {
+            for &y in ys.iter().flatten() {
+                let (a, b) = self.pyramid.range(&self.texels, self.width, x, y);
+                min = min.min(a);
+                max = max.max(b);
+            }
+        }
+        (min.min(max), max)
+    }
+
+    /// The value of the density over the UV box `[lo, hi]` if it is
+    /// constant there (all the texels it reads are equal), found in O(1).
+    pub fn constant_over_box(&self, lo: DVec2, hi: DVec2) -> Option<f32> {
+        let (xs, ys) = self.texel_spans(lo, hi);
+        self.constant_over(&xs, &ys)
+    }
+
+    /// The texel columns and rows the density over a UV box reads: those
+    /// of the cells it touches (and the next ones for bilinear filtering),
+    /// as at most two ranges each after wrapping.
+    #[expect(clippy::type_complexity, reason = "two small fixed arrays of ranges")]
+    fn texel_spans(
+        &self,
+        lo: DVec2,
+        hi: DVec2,
+    ) -> ([Option<(usize, usize)>; 2], [Option<(usize, usize)>; 2]) {
+        let (lo, hi) = (self.to_cells(lo), self.to_cells(hi));
+        let reach = i64::from(self.filter == Filter::Bilinear);
+        let span = |l: f64, h: f64, n: usize| {
+            let (a, b) = (floor_i64(l), floor_i64(h).saturating_add(reach));
+            self.wrap_span(a.min(b), a.max(b), n)
+        };
+        (span(lo.x, hi.x, self.width), span(lo.y, hi.y, self.height))
+    }
+
+    /// The common value of the texels in the spans, if they are all equal.
+    fn constant_over(
+        &self,
+        xs: &[Option<(usize, usize)>; 2],
+        ys: &[Option<(usize, usize)>; 2],
+    ) -> Option<f32> {
+        let mut value = None;
+        for &x in xs.iter().flatten() {
+            for &y in ys.iter().flatten() {
+                if !self.changes.constant(x, y) {
+                    return None;
+                }
+                let v = self.texels[y.0 * self.width + x.0];
+                if value.is_some_and(|c| c != v) {
+                    return None;
+                }
+                value = Some(v);
+            }
+        }
+        value
+    }
+
+    /// The texel columns (or rows) `i0..=i1` as at most two ranges inside
+    /// `0..n` whose union contains every texel they name after wrapping.
+    fn wrap_span(&self, i0: i64, i1: i64, n: usize) -> [Option<(usize, usize)>; 2] {
+        let last = n as i64 - 1;
+        let all = [Some((0, n - 1)), None];
+        match self.wrap {
+            Wrap::ClampToEdge => {
+                let (a, b) = (i0.clamp(0, last) as usize, i1.clamp(0, last) as usize);
+                [Some((a, b)), None]
+            }
+            Wrap::Repeat => {
+                if i1.saturating_sub(i0) >= last {
+                    return all;
+                }
+                let (a, b) = (i0.rem_euclid(n as i64) as usize, i1.rem_euclid(n as i64) as usize);
+                if a <= b {
+                    [Some((a, b)), None]
+                } else {
+                    [Some((a, n - 1)), Some((0, b))]
+                }
+            }
+            Wrap::MirroredRepeat => {
+                if i1.saturating_sub(i0) >= last {
+                    return all;
+                }
+                // Shorter than a half-period: inside one half (rising
+                // or falling) it maps to one contiguous range; across one
+                // fold, to the range from the nearer end to the fold's
+                // texel.
+                let (a, b) = (self.wrap_index(i0, n), self.wrap_index(i1, n));
+                let (h0, h1) = (i0.div_euclid(n as i64), i1.div_euclid(n as i64));
+                if h0 == h1 {
+                    [Some((a.min(b), a.max(b))), None]
+                } else if h0.rem_euclid(2) == 0 {
+                    [Some((a.min(b), n - 1)), None]
+                } else {
+                    [Some((0, a.max(b))), None]
+                }
+            }
+        }
+    }
+
+    /// Column or row `i` wrapped, mirrored or clamped into `0..n`.
     #[inline]
     fn wrap_index(&self, i: i64, n: usize) -> usize {
         if (0..n as i64).contains(&i) {
@@ -202,7 +341,11 @@ impl DensityTexture {
         }
         match self.wrap {
             Wrap::Repeat => i.rem_euclid(n as i64) as usize,
-            Wrap::Clamp => i.clamp(0, n as i64 - 1) as usize,
+            Wrap::MirroredRepeat => {
+                let m = i.rem_euclid(2 * n as i64) as usize;
+                if m < n { m } else { 2 * n - 1 - m }
+            }
+            Wrap::ClampToEdge => i.clamp(0, n as i64 - 1) as usize,
         }
     }
 
@@ -232,7 +375,7 @@ impl DensityTexture {
     #[inline]
     fn at_cell(&self, p: DVec2) -> f64 {
         // Saturating casts: a UV of 1e30 is a valid (if silly) tiled UV.
-        self.in_cell((p.x.floor() as i64, p.y.floor() as i64), p)
+        self.in_cell((floor_i64(p.x), floor_i64(p.y)), p)
     }
 
     /// The filtered density at texture coordinate `uv`.
@@ -244,6 +387,12 @@ impl DensityTexture {
     /// The exact integral of the filtered density over the UV triangle
     /// `uv`, in UV area (the unit square has area 1).
     pub fn integral(&self, uv: [DVec2; 3]) -> f64 {
+        let (lo, hi) = (uv[0].min(uv[1]).min(uv[2]), uv[0].max(uv[1]).max(uv[2]));
+        if let Some(c) = self.constant_over_box(lo, hi) {
+            // Constant over the footprint (say a tiled constant region):
+            // the value times the UV area, without visiting its cells.
+            return f64::from(c) * 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
+        }
         let scale = 1.0 / (self.width as f64 * self.height as f64);
         let tri = uv.map(|p| self.to_cells(p));
         let mut sum = 0.0;
@@ -259,7 +408,15 @@ impl DensityTexture {
     /// bilinear function is linear along each axis, so on a box inside
     /// one cell it peaks at a corner, and the box's maximum is at a point
     /// of the grid its corners and the cell lines crossing it make.
+    ///
+    /// A box over more than 64 cells takes the pyramid's bound instead
+    /// (at least the true maximum, at most the largest texel it reads),
+    /// so that the cost stays O(1) for footprints that tile the texture.
     pub fn max_over_box(&self, lo: DVec2, hi: DVec2) -> f64 {
+        let cells = (self.to_cells(hi) - self.to_cells(lo)).abs() + 1.0;
+        if cells.x * cells.y > 64.0 {
+            return f64::from(self.range_over_box(lo, hi).1) * (1.0 + 1e-6);
+        }
         let (lo, hi) = (self.to_cells(lo), self.to_cells(hi));
         let mut max = 0.0f64;
         match self.filter {
@@ -301,9 +458,9 @@ impl DensityTexture {
             Filter::Bilinear => {
                 let (fx, fy) = (p.x - cell.0 as f64, p.y - cell.1 as f64);
                 let x0 = self.wrap_index(cell.0, self.width);
-                let x1 = self.wrap_index(cell.0 + 1, self.width);
+                let x1 = self.wrap_index(cell.0.saturating_add(1), self.width);
                 let row0 = self.wrap_index(cell.1, self.height) * self.width;
-                let row1 = self.wrap_index(cell.1 + 1, self.height) * self.width;
+                let row1 = self.wrap_index(cell.1.saturating_add(1), self.height) * self.width;
                 let t = |i: usize| f64::from(self.texels[i]);
                 let top = lerp(t(row0 + x0), t(row0 + x1), fx);
                 let bottom = lerp(t(row1 + x0), t(row1 + x1), fx);
@@ -344,6 +501,141 @@ impl DensityTexture {
 #[inline]
 fn lerp(a: f64, b: f64, t: f64) -> f64 {
     a + (b - a) * t
+}
+
+/// `⌊x⌋` as an integer, saturating (NaN gives 0): far-out UVs are valid.
+#[inline]
+fn floor_i64(x: f64) -> i64 {
+    x.floor() as i64
+}
+
+/// Minima and maxima of blocks of texels, level by level: level `k ≥ 1`
+/// holds, for each block of `2^k × 2^k` texels, their smallest and largest
+/// value (level 0 is the texels themselves, not stored again). A box of at
+/// most `2^k` texels each way touches at most 2×2 entries of level `k`, so
+/// its range costs four lookups.
+#[derive(Debug, Clone, PartialEq)]
+struct Pyramid {
+    /// Levels 1, 2, …: (width, (min, max) per entry).
+    levels: Vec<(usize, Vec<(f32, f32)>)>,
+}
+
+impl Pyramid {
+    fn new(width: usize, height: usize, texels: &[f32]) -> Self {
+        let mut levels: Vec<(usize, Vec<(f32, f32)>)> = Vec::new();
+        let (mut w, mut h) = (width, height);
+        while w > 1 || h > 1 {
+            let (nw, nh) = (w.div_ceil(2), h.div_ceil(2));
+            let mut next = vec![(f32::INFINITY, 0.0f32); nw * nh];
+            let prev = levels.last();
+            for y in 0..h {
+                for x in 0..w {
+                    let (a, b) = match prev {
+                        Some((pw, p)) => p[y * pw + x],
+                        None => (texels[y * w + x], texels[y * w + x]),
+                    };
+                    let slot = &mut next[(y / 2) * nw + x / 2];
+                    slot.0 = slot.0.min(a);
+                    slot.1 = slot.1.max(b);
+                }
+            }
+            levels.push((nw, next));
+            (w, h) = (nw, nh);
+        }
+        Self { levels }
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.levels
+            .iter()
+            .map(|l| l.1.len() * size_of::<(f32, f32)>())
+            .sum()
+    }
+
+    /// (min, max) bounds over texels `x0..=x1` × `y0..=y1` (all inside the
+    /// texture of `width` columns whose texels are `texels`).
+    fn range(
+        &self,
+        texels: &[f32],
+        width: usize,
+        (x0, x1): (usize, usize),
+        (y0, y1): (usize, usize),
+    ) -> (f32, f32) {
+        let extent = (x1 - x0).max(y1 - y0) + 1;
+        // The level whose blocks are at least `extent` wide.
+        let k = (extent.next_power_of_two().trailing_zeros() as usize).min(self.levels.len());
+        let (mut lo, mut hi) = (f32::INFINITY, 0.0f32);
+        for y in (y0 >> k)..=(y1 >> k) {
+            for x in (x0 >> k)..=(x1 >> k) {
+                let (a, b) = match k {
+                    0 => (texels[y * width + x], texels[y * width + x]),
+                    _ => {
+                        let (w, level) = &self.levels[k - 1];
+                        level[y * w + x]
+                    }
+                };
+                lo = lo.min(a);
+                hi = hi.max(b);
+            }
+        }
+        (lo, hi)
+    }
+}
+
+/// Summed-area tables of where neighbouring texels differ, horizontally
+/// and vertically: a block of texels is constant exactly when neither
+/// counts a change inside it (four lookups each, whatever the block's
+/// size). Counts are `u32` with wrapping arithmetic, exact while the
+/// texture has fewer than 2³² texels.
+#[derive(Debug, Clone, PartialEq)]
+struct Changes {
+    /// `(width + 1) × (height + 1)`: changes between `(x, y)` and
+    /// `(x + 1, y)` summed over `x' < x, y' < y`.
+    across: Vec<u32>,
+    /// The same for `(x, y)` and `(x, y + 1)`.
+    down: Vec<u32>,
+    width: usize,
+}
+
+impl Changes {
+    fn new(width: usize, height: usize, texels: &[f32]) -> Self {
+        let stride = width + 1;
+        let mut across = vec![0u32; stride * (height + 1)];
+        let mut down = vec![0u32; stride * (height + 1)];
+        for y in 0..height {
+            let (mut row_a, mut row_d) = (0u32, 0u32);
+            for x in 0..width {
+                let t = texels[y * width + x];
+                row_a = row_a.wrapping_add(u32::from(x + 1 < width && texels[y * width + x + 1] != t));
+                row_d = row_d.wrapping_add(u32::from(y + 1 < height && texels[(y + 1) * width + x] != t));
+                let at = (y + 1) * stride + x + 1;
+                across[at] = across[at - stride].wrapping_add(row_a);
+                down[at] = down[at - stride].wrapping_add(row_d);
+            }
+        }
+        Self { across, down, width }
+    }
+
+    fn memory_bytes(&self) -> usize {
+        (self.across.len() + self.down.len()) * size_of::<u32>()
+    }
+
+    /// The sum of `table` over texels `x0..x1` × `y0..y1` (exclusive ends).
+    fn sum(&self, table: &[u32], (x0, x1): (usize, usize), (y0, y1): (usize, usize)) -> u32 {
+        let s = self.width + 1;
+        table[y1 * s + x1]
+            .wrapping_sub(table[y0 * s + x1])
+            .wrapping_sub(table[y1 * s + x0])
+            .wrapping_add(table[y0 * s + x0])
+    }
+
+    /// Whether texels `x0..=x1` × `y0..=y1` are all equal.
+    fn constant(&self, (x0, x1): (usize, usize), (y0, y1): (usize, usize)) -> bool {
+        // Horizontal pairs starting at x0..x1 − 1 and vertical pairs
+        // starting at y0..y1 − 1: those inside the block.
+        self.sum(&self.across, (x0, x1), (y0, y1 + 1)) == 0
+            && self.sum(&self.down, (x0, x1 + 1), (y0, y1)) == 0
+    }
 }
 
 /// A convex polygon of at most 8 corners on the stack: a triangle clipped
@@ -454,7 +746,7 @@ mod tests {
             DVec2::new(1.4, 0.05),
             DVec2::new(0.3, 1.21),
         ];
-        for wrap in [Wrap::Repeat, Wrap::Clamp] {
+        for wrap in [Wrap::Repeat, Wrap::MirroredRepeat, Wrap::ClampToEdge] {
             for filter in [Filter::Bilinear, Filter::Nearest] {
                 let t = noise(7, 5).with_wrap(wrap).with_filter(filter);
                 let exact = t.integral(tri);
@@ -517,6 +809,101 @@ mod tests {
                 assert!((t.eval(uv + DVec2::new(2.0, -3.0)) - v).abs() < 1e-6);
             }
         }
+    }
+
+    #[test]
+    fn mirrored_repeat_reflects_every_other_tile() {
+        for filter in [Filter::Bilinear, Filter::Nearest] {
+            let t = noise(5, 3)
+                .with_wrap(Wrap::MirroredRepeat)
+                .with_filter(filter);
+            for k in 0..200 {
+                let uv = DVec2::new(k as f64 * 0.0123 % 1.0, (k as f64 * 0.0371) % 1.0);
+                let v = t.eval(uv);
+                // u ↦ 2 − u and v ↦ −v are mirrors; +2 is a whole period.
+                assert!((t.eval(DVec2::new(2.0 - uv.x, uv.y)) - v).abs() < 1e-9);
+                assert!((t.eval(DVec2::new(uv.x, -uv.y)) - v).abs() < 1e-9);
+                assert!((t.eval(uv + DVec2::new(2.0, -4.0)) - v).abs() < 1e-9);
+            }
+        }
+        // Texel columns 0 1 2 | 2 1 0 | 0 1 2 (nearest).
+        let t = DensityTexture::new(3, 1, vec![1.0, 2.0, 3.0])
+            .unwrap()
+            .with_wrap(Wrap::MirroredRepeat)
+            .with_filter(Filter::Nearest);
+        let row: Vec<f64> = (-3..6)
+            .map(|x| t.eval(DVec2::new((x as f64 + 0.5) / 3.0, 0.5)))
+            .collect();
+        assert_eq!(row, [3.0, 2.0, 1.0, 1.0, 2.0, 3.0, 3.0, 2.0, 1.0]);
+    }
+
+    /// The pyramid's range contains every value the density takes over
+    /// the box, for every wrap mode and filter, and is exact on constant
+    /// regions.
+    #[test]
+    fn range_over_box_bounds_dense_probes() {
+        let mut rng_state = 12345u64;
+        let mut next = || {
+            rng_state = rng_state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (rng_state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for wrap in [Wrap::Repeat, Wrap::MirroredRepeat, Wrap::ClampToEdge] {
+            for filter in [Filter::Bilinear, Filter::Nearest] {
+                let t = noise(13, 7).with_wrap(wrap).with_filter(filter);
+                for _ in 0..300 {
+                    let lo = DVec2::new(next() * 6.0 - 3.0, next() * 6.0 - 3.0);
+                    let size = DVec2::new(next(), next()) * if next() < 0.5 { 0.3 } else { 2.0 };
+                    let hi = lo + size;
+                    let (min, max) = t.range_over_box(lo, hi);
+                    for i in 0..=40 {
+                        for j in 0..=40 {
+                            let p = lo + size * DVec2::new(i as f64, j as f64) / 40.0;
+                            let v = t.eval(p) as f32;
+                            assert!(
+                                v >= min - 1e-5 && v <= max + 1e-5,
+                                "{wrap:?} {filter:?} [{lo}, {hi}]: {v} outside [{min}, {max}]"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        // A constant region is found constant.
+        let mut texels = vec![0.0f32; 64 * 64];
+        for (i, t) in texels.iter_mut().enumerate() {
+            if i % 64 >= 32 {
+                *t = (i % 7) as f32;
+            } else {
+                *t = 2.0;
+            }
+        }
+        let t = DensityTexture::new(64, 64, texels).unwrap();
+        let (lo, hi) = (DVec2::new(0.05, 0.1), DVec2::new(0.4, 0.9));
+        assert_eq!(t.range_over_box(lo, hi), (2.0, 2.0));
+        assert_eq!(t.constant_over_box(lo, hi), Some(2.0));
+        // Repeat: the box wraps from the right half into the left one.
+        assert_eq!(t.constant_over_box(DVec2::new(0.9, 0.1), DVec2::new(1.2, 0.3)), None);
+        assert_eq!(t.constant_over_box(DVec2::new(1.05, 0.1), DVec2::new(1.4, 0.3)), Some(2.0));
+        for clamp in [Wrap::ClampToEdge, Wrap::MirroredRepeat] {
+            let c = t.clone().with_wrap(clamp);
+            assert_eq!(c.constant_over_box(DVec2::new(-0.3, 0.1), DVec2::new(0.2, 0.3)), Some(2.0));
+        }
+        assert_eq!(
+            t.range_over_box(lo, DVec2::new(0.6, 0.9)),
+            (0.0, 6.0),
+            "crosses into the varying half"
+        );
+    }
+
+    #[test]
+    fn luminance_is_rec709() {
+        assert!((luminance([1.0, 0.0, 0.0]) - 0.2126).abs() < 1e-6);
+        assert!((luminance([0.0, 1.0, 0.0]) - 0.7152).abs() < 1e-6);
+        assert!((luminance([0.0, 0.0, 1.0]) - 0.0722).abs() < 1e-6);
+        // 0.5·0.2126 + 0.25·0.7152 + 2·0.0722 = 0.1063 + 0.1788 + 0.1444.
+        assert!((luminance([0.5, 0.25, 2.0]) - 0.4295).abs() < 1e-6);
     }
 
     #[test]

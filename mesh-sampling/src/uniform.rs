@@ -6,7 +6,7 @@ use discrete_sampling::{DiscreteSampler, GuideTable};
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::parallel::{BLOCK, for_each_chunk, unit};
+use crate::parallel::{BLOCK, check_points, for_each_chunk, unit};
 use crate::point::{Frame, uniform_barycentric};
 use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 
@@ -26,7 +26,7 @@ use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 /// let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(7);
 /// let p = sampler.sample(&mut rng);
 /// assert!((p.pdf - 1.0).abs() < 1e-6); // unit square
-/// let cloud = sampler.sample_n(42, 10_000); // parallel, deterministic
+/// let cloud = sampler.sample_n(42, 10_000).unwrap(); // parallel, deterministic
 /// assert_eq!(cloud.len(), 10_000);
 /// # Ok::<(), mesh_sampling::Error>(())
 /// ```
@@ -91,7 +91,8 @@ impl<'a> UniformSampler<'a> {
 
     /// The point for uniform variates `u = [u0, u1]` in `[0, 1)²`: `u0`
     /// picks the triangle and, through its remapped remainder, the first
-    /// barycentric variate; `u1` is the second.
+    /// barycentric variate; `u1` is the second. Variates outside `[0, 1)`
+    /// are clamped into it and NaN counts as 0 (as in `discrete-sampling`).
     /// For stratified or low-discrepancy variates; the random-number
     /// paths use three variates instead, which is faster (no division, no
     /// unpredictable branch).
@@ -136,7 +137,10 @@ impl UniformSampler<'_> {
     /// with mean `points_per_unit_area · A`.
     ///
     /// # Errors
-    /// [`Error::InvalidDensity`] for a negative, NaN or infinite density.
+    /// [`Error::InvalidDensity`] for a negative, NaN or infinite density;
+    /// [`Error::TooManyPoints`] when the count could exceed
+    /// [`MAX_POINTS`](crate::MAX_POINTS) (`points_per_unit_area · A` plus
+    /// one per triangle for the rounding), checked before allocating.
     pub fn sample_stable(
         &self,
         seed: u64,
@@ -145,6 +149,8 @@ impl UniformSampler<'_> {
         if !(points_per_unit_area >= 0.0 && points_per_unit_area.is_finite()) {
             return Err(Error::InvalidDensity(points_per_unit_area));
         }
+        let faces = self.mesh.indices.len() as f64;
+        check_points(points_per_unit_area * self.total_area + faces)?;
         let triangle = |face: usize| -> Vec<SurfacePoint> {
             let area = self.mesh.area(face);
             if area <= 0.0 {
@@ -188,14 +194,15 @@ impl SurfaceSampler for UniformSampler<'_> {
 
     /// The positions of [`sample_n`](SurfaceSampler::sample_n)'s points,
     /// computed without the rest of each point.
-    fn sample_positions(&self, seed: u64, n: usize) -> Vec<[f32; 3]> {
+    fn sample_positions(&self, seed: u64, n: usize) -> Result<Vec<[f32; 3]>, Error> {
+        check_points(n as f64)?;
         let mut out = vec![[0.0f32; 3]; n];
         for_each_chunk(seed, &mut out, |rng, chunk| {
             self.blocks(rng, chunk, |face, [_, w1, w2]| {
                 self.frames[face as usize].at(w1, w2).to_array()
             });
         });
-        out
+        Ok(out)
     }
 }
 

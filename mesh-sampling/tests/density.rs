@@ -191,7 +191,7 @@ fn checkerboards_put_no_point_in_a_black_texel_and_split_white_by_area() {
         for options in [Options::default(), exact()] {
             let sampler =
                 DensitySampler::with_options(mesh_ref(&m), Density::Texture(&t), &options).unwrap();
-            let points = sampler.sample_n(3, 200_000);
+            let points = sampler.sample_n(3, 200_000).unwrap();
             let counts = texel_counts(&m, &t, &points);
             for (texel, &c) in counts.iter().enumerate() {
                 assert!(
@@ -213,7 +213,7 @@ fn approximate_mode_samples_the_papers_p_prime() {
     let sampler = DensitySampler::new(mesh_ref(&m), Density::Texture(&t)).unwrap();
     assert!((0..m.2.len()).all(|f| sampler.level(f) == 1));
     let expected = approximate_bin_masses(&m, &t);
-    let counts = texel_counts(&m, &t, &sampler.sample_n(5, N));
+    let counts = texel_counts(&m, &t, &sampler.sample_n(5, N).unwrap());
     let test = stats::chi_square(&counts, &stats::probabilities(&expected), 20.0);
     assert!(test.p_value > 1e-3, "{test:?}");
     // The normalisation is Σ f_i |D_i| (Eq. 2).
@@ -236,7 +236,7 @@ fn exact_mode_matches_the_exact_integrals_per_triangle() {
     let sampler =
         DensitySampler::with_options(mesh_ref(&m), Density::Texture(&t), &exact()).unwrap();
     let masses = exact_face_masses(&m, &t);
-    let counts = face_counts(m.2.len(), &sampler.sample_n(6, N));
+    let counts = face_counts(m.2.len(), &sampler.sample_n(6, N).unwrap());
     let test = stats::chi_square(&counts, &stats::probabilities(&masses), 20.0);
     assert!(test.p_value > 1e-3, "{test:?}");
     let total: f64 = masses.iter().sum();
@@ -249,12 +249,12 @@ fn tiled_and_clamped_uvs_outside_the_unit_square() {
     let t = noise(8, 8);
     // UVs over [−1, 2]²: nine tiles with repeat.
     let m = grid(12, |uv| uv * 3.0 - Vec2::ONE);
-    for wrap in [Wrap::Repeat, Wrap::Clamp] {
+    for wrap in [Wrap::Repeat, Wrap::MirroredRepeat, Wrap::ClampToEdge] {
         let t = t.clone().with_wrap(wrap);
         let sampler =
             DensitySampler::with_options(mesh_ref(&m), Density::Texture(&t), &exact()).unwrap();
         let masses = exact_face_masses(&m, &t);
-        let counts = face_counts(m.2.len(), &sampler.sample_n(7, N));
+        let counts = face_counts(m.2.len(), &sampler.sample_n(7, N).unwrap());
         let test = stats::chi_square(&counts, &stats::probabilities(&masses), 20.0);
         assert!(test.p_value > 1e-3, "{wrap:?}: {test:?}");
     }
@@ -268,7 +268,7 @@ fn tiled_and_clamped_uvs_outside_the_unit_square() {
     };
     let sampler = DensitySampler::new(mesh_ref(&flat), Density::Texture(&t)).unwrap();
     let mut tiles = [0u64; 9];
-    for p in sampler.sample_n(8, 300_000) {
+    for p in sampler.sample_n(8, 300_000).unwrap() {
         let uv = uv_of(&flat, &p);
         let (x, y) = ((uv.x + 1.0).floor() as usize, (uv.y + 1.0).floor() as usize);
         tiles[y.min(2) * 3 + x.min(2)] += 1;
@@ -299,9 +299,9 @@ fn exact_mode_and_rejection_sample_the_same_distribution() {
     let mesh = mesh_ref(&m);
     let exact_points = DensitySampler::with_options(mesh, Density::Texture(&t), &exact())
         .unwrap()
-        .sample_n(9, N);
+        .sample_n(9, N).unwrap();
     let rejection = RejectionSampler::new(mesh, &t).unwrap();
-    let reject_points = rejection.sample_n(10, N);
+    let reject_points = rejection.sample_n(10, N).unwrap();
     let p = two_sample_p(
         &texel_counts(&m, &t, &exact_points),
         &texel_counts(&m, &t, &reject_points),
@@ -315,7 +315,7 @@ fn exact_mode_and_rejection_sample_the_same_distribution() {
     };
     let approximate = DensitySampler::with_options(mesh, Density::Texture(&t), &coarse)
         .unwrap()
-        .sample_n(11, N);
+        .sample_n(11, N).unwrap();
     let p = two_sample_p(
         &texel_counts(&m, &t, &approximate),
         &texel_counts(&m, &t, &reject_points),
@@ -340,7 +340,7 @@ fn per_face_and_per_vertex_weights() {
             .zip(&face_w)
             .map(|(tri, &w)| f64::from(w) * area(tri.map(|i| m.0[i as usize])))
             .collect();
-    let counts = face_counts(m.2.len(), &sampler.sample_n(12, 300_000));
+    let counts = face_counts(m.2.len(), &sampler.sample_n(12, 300_000).unwrap());
     let test = stats::chi_square(&counts, &stats::probabilities(&masses), 20.0);
     assert!(test.p_value > 1e-3, "per face: {test:?}");
 
@@ -355,7 +355,7 @@ fn per_face_and_per_vertex_weights() {
                 area(tri.map(|i| m.0[i as usize])) * w / 3.0
             })
             .collect();
-    let counts = face_counts(m.2.len(), &sampler.sample_n(13, 300_000));
+    let counts = face_counts(m.2.len(), &sampler.sample_n(13, 300_000).unwrap());
     let test = stats::chi_square(&counts, &stats::probabilities(&masses), 20.0);
     assert!(test.p_value > 1e-3, "per vertex: {test:?}");
 }
@@ -435,7 +435,7 @@ fn a_linear_density_is_linear_inside_the_triangle() {
     let w = [1.0, 0.0, 0.0];
     let sampler =
         DensitySampler::new(MeshRef::new(&positions, &indices), Density::PerVertex(&w)).unwrap();
-    let points = sampler.sample_n(14, 200_000);
+    let points = sampler.sample_n(14, 200_000).unwrap();
     let bins = 20;
     for (corner, cdf) in [
         (
@@ -482,9 +482,9 @@ fn pdfs_agree_with_the_samples_and_integrate_to_one() {
         DensitySampler::new(mesh, Density::PerVertex(&vertex_w)).unwrap(),
     ];
     let uniform = UniformSampler::new(mesh).unwrap();
-    let probes = uniform.sample_n(15, 200_000);
+    let probes = uniform.sample_n(15, 200_000).unwrap();
     for (k, s) in samplers.iter().enumerate() {
-        for p in s.sample_n(16, 2000) {
+        for p in s.sample_n(16, 2000).unwrap() {
             let q = s.pdf(p.face as usize, p.barycentric);
             assert!(
                 (q - p.pdf).abs() <= 1e-4 * q,
@@ -548,12 +548,12 @@ fn zero_area_triangles_are_never_sampled() {
     let t = noise(8, 8);
     for options in [Options::default(), exact()] {
         let sampler = DensitySampler::with_options(mesh, Density::Texture(&t), &options).unwrap();
-        assert!(sampler.sample_n(17, 10_000).iter().all(|p| p.face == 0));
+        assert!(sampler.sample_n(17, 10_000).unwrap().iter().all(|p| p.face == 0));
         assert_eq!(sampler.pdf(1, [0.3, 0.3, 0.4]), 0.0);
     }
     let w = [1.0, 1.0];
     let sampler = DensitySampler::new(mesh, Density::PerFace(&w)).unwrap();
-    assert!(sampler.sample_n(18, 10_000).iter().all(|p| p.face == 0));
+    assert!(sampler.sample_n(18, 10_000).unwrap().iter().all(|p| p.face == 0));
 }
 
 #[test]
@@ -570,7 +570,7 @@ fn batches_do_not_depend_on_the_thread_count() {
                 .install(|| {
                     let s =
                         DensitySampler::with_options(mesh, Density::Texture(&t), &options).unwrap();
-                    (s.pieces(), s.total_mass(), s.sample_n(19, 50_000))
+                    (s.pieces(), s.total_mass(), s.sample_n(19, 50_000).unwrap())
                 })
         };
         let one = run(1);
@@ -582,7 +582,7 @@ fn batches_do_not_depend_on_the_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| r.sample_n(20, 50_000))
+            .install(|| r.sample_n(20, 50_000).unwrap())
     };
     assert_eq!(run(1), run(2));
 }
@@ -598,10 +598,10 @@ fn streaming_hands_out_the_points_of_sample_n() {
     sampler.sample_stream(25, n, |first, chunk| {
         streamed.lock().unwrap()[first..first + chunk.len()].copy_from_slice(chunk);
     });
-    let points = sampler.sample_n(25, n);
+    let points = sampler.sample_n(25, n).unwrap();
     assert_eq!(streamed.into_inner().unwrap(), points);
     let positions: Vec<[f32; 3]> = points.iter().map(|p| p.position.to_array()).collect();
-    assert_eq!(sampler.sample_positions(25, n), positions);
+    assert_eq!(sampler.sample_positions(25, n).unwrap(), positions);
 }
 
 #[test]
@@ -609,11 +609,11 @@ fn points_follow_a_deformed_mesh() {
     let t = noise(16, 16);
     let m = grid(4, |uv| uv);
     let sampler = DensitySampler::new(mesh_ref(&m), Density::Texture(&t)).unwrap();
-    let points = sampler.sample_n(21, 100);
+    let points = sampler.sample_n(21, 100).unwrap();
     let moved: Vec<Vec3> = m.0.iter().map(|p| *p * 2.0 + Vec3::Z).collect();
     let deformed = MeshRef::new(&moved, &m.2);
     for p in points {
-        let q = SurfacePoint::on(&deformed, p.face, p.barycentric, p.pdf);
+        let q = SurfacePoint::on(&deformed, p.face, p.barycentric, p.pdf).unwrap();
         assert!((q.position - (p.position * 2.0 + Vec3::Z)).length() < 1e-5);
     }
 }
@@ -746,7 +746,7 @@ fn hdr_images_as_densities() {
         let m = grid(16, |uv| uv);
         let mesh = mesh_ref(&m);
         let approximate = DensitySampler::new(mesh, Density::Texture(&t)).unwrap();
-        let counts = texel_counts(&m, &t, &approximate.sample_n(22, N));
+        let counts = texel_counts(&m, &t, &approximate.sample_n(22, N).unwrap());
         let expected = approximate_bin_masses(&m, &t);
         let test = stats::chi_square(&counts, &stats::probabilities(&expected), 20.0);
         assert!(
@@ -757,7 +757,7 @@ fn hdr_images_as_densities() {
 
         let exact_sampler =
             DensitySampler::with_options(mesh, Density::Texture(&t), &exact()).unwrap();
-        let counts = face_counts(m.2.len(), &exact_sampler.sample_n(23, N));
+        let counts = face_counts(m.2.len(), &exact_sampler.sample_n(23, N).unwrap());
         let test = stats::chi_square(
             &counts,
             &stats::probabilities(&exact_face_masses(&m, &t)),
@@ -803,7 +803,7 @@ fn bunny_checkerboard_exact_mode_never_lands_on_black() {
     .with_filter(Filter::Nearest);
     let m: Mesh = (positions.clone(), uvs.clone(), indices.clone());
     let on_black = |s: &DensitySampler<'_>| -> u64 {
-        let counts = texel_counts(&m, &t, &s.sample_n(24, 200_000));
+        let counts = texel_counts(&m, &t, &s.sample_n(24, 200_000).unwrap());
         let black = counts.iter().zip(t.texels()).filter(|(_, v)| **v == 0.0);
         black.map(|(c, _)| c).sum()
     };

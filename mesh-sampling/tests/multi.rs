@@ -81,7 +81,7 @@ fn batches_do_not_depend_on_the_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| sampler.sample_n(5, 50_000))
+            .install(|| sampler.sample_n(5, 50_000).unwrap())
     };
     assert_eq!(run(1), run(2));
 }
@@ -122,7 +122,7 @@ fn densities_over_several_meshes_follow_their_masses() {
     assert!((sampler.total_mass() - 7.0).abs() < 1e-5);
     let count = |s: &MultiDensitySampler<'_>| {
         let mut counts = vec![0u64; 2];
-        for p in s.sample_n(3, 200_000) {
+        for p in s.sample_n(3, 200_000).unwrap() {
             counts[p.mesh] += 1;
             assert_eq!(p.point.position.z, p.mesh as f32);
             let pdf = s.pdf(p.mesh, p.point.face as usize, p.point.barycentric);
