@@ -110,8 +110,10 @@ impl AliasTable {
     pub fn new<W: Copy + Into<f64>>(weights: &[W]) -> Result<Self, Error> {
         let total = checked_total(weights)?;
         let n = weights.len();
-        let (inv_total, n_f) = (1.0 / total, n as f64);
-        let probabilities: Vec<f64> = weights.iter().map(|&w| w.into() * inv_total).collect();
+        let n_f = n as f64;
+        // By division: `1 / total` overflows for a subnormal total (see
+        // `Cdf::new`).
+        let probabilities: Vec<f64> = weights.iter().map(|&w| w.into() / total).collect();
 
         // Shares scaled to mean 1: entries below 1 are "small" and give the
         // rest of their column to a "large" one. A small entry's threshold is

@@ -22,13 +22,17 @@ impl Cdf {
         let total = checked_total(weights)?;
         let mut cdf = Vec::with_capacity(weights.len() + 1);
         cdf.push(0.0);
-        let scale = 1.0 / total;
+        // Normalised by division, not by multiplying with `1 / total`: for
+        // a subnormal total that reciprocal is infinite (weights
+        // [5e-324, 1e-323] would give a CDF of [0, inf, NaN]), and for a
+        // total above 2^1022 it is subnormal and has lost bits. A division
+        // is correctly rounded for every finite positive total.
         let mut running = 0.0f64;
         for &w in weights {
             running += w.into();
-            cdf.push(running * scale);
+            cdf.push(running / total);
         }
-        // `total * (1 / total)` may miss 1 by an ulp. Every value equal to
+        // `running / total` may miss 1 by an ulp. Every value equal to
         // the last one (the trailing zero weights and whatever rounds alike)
         // becomes exactly 1; the values before it are at most the float
         // below 1, so the CDF stays monotone.

@@ -171,12 +171,10 @@ impl<S: DiscreteSampler> Distribution2D<S> {
         &self.marginal
     }
 
-    /// The conditional distribution of the columns of `row`.
-    ///
-    /// # Panics
-    /// If `row >= height()`.
-    pub fn row(&self, row: usize) -> &S {
-        &self.rows[row]
+    /// The conditional distribution of the columns of `row`, `None` when
+    /// `row >= height()`.
+    pub fn row(&self, row: usize) -> Option<&S> {
+        self.rows.get(row)
     }
 
     /// Probability of drawing the cell `[column, row]`.
@@ -188,19 +186,33 @@ impl<S: DiscreteSampler> Distribution2D<S> {
         }
     }
 
-    /// Density (w.r.t. area in `[0, 1)²`) at `point`; 0 outside the square.
+    /// Density (w.r.t. area in `[0, 1)²`) at `point`; 0 outside the square
+    /// and for NaN coordinates.
     pub fn pdf(&self, point: [f64; 2]) -> f64 {
+        match self.cell_at(point) {
+            Some(cell) => self.cell_probability(cell) * self.area(),
+            None => 0.0,
+        }
+    }
+
+    /// The cell `[column, row]` that contains `point`, or `None` outside
+    /// `[0, 1)²` (and for NaN). The one rule shared by [`pdf`](Self::pdf),
+    /// [`invert`](Distribution2D::invert) and the placement of sampled
+    /// points, so a sampled point is always found in the cell it was drawn
+    /// from.
+    pub fn cell_at(&self, point: [f64; 2]) -> Option<[usize; 2]> {
         let [x, y] = point;
         if !((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y)) {
-            return 0.0;
+            return None;
         }
-        let column = ((x * self.width as f64) as usize).min(self.width - 1);
-        let row = ((y * self.height as f64) as usize).min(self.height - 1);
-        self.cell_probability([column, row]) * self.area()
+        Some([cell_of(x, self.width), cell_of(y, self.height)])
     }
 
     /// Draws a point for the variates `u = [u0, u1]` in `[0, 1)²` (clamped
-    /// otherwise): `u1` picks the row, `u0` the column.
+    /// otherwise, NaN counts as 0, as for the 1D samplers): `u1` picks the
+    /// row, `u0` the column. The point always lies inside its cell, also
+    /// for a variate just below 1, where `(row + v) / height` would round up
+    /// onto the next cell's edge.
     pub fn sample_u(&self, u: [f64; 2]) -> Sample2D {
         let (row, v) = self.marginal.sample_remapped(u[1]);
         let conditional = &self.rows[row];
@@ -208,8 +220,8 @@ impl<S: DiscreteSampler> Distribution2D<S> {
         let [inv_w, inv_h] = self.inv_size;
         Sample2D {
             point: [
-                ((column as f64 + w) * inv_w).min(ONE_MINUS_EPSILON),
-                ((row as f64 + v) * inv_h).min(ONE_MINUS_EPSILON),
+                place(column, w, self.width, inv_w),
+                place(row, v, self.height, inv_h),
             ],
             cell: [column, row],
             pdf: self.marginal.pdf(row) * conditional.pdf(column) * self.area(),
@@ -234,20 +246,59 @@ impl<S: DiscreteSampler> Distribution2D<S> {
 
 impl<S: InvertibleSampler> Distribution2D<S> {
     /// The variates that [`sample_u`](Self::sample_u) maps to `point`, or
-    /// `None` where the density is zero. `sample_u(invert(p)?).point ≈ p`.
+    /// `None` where the density is zero (and outside `[0, 1)²`, NaN
+    /// included). `sample_u(invert(p)?)` lands in the cell of `p`, at `p` up
+    /// to rounding.
     pub fn invert(&self, point: [f64; 2]) -> Option<[f64; 2]> {
-        let [x, y] = point;
-        if !((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y)) {
-            return None;
-        }
-        let (xs, ys) = (x * self.width as f64, y * self.height as f64);
-        let column = (xs as usize).min(self.width - 1);
-        let row = (ys as usize).min(self.height - 1);
-        let conditional = &self.rows[row];
-        let u1 = self.marginal.invert(row)? + (ys - row as f64) * self.marginal.pdf(row);
-        let u0 = conditional.invert(column)? + (xs - column as f64) * conditional.pdf(column);
-        Some([u0.min(ONE_MINUS_EPSILON), u1.min(ONE_MINUS_EPSILON)])
+        let [column, row] = self.cell_at(point)?;
+        let ys = point[1] * self.height as f64 - row as f64;
+        let xs = point[0] * self.width as f64 - column as f64;
+        let u1 = invert_within(&self.marginal, row, ys)?;
+        let u0 = invert_within(&self.rows[row], column, xs)?;
+        Some([u0, u1])
     }
+}
+
+/// The variate that draws `index` from `sampler` with remainder about
+/// `fraction`: the start of the entry's interval plus `fraction` of its
+/// width, stepped back below the interval's end if rounding carried it
+/// there (it would draw the next entry).
+fn invert_within<S: InvertibleSampler>(sampler: &S, index: usize, fraction: f64) -> Option<f64> {
+    let start = sampler.invert(index)?;
+    let fraction = fraction.clamp(0.0, ONE_MINUS_EPSILON);
+    let mut u = (start + fraction * sampler.pdf(index)).min(ONE_MINUS_EPSILON);
+    // A few ulps at most; bounded so a sampler that disagrees with its own
+    // `invert` cannot make this loop long.
+    for _ in 0..64 {
+        if u <= start || sampler.sample_u(u) == index {
+            return Some(u);
+        }
+        u = u.next_down();
+    }
+    Some(start)
+}
+
+/// The cell among `n` equal cells of `[0, 1)` that contains `x`.
+#[inline]
+fn cell_of(x: f64, n: usize) -> usize {
+    ((x * n as f64) as usize).min(n - 1)
+}
+
+/// The point of `[0, 1)` at `fraction` of cell `index` of `n` (`inv_n` =
+/// `1 / n`), kept inside that cell as [`cell_of`] sees it: rounding of
+/// `(index + fraction) / n` may reach the next cell's lower edge (or, by an
+/// ulp, stay below this cell's), so the point is stepped by ulps until it
+/// is inside. At most a few steps, and only for fractions next to 0 or 1.
+#[inline]
+fn place(index: usize, fraction: f64, n: usize, inv_n: f64) -> f64 {
+    let mut p = ((index as f64 + fraction) * inv_n).min(ONE_MINUS_EPSILON);
+    while p > 0.0 && cell_of(p, n) > index {
+        p = p.next_down();
+    }
+    while cell_of(p, n) < index {
+        p = p.next_up();
+    }
+    p
 }
 
 impl<S: DiscreteSampler> Distribution<Sample2D> for Distribution2D<S> {
@@ -260,7 +311,8 @@ impl<S: DiscreteSampler> Distribution<Sample2D> for Distribution2D<S> {
 
 /// The direction of a point of an equirectangular map: `θ = π y` from the
 /// `+Z` pole (row 0 is the top), `φ = 2π x` from `+X` towards `+Y`; returns
-/// `[sin θ cos φ, sin θ sin φ, cos θ]`. Convert to your renderer's axes.
+/// the unit vector `[sin θ cos φ, sin θ sin φ, cos θ]`. Convert to your
+/// renderer's axes. [`equirect_point`] is its inverse.
 pub fn equirect_direction(point: [f64; 2]) -> [f64; 3] {
     let theta = PI * point[1];
     let phi = 2.0 * PI * point[0];
@@ -269,14 +321,86 @@ pub fn equirect_direction(point: [f64; 2]) -> [f64; 3] {
     [sin_t * cos_p, sin_t * sin_p, cos_t]
 }
 
+/// The point of an equirectangular map in `[0, 1)²` that looks in
+/// `direction` (any length): the inverse of [`equirect_direction`], with
+/// `x = φ / 2π`, `φ = atan2(y, x)` in `[0, 2π)`, and `y = θ / π`,
+/// `θ = atan2(√(x² + y²), z)`. `None` for a zero, infinite or NaN direction. At the
+/// poles, where every `φ` looks the same way, `x` is 0.
+pub fn equirect_point(direction: [f64; 3]) -> Option<[f64; 2]> {
+    if !direction.iter().all(|c| c.is_finite()) {
+        return None;
+    }
+    // Scaled by the largest component first, so that the length of a
+    // huge (or subnormal) direction neither overflows nor underflows.
+    let big = direction.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    if big == 0.0 {
+        return None;
+    }
+    let [dx, dy, dz] = direction.map(|c| c / big);
+    // atan2 rather than acos(z / len): acos loses half the digits next to
+    // the poles, where z is close to ±1.
+    let theta = (dx * dx + dy * dy).sqrt().atan2(dz);
+    let mut phi = dy.atan2(dx);
+    if phi < 0.0 {
+        phi += 2.0 * PI;
+    }
+    // φ just below 2π and θ = π round to 1, which is outside the map.
+    Some([
+        (phi / (2.0 * PI)).min(ONE_MINUS_EPSILON),
+        (theta / PI).min(ONE_MINUS_EPSILON),
+    ])
+}
+
 /// Converts a density over `[0, 1)²` of an equirectangular map to a density
-/// over solid angle: `p(ω) = p(x, y) / (2π² sin θ)`. Returns 0 at the poles,
-/// where the map is singular.
+/// over solid angle: `p(ω) = p(x, y) / (2π² sin θ)`, the Jacobian of
+/// `dω = 2π² sin θ dx dy`. Returns 0 at the poles, where the map is
+/// singular.
 pub fn pdf_solid_angle(pdf_area: f64, point: [f64; 2]) -> f64 {
     let sin_t = (PI * point[1]).sin();
-    if sin_t <= 0.0 {
-        0.0
-    } else {
+    if sin_t > 0.0 {
         pdf_area / (2.0 * PI * PI * sin_t)
+    } else {
+        0.0
+    }
+}
+
+/// A direction drawn from an environment map by
+/// [`Distribution2D::sample_direction`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DirectionSample {
+    /// Unit vector, in the axes of [`equirect_direction`].
+    pub direction: [f64; 3],
+    /// Density with respect to solid angle (per steradian).
+    pub pdf: f64,
+    /// The point of the map, as [`Distribution2D::sample_u`] returns it.
+    pub point: [f64; 2],
+}
+
+/// Environment maps: a `Distribution2D` read as an equirectangular map
+/// (best built by [`Distribution2D::from_equirect`], whose rows are
+/// weighted by `sin θ`, so that the density over directions follows the
+/// map's values), in the axes of [`equirect_direction`].
+impl<S: DiscreteSampler> Distribution2D<S> {
+    /// Draws a direction for the variates `u` and its density with respect
+    /// to solid angle, for a path tracer's light sampling.
+    pub fn sample_direction(&self, u: [f64; 2]) -> DirectionSample {
+        let s = self.sample_u(u);
+        DirectionSample {
+            direction: equirect_direction(s.point),
+            pdf: pdf_solid_angle(s.pdf, s.point),
+            point: s.point,
+        }
+    }
+
+    /// The density with respect to solid angle with which
+    /// [`sample_direction`](Self::sample_direction) draws `direction` (any
+    /// length): what multiple importance sampling needs for a direction
+    /// found by BSDF sampling. 0 for a zero or NaN direction and at the
+    /// poles. Integrates to 1 over the sphere.
+    pub fn pdf_direction(&self, direction: [f64; 3]) -> f64 {
+        match equirect_point(direction) {
+            Some(point) => pdf_solid_angle(self.pdf(point), point),
+            None => 0.0,
+        }
     }
 }

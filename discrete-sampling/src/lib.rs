@@ -83,13 +83,20 @@ mod cdf;
 mod dist2d;
 mod error;
 mod guide_table;
+mod luminance;
 mod sampler;
 mod uniform;
 mod weights;
 
 pub use alias::AliasTable;
 pub use bisection::CdfBisection;
-pub use dist2d::{Distribution2D, Sample2D, equirect_direction, pdf_solid_angle};
+pub use dist2d::{
+    DirectionSample, Distribution2D, Sample2D, equirect_direction, equirect_point, pdf_solid_angle,
+};
 pub use error::Error;
 pub use guide_table::{DEFAULT_RATIO, GuideTable, MAX_RATIO};
+pub use luminance::luminance;
+/// The `rand` this crate's API speaks (its `Rng` and `Distribution` traits),
+/// re-exported so that callers use the same version.
+pub use rand;
 pub use sampler::{DiscreteSampler, InvertibleSampler};

@@ -8,8 +8,11 @@ use sprs::CsMat;
 use crate::Error;
 use crate::coarse::{galerkin, restrict_by_selection, substituted};
 use crate::hierarchy::{Hierarchy, HierarchyOptions, Weights};
-use crate::krylov::{Monitor, Report, SolveOptions, bicgstab, cg, jacobi_cg_checked, nonzero};
-use crate::matrix::{check_square, check_vector, mul_vec, transpose};
+use crate::krylov::{
+    Monitor, Report, SolveOptions, bicgstab_checked, jacobi_cg_checked, no_monitor, nonzero,
+    pcg_checked,
+};
+use crate::matrix::{check_square, check_symmetric, check_vector, mul_vec, transpose};
 
 /// Which coarse systems the cascade solves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -50,10 +53,7 @@ impl Default for CascadeOptions {
                 ..HierarchyOptions::default()
             },
             system: CoarseSystem::Substituted,
-            coarsest: SolveOptions {
-                tolerance: 1e-4,
-                max_iterations: 500,
-            },
+            coarsest: SolveOptions::new(1e-4, 500),
             intermediate_iterations: 2,
         }
     }
@@ -78,16 +78,16 @@ impl CascadeOptions {
                 ..HierarchyOptions::default()
             },
             system: CoarseSystem::Galerkin,
-            coarsest: SolveOptions {
-                tolerance: 1e-1,
-                max_iterations: 1_000,
-            },
+            coarsest: SolveOptions::new(1e-1, 1_000),
             intermediate_iterations: 1,
         }
     }
 }
 
-/// What a cascade solve did.
+/// What a cascade solve did. Read it: with
+/// [`SolveOptions::require_convergence`] off, a cascade whose final CG
+/// stopped short is still `Ok`.
+#[must_use = "a solve may stop before its tolerance: check `finest.converged()`"]
 #[derive(Debug, Clone, PartialEq)]
 pub struct CascadeReport {
     /// The level whose solve converged and started the cascade.
@@ -136,6 +136,9 @@ impl Cascade {
         options: &CascadeOptions,
     ) -> Result<Self, Error> {
         let hierarchy = Hierarchy::new(m, weights, &options.hierarchy)?;
+        // The cascade ends in CG on `m`: refuse a non-symmetric matrix
+        // now rather than at every solve's end.
+        check_symmetric(m)?;
         let mut matrices: Vec<CsMat<f64>> = Vec::with_capacity(hierarchy.steps.len());
         for step in &hierarchy.steps {
             let finer = matrices.last().unwrap_or(m);
@@ -170,9 +173,16 @@ impl Cascade {
         x: &mut [f64],
         options: &SolveOptions,
     ) -> Result<Report, Error> {
+        // Coarse levels never fail the solve: a coarsest level that does
+        // not converge is a fallback, an intermediate one runs a fixed
+        // number of iterations. Their matrices were built here from a
+        // checked one.
         match self.options.system {
-            CoarseSystem::Substituted => bicgstab(a, b, x, options),
-            CoarseSystem::Galerkin => cg(a, b, x, options),
+            CoarseSystem::Substituted => bicgstab_checked(a, b, x, options, &mut no_monitor()),
+            CoarseSystem::Galerkin => {
+                let jacobi = crate::Jacobi::new(a)?;
+                pcg_checked(a, b, x, &jacobi, options, &mut no_monitor())
+            }
         }
     }
 
@@ -226,6 +236,7 @@ impl Cascade {
         monitor: Monitor<'_>,
     ) -> Result<CascadeReport, Error> {
         let n = check_square(m)?;
+        check_symmetric(m)?;
         let sizes = self.hierarchy.sizes();
         if n != sizes[0] {
             return Err(Error::DimensionMismatch {
@@ -283,8 +294,8 @@ impl Cascade {
                     break;
                 }
                 let few = SolveOptions {
-                    tolerance: self.options.coarsest.tolerance,
                     max_iterations: self.options.intermediate_iterations,
+                    ..self.options.coarsest
                 };
                 let report = self.coarse_solve(&self.matrices[l - 1], &rhs[l], &mut xf, &few)?;
                 coarse.push((l, report));
@@ -308,11 +319,18 @@ impl Cascade {
             });
         }
         let finest = jacobi_cg_checked(m, b, x, options, monitor)?;
-        Ok(CascadeReport {
+        let report = CascadeReport {
             start_level,
             fallbacks,
             coarse,
             finest,
-        })
+        };
+        match options.settle(finest) {
+            Ok(_) => Ok(report),
+            Err(_) => Err(Error::CascadeNotConverged {
+                report: Box::new(report),
+                tolerance: options.tolerance,
+            }),
+        }
     }
 }

@@ -1,7 +1,9 @@
 //! The crate's one error type.
 
-/// What is wrong with a solver's or a hierarchy's input.
+/// What is wrong with a solver's or a hierarchy's input, or why a solve
+/// did not deliver.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// The matrix is stored column-major; the solvers read rows.
     #[error("the matrix is stored as CSC; convert it with `to_csr()`")]
@@ -84,4 +86,49 @@ pub enum Error {
     /// Indices are stored in 32 bits in the hierarchy.
     #[error("{0} unknowns is more than the hierarchy's 32-bit indices allow")]
     TooLarge(usize),
+    /// CG (and the V-cycle and cascade, which end in CG) need a symmetric
+    /// matrix.
+    #[error(
+        "CG needs a symmetric matrix, but entry ({row}, {col}) is {value} and entry ({col}, {row}) is {transposed}; solve non-symmetric systems with bicgstab"
+    )]
+    NotSymmetric {
+        /// Row of the first entry found without its mirror.
+        row: usize,
+        /// Its column.
+        col: usize,
+        /// `a[row][col]`.
+        value: f64,
+        /// `a[col][row]` (0 when not stored).
+        transposed: f64,
+    },
+    /// The solve stopped before reaching its tolerance (iteration cap,
+    /// breakdown or stagnation) while [`crate::SolveOptions::require_convergence`]
+    /// was on. `x` holds the last iterate, whose true residual the report
+    /// gives.
+    #[error("the solve did not converge to the tolerance {tolerance:e}: it {report}")]
+    NotConverged {
+        /// What the solve did, with the residual of the returned `x`.
+        report: crate::Report,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
+    /// The cascade's final CG stopped before reaching its tolerance while
+    /// [`crate::SolveOptions::require_convergence`] was on.
+    #[error("the cascade did not converge to the tolerance {tolerance:e}: its final CG {}", report.finest)]
+    CascadeNotConverged {
+        /// What every level did; `report.finest` has the true residual.
+        report: Box<crate::CascadeReport>,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
+    /// A Matrix Market file could not be read.
+    #[error("{}:{line}: {message}", path.display())]
+    MatrixMarket {
+        /// The file.
+        path: std::path::PathBuf,
+        /// 1-based line of the problem (0: the file as a whole).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
 }

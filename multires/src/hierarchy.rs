@@ -20,10 +20,42 @@ use crate::matrix::{assemble, check_square};
 pub enum Weights<'a> {
     /// `λ_ij = 1`: plain averages.
     Uniform,
-    /// `λ_ij = 1 / |x_i − x_j|` (the paper's choice).
+    /// `λ_ij = 1 / |x_i − x_j|` (the paper's choice), positions as arrays.
     Positions(&'a [[f64; 3]]),
+    /// As [`Positions`](Self::Positions), for positions of any type that is
+    /// `AsRef<[f64; 3]>` (glam's `DVec3`), read in place: pass
+    /// `Weights::Points(&mesh.positions)` with a `Vec<DVec3>`, no copy.
+    Points(&'a dyn PositionList),
     /// Any positive weight of an edge, such as a conductance.
     Custom(&'a (dyn Fn(usize, usize) -> f64 + Sync)),
+}
+
+/// Vertex positions the hierarchy can read in place: implemented for
+/// `Vec<P>` and `&[P]` of any `P: AsRef<[f64; 3]>` (glam's `DVec3`
+/// implements it), so a mesh's own position buffer goes in without a copy.
+pub trait PositionList: Sync {
+    /// Number of positions.
+    fn count(&self) -> usize;
+    /// Position `i` (`i < count()`).
+    fn position(&self, i: usize) -> [f64; 3];
+}
+
+impl<P: AsRef<[f64; 3]> + Sync> PositionList for Vec<P> {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn position(&self, i: usize) -> [f64; 3] {
+        *self[i].as_ref()
+    }
+}
+
+impl<P: AsRef<[f64; 3]> + Sync> PositionList for &[P] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn position(&self, i: usize) -> [f64; 3] {
+        *self[i].as_ref()
+    }
 }
 
 impl std::fmt::Debug for Weights<'_> {
@@ -31,6 +63,7 @@ impl std::fmt::Debug for Weights<'_> {
         match self {
             Self::Uniform => write!(f, "Uniform"),
             Self::Positions(p) => write!(f, "Positions({} points)", p.len()),
+            Self::Points(p) => write!(f, "Points({} points)", p.count()),
             Self::Custom(_) => write!(f, "Custom"),
         }
     }
@@ -38,13 +71,30 @@ impl std::fmt::Debug for Weights<'_> {
 
 impl Weights<'_> {
     fn get(&self, i: usize, j: usize) -> f64 {
+        match (self.position(i), self.position(j)) {
+            (Some(a), Some(b)) => 1.0 / dist(a, b),
+            _ => match self {
+                Self::Custom(f) => f(i, j),
+                _ => 1.0,
+            },
+        }
+    }
+
+    /// Number of positions, for the variants that have them.
+    fn position_count(&self) -> Option<usize> {
         match self {
-            Self::Uniform => 1.0,
-            Self::Positions(x) => {
-                let d: f64 = (0..3).map(|k| (x[i][k] - x[j][k]).powi(2)).sum();
-                1.0 / d.sqrt()
-            }
-            Self::Custom(f) => f(i, j),
+            Self::Positions(x) => Some(x.len()),
+            Self::Points(p) => Some(p.count()),
+            _ => None,
+        }
+    }
+
+    /// Position `i`, for the variants that have positions.
+    fn position(&self, i: usize) -> Option<[f64; 3]> {
+        match self {
+            Self::Positions(x) => Some(x[i]),
+            Self::Points(p) => Some(p.position(i)),
+            _ => None,
         }
     }
 }
@@ -151,28 +201,28 @@ impl Hierarchy {
         if n > u32::MAX as usize {
             return Err(Error::TooLarge(n));
         }
-        if let Weights::Positions(x) = weights {
-            if x.len() != n {
+        if let Some(count) = weights.position_count() {
+            if count != n {
                 return Err(Error::DimensionMismatch {
                     what: "positions",
                     expected: n,
-                    found: x.len(),
+                    found: count,
                 });
             }
-            if let Some(i) = x.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-                return Err(Error::NotFiniteVector {
-                    what: "positions",
-                    index: i,
-                    value: x[i]
-                        .into_iter()
-                        .find(|c| !c.is_finite())
-                        .unwrap_or(f64::NAN),
-                });
+            for i in 0..n {
+                let p = weights.position(i).unwrap_or([0.0; 3]);
+                if let Some(&value) = p.iter().find(|c| !c.is_finite()) {
+                    return Err(Error::NotFiniteVector {
+                        what: "positions",
+                        index: i,
+                        value,
+                    });
+                }
             }
         }
-        if options.linear_precision && !matches!(weights, Weights::Positions(_)) {
+        if options.linear_precision && weights.position_count().is_none() {
             return Err(Error::InvalidOption(
-                "linear_precision needs Weights::Positions",
+                "linear_precision needs Weights::Positions or Weights::Points",
             ));
         }
         if options.max_levels == 0 {
@@ -387,8 +437,8 @@ fn coarsen(
         for (_, w) in &mut out[start..] {
             *w /= total;
         }
-        if let (true, Weights::Positions(x)) = (options.linear_precision, weights) {
-            let at = |k: usize| x[original[k] as usize];
+        if options.linear_precision && weights.position_count().is_some() {
+            let at = |k: usize| weights.position(original[k] as usize).unwrap_or([0.0; 3]);
             let neighbours: Vec<[f64; 3]> = graph
                 .neighbors(i)
                 .iter()

@@ -14,34 +14,75 @@ use std::ops::ControlFlow;
 use sprs::CsMat;
 
 use crate::Error;
-use crate::matrix::{check_square, check_vector, inverse_diagonal, mul_vec};
+use crate::matrix::{check_square, check_symmetric, check_vector, inverse_diagonal, mul_vec};
 use crate::vector::{axpy, cg_update, dot, norm, scale as diagonal_scale, xpby};
 
-/// When a solver stops.
+/// When a solver stops, and whether stopping short is an error.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolveOptions {
     /// Relative residual `‖b − A x‖ / ‖b‖` to reach.
     pub tolerance: f64,
     /// Iterations allowed (one mat-vec each for CG, two for BiCGSTAB).
     pub max_iterations: usize,
+    /// Turn a solve that does not reach `tolerance` — the iteration cap,
+    /// a breakdown, or stagnation above the tolerance — into
+    /// [`Error::NotConverged`] (carrying the [`Report`] with the true
+    /// residual; `x` still holds the last iterate). On by default; turn it
+    /// off to take whatever a fixed budget of iterations gives (an
+    /// interactive preview) and read [`Report::converged`] yourself. A
+    /// monitor's `Break` is never an error.
+    pub require_convergence: bool,
 }
 
 impl Default for SolveOptions {
-    /// `10⁻⁶` in at most 10 000 iterations.
+    /// `10⁻⁶` in at most 10 000 iterations, non-convergence an error.
     fn default() -> Self {
         Self {
             tolerance: 1e-6,
             max_iterations: 10_000,
+            require_convergence: true,
         }
     }
 }
 
 impl SolveOptions {
+    /// `tolerance` in at most `max_iterations`, non-convergence an error.
+    pub fn new(tolerance: f64, max_iterations: usize) -> Self {
+        Self {
+            tolerance,
+            max_iterations,
+            require_convergence: true,
+        }
+    }
+
+    /// The same options with non-convergence reported in the [`Report`]
+    /// only, not as an error.
+    pub fn allow_unconverged(self) -> Self {
+        Self {
+            require_convergence: false,
+            ..self
+        }
+    }
+
     fn check(&self) -> Result<(), Error> {
         if !(self.tolerance >= 0.0 && self.tolerance.is_finite()) {
             return Err(Error::InvalidOption("tolerance must be finite and ≥ 0"));
         }
         Ok(())
+    }
+
+    /// The report, or [`Error::NotConverged`] when convergence is
+    /// required and the solve stopped short for a reason of its own.
+    pub(crate) fn settle(&self, report: Report) -> Result<Report, Error> {
+        match report.stop {
+            Stop::MaxIterations | Stop::Breakdown | Stop::Stagnated if self.require_convergence => {
+                Err(Error::NotConverged {
+                    report,
+                    tolerance: self.tolerance,
+                })
+            }
+            _ => Ok(report),
+        }
     }
 }
 
@@ -63,7 +104,10 @@ pub enum Stop {
     Stagnated,
 }
 
-/// What a solve did.
+/// What a solve did. Read it: with
+/// [`SolveOptions::require_convergence`] off, a solve that stopped short is
+/// still `Ok`.
+#[must_use = "a solve may stop before its tolerance: check `converged()`"]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Report {
     /// Why it stopped.
@@ -78,6 +122,28 @@ impl Report {
     /// Whether the tolerance was reached.
     pub fn converged(&self) -> bool {
         self.stop == Stop::Converged
+    }
+}
+
+impl std::fmt::Display for Stop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Stop::Converged => "converged",
+            Stop::MaxIterations => "reached the iteration cap",
+            Stop::Breakdown => "broke down (a recurrence scalar vanished or overflowed)",
+            Stop::Interrupted => "was stopped by its monitor",
+            Stop::Stagnated => "stagnated (restarts no longer lowered the residual)",
+        })
+    }
+}
+
+impl std::fmt::Display for Report {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} after {} iterations at relative residual {:.3e}",
+            self.stop, self.iterations, self.residual
+        )
     }
 }
 
@@ -117,7 +183,7 @@ impl Preconditioner for Jacobi {
 /// application's time budget, a benchmark's error target).
 pub type Monitor<'m> = &'m mut dyn FnMut(usize, &[f64]) -> ControlFlow<()>;
 
-fn no_monitor() -> impl FnMut(usize, &[f64]) -> ControlFlow<()> {
+pub(crate) fn no_monitor() -> impl FnMut(usize, &[f64]) -> ControlFlow<()> {
     |_, _| ControlFlow::Continue(())
 }
 
@@ -127,7 +193,10 @@ fn no_monitor() -> impl FnMut(usize, &[f64]) -> ControlFlow<()> {
 /// # Errors
 /// [`Error::NotCsr`], [`Error::NotSquare`], [`Error::DimensionMismatch`],
 /// [`Error::NotFiniteEntry`] / [`Error::NotFiniteVector`] for NaN or
-/// infinite input, [`Error::BadDiagonal`] for a zero or negative diagonal.
+/// infinite input, [`Error::BadDiagonal`] for a zero or negative diagonal,
+/// [`Error::NotSymmetric`] for a matrix that is not symmetric (use
+/// [`bicgstab`]), and [`Error::NotConverged`] when the tolerance is not
+/// reached and [`SolveOptions::require_convergence`] is on.
 ///
 /// # Example
 /// ```
@@ -159,7 +228,8 @@ pub fn cg_monitored(
     monitor: Monitor<'_>,
 ) -> Result<Report, Error> {
     check_square(a)?;
-    jacobi_cg_checked(a, b, x, options, monitor)
+    check_symmetric(a)?;
+    options.settle(jacobi_cg_checked(a, b, x, options, monitor)?)
 }
 
 /// [`cg_monitored`] for a matrix already checked by [`check_square`]
@@ -204,10 +274,13 @@ pub fn pcg_monitored(
     monitor: Monitor<'_>,
 ) -> Result<Report, Error> {
     check_square(a)?;
-    pcg_checked(a, b, x, m, options, monitor)
+    check_symmetric(a)?;
+    options.settle(pcg_checked(a, b, x, m, options, monitor)?)
 }
 
-/// [`pcg_monitored`] for a matrix already checked by [`check_square`].
+/// [`pcg_monitored`] for a matrix already checked by [`check_square`]
+/// (and, where it matters, [`check_symmetric`]); the report is returned
+/// whatever the stop (see [`SolveOptions::settle`]).
 pub(crate) fn pcg_checked(
     a: &CsMat<f64>,
     b: &[f64],
@@ -308,7 +381,8 @@ fn precondition_dot(m: &(impl Preconditioner + ?Sized), r: &[f64], z: &mut [f64]
 /// `x`. Each iteration costs two mat-vecs.
 ///
 /// # Errors
-/// As [`cg`], with [`Error::BadDiagonal`] only for a zero diagonal entry.
+/// As [`cg`], with [`Error::BadDiagonal`] only for a zero diagonal entry
+/// and no symmetry required.
 pub fn bicgstab(
     a: &CsMat<f64>,
     b: &[f64],
@@ -329,7 +403,20 @@ pub fn bicgstab_monitored(
     options: &SolveOptions,
     monitor: Monitor<'_>,
 ) -> Result<Report, Error> {
-    let n = check_square(a)?;
+    check_square(a)?;
+    options.settle(bicgstab_checked(a, b, x, options, monitor)?)
+}
+
+/// [`bicgstab_monitored`] for a matrix already checked by [`check_square`];
+/// the report is returned whatever the stop.
+pub(crate) fn bicgstab_checked(
+    a: &CsMat<f64>,
+    b: &[f64],
+    x: &mut [f64],
+    options: &SolveOptions,
+    monitor: Monitor<'_>,
+) -> Result<Report, Error> {
+    let n = a.rows();
     check_vector("right-hand side", b, n)?;
     check_vector("start vector", x, n)?;
     options.check()?;

@@ -37,7 +37,7 @@
 //! ```
 //! use multires::{cg, grid, SolveOptions, VCycle, VCycleOptions, Weights};
 //! let p = grid::diffusion([20, 20, 20], 6.0)?;
-//! let options = SolveOptions { tolerance: 1e-8, max_iterations: 1_000 };
+//! let options = SolveOptions::new(1e-8, 1_000);
 //!
 //! let mut plain = vec![0.0; p.rhs.len()];
 //! let jacobi = cg(&p.matrix, &p.rhs, &mut plain, &options)?;
@@ -58,15 +58,19 @@ pub mod grid;
 pub mod hierarchy;
 pub mod krylov;
 pub mod matrix;
+pub mod mtx;
 pub mod vcycle;
 pub mod vector;
 
 pub use cascade::{Cascade, CascadeOptions, CascadeReport, CoarseSystem};
 pub use error::Error;
 pub use graph::Graph;
-pub use hierarchy::{Coarsening, Hierarchy, HierarchyOptions, Weights};
+pub use hierarchy::{Coarsening, Hierarchy, HierarchyOptions, PositionList, Weights};
 pub use krylov::{
     Jacobi, Monitor, Preconditioner, Report, SolveOptions, Stop, bicgstab, bicgstab_monitored, cg,
     cg_monitored, pcg, pcg_monitored,
 };
+/// The `sprs` whose `CsMat` this crate's API takes, re-exported so that
+/// callers build matrices with the same version.
+pub use sprs;
 pub use vcycle::{VCycle, VCycleOptions};

@@ -44,6 +44,65 @@ pub(crate) fn check_square(a: &CsMat<f64>) -> Result<usize, Error> {
     Ok(a.rows())
 }
 
+/// Checks that a square CSR matrix is symmetric: every stored `a_ij` has
+/// a stored `a_ji` equal to it up to rounding (`|a_ij − a_ji| ≤ 10⁻¹⁰ ·
+/// max(|a_ij|, |a_ji|, √|a_ii a_jj|)`, room for assembly in different
+/// orders). One parallel pass over the entries, a binary search each: about
+/// the cost of a few mat-vecs, paid once per solve.
+pub(crate) fn check_symmetric(a: &CsMat<f64>) -> Result<(), Error> {
+    let indptr = a.indptr();
+    let indptr = indptr.to_proper();
+    let (indices, data) = (a.indices(), a.data());
+    let row = |i: usize| {
+        (
+            &indices[indptr[i]..indptr[i + 1]],
+            &data[indptr[i]..indptr[i + 1]],
+        )
+    };
+    // Duplicates are summed, so look entries up by summing all matches.
+    let entry = |i: usize, j: usize| -> f64 {
+        let (cols, vals) = row(i);
+        cols.iter()
+            .zip(vals)
+            .filter(|&(&c, _)| c == j)
+            .map(|(_, v)| v)
+            .sum()
+    };
+    let sorted = |i: usize| row(i).0.windows(2).all(|w| w[0] < w[1]);
+    let lookup = |i: usize, j: usize| -> f64 {
+        let (cols, vals) = row(i);
+        if sorted(i) {
+            cols.binary_search(&j).map_or(0.0, |k| vals[k])
+        } else {
+            entry(i, j)
+        }
+    };
+    let diagonal = diagonal(a);
+    let bad = (0..a.rows()).into_par_iter().find_map_first(|i| {
+        let (cols, _) = row(i);
+        cols.iter().find_map(|&j| {
+            if j <= i {
+                return None;
+            }
+            let (v, w) = (lookup(i, j), lookup(j, i));
+            let scale = v
+                .abs()
+                .max(w.abs())
+                .max((diagonal[i] * diagonal[j]).abs().sqrt());
+            ((v - w).abs() > 1e-10 * scale).then_some((i, j, v, w))
+        })
+    });
+    match bad {
+        Some((row, col, value, transposed)) => Err(Error::NotSymmetric {
+            row,
+            col,
+            value,
+            transposed,
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Checks a vector's length and entries.
 pub(crate) fn check_vector(what: &'static str, v: &[f64], n: usize) -> Result<(), Error> {
     if v.len() != n {

@@ -16,7 +16,7 @@ use crate::dense::Cholesky;
 use crate::graph::Graph;
 use crate::hierarchy::{Hierarchy, HierarchyOptions, Weights};
 use crate::krylov::{Monitor, Preconditioner, Report, SolveOptions, pcg_checked};
-use crate::matrix::{check_square, inverse_diagonal, mul_vec, transpose};
+use crate::matrix::{check_square, check_symmetric, inverse_diagonal, mul_vec, transpose};
 use crate::vector::{CHUNK, scale};
 
 /// How the V-cycle is built and smooths.
@@ -91,6 +91,7 @@ impl<'m> VCycle<'m> {
             return Err(Error::InvalidOption("damping must be in (0, 1]"));
         }
         check_square(m)?;
+        check_symmetric(m)?;
         let fine_inverse_diagonal = damped_inverse_diagonal(m, options.damping)?;
         // Each level's graph is that of its Galerkin operator, so the
         // coarsening follows the couplings the operator really has.
@@ -265,8 +266,9 @@ impl<'m> VCycle<'m> {
         options: &SolveOptions,
         monitor: Monitor<'_>,
     ) -> Result<Report, Error> {
-        // The matrix was checked when the V-cycle was built.
-        pcg_checked(self.fine, b, x, self, options, monitor)
+        // The matrix was checked (square, finite, symmetric) when the
+        // V-cycle was built.
+        options.settle(pcg_checked(self.fine, b, x, self, options, monitor)?)
     }
 }
 

@@ -216,7 +216,7 @@ fn linear_precision_reproduces_linear_functions() {
             }
         )
         .unwrap_err(),
-        Error::InvalidOption("linear_precision needs Weights::Positions")
+        Error::InvalidOption("linear_precision needs Weights::Positions or Weights::Points")
     );
 }
 

@@ -11,10 +11,7 @@ use multires::{
 use sprs::{CsMat, TriMat};
 
 fn tight() -> SolveOptions {
-    SolveOptions {
-        tolerance: 1e-10,
-        max_iterations: 5_000,
-    }
+    SolveOptions::new(1e-10, 5_000)
 }
 
 /// `x*` with entries in [−1, 1] and `b = A x*`.
@@ -96,26 +93,43 @@ fn bicgstab_solves_non_symmetric_systems() {
     let true_residual = relative_residual(&a, &b, &x);
     assert!((report.residual - true_residual).abs() <= 1e-3 * true_residual + 1e-15);
     assert!(max_error(&x, &exact) < 1e-6);
-    // CG is not for this matrix: it does not reach the tolerance.
+    // CG is not for this matrix: it refuses it, once, pointing to
+    // BiCGSTAB, and so do the solvers that end in CG.
     let mut y = vec![0.0; a.rows()];
-    let capped = SolveOptions {
-        max_iterations: 60,
-        ..tight()
-    };
-    assert!(!cg(&a, &b, &mut y, &capped).unwrap().converged());
+    let e = cg(&a, &b, &mut y, &tight()).unwrap_err();
+    assert!(matches!(e, Error::NotSymmetric { .. }), "{e}");
+    assert!(e.to_string().contains("bicgstab"), "{e}");
+    assert!(matches!(
+        multires::pcg(&a, &b, &mut y, &Jacobi::new(&a).unwrap(), &tight()),
+        Err(Error::NotSymmetric { .. })
+    ));
+    assert!(matches!(
+        VCycle::new(&a, Weights::Uniform, &VCycleOptions::default()),
+        Err(Error::NotSymmetric { .. })
+    ));
+    assert!(matches!(
+        Cascade::new(&a, Weights::Uniform, &CascadeOptions::default()),
+        Err(Error::NotSymmetric { .. })
+    ));
 }
 
 #[test]
 fn solvers_stop_at_the_cap_or_on_breakdown() {
     let g = grid_problem(10);
-    let capped = SolveOptions {
-        tolerance: 1e-12,
-        max_iterations: 7,
-    };
+    let capped = SolveOptions::new(1e-12, 7).allow_unconverged();
     let mut x = vec![0.0; g.rhs.len()];
     let r = cg(&g.matrix, &g.rhs, &mut x, &capped).unwrap();
     assert_eq!((r.stop, r.iterations), (Stop::MaxIterations, 7));
     assert!((r.residual - relative_residual(&g.matrix, &g.rhs, &x)).abs() < 1e-12);
+    // By default the cap is an error that carries the same report.
+    let mut y = vec![0.0; g.rhs.len()];
+    match cg(&g.matrix, &g.rhs, &mut y, &SolveOptions::new(1e-12, 7)) {
+        Err(Error::NotConverged { report, tolerance }) => {
+            assert_eq!((report, tolerance), (r, 1e-12));
+            assert_eq!(x, y);
+        }
+        other => panic!("expected NotConverged, got {other:?}"),
+    }
     let mut x = vec![0.0; g.rhs.len()];
     let r = bicgstab(&g.matrix, &g.rhs, &mut x, &capped).unwrap();
     assert_eq!(r.stop, Stop::MaxIterations);
@@ -128,11 +142,17 @@ fn solvers_stop_at_the_cap_or_on_breakdown() {
     }
     let a: CsMat<f64> = t.to_csr();
     let mut x = vec![0.0; 2];
-    let r = cg(&a, &[1.0, -1.0], &mut x, &tight()).unwrap();
+    let r = cg(&a, &[1.0, -1.0], &mut x, &tight().allow_unconverged()).unwrap();
     assert!(
         r.stop == Stop::Converged || r.stop == Stop::Breakdown,
         "{r:?}"
     );
+    if r.stop == Stop::Breakdown {
+        let mut y = vec![0.0; 2];
+        let e = cg(&a, &[1.0, -1.0], &mut y, &tight()).unwrap_err();
+        assert!(matches!(e, Error::NotConverged { .. }), "{e}");
+        assert!(e.to_string().contains("broke down"), "{e}");
+    }
     assert!((r.residual - relative_residual(&a, &[1.0, -1.0], &x)).abs() < 1e-9);
     // A zero right-hand side gives x = 0 at once.
     let mut x = vec![0.0; g.rhs.len()];
@@ -166,11 +186,8 @@ fn the_cascade_and_the_v_cycle_solve_to_the_reported_residual() {
     let g = grid::diffusion([20, 18, 16], 8.0).unwrap();
     let w = Weights::Positions(&g.positions);
     let mut reference = vec![0.0; g.rhs.len()];
-    cg(&g.matrix, &g.rhs, &mut reference, &tight()).unwrap();
-    let options = SolveOptions {
-        tolerance: 1e-8,
-        max_iterations: 2_000,
-    };
+    let _ = cg(&g.matrix, &g.rhs, &mut reference, &tight()).unwrap();
+    let options = SolveOptions::new(1e-8, 2_000);
     for system in [CoarseSystem::Substituted, CoarseSystem::Galerkin] {
         let o = CascadeOptions {
             system,
@@ -250,22 +267,23 @@ fn galerkin_and_linear_precision_give_an_accurate_start() {
     // are consistent: the interpolated start is already close.
     let g = grid::diffusion([24, 24, 24], 6.0).unwrap();
     let mut reference = vec![0.0; g.rhs.len()];
-    cg(&g.matrix, &g.rhs, &mut reference, &tight()).unwrap();
+    let _ = cg(&g.matrix, &g.rhs, &mut reference, &tight()).unwrap();
     let start_error = |o: &CascadeOptions| {
         let c = Cascade::new(&g.matrix, Weights::Positions(&g.positions), o).unwrap();
         let mut x = vec![0.0; g.rhs.len()];
         let mut first = None;
-        c.solve_monitored(&g.matrix, &g.rhs, &mut x, &tight(), &mut |_, x| {
-            first = Some(
-                x.iter()
-                    .zip(&reference)
-                    .map(|(a, b)| (a - b).powi(2))
-                    .sum::<f64>()
-                    .sqrt(),
-            );
-            std::ops::ControlFlow::Break(())
-        })
-        .unwrap();
+        let _ = c
+            .solve_monitored(&g.matrix, &g.rhs, &mut x, &tight(), &mut |_, x| {
+                first = Some(
+                    x.iter()
+                        .zip(&reference)
+                        .map(|(a, b)| (a - b).powi(2))
+                        .sum::<f64>()
+                        .sqrt(),
+                );
+                std::ops::ControlFlow::Break(())
+            })
+            .unwrap();
         first.unwrap() / reference.iter().map(|v| v * v).sum::<f64>().sqrt()
     };
     let small = HierarchyOptions {
@@ -283,10 +301,7 @@ fn galerkin_and_linear_precision_give_an_accurate_start() {
             max_levels: 3,
             ..small
         },
-        coarsest: SolveOptions {
-            tolerance: 1e-8,
-            max_iterations: 2_000,
-        },
+        coarsest: SolveOptions::new(1e-8, 2_000),
         ..CascadeOptions::default()
     });
     assert!(consistent < 5e-3, "Galerkin start error {consistent}");
@@ -334,21 +349,18 @@ fn a_coarse_level_that_does_not_converge_falls_back_to_the_finer_one() {
 fn results_do_not_depend_on_the_thread_count() {
     let g = grid::diffusion([30, 30, 30], 10.0).unwrap();
     let w = Weights::Positions(&g.positions);
-    let options = SolveOptions {
-        tolerance: 1e-9,
-        max_iterations: 1_000,
-    };
+    let options = SolveOptions::new(1e-9, 1_000);
     let run = || {
         let mut a = vec![0.0; g.rhs.len()];
-        cg(&g.matrix, &g.rhs, &mut a, &options).unwrap();
+        let _ = cg(&g.matrix, &g.rhs, &mut a, &options).unwrap();
         let mut b = vec![0.0; g.rhs.len()];
-        bicgstab(&g.matrix, &g.rhs, &mut b, &options).unwrap();
+        let _ = bicgstab(&g.matrix, &g.rhs, &mut b, &options).unwrap();
         let cascade = Cascade::new(&g.matrix, w, &CascadeOptions::default()).unwrap();
         let mut c = vec![0.0; g.rhs.len()];
-        cascade.solve(&g.matrix, &g.rhs, &mut c, &options).unwrap();
+        let _ = cascade.solve(&g.matrix, &g.rhs, &mut c, &options).unwrap();
         let v = VCycle::new(&g.matrix, w, &VCycleOptions::default()).unwrap();
         let mut d = vec![0.0; g.rhs.len()];
-        v.solve(&g.rhs, &mut d, &options).unwrap();
+        let _ = v.solve(&g.rhs, &mut d, &options).unwrap();
         let coarse = coarse::galerkin(&g.matrix, &cascade.hierarchy().steps[0]);
         (a, b, c, d, coarse)
     };

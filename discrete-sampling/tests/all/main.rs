@@ -7,11 +7,14 @@ mod shapes;
 #[path = "../support/stats.rs"]
 mod stats;
 
+mod environment;
 mod errors;
 mod exactness;
 mod goodness_of_fit;
+mod no_panic;
 mod precision;
 mod real_data;
+mod regressions;
 mod stability;
 mod two_d;
 

@@ -55,7 +55,7 @@ pub(crate) fn load_luminance(path: &Path) -> Result<Luminance, String> {
     let (width, height) = (image.width() as usize, image.height() as usize);
     let values = image
         .pixels()
-        .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+        .map(|p| discrete_sampling::luminance([p[0], p[1], p[2]]))
         .collect();
     let name = path
         .file_name()
