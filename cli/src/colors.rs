@@ -20,7 +20,11 @@ use crate::{Error, Result};
 /// A mesh-colours texture of the image's linear RGB (3 channels), row 0 at
 /// `v = 0` like `TriMesh` UVs (no flip).
 pub fn texture(image: &Image) -> Result<Texture> {
-    let data = image.pixels.iter().flat_map(|p| [p[0], p[1], p[2]]).collect();
+    let data = image
+        .pixels
+        .iter()
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
     Ok(Texture::new(
         image.width as usize,
         image.height as usize,
@@ -51,7 +55,8 @@ pub fn texture_image(texture: &Texture) -> Image {
 }
 
 /// mesh-colors' wrap mode for a material's (glTF sampler semantics;
-/// mirrored repeat is read as repeat).
+/// mirrored repeat is read as repeat where mesh-colors has no mirrored
+/// mode).
 pub fn colors_wrap(wrap: trilux_io::mesh::Wrap) -> mesh_colors::Wrap {
     match wrap {
         trilux_io::mesh::Wrap::ClampToEdge => mesh_colors::Wrap::Clamp,
@@ -84,6 +89,9 @@ pub struct ColorMesh {
     /// Triangles that kept vertices of their own (degenerate after welding,
     /// or a third triangle on an edge).
     pub detached: usize,
+    /// The mesh's origin: positions are relative to it (see
+    /// `TriMesh::origin`).
+    pub origin: glam::DVec3,
 }
 
 impl ColorMesh {
@@ -113,7 +121,10 @@ impl ColorMesh {
             let degenerate = face[0] == face[1] || face[1] == face[2] || face[2] == face[0];
             let full = |edges: &HashMap<(u32, u32), u8>| {
                 (0..3).any(|k| {
-                    let (a, b) = (compact[face[k] as usize], compact[face[(k + 1) % 3] as usize]);
+                    let (a, b) = (
+                        compact[face[k] as usize],
+                        compact[face[(k + 1) % 3] as usize],
+                    );
                     a != u32::MAX
                         && b != u32::MAX
                         && edges.get(&(a.min(b), a.max(b))).is_some_and(|&c| c >= 2)
@@ -158,6 +169,7 @@ impl ColorMesh {
                     .collect()
             }),
             detached,
+            origin: mesh.origin,
         })
     }
 
@@ -175,15 +187,15 @@ impl ColorMesh {
     /// [`Error::WrongMesh`] with the counts, or the first face that differs.
     pub fn check(&self, colors: &MeshColors, path: &Path) -> Result<()> {
         let t = colors.topology();
-        let detail = if t.vertex_count() == self.positions.len() && t.faces().len() == self.faces.len()
-        {
-            match t.faces().iter().zip(&self.faces).position(|(a, b)| a != b) {
-                None => return Ok(()),
-                Some(f) => format!(" (face {f} differs)"),
-            }
-        } else {
-            String::new()
-        };
+        let detail =
+            if t.vertex_count() == self.positions.len() && t.faces().len() == self.faces.len() {
+                match t.faces().iter().zip(&self.faces).position(|(a, b)| a != b) {
+                    None => return Ok(()),
+                    Some(f) => format!(" (face {f} differs)"),
+                }
+            } else {
+                String::new()
+            };
         Err(Error::WrongMesh {
             path: path.to_path_buf(),
             file_vertices: t.vertex_count(),
@@ -423,11 +435,17 @@ pub fn to_mesh_colors(
 
 /// Every sample the bilinear value of its face's texture at its UV (or the
 /// face's flat colour), averaged over its distinct (texture, UV) pairs.
-fn fill(colors: &mut MeshColors, corner_uvs: &[[Vec2; 3]], textures: &[Texture], sources: &[Source]) {
+fn fill(
+    colors: &mut MeshColors,
+    corner_uvs: &[[Vec2; 3]],
+    textures: &[Texture],
+    sources: &[Source],
+) {
     use rayon::prelude::*;
     const FLAT: u32 = u32::MAX;
     // (sample, texture or FLAT, u bits, v bits; for FLAT: the face).
-    let mut entries: Vec<(usize, u32, u32, u32)> = Vec::with_capacity(colors.sample_count() * 3 / 2);
+    let mut entries: Vec<(usize, u32, u32, u32)> =
+        Vec::with_capacity(colors.sample_count() * 3 / 2);
     for (f, uv) in corner_uvs.iter().enumerate() {
         let r = colors.face_resolution(f);
         let rf = f64::from(r);
@@ -437,7 +455,9 @@ fn fill(colors: &mut MeshColors, corner_uvs: &[[Vec2; 3]], textures: &[Texture],
             };
             match sources[f] {
                 Source::Texture(t) => {
-                    let p = (0..3).fold(DVec2::ZERO, |s, k| s + f64::from(a[k]) / rf * uv[k].as_dvec2());
+                    let p = (0..3).fold(DVec2::ZERO, |s, k| {
+                        s + f64::from(a[k]) / rf * uv[k].as_dvec2()
+                    });
                     entries.push((i, t as u32, (p.x as f32).to_bits(), (p.y as f32).to_bits()));
                 }
                 Source::Flat(_) => entries.push((i, FLAT, f as u32, 0)),
@@ -448,7 +468,10 @@ fn fill(colors: &mut MeshColors, corner_uvs: &[[Vec2; 3]], textures: &[Texture],
     entries.dedup_by(|a, b| {
         // Flat entries of one sample from several faces of one colour
         // count once, like equal UVs.
-        a.0 == b.0 && a.1 == b.1 && (a.1 == FLAT && sources[a.2 as usize] == sources[b.2 as usize] || a.2 == b.2 && a.3 == b.3)
+        a.0 == b.0
+            && a.1 == b.1
+            && (a.1 == FLAT && sources[a.2 as usize] == sources[b.2 as usize]
+                || a.2 == b.2 && a.3 == b.3)
     });
     let values: Vec<[f32; 3]> = entries
         .par_iter()
@@ -490,7 +513,11 @@ fn fill(colors: &mut MeshColors, corner_uvs: &[[Vec2; 3]], textures: &[Texture],
 /// UVs as they are (glTF convention, like every `TriMesh`; the OBJ writer
 /// converts), and one material whose texture is `texture_file`. Triangle
 /// `f` is triangle `f` of the surface.
-pub fn atlas_mesh(surface: &ColorMesh, atlas: &Atlas, texture_file: Option<PathBuf>) -> (TriMesh, Image) {
+pub fn atlas_mesh(
+    surface: &ColorMesh,
+    atlas: &Atlas,
+    texture_file: Option<PathBuf>,
+) -> (TriMesh, Image) {
     let n = surface.faces.len();
     let mut positions = Vec::with_capacity(3 * n);
     let mut uvs = Vec::with_capacity(3 * n);
@@ -511,8 +538,11 @@ pub fn atlas_mesh(surface: &ColorMesh, atlas: &Atlas, texture_file: Option<PathB
         wrap: [trilux_io::mesh::Wrap::ClampToEdge; 2],
     };
     let mesh = TriMesh {
+        origin: surface.origin,
         positions,
-        indices: (0..n as u32).map(|f| [3 * f, 3 * f + 1, 3 * f + 2]).collect(),
+        indices: (0..n as u32)
+            .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+            .collect(),
         normals,
         uvs: Some(uvs),
         objects: vec![Object {

@@ -33,10 +33,12 @@ pub fn density_texture(image: &Image, channel: Channel) -> Result<DensityTexture
     )?)
 }
 
-/// mesh-sampling's wrap mode for a material's (glTF sampler semantics).
+/// mesh-sampling's wrap mode for a material's (both follow glTF's
+/// sampler semantics).
 pub fn sampling_wrap(wrap: trilux_io::mesh::Wrap) -> mesh_sampling::Wrap {
     match wrap {
-        trilux_io::mesh::Wrap::ClampToEdge => mesh_sampling::Wrap::Clamp,
-        _ => mesh_sampling::Wrap::Repeat,
+        trilux_io::mesh::Wrap::Repeat => mesh_sampling::Wrap::Repeat,
+        trilux_io::mesh::Wrap::MirroredRepeat => mesh_sampling::Wrap::MirroredRepeat,
+        trilux_io::mesh::Wrap::ClampToEdge => mesh_sampling::Wrap::ClampToEdge,
     }
 }

@@ -40,7 +40,7 @@
 //!
 //! let density = trilux::density_texture(&trilux::shapes::noise(64, 64, 1), Channel::Luminance)?;
 //! let sampler = DensitySampler::new(trilux::mesh_ref(&torus), Density::Texture(&density))?;
-//! let cloud = trilux::point_cloud(&torus, &sampler.sample_n(1, 10_000));
+//! let cloud = trilux::point_cloud(&torus, &sampler.sample_n(1, 10_000)?);
 //! assert_eq!(cloud.positions.len(), 10_000);
 //! # Ok::<(), trilux::Error>(())
 //! ```

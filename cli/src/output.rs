@@ -39,7 +39,11 @@ pub fn check_new(path: &Path, force: bool) -> Result<()> {
 ///
 /// # Errors
 /// [`Error::Exists`], `write`'s error, or the rename's.
-pub fn write_atomic(path: &Path, force: bool, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+pub fn write_atomic(
+    path: &Path,
+    force: bool,
+    write: impl FnOnce(&Path) -> Result<()>,
+) -> Result<()> {
     check_new(path, force)?;
     let tmp = temporary_name(path);
     let result = write(&tmp).and_then(|()| {
@@ -51,6 +55,54 @@ pub fn write_atomic(path: &Path, force: bool, write: impl FnOnce(&Path) -> Resul
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
+    result
+}
+
+/// Writes a set of files that belong together (an OBJ, its `.mtl` and
+/// its textures): `write(path in a temporary folder beside path)` writes
+/// them all into a hidden folder next to `path`, then each is renamed
+/// into place. Nothing is moved if one of them exists (unless `force`) or
+/// the writing fails; the temporary folder is removed either way. Returns
+/// the paths written.
+///
+/// # Errors
+/// [`Error::Exists`] naming the first file in the way, `write`'s error,
+/// or a rename's.
+pub fn write_atomic_files(
+    path: &Path,
+    force: bool,
+    write: impl FnOnce(&Path) -> Result<()>,
+) -> Result<Vec<PathBuf>> {
+    check_new(path, force)?;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.partial-{}", std::process::id()));
+    let file_error = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| Error::File { path, source }
+    };
+    std::fs::create_dir_all(&tmp).map_err(file_error(&tmp))?;
+    let result = (|| {
+        write(&tmp.join(&name))?;
+        let mut files = Vec::new();
+        for entry in std::fs::read_dir(&tmp).map_err(file_error(&tmp))? {
+            let entry = entry.map_err(file_error(&tmp))?;
+            let target = dir.join(entry.file_name());
+            check_new(&target, force)?;
+            files.push((entry.path(), target));
+        }
+        for (from, to) in &files {
+            std::fs::rename(from, to).map_err(file_error(to))?;
+        }
+        Ok(files.into_iter().map(|(_, to)| to).collect())
+    })();
+    let _ = std::fs::remove_dir_all(&tmp);
     result
 }
 

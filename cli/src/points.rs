@@ -8,9 +8,9 @@ use trilux_io::mesh::ply::PlyData;
 /// A point cloud of sampled points on `mesh`: positions; normals (the
 /// interpolated shading normal when the mesh has normals, else the
 /// triangle's); the mesh's UVs interpolated at the point (glTF convention;
-/// the PLY writer converts) when it has UVs; and the triangle of each point
-/// as the scalar property `face` (exact up to 2²⁴ triangles, the precision
-/// of the format's `float`). Attributes are taken from `mesh` at each
+/// the PLY writer converts) when it has UVs; the triangle of each point
+/// (PLY `face_id`); and the mesh's origin (far-from-origin scans keep
+/// their coordinates). Attributes are taken from `mesh` at each
 /// point's face and barycentrics, so points drawn on a re-parameterised
 /// copy of the mesh (the same triangles in the same order) get `mesh`'s
 /// UVs.
@@ -19,7 +19,7 @@ use trilux_io::mesh::ply::PlyData;
 /// ```
 /// use mesh_sampling::{SurfaceSampler, UniformSampler};
 /// let mesh = trilux::shapes::torus(16, 8);
-/// let points = UniformSampler::new(trilux::mesh_ref(&mesh))?.sample_n(7, 100);
+/// let points = UniformSampler::new(trilux::mesh_ref(&mesh))?.sample_n(7, 100)?;
 /// let cloud = trilux::point_cloud(&mesh, &points);
 /// assert_eq!(cloud.positions.len(), 100);
 /// # Ok::<(), mesh_sampling::Error>(())
@@ -56,13 +56,13 @@ pub fn point_cloud(mesh: &TriMesh, points: &[SurfacePoint]) -> PlyData {
             })
             .collect()
     });
-    let face = points.par_iter().map(|p| p.face as f32).collect();
+    let face_ids = points.par_iter().map(|p| p.face).collect();
     PlyData {
         positions,
-        triangles: Vec::new(),
+        origin: mesh.origin,
         normals: Some(normals),
-        colors: None,
         uvs,
-        scalars: vec![("face".to_string(), face)],
+        face_ids: Some(face_ids),
+        ..PlyData::default()
     }
 }

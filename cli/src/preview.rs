@@ -217,7 +217,11 @@ impl Renderer {
                         db_dx: [0, 1, 2].map(|k| (bx[k] - bc[k]) * scale),
                         db_dy: [0, 1, 2].map(|k| (by[k] - bc[k]) * scale),
                         position,
-                        normal: if normal.dot(to_eye) < 0.0 { -normal } else { normal },
+                        normal: if normal.dot(to_eye) < 0.0 {
+                            -normal
+                        } else {
+                            normal
+                        },
                         to_eye,
                     };
                     let rgb = shade(&fragment);
@@ -308,6 +312,8 @@ pub fn render_mesh(positions: &[Vec3], faces: &[[u32; 3]], width: u32, height: u
 /// The bounding box of points (`None` when empty or not finite).
 pub fn bounds(points: &[Vec3]) -> Option<(Vec3, Vec3)> {
     let first = *points.first()?;
-    let b = points.iter().fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let b = points
+        .iter()
+        .fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
     (b.0.is_finite() && b.1.is_finite()).then_some(b)
 }

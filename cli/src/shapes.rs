@@ -69,11 +69,17 @@ pub fn icosphere(subdivisions: u32) -> TriMesh {
             for k in 0..3 {
                 let (a, b) = (f[k], f[(k + 1) % 3]);
                 m[k] = *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                    positions.push(((positions[a as usize] + positions[b as usize]) * 0.5).normalize());
+                    positions
+                        .push(((positions[a as usize] + positions[b as usize]) * 0.5).normalize());
                     positions.len() as u32 - 1
                 });
             }
-            next.extend([[f[0], m[0], m[2]], [f[1], m[1], m[0]], [f[2], m[2], m[1]], m]);
+            next.extend([
+                [f[0], m[0], m[2]],
+                [f[1], m[1], m[0]],
+                [f[2], m[2], m[1]],
+                m,
+            ]);
         }
         faces = next;
     }
@@ -191,7 +197,10 @@ pub fn checkerboard(width: u32, height: u32, cells: u32) -> Image {
 /// image's borders (grey, alpha 1).
 pub fn noise(width: u32, height: u32, seed: u64) -> Image {
     let hash = |x: i64, y: i64, o: u64| {
-        let mut z = seed ^ (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F) ^ o.wrapping_mul(0x1656_67B1_9E37_79F9);
+        let mut z = seed
+            ^ (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+            ^ o.wrapping_mul(0x1656_67B1_9E37_79F9);
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
@@ -207,7 +216,8 @@ pub fn noise(width: u32, height: u32, seed: u64) -> Image {
                 let (x0, y0) = (fx.floor() as i64, fy.floor() as i64);
                 let (tx, ty) = (fx - x0 as f32, fy - y0 as f32);
                 let s = |t: f32| t * t * (3.0 - 2.0 * t);
-                let at = |i: i64, j: i64| hash(i.rem_euclid(period), j.rem_euclid(period), u64::from(o));
+                let at =
+                    |i: i64, j: i64| hash(i.rem_euclid(period), j.rem_euclid(period), u64::from(o));
                 let top = at(x0, y0) + (at(x0 + 1, y0) - at(x0, y0)) * s(tx);
                 let bottom = at(x0, y0 + 1) + (at(x0 + 1, y0 + 1) - at(x0, y0 + 1)) * s(tx);
                 value += amp * (top + (bottom - top) * s(ty));
@@ -235,7 +245,11 @@ pub fn sky(width: u32, height: u32) -> Image {
         let theta = (y as f32 + 0.5) / height as f32 * PI;
         for x in 0..width {
             let phi = (x as f32 + 0.5) / width as f32 * TAU;
-            let d = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            let d = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            );
             let px = if d.y < 0.0 {
                 [0.08, 0.07, 0.05, 1.0]
             } else {
@@ -243,7 +257,11 @@ pub fn sky(width: u32, height: u32) -> Image {
                 [0.3 + 0.3 * (1.0 - t), 0.5 + 0.25 * (1.0 - t), 0.9, 1.0]
             };
             let c = d.dot(sun);
-            let glow = if c > 0.9995 { 5_000.0 } else { 2.0 * (40.0 * (c - 1.0)).exp() };
+            let glow = if c > 0.999 {
+                5_000.0
+            } else {
+                2.0 * (40.0 * (c - 1.0)).exp()
+            };
             pixels.push([px[0] + glow, px[1] + glow * 0.95, px[2] + glow * 0.85, 1.0]);
         }
     }

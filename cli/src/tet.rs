@@ -70,7 +70,12 @@ pub fn dihedral_angles(p: [DVec3; 4]) -> [f64; 6] {
 pub fn dihedral_range(mesh: &TetMesh) -> Option<(f64, f64)> {
     let mut range: Option<(f64, f64)> = None;
     for t in &mesh.tets {
-        let p = t.map(|v| mesh.positions.get(v as usize).copied().unwrap_or(DVec3::NAN));
+        let p = t.map(|v| {
+            mesh.positions
+                .get(v as usize)
+                .copied()
+                .unwrap_or(DVec3::NAN)
+        });
         for a in dihedral_angles(p) {
             if a.is_nan() {
                 return None;

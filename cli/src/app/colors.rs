@@ -105,7 +105,7 @@ pub(crate) fn run(context: &mut Context, command: Command) -> Result<()> {
 /// `n` uniform surface points as `(face, barycentrics)`.
 pub(crate) fn surface_points(mesh: &TriMesh, n: usize, seed: u64) -> Result<Vec<(u32, [f32; 3])>> {
     Ok(UniformSampler::new(trilux::mesh_ref(mesh))?
-        .sample_n(seed, n)
+        .sample_n(seed, n)?
         .iter()
         .map(|p| (p.face, p.barycentric))
         .collect())
@@ -198,7 +198,10 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
         colors.sample_count(),
         surface.positions.len(),
         if surface.detached > 0 {
-            format!(" ({} faces kept apart: degenerate or on a non-manifold edge)", surface.detached)
+            format!(
+                " ({} faces kept apart: degenerate or on a non-manifold edge)",
+                surface.detached
+            )
         } else {
             String::new()
         },
@@ -222,61 +225,11 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
 
 /// Loads mesh colours and checks they belong to the mesh.
 pub(crate) fn load_for(mesh: &TriMesh, path: &Path) -> Result<(ColorMesh, MeshColors)> {
-    let (colors, _) = mesh_colors::file::load(path)
-        .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+    let (colors, _) =
+        mesh_colors::file::load(path).map_err(|e| invalid(format!("{}: {e}", path.display())))?;
     let surface = ColorMesh::new(mesh)?;
     surface.check(&colors, path)?;
     Ok((surface, colors))
-}
-
-/// Writes an OBJ with its material file and texture beside it.
-pub(crate) fn write_obj_with_texture(
-    context: &Context,
-    obj: &Path,
-    mesh: &TriMesh,
-    image: &trilux_io::image::Image,
-) -> Result<(PathBuf, PathBuf)> {
-    let png = obj.with_extension("png");
-    let mtl = obj.with_extension("mtl");
-    for p in [obj, &png, &mtl] {
-        trilux::output::check_new(p, context.force)?;
-    }
-    super::write_image(context, &png, image)?;
-    let png_name = png
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let mtl_name = mtl
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    trilux::output::write_atomic(&mtl, context.force, |tmp| {
-        std::fs::write(tmp, format!("newmtl atlas\nKd 1 1 1\nmap_Kd {png_name}\n")).map_err(
-            |source| trilux::Error::File {
-                path: tmp.to_path_buf(),
-                source,
-            },
-        )
-    })?;
-    trilux::output::write_atomic(obj, context.force, |tmp| {
-        trilux_io::mesh::obj::write(tmp, mesh)?;
-        // The OBJ writer of this trilux-io version writes no material
-        // lines: add them.
-        let text = std::fs::read_to_string(tmp).map_err(|source| trilux::Error::File {
-            path: tmp.to_path_buf(),
-            source,
-        })?;
-        if !text.contains("mtllib") {
-            std::fs::write(tmp, format!("mtllib {mtl_name}\nusemtl atlas\n{text}")).map_err(
-                |source| trilux::Error::File {
-                    path: tmp.to_path_buf(),
-                    source,
-                },
-            )?;
-        }
-        Ok(())
-    })?;
-    Ok((png, mtl))
 }
 
 fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
@@ -289,7 +242,8 @@ fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
     }
     super::check_output(context, &args.output, &["obj"])?;
     let mesh = super::read_mesh(context, &args.mesh)?;
-    let (surface, colors) = context.step("reading the mesh colours", || load_for(&mesh, &args.colors))?;
+    let (surface, colors) =
+        context.step("reading the mesh colours", || load_for(&mesh, &args.colors))?;
     let atlas = context.step("baking the atlas", || {
         mesh_colors::atlas::bake(
             &colors,
@@ -299,19 +253,15 @@ fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
             },
         )
     })?;
-    let png_name = args.output.with_extension("png");
-    let (baked, image) = trilux::atlas_mesh(
-        &surface,
-        &atlas,
-        png_name.file_name().map(PathBuf::from),
-    );
-    let start = std::time::Instant::now();
-    let (png, mtl) = write_obj_with_texture(context, &args.output, &baked, &image)?;
-    context
-        .timings
-        .push(("writing OBJ, MTL and PNG".into(), start.elapsed().as_secs_f64()));
+    // No texture file named: the OBJ writer writes the atlas image
+    // beside the .obj and .mtl as NAME_atlas.png.
+    let (baked, image) = trilux::atlas_mesh(&surface, &atlas, None);
+    let force = context.force;
+    let files = context.step("writing OBJ, MTL and PNG", || {
+        trilux::output::write_atomic_files(&args.output, force, |tmp| Ok(baked.write(tmp)?))
+    })?;
     let text = format!(
-        "{} faces baked to a {}×{} atlas{}: {}, {}, {}\n",
+        "{} faces baked to a {}×{} atlas{}: {}\n",
         colors.face_count(),
         image.width,
         image.height,
@@ -320,9 +270,11 @@ fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
         } else {
             String::new()
         },
-        args.output.display(),
-        mtl.display(),
-        png.display()
+        files
+            .iter()
+            .map(|f| f.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     let json = serde_json::json!({
         "command": "colors bake",
@@ -330,8 +282,7 @@ fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
         "atlas": [image.width, image.height],
         "mip_levels": args.mip,
         "output": super::shown(&args.output),
-        "material": super::shown(&mtl),
-        "texture": super::shown(&png),
+        "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
         "seconds": context.timings_json(),
     });
     context.report(&text, json);
@@ -349,7 +300,8 @@ pub(crate) fn render_colors(
     let Some((lo, hi)) = trilux::preview::bounds(&surface.positions) else {
         return trilux::preview::render_mesh(&[], &[], size, size);
     };
-    let mip: Option<MipMap> = matches!(filter, Filter::Mip | Filter::Aniso).then(|| colors.mip_map());
+    let mip: Option<MipMap> =
+        matches!(filter, Filter::Mip | Filter::Aniso).then(|| colors.mip_map());
     let c = colors.channels();
     let mut r = Renderer::new(size, size, Camera::fit(lo, hi));
     r.draw_mesh(&surface.positions, &surface.faces, |frag| {
@@ -377,11 +329,15 @@ pub(crate) fn render_colors(
 
 fn render(context: &mut Context, args: RenderArgs) -> Result<()> {
     if args.size == 0 || args.size > 8192 {
-        return Err(invalid(format!("--size {}: must be 1..=8192 pixels", args.size)));
+        return Err(invalid(format!(
+            "--size {}: must be 1..=8192 pixels",
+            args.size
+        )));
     }
     super::check_output(context, &args.output, &["png", "exr"])?;
     let mesh = super::read_mesh(context, &args.mesh)?;
-    let (surface, colors) = context.step("reading the mesh colours", || load_for(&mesh, &args.colors))?;
+    let (surface, colors) =
+        context.step("reading the mesh colours", || load_for(&mesh, &args.colors))?;
     let image = context.step("rendering", || {
         render_colors(&surface, &colors, args.filter, args.size)
     });

@@ -70,6 +70,9 @@ fn ply_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     if ply.colors.is_some() {
         attributes.push("colors".to_string());
     }
+    if ply.face_ids.is_some() {
+        attributes.push("face ids".to_string());
+    }
     attributes.extend(ply.scalars.iter().map(|(n, _)| n.clone()));
     let _ = writeln!(text, "  attributes: {}", attributes.join(", "));
     Ok((
@@ -79,7 +82,11 @@ fn ply_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     ))
 }
 
-fn describe_mesh(context: &mut Context, path: &Path, mesh: &trilux_io::mesh::TriMesh) -> (String, Value) {
+fn describe_mesh(
+    context: &mut Context,
+    path: &Path,
+    mesh: &trilux_io::mesh::TriMesh,
+) -> (String, Value) {
     let shape = context.step("checking the topology", || trilux::mesh::shape(mesh));
     let (lo, hi) = trilux::mesh::bounds(mesh).unwrap_or_default();
     let diagonal = (hi - lo).length();
@@ -125,11 +132,10 @@ fn describe_mesh(context: &mut Context, path: &Path, mesh: &trilux_io::mesh::Tri
     );
     let uv_json = match &mesh.uvs {
         Some(uvs) => {
-            let (ulo, uhi) = uvs
-                .iter()
-                .fold((glam::Vec2::INFINITY, glam::Vec2::NEG_INFINITY), |(a, b), &p| {
-                    (a.min(p), b.max(p))
-                });
+            let (ulo, uhi) = uvs.iter().fold(
+                (glam::Vec2::INFINITY, glam::Vec2::NEG_INFINITY),
+                |(a, b), &p| (a.min(p), b.max(p)),
+            );
             let tiled = ulo.x < -0.01 || ulo.y < -0.01 || uhi.x > 1.01 || uhi.y > 1.01;
             let _ = writeln!(
                 text,
@@ -199,13 +205,13 @@ fn describe_mesh(context: &mut Context, path: &Path, mesh: &trilux_io::mesh::Tri
 }
 
 fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
-    let mesh = context.step("reading the tetrahedra", || trilux_io::tet::TetMesh::read(path))?;
-    let (lo, hi) = mesh
-        .positions
-        .iter()
-        .fold((glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY), |(a, b), &p| {
-            (a.min(p), b.max(p))
-        });
+    let mesh = context.step("reading the tetrahedra", || {
+        trilux_io::tet::TetMesh::read(path)
+    })?;
+    let (lo, hi) = mesh.positions.iter().fold(
+        (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY),
+        |(a, b), &p| (a.min(p), b.max(p)),
+    );
     let inverted = (0..mesh.tets.len())
         .filter(|&t| mesh.signed_volume6(t) <= 0.0)
         .count();
@@ -290,7 +296,11 @@ fn meshcolors_info(context: &mut Context, path: &Path) -> Result<(String, Value)
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let _ = writeln!(text, "  MIP pyramid: {}", if mip.is_some() { "yes" } else { "no" });
+    let _ = writeln!(
+        text,
+        "  MIP pyramid: {}",
+        if mip.is_some() { "yes" } else { "no" }
+    );
     Ok((
         text,
         json!({"file": super::shown(path), "kind": "mesh colours", "channels": colors.channels(),

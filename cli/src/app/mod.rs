@@ -13,7 +13,7 @@ use trilux::Error;
 
 // mod bench;
 mod colors;
-// mod demo;
+mod demo;
 mod info;
 mod sample;
 
@@ -52,7 +52,7 @@ enum Command {
     Sample(sample::Args),
     #[command(subcommand)]
     Colors(colors::Command),
-    // Demo(demo::Args),
+    Demo(demo::Args),
     // Bench(bench::Args),
 }
 
@@ -132,7 +132,7 @@ pub(crate) fn run() -> ExitCode {
         Command::Info(args) => info::run(&mut context, args),
         Command::Sample(args) => sample::run(&mut context, args),
         Command::Colors(command) => colors::run(&mut context, command),
-        // Command::Demo(args) => demo::run(&mut context, args),
+        Command::Demo(args) => demo::run(&mut context, args),
         // Command::Bench(args) => bench::run(&mut context, args),
     };
     match result {
@@ -229,7 +229,11 @@ pub(crate) fn check_output(context: &Context, path: &Path, allowed: &[&str]) -> 
         return Err(invalid(format!(
             "{}: unknown output extension {ext:?} (expected {})",
             path.display(),
-            allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(", ")
+            allowed
+                .iter()
+                .map(|e| format!(".{e}"))
+                .collect::<Vec<_>>()
+                .join(", ")
         )));
     }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())

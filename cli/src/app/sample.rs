@@ -134,7 +134,7 @@ pub(crate) fn draw(
         Source::Texture(t) => (base, Some(t)),
         Source::FaceWeights(w) => {
             let sampler = DensitySampler::new(base, Density::PerFace(w))?;
-            return Ok(sampler.sample_n(seed, n));
+            return Ok(sampler.sample_n(seed, n)?);
         }
         Source::Atlas {
             texture,
@@ -150,7 +150,7 @@ pub(crate) fn draw(
         ),
     };
     let Some(texture) = texture else {
-        return Ok(UniformSampler::new(mesh_ref)?.sample_n(seed, n));
+        return Ok(UniformSampler::new(mesh_ref)?.sample_n(seed, n)?);
     };
     let points = match method {
         Method::Uniform => UniformSampler::new(mesh_ref)?.sample_n(seed, n),
@@ -168,7 +168,7 @@ pub(crate) fn draw(
                 .sample_n(seed, n)
         }
     };
-    Ok(points)
+    Ok(points?)
 }
 
 /// Reads per-face weights: one number per line, blank lines and `#`
@@ -223,8 +223,8 @@ fn density_of(sample: &[f32], channel: Channel) -> f32 {
 /// linear filter, exactly for colours affine on each face) over a copy of
 /// the mesh with one vertex per corner.
 pub(crate) fn meshcolors_source(mesh: &TriMesh, path: &Path, channel: Channel) -> Result<Source> {
-    let (colors, _) = mesh_colors::file::load(path)
-        .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+    let (colors, _) =
+        mesh_colors::file::load(path).map_err(|e| invalid(format!("{}: {e}", path.display())))?;
     let surface = ColorMesh::new(mesh)?;
     surface.check(&colors, path)?;
     let c = colors.channels();
@@ -269,7 +269,7 @@ pub(crate) fn meshcolors_source(mesh: &TriMesh, path: &Path, channel: Channel) -
         .collect();
     let texture = DensityTexture::new(t.width(), t.height(), texels)
         .map_err(|e| invalid(format!("{}: {e}", path.display())))?
-        .with_wrap(mesh_sampling::Wrap::Clamp);
+        .with_wrap(mesh_sampling::Wrap::ClampToEdge);
     let positions = surface
         .faces
         .iter()
@@ -328,7 +328,9 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         let wrap = mesh
             .materials
             .first()
-            .map_or(mesh_sampling::Wrap::Repeat, |m| trilux::sampling_wrap(m.wrap[0]));
+            .map_or(mesh_sampling::Wrap::Repeat, |m| {
+                trilux::sampling_wrap(m.wrap[0])
+            });
         let texture = trilux::density_texture(&image, args.channel.channel())
             .map_err(|e| invalid(format!("{}: {e}", path.display())))?
             .with_wrap(wrap);
