@@ -554,3 +554,115 @@ pub fn atlas_mesh(
     };
     (mesh, image)
 }
+
+/// One channel of mesh colours as a sampling density: the colours baked
+/// to an atlas (bilinear filtering of the atlas reproduces the mesh
+/// colours' linear filter, exactly for colours affine on each face) over a
+/// copy of the surface with one vertex per triangle corner. Triangle `f`
+/// is triangle `f` of the surface (and of the `TriMesh` it came from), so
+/// sampled points' faces and barycentrics apply to the original mesh.
+#[derive(Debug, Clone)]
+pub struct ColorDensity {
+    /// The atlas channel, clamped at the atlas's edges.
+    pub texture: mesh_sampling::DensityTexture,
+    /// Three vertices per triangle.
+    pub positions: Vec<Vec3>,
+    /// Their atlas UVs.
+    pub uvs: Vec<Vec2>,
+    /// `[3f, 3f + 1, 3f + 2]`.
+    pub indices: Vec<[u32; 3]>,
+}
+
+impl ColorDensity {
+    /// The mesh to hand to a mesh-sampling sampler with
+    /// `Density::Texture(&self.texture)`.
+    pub fn mesh_ref(&self) -> mesh_sampling::MeshRef<'_> {
+        mesh_sampling::MeshRef {
+            uvs: Some(&self.uvs),
+            ..mesh_sampling::MeshRef::new(&self.positions, &self.indices)
+        }
+    }
+}
+
+/// The density of one sample (or texel) for `channel`.
+fn density_of(sample: &[f32], channel: mesh_sampling::Channel) -> f32 {
+    match channel {
+        mesh_sampling::Channel::Luminance => {
+            0.2126 * sample[0] + 0.7152 * sample[1] + 0.0722 * sample[2]
+        }
+        mesh_sampling::Channel::Index(i) => sample.get(i).copied().unwrap_or(f32::NAN),
+    }
+}
+
+/// A sampling density from one channel (or the Rec. 709 luminance of the
+/// first three) of mesh colours on `surface` (see [`ColorDensity`]).
+///
+/// # Errors
+/// [`Error::Invalid`] for a channel the colours do not have or a sample
+/// whose density is negative or not finite (naming the sample);
+/// mesh-colors' and mesh-sampling's errors.
+///
+/// # Example
+/// ```
+/// use mesh_sampling::{Channel, Density, DensitySampler, SurfaceSampler};
+/// let torus = trilux::shapes::torus(32, 16);
+/// let checker = trilux::shapes::checkerboard(64, 64, 4);
+/// let (surface, colors) = trilux::to_mesh_colors(&torus, Some(&checker), &Default::default())?;
+/// let density = trilux::colors::color_density(&surface, &colors, Channel::Luminance)?;
+/// let sampler = DensitySampler::new(density.mesh_ref(), Density::Texture(&density.texture))?;
+/// let cloud = trilux::point_cloud(&torus, &sampler.sample_n(3, 1000)?);
+/// # Ok::<(), trilux::Error>(())
+/// ```
+pub fn color_density(
+    surface: &ColorMesh,
+    colors: &MeshColors,
+    channel: mesh_sampling::Channel,
+) -> Result<ColorDensity> {
+    let c = colors.channels();
+    let needed = match channel {
+        mesh_sampling::Channel::Luminance => 3,
+        mesh_sampling::Channel::Index(i) => i + 1,
+    };
+    if c < needed {
+        return Err(Error::Invalid(format!(
+            "the mesh colours have {c} channel(s); {channel:?} needs {needed}"
+        )));
+    }
+    if let Some(i) = colors
+        .samples()
+        .chunks_exact(c)
+        .position(|s| !(density_of(s, channel) >= 0.0 && density_of(s, channel).is_finite()))
+    {
+        return Err(Error::Invalid(format!(
+            "mesh colour sample {i} gives density {} (densities must be finite and >= 0)",
+            density_of(colors.sample(i), channel)
+        )));
+    }
+    let atlas = mesh_colors::atlas::bake(colors, &Default::default())?;
+    let t = &atlas.texture;
+    // The atlas extrapolates past each face's hypotenuse (exact for affine
+    // colours); where that dips below zero next to a zero density, zero is
+    // the density's floor.
+    let texels: Vec<f32> = t
+        .data()
+        .chunks_exact(c)
+        .map(|s| density_of(s, channel).max(0.0))
+        .collect();
+    let texture = mesh_sampling::DensityTexture::new(t.width(), t.height(), texels)?
+        .with_wrap(mesh_sampling::Wrap::ClampToEdge);
+    let positions = surface
+        .faces
+        .iter()
+        .flat_map(|f| f.map(|v| surface.positions[v as usize]))
+        .collect();
+    let uvs = atlas.corner_uvs.iter().flatten().copied().collect();
+    let indices = (0..surface.faces.len() as u32)
+        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+        .collect();
+    Ok(ColorDensity {
+        texture,
+        positions,
+        uvs,
+        indices,
+    })
+}

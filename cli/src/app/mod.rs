@@ -11,10 +11,11 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use trilux::Error;
 
-// mod bench;
+mod bench;
 mod colors;
 mod demo;
 mod info;
+mod plot;
 mod sample;
 
 pub(crate) type Result<T> = std::result::Result<T, Error>;
@@ -53,7 +54,7 @@ enum Command {
     #[command(subcommand)]
     Colors(colors::Command),
     Demo(demo::Args),
-    // Bench(bench::Args),
+    Bench(bench::Args),
 }
 
 /// What every subcommand gets: the shared flags, progress, timings.
@@ -133,7 +134,7 @@ pub(crate) fn run() -> ExitCode {
         Command::Sample(args) => sample::run(&mut context, args),
         Command::Colors(command) => colors::run(&mut context, command),
         Command::Demo(args) => demo::run(&mut context, args),
-        // Command::Bench(args) => bench::run(&mut context, args),
+        Command::Bench(args) => bench::run(&mut context, args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

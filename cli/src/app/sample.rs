@@ -7,10 +7,9 @@ use std::path::{Path, PathBuf};
 use clap::ValueEnum;
 use glam::Vec3;
 use mesh_sampling::{
-    Channel, Density, DensitySampler, DensityTexture, MeshRef, Mode, RejectionSampler,
-    SurfacePoint, SurfaceSampler, UniformSampler,
+    Channel, Density, DensitySampler, Mode, RejectionSampler, SurfacePoint, SurfaceSampler,
+    UniformSampler,
 };
-use trilux::ColorMesh;
 use trilux_io::mesh::TriMesh;
 use trilux_io::mesh::ply;
 
@@ -109,15 +108,10 @@ impl Method {
 /// The density a run samples.
 pub(crate) enum Source {
     Uniform,
-    Texture(DensityTexture),
+    Texture(mesh_sampling::DensityTexture),
     FaceWeights(Vec<f32>),
-    /// A texture over a mesh of per-corner vertices with atlas UVs.
-    Atlas {
-        texture: DensityTexture,
-        positions: Vec<Vec3>,
-        uvs: Vec<glam::Vec2>,
-        indices: Vec<[u32; 3]>,
-    },
+    /// Mesh colours, as a texture over a mesh of per-corner vertices.
+    Atlas(trilux::colors::ColorDensity),
 }
 
 /// Draws `n` points of `source` on `mesh` with `method`.
@@ -136,18 +130,7 @@ pub(crate) fn draw(
             let sampler = DensitySampler::new(base, Density::PerFace(w))?;
             return Ok(sampler.sample_n(seed, n)?);
         }
-        Source::Atlas {
-            texture,
-            positions,
-            uvs,
-            indices,
-        } => (
-            MeshRef {
-                uvs: Some(uvs),
-                ..MeshRef::new(positions, indices)
-            },
-            Some(texture),
-        ),
+        Source::Atlas(density) => (density.mesh_ref(), Some(&density.texture)),
     };
     let Some(texture) = texture else {
         return Ok(UniformSampler::new(mesh_ref)?.sample_n(seed, n)?);
@@ -210,81 +193,12 @@ pub(crate) fn read_face_weights(path: &Path, triangles: usize) -> Result<Vec<f32
     Ok(weights)
 }
 
-/// The density of one sample (or texel) of `channel`.
-fn density_of(sample: &[f32], channel: Channel) -> f32 {
-    match channel {
-        Channel::Luminance => 0.2126 * sample[0] + 0.7152 * sample[1] + 0.0722 * sample[2],
-        Channel::Index(i) => sample[i],
-    }
-}
-
-/// A density from one channel of mesh colours made for `mesh`: baked to
-/// an atlas (bilinear filtering of the atlas reproduces the mesh colours'
-/// linear filter, exactly for colours affine on each face) over a copy of
-/// the mesh with one vertex per corner.
+/// A density from one channel of mesh colours made for `mesh`.
 pub(crate) fn meshcolors_source(mesh: &TriMesh, path: &Path, channel: Channel) -> Result<Source> {
-    let (colors, _) =
-        mesh_colors::file::load(path).map_err(|e| invalid(format!("{}: {e}", path.display())))?;
-    let surface = ColorMesh::new(mesh)?;
-    surface.check(&colors, path)?;
-    let c = colors.channels();
-    let ok = match channel {
-        Channel::Luminance => c >= 3,
-        Channel::Index(i) => i < c,
-    };
-    if !ok {
-        return Err(invalid(format!(
-            "{}: the mesh colours have {c} channel(s); --channel {} needs {}",
-            path.display(),
-            match channel {
-                Channel::Luminance => "luminance".to_string(),
-                Channel::Index(i) => ["r", "g", "b", "a"].get(i).unwrap_or(&"?").to_string(),
-            },
-            match channel {
-                Channel::Luminance => 3,
-                Channel::Index(i) => i + 1,
-            }
-        )));
-    }
-    if let Some(i) = colors
-        .samples()
-        .chunks_exact(c)
-        .position(|s| !density_of(s, channel).is_finite() || density_of(s, channel) < 0.0)
-    {
-        return Err(invalid(format!(
-            "{}: sample {i} gives density {} (densities must be finite and >= 0)",
-            path.display(),
-            density_of(colors.sample(i), channel)
-        )));
-    }
-    let atlas = mesh_colors::atlas::bake(&colors, &Default::default())?;
-    let t = &atlas.texture;
-    // The atlas extrapolates past each face's hypotenuse (exact for
-    // affine colours); where that dips below zero near a zero density,
-    // zero is the density's own floor.
-    let texels: Vec<f32> = t
-        .data()
-        .chunks_exact(c)
-        .map(|s| density_of(s, channel).max(0.0))
-        .collect();
-    let texture = DensityTexture::new(t.width(), t.height(), texels)
-        .map_err(|e| invalid(format!("{}: {e}", path.display())))?
-        .with_wrap(mesh_sampling::Wrap::ClampToEdge);
-    let positions = surface
-        .faces
-        .iter()
-        .flat_map(|f| f.map(|v| surface.positions[v as usize]))
-        .collect();
-    let uvs = atlas.corner_uvs.iter().flatten().copied().collect();
-    let indices = (0..surface.faces.len() as u32)
-        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
-        .collect();
-    Ok(Source::Atlas {
-        texture,
-        positions,
-        uvs,
-        indices,
-    })
+    let (surface, colors) = super::colors::load_for(mesh, path)?;
+    let density = trilux::colors::color_density(&surface, &colors, channel)
+        .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+    Ok(Source::Atlas(density))
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
