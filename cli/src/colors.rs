@@ -5,6 +5,15 @@
 //!
 //! Colours are stored **linear** (as trilux-io decodes images); PNG
 //! writing sRGB-encodes them again.
+//!
+//! **Accuracy** (PSNR of the mesh colours' linear filter against the
+//! texture's bilinear filter at random surface points, on sRGB-encoded
+//! values, [`psnr`]): with the default budget (one sample per texel),
+//! Spot's 1024² texture converts at about 45 dB, smooth textures at
+//! more than 35 dB; a checkerboard's hard edges at about 32 dB. The baked
+//! atlas ([`atlas_mesh`]) read back with bilinear filtering loses less
+//! than 1 dB more (tested: ≥ 38 dB for Spot in memory, ≥ 36 dB through
+//! an 8-bit PNG).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};

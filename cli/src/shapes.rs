@@ -104,12 +104,14 @@ pub fn torus(major: u32, minor: u32) -> TriMesh {
     let mut positions = Vec::new();
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
+    // Angles from the index modulo the count, so that the seam's
+    // duplicated vertices have bit-identical positions (they weld).
     for i in 0..=major {
         let u = i as f32 / major as f32;
-        let (su, cu) = (u * TAU).sin_cos();
+        let (su, cu) = ((i % major) as f32 / major as f32 * TAU).sin_cos();
         for j in 0..=minor {
             let v = j as f32 / minor as f32;
-            let (sv, cv) = (v * TAU).sin_cos();
+            let (sv, cv) = ((j % minor) as f32 / minor as f32 * TAU).sin_cos();
             let n = Vec3::new(cu * cv, sv, su * cv);
             positions.push(Vec3::new(cu * big, 0.0, su * big) + n * small);
             normals.push(n);

@@ -42,8 +42,9 @@ pub fn surface(mesh: &TetMesh) -> TriMesh {
     }
 }
 
-/// The six interior dihedral angles of a tetrahedron, in degrees (NaN for
-/// a flat one).
+/// The six interior dihedral angles of a tetrahedron, in degrees: 0° and
+/// 180° for a flat one, NaN where a face has no area (two corners
+/// coincide).
 pub fn dihedral_angles(p: [DVec3; 4]) -> [f64; 6] {
     // Outward-or-inward normal of the face opposite each vertex; the angle
     // at the edge shared by faces k and l is π minus the angle between
@@ -66,7 +67,7 @@ pub fn dihedral_angles(p: [DVec3; 4]) -> [f64; 6] {
 }
 
 /// The smallest and largest dihedral angle over all tetrahedra, in
-/// degrees (`None` without tetrahedra or with a flat one).
+/// degrees (`None` without tetrahedra or with a face of no area).
 pub fn dihedral_range(mesh: &TetMesh) -> Option<(f64, f64)> {
     let mut range: Option<(f64, f64)> = None;
     for t in &mesh.tets {
