@@ -164,7 +164,10 @@ impl Renderer {
                 continue;
             };
             let clip = [0, 1, 2].map(|k| self.view_projection * p[k].extend(1.0));
-            if clip.iter().any(|c| !(c.w > 0.0) || !c.is_finite()) {
+            if clip
+                .iter()
+                .any(|c| c.w.is_nan() || c.w <= 0.0 || !c.is_finite())
+            {
                 continue;
             }
             let s = clip.map(|c| to_screen(c, wf, hf));
@@ -202,7 +205,7 @@ impl Renderer {
                     }
                     let z = l[0] * s[0].1 + l[1] * s[1].1 + l[2] * s[2].1;
                     let i = (y * w + x) as usize;
-                    if !(z < self.depth[i]) || z < -1.0 {
+                    if z.is_nan() || z >= self.depth[i] || z < -1.0 {
                         continue;
                     }
                     self.depth[i] = z;
@@ -240,7 +243,7 @@ impl Renderer {
         let ri = r.ceil() as i64;
         for (k, p) in points.iter().enumerate() {
             let clip = self.view_projection * p.extend(1.0);
-            if !(clip.w > 0.0) || !clip.is_finite() {
+            if clip.w.is_nan() || clip.w <= 0.0 || !clip.is_finite() {
                 continue;
             }
             let (s, z, _) = to_screen(clip, w as f32, h as f32);
@@ -275,8 +278,8 @@ impl Renderer {
                 for dy in 0..self.ss {
                     for dx in 0..self.ss {
                         let i = ((y * self.ss + dy) * w + x * self.ss + dx) as usize;
-                        for c in 0..4 {
-                            sum[c] += self.color[i][c];
+                        for (s, c) in sum.iter_mut().zip(self.color[i]) {
+                            *s += c;
                         }
                     }
                 }
