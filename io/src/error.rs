@@ -86,7 +86,7 @@ pub enum ErrorKind {
     Unsupported(String),
     /// A codec (PNG, JPEG, HDR, EXR) could not decode or encode the data;
     /// its own error is the source.
-    #[error("{format}: {source}")]
+    #[error("the {format} codec failed: {source}")]
     Codec {
         /// The format.
         format: &'static str,

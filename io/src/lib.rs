@@ -1,35 +1,41 @@
 //! `trilux-io`: the files trilux users already have, in and out.
 //!
-//! - **Triangle meshes** ([`mesh`]): OBJ and glTF/GLB in, PLY in and out,
-//!   OBJ out; one index stream, materials with decoded glTF textures.
+//! - **Triangle meshes** ([`mesh`]): OBJ (with MTL), glTF/GLB and PLY in;
+//!   OBJ (with MTL and textures) and PLY out, chosen by extension
+//!   ([`mesh::read`], [`mesh::TriMesh::write`]); PLY point clouds for
+//!   sampled points. One index stream, materials with decoded glTF
+//!   textures.
 //! - **Images** ([`image`]): PNG, JPEG, Radiance HDR, OpenEXR in as linear
 //!   `f32` RGBA; PNG (8/16 bit) and EXR (f32/f16) out.
 //! - **Tetrahedral meshes** ([`tet`]): TetGen `.node`/`.ele` (+ `.face`),
 //!   Gmsh `.msh` 2.2 (ASCII and binary) and 4.1 (ASCII), MEDIT `.mesh` in;
 //!   TetGen, MEDIT and VTK `.vtu` (with scalar fields, for ParaView) out.
 //!
-//! Readers return plain data (`glam` vectors, `[u32; N]` indices) and
-//! never a half-read mesh. Every
-//! failure is an [`Error`] that names the file, the line (or byte offset)
-//! and what was wrong: a truncated record, a non-finite coordinate, a
-//! tetrahedron that references a missing node, or a header that declares
-//! more records than the file can hold (refused before allocating). The
-//! boundary surface is derived from the tetrahedra
-//! ([`tet::TetMesh::boundary`]), not trusted from a file's face list.
+//! Readers return plain data ([`glam`] vectors, `[u32; N]` indices) and
+//! never a half-read mesh. One convention per concept: [`mesh::TriMesh`]
+//! UVs are glTF's (v down, `v = 0` at image row 0; the OBJ and PLY
+//! readers and writers flip, nothing else does), far-from-origin
+//! coordinates keep their precision through [`mesh::TriMesh::origin`], and
+//! luminance is Rec. 709 ([`image::luminance`]).
 //!
-//! A glTF's URIs are confined to its folder, and image dimensions and
-//! header counts are checked before anything is allocated, so hostile files
-//! fail cleanly.
+//! Every failure is an [`Error`] that names the file, the line (or byte
+//! offset) and what was wrong: a truncated record, a non-finite
+//! coordinate, a tetrahedron that references a missing node, or a header
+//! that declares more than the file can hold or the memory budget allows
+//! (refused before allocating). A glTF's URIs are confined to its folder.
 //!
 //! # Example
 //!
-//! ```no_run
-//! use trilux_io::tet::TetMesh;
-//!
-//! let mesh = TetMesh::read("bunny.node")?; // finds bunny.ele beside it
-//! println!("{} nodes, {} tets", mesh.positions.len(), mesh.tets.len());
-//! let surface = mesh.boundary(); // outward triangles
-//! trilux_io::tet::tetgen::write(std::path::Path::new("copy.node"), &mesh)?;
+//! ```
+//! # let folder = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/regressions");
+//! # let scratch = std::env::temp_dir().join(format!("trilux-io-doc-{}", std::process::id()));
+//! # std::fs::create_dir_all(&scratch).unwrap();
+//! // A CRLF OBJ with a byte-order mark and a material library.
+//! let mesh = trilux_io::mesh::read(folder.join("obj-utf8-bom/model.obj"))?;
+//! assert_eq!((mesh.indices.len(), mesh.materials[0].name.as_str()), (1, "red"));
+//! mesh.write(scratch.join("copy.ply"))?; // binary PLY, chosen by extension
+//! let tets = trilux_io::tet::read(folder.join("tetgen-real-attribute/mesh.node"))?;
+//! assert_eq!(tets.attributes, vec![vec![1.0, 1.5]]); // TetGen attributes are reals
 //! # Ok::<(), trilux_io::Error>(())
 //! ```
 
@@ -47,3 +53,8 @@ pub mod tet;
 mod text;
 
 pub use error::{Error, ErrorKind, Location, Result};
+
+/// The README's examples, compiled as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

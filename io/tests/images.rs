@@ -218,6 +218,103 @@ fn hostile_and_broken_images_are_refused() {
         height: 2,
         pixels: vec![[0.0; 4]; 3],
     };
-    let err = image::write_png(&dir.join("w.png"), &wrong, PngDepth::Eight).unwrap_err();
+    let err = image::write_png(dir.join("w.png"), &wrong, PngDepth::Eight).unwrap_err();
     assert!(matches!(err.kind, ErrorKind::InvalidInput(_)), "{err}");
+}
+
+/// The f32 RGBA conversion after decoding has its own budget: a 64×64
+/// image needs 131,072 bytes at the conversion's peak, so a budget of
+/// 100,000 refuses it with that number, before anything is decoded.
+#[test]
+fn the_rgba_conversion_is_checked_against_the_budget() {
+    let dir = scratch("budget");
+    let path = dir.join("g.png");
+    image::write_png(&path, &gradient(64, 64), PngDepth::Eight).unwrap();
+    let tight = ReadOptions {
+        max_bytes: 100_000,
+        ..ReadOptions::default()
+    };
+    let err = image::read_with(&path, tight).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::LimitExceeded(_)), "{err}");
+    let text = err.to_string();
+    assert!(text.contains("131072") && text.contains("100000"), "{text}");
+    let enough = ReadOptions {
+        max_bytes: 131_072 + 64 * 64 * 4,
+        ..ReadOptions::default()
+    };
+    assert_eq!(image::read_with(&path, enough).unwrap().width, 64);
+}
+
+/// `Error::source()` reaches the codec's own error and the I/O error, and
+/// the chain can be walked to its end.
+#[test]
+fn error_sources_form_a_chain() {
+    let dir = scratch("sources");
+    let path = dir.join("g.png");
+    image::write_png(&path, &gradient(8, 8), PngDepth::Eight).unwrap();
+    let mut bytes = std::fs::read(&path).unwrap();
+    let n = bytes.len();
+    bytes[n - 20] ^= 0xFF; // corrupt the image data's checksum region
+    bytes.truncate(n - 12);
+    let broken = dir.join("broken.png");
+    std::fs::write(&broken, &bytes).unwrap();
+    let err = image::read(&broken).unwrap_err();
+    let mut chain = vec![err.to_string()];
+    let mut source = std::error::Error::source(&err);
+    while let Some(s) = source {
+        chain.push(s.to_string());
+        source = s.source();
+    }
+    assert!(chain.len() >= 2, "{chain:?}");
+    assert!(
+        chain[0].starts_with(&broken.display().to_string()),
+        "{chain:?}"
+    );
+
+    let err = image::read(dir.join("missing.png")).unwrap_err();
+    let io = std::error::Error::source(&err).expect("the I/O error");
+    assert!(io.downcast_ref::<std::io::Error>().is_some());
+    assert_eq!(
+        io.downcast_ref::<std::io::Error>().unwrap().kind(),
+        std::io::ErrorKind::NotFound
+    );
+
+    let err = trilux_io::mesh::gltf::from_bytes(b"{ not json", "bad.gltf", Default::default())
+        .unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::Codec { format: "glTF", .. }));
+    assert!(std::error::Error::source(&err).is_some(), "{err}");
+}
+
+/// Rec. 709 luminance: the values every trilux crate tests
+/// (0.2126·0.5 + 0.7152·0.25 + 0.0722·2 = 0.4295).
+#[test]
+fn luminance_is_rec_709() {
+    for (rgb, y) in [
+        ([1.0, 0.0, 0.0], 0.2126),
+        ([0.0, 1.0, 0.0], 0.7152),
+        ([0.0, 0.0, 1.0], 0.0722),
+        ([0.5, 0.25, 2.0], 0.4295),
+    ] {
+        assert!((image::luminance(rgb) - y).abs() < 1e-6, "{rgb:?}");
+    }
+    let picture = Image {
+        width: 2,
+        height: 1,
+        pixels: vec![[1.0, 0.0, 0.0, 0.5], [0.5, 0.25, 2.0, 1.0]],
+    };
+    let y = picture.luminance();
+    assert!((y[0] - 0.2126).abs() < 1e-6 && (y[1] - 0.4295).abs() < 1e-6);
+}
+
+#[test]
+fn write_picks_the_format_by_extension() {
+    let dir = scratch("write-ext");
+    let picture = gradient(4, 3);
+    image::write(dir.join("a.png"), &picture).unwrap();
+    image::write(dir.join("a.exr"), &picture).unwrap();
+    let exr = image::read(dir.join("a.exr")).unwrap();
+    assert_eq!(exr, picture, "EXR f32 is exact");
+    assert_eq!(image::read(dir.join("a.png")).unwrap().height, 3);
+    let err = image::write(dir.join("a.tga"), &picture).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::UnknownExtension(..)), "{err}");
 }

@@ -82,7 +82,7 @@ const MTL: &[u8] =
 fn every_obj_feature() {
     let dir = scratch("features");
     write(&dir, "parts.mtl", MTL);
-    let mesh = obj::read(&write(&dir, "m.obj", FEATURES)).unwrap();
+    let mesh = obj::read(write(&dir, "m.obj", FEATURES)).unwrap();
     // The quad fans into two triangles; the last face reuses corners with
     // the same v/vt/vn, so only 4 vertices exist and v 9 9 9 is unused.
     assert_eq!(mesh.indices, vec![[0, 1, 2], [0, 2, 3], [0, 2, 3]]);
@@ -199,11 +199,11 @@ fn malformed_obj_files_name_the_line() {
         ),
     ];
     for (name, bytes, kind_ok, line) in cases {
-        let err = obj::read(&write(&dir, &format!("{name}.obj"), bytes)).unwrap_err();
+        let err = obj::read(write(&dir, &format!("{name}.obj"), bytes)).unwrap_err();
         assert!(kind_ok(&err.kind), "{name}: {err}");
         assert_eq!(err.location, Some(Location::Line(line)), "{name}: {err}");
     }
-    let err = obj::read(&write(&dir, "lib.obj", b"mtllib gone.mtl\nv 0 0 0\n")).unwrap_err();
+    let err = obj::read(write(&dir, "lib.obj", b"mtllib gone.mtl\nv 0 0 0\n")).unwrap_err();
     assert!(matches!(err.kind, ErrorKind::Io(_)));
     assert!(err.path.ends_with("gone.mtl"), "{err}");
     let err = TriMesh::read("mesh.stl").unwrap_err();
@@ -218,11 +218,11 @@ fn obj_writer_refuses_inconsistent_meshes() {
         indices: vec![[0, 1, 3]],
         ..TriMesh::default()
     };
-    let err = obj::write(&dir.join("a.obj"), &mesh).unwrap_err();
+    let err = obj::write(dir.join("a.obj"), &mesh).unwrap_err();
     assert!(matches!(err.kind, ErrorKind::InvalidInput(_)), "{err}");
     mesh.indices = vec![[0, 1, 2]];
     mesh.uvs = Some(vec![Vec2::ZERO]);
-    assert!(obj::write(&dir.join("b.obj"), &mesh).is_err());
+    assert!(obj::write(dir.join("b.obj"), &mesh).is_err());
 }
 
 use trilux_io::mesh::ply::{self, Format, PlyData};
@@ -402,7 +402,7 @@ fn malformed_ply_files() {
 fn obj_and_ply_uvs_are_flipped_to_v_down_once() {
     let dir = scratch("uv-convention");
     let text = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 1\nvt 1 1\nvt 0.25 0.75\nf 1/1 2/2 3/3\n";
-    let mesh = obj::read(&write(&dir, "uv.obj", text)).unwrap();
+    let mesh = obj::read(write(&dir, "uv.obj", text)).unwrap();
     let expected = vec![
         Vec2::new(0.0, 0.0),
         Vec2::new(1.0, 0.0),
@@ -427,4 +427,210 @@ element face 1\nproperty list uchar int vertex_indices\nend_header\n\
         text.contains("0 0 0 0 1\n") && text.contains("0 1 0 0.25 0.75\n"),
         "{text}"
     );
+}
+
+/// `obj::write` keeps materials: `mtllib`, `usemtl`, the `.mtl` with `Kd`
+/// and `map_Kd` (a clamped texture stays clamped), and decoded textures
+/// without a file are written beside the OBJ. Reading it back gives the
+/// same materials and objects.
+#[test]
+fn obj_written_with_materials_reads_back_with_them() {
+    use trilux_io::image::Image;
+    use trilux_io::mesh::{Material, Object, Wrap};
+    let dir = scratch("materials");
+    let texture = dir.join("wood grain.png");
+    let pixels = Image {
+        width: 2,
+        height: 2,
+        pixels: vec![[1.0, 0.5, 0.25, 1.0]; 4],
+    };
+    trilux_io::image::write_png(&texture, &pixels, trilux_io::image::PngDepth::Eight).unwrap();
+    let mesh = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ONE],
+        indices: vec![[0, 1, 2], [1, 3, 2]],
+        uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE]),
+        objects: vec![
+            Object {
+                name: "left half".into(),
+                triangles: 0..1,
+                material: Some(0),
+            },
+            Object {
+                name: "right".into(),
+                triangles: 1..2,
+                material: Some(1),
+            },
+        ],
+        materials: vec![
+            Material {
+                name: "wood".into(),
+                diffuse: [1.0, 0.5, 0.25],
+                diffuse_texture: Some(texture.clone()),
+                diffuse_image: None,
+                wrap: [Wrap::ClampToEdge; 2],
+            },
+            Material {
+                name: String::new(),
+                diffuse: [0.0, 0.0, 1.0],
+                diffuse_texture: None,
+                diffuse_image: Some(pixels.clone()),
+                wrap: [Wrap::Repeat; 2],
+            },
+        ],
+        ..TriMesh::default()
+    };
+    let path = dir.join("out.obj");
+    mesh.write(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(text.contains("mtllib out.mtl\n"), "{text}");
+    assert!(text.contains("usemtl wood\n") && text.contains("usemtl material_1\n"));
+    let mtl = std::fs::read_to_string(dir.join("out.mtl")).unwrap();
+    assert!(mtl.contains("map_Kd -clamp on wood grain.png\n"), "{mtl}");
+    assert!(mtl.contains("map_Kd out_1.png\n"), "{mtl}");
+
+    let back = obj::read(&path).unwrap();
+    assert_eq!(back.materials.len(), 2);
+    assert_eq!(back.materials[0].name, "wood");
+    assert_eq!(back.materials[0].diffuse, [1.0, 0.5, 0.25]);
+    assert_eq!(
+        back.materials[0].diffuse_texture.as_deref(),
+        Some(texture.as_path())
+    );
+    assert_eq!(back.materials[0].wrap, [Wrap::ClampToEdge; 2]);
+    assert_eq!(back.materials[1].name, "material_1");
+    let written = back.materials[1].diffuse_texture.clone().unwrap();
+    assert_eq!(trilux_io::image::read(&written).unwrap().width, 2);
+    let objects: Vec<_> = back
+        .objects
+        .iter()
+        .map(|o| (o.name.as_str(), o.triangles.clone(), o.material))
+        .collect();
+    assert_eq!(
+        objects,
+        vec![("left half", 0..1, Some(0)), ("right", 1..2, Some(1))]
+    );
+    assert_eq!(back.uvs, mesh.uvs);
+    assert_eq!(back.positions, mesh.positions);
+
+    // Through PLY the geometry survives; unknown extensions are refused.
+    mesh.write(dir.join("out.ply")).unwrap();
+    let ply_back = TriMesh::read(dir.join("out.ply")).unwrap();
+    assert_eq!(ply_back.positions, mesh.positions);
+    assert_eq!(ply_back.indices, mesh.indices);
+    assert_eq!(ply_back.uvs, mesh.uvs);
+    let err = mesh.write(dir.join("out.stl")).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::UnknownExtension(..)), "{err}");
+    let mut bad = mesh.clone();
+    bad.materials[0].name = "a # b".into();
+    assert!(matches!(
+        bad.write(dir.join("bad.obj")).unwrap_err().kind,
+        ErrorKind::InvalidInput(_)
+    ));
+}
+
+/// MTL texture options are parsed, not taken for the file name; names
+/// keep their spaces; `-s`/`-o` are applied to the UVs.
+#[test]
+fn mtl_texture_options() {
+    use trilux_io::mesh::Wrap;
+    let dir = scratch("mtl-options");
+    let obj_text = b"\xEF\xBB\xBFmtllib my lib.mtl\r\nv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\n\
+vt 0 0\r\nvt 1 0\r\nvt 0 1\r\nusemtl a b\r\nf 1/1 2/2 3/3 # comment\r\n";
+    let cases: [(&str, Option<(&str, Wrap)>); 6] = [
+        (
+            "map_Kd -blendu on -blendv off -bm 0.5 -boost 2 -cc off -clamp on -imfchan l -mm 0 1 -t 0 0 -texres 512 my file.png",
+            Some(("my file.png", Wrap::ClampToEdge)),
+        ),
+        (
+            "map_Kd -s 1 1 1 -o 0 0 0 textures/a b.png # trailing",
+            Some(("textures/a b.png", Wrap::Repeat)),
+        ),
+        ("map_Kd -s 1 1 plain.png", Some(("plain.png", Wrap::Repeat))),
+        (
+            "map_Kd -clamp off -o 0 x.png",
+            Some(("x.png", Wrap::Repeat)),
+        ),
+        (
+            "map_Kd -s 2 2 1 scaled.png",
+            Some(("scaled.png", Wrap::Repeat)),
+        ),
+        ("map_Kd -unknown 3 f.png", None),
+    ];
+    for (k, (line, expected)) in cases.into_iter().enumerate() {
+        let sub = dir.join(k.to_string());
+        std::fs::create_dir_all(&sub).unwrap();
+        write(
+            &sub,
+            "my lib.mtl",
+            format!("newmtl a b\nKd 0 1 0\n{line}\n").as_bytes(),
+        );
+        let result = obj::read(write(&sub, "m.obj", obj_text));
+        match expected {
+            Some((file, wrap)) => {
+                let mesh = result.unwrap_or_else(|e| panic!("{line}: {e}"));
+                let m = &mesh.materials[0];
+                assert_eq!(m.name, "a b");
+                assert_eq!(m.diffuse, [0.0, 1.0, 0.0]);
+                assert_eq!(
+                    m.diffuse_texture.as_deref(),
+                    Some(sub.join(file).as_path()),
+                    "{line}"
+                );
+                assert_eq!(m.wrap, [wrap; 2], "{line}");
+                let uvs = mesh.uvs.unwrap();
+                if line.contains("-s 2 2") {
+                    // vt (1, 0) and (0, 1), v up, scaled by 2: (2, 0) and
+                    // (0, 2), i.e. (2, 1) and (0, -1) v down.
+                    assert_eq!(
+                        uvs,
+                        vec![
+                            Vec2::new(0.0, 1.0),
+                            Vec2::new(2.0, 1.0),
+                            Vec2::new(0.0, -1.0)
+                        ]
+                    );
+                } else {
+                    assert_eq!(
+                        uvs,
+                        vec![Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::ZERO],
+                        "{line}"
+                    );
+                }
+            }
+            None => {
+                let err = result.unwrap_err();
+                assert_eq!(err.location, Some(Location::Line(3)), "{line}: {err}");
+                assert!(err.path.ends_with("my lib.mtl"), "{err}");
+            }
+        }
+    }
+}
+
+/// A vertex shared by a triangle whose texture is shifted (`-o`) and one
+/// whose texture is not is split, so each triangle reads its own texels.
+#[test]
+fn mtl_offsets_split_shared_vertices() {
+    let dir = scratch("mtl-offset");
+    write(
+        &dir,
+        "m.mtl",
+        b"newmtl plain\nmap_Kd a.png\nnewmtl shifted\nmap_Kd -o 0.5 0.25 b.png\n",
+    );
+    let text =
+        b"mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n\
+usemtl plain\nf 1/1 2/2 3/3\nusemtl shifted\nf 2/2 4/4 3/3\n";
+    let mesh = obj::read(write(&dir, "m.obj", text)).unwrap();
+    // Vertices 1 and 2 (0-based) are shared: split into copies.
+    assert_eq!(mesh.positions.len(), 6);
+    let uvs = mesh.uvs.as_ref().unwrap();
+    let uv_of = |t: usize, c: usize| uvs[mesh.indices[t][c] as usize];
+    assert_eq!(
+        uv_of(0, 1),
+        Vec2::new(1.0, 1.0),
+        "plain: vt (1, 0) is v-down (1, 1)"
+    );
+    // Shifted: vt (1, 0) + (0.5, 0.25) = (1.5, 0.25) v up = (1.5, 0.75) v down.
+    assert_eq!(uv_of(1, 0), Vec2::new(1.5, 0.75));
+    assert_eq!(mesh.positions[mesh.indices[1][0] as usize], Vec3::X);
+    assert!((mesh.area() - 1.0).abs() < 1e-12);
 }

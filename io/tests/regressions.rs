@@ -149,3 +149,21 @@ fn far_from_origin_coordinates_keep_their_triangles() {
     let plain = obj::from_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "t.obj").unwrap();
     assert_eq!(plain.origin, DVec3::ZERO);
 }
+
+/// KHR_mesh_quantization: `UNSIGNED_SHORT` positions, node scale 0.001.
+#[test]
+fn gltf_quantized_positions() {
+    let mesh = TriMesh::read(file("gltf-quantized-positions", "quantized.gltf")).unwrap();
+    assert_eq!(mesh.positions.len(), 3);
+    assert!((mesh.area() - 0.5).abs() < 1e-6, "{}", mesh.area());
+    assert!(close(mesh.positions[1], Vec3::X), "{}", mesh.positions[1]);
+}
+
+/// A POSITION accessor whose sparse block moves 2 vertices.
+#[test]
+fn gltf_sparse_accessor() {
+    let mesh = TriMesh::read(file("gltf-sparse-accessor", "sparse.gltf")).unwrap();
+    assert_eq!(mesh.positions.len(), 4);
+    assert_eq!(mesh.positions[2], Vec3::new(1.0, 2.0, 0.0));
+    assert!((mesh.area() - 2.0).abs() < 1e-6, "{}", mesh.area());
+}

@@ -32,7 +32,7 @@ fn real_tetgen_meshes_match_the_data_readme() {
         ("bunny_500k", 93_375, 507_125, 43_188, 7.54483e-4),
     ];
     for (name, nodes, tets, faces, volume) in expected {
-        let files = tetgen::read_all(&data.join("tets").join(format!("{name}.node"))).unwrap();
+        let files = tetgen::read_all(data.join("tets").join(format!("{name}.node"))).unwrap();
         let mesh = &files.mesh;
         assert_eq!(files.first_index, 1, "{name}");
         assert_eq!(mesh.positions.len(), nodes, "{name}");
@@ -142,7 +142,7 @@ fn gmsh_22_ascii() {
 
 fn gmsh_from(bytes: &[u8]) -> TetMesh {
     let dir = scratch(&format!("gmsh-{}", bytes.len()));
-    gmsh::read(&write(&dir, "m.msh", bytes)).unwrap()
+    gmsh::read(write(&dir, "m.msh", bytes)).unwrap()
 }
 
 /// The same mesh as GMSH_22 in the 2.2 binary layout.
@@ -387,7 +387,7 @@ fn gmsh_errors() {
         ("garbage", b"hello", |k| matches!(k, ErrorKind::Syntax { .. })),
     ];
     for (name, bytes, kind_ok) in cases {
-        let err = gmsh::read(&write(&dir, &format!("{name}.msh"), bytes)).unwrap_err();
+        let err = gmsh::read(write(&dir, &format!("{name}.msh"), bytes)).unwrap_err();
         assert!(kind_ok(&err.kind), "{name}: {err}");
         assert!(
             err.location.is_some() || matches!(err.kind, ErrorKind::Truncated(_)),
@@ -458,7 +458,7 @@ fn medit_errors() {
         ("huge", b"MeshVersionFormatted 1\nDimension 3\nVertices\n4000000000\n0 0 0 0\n", |k| matches!(k, ErrorKind::CountTooLarge { .. })),
     ];
     for (name, bytes, kind_ok) in cases {
-        let err = medit::read(&write(&dir, &format!("{name}.mesh"), bytes)).unwrap_err();
+        let err = medit::read(write(&dir, &format!("{name}.mesh"), bytes)).unwrap_err();
         assert!(kind_ok(&err.kind), "{name}: {err}");
     }
 }
@@ -561,4 +561,52 @@ fn vtu_arrays_decode_to_the_mesh_and_fields() {
             .contains("\"short\" has 3 values for 5 nodes"),
         "{err}"
     );
+}
+
+/// `tet::write` picks the format by extension; real attributes survive a
+/// TetGen round trip, and region tags exist only for integer attributes.
+#[test]
+fn tet_write_by_extension_keeps_real_attributes() {
+    let dir = scratch("tet-write");
+    let mesh = TetMesh {
+        positions: vec![
+            glam::DVec3::ZERO,
+            glam::DVec3::X,
+            glam::DVec3::Y,
+            glam::DVec3::Z,
+            glam::DVec3::ONE,
+        ],
+        tets: vec![[0, 1, 2, 3], [4, 1, 3, 2]],
+        regions: Vec::new(),
+        attributes: vec![vec![1.0, 1.5], vec![-2.0, 1e-3]],
+    };
+    trilux_io::tet::write(dir.join("m.node"), &mesh).unwrap();
+    assert_eq!(trilux_io::tet::read(dir.join("m.ele")).unwrap(), mesh);
+    let tagged = TetMesh {
+        attributes: vec![vec![3.0, -1.0]],
+        ..mesh.clone()
+    };
+    trilux_io::tet::write(dir.join("t.ele"), &tagged).unwrap();
+    let back = trilux_io::tet::read(dir.join("t.node")).unwrap();
+    assert_eq!(back.regions, vec![3, -1]);
+    assert_eq!(back.attributes, tagged.attributes);
+    // Regions that contradict the first attribute cannot both be written.
+    let contradiction = TetMesh {
+        regions: vec![1, 2],
+        ..tagged.clone()
+    };
+    let err = trilux_io::tet::write(dir.join("c.node"), &contradiction).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::InvalidInput(_)), "{err}");
+
+    trilux_io::tet::write(dir.join("m.mesh"), &mesh).unwrap();
+    let medit_back = trilux_io::tet::read(dir.join("m.mesh")).unwrap();
+    assert_eq!(medit_back.tets, mesh.tets);
+    trilux_io::tet::write(dir.join("m.vtu"), &mesh).unwrap();
+    assert!(
+        std::fs::read_to_string(dir.join("m.vtu"))
+            .unwrap()
+            .contains("UnstructuredGrid")
+    );
+    let err = trilux_io::tet::write(dir.join("m.off"), &mesh).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::UnknownExtension(..)), "{err}");
 }

@@ -1,7 +1,16 @@
 //! glTF 2.0 (`.gltf` with external or `data:` buffers, and binary `.glb`):
 //! every triangle primitive of the default scene with its node transforms
-//! applied; POSITION, NORMAL, TEXCOORD_0 and indices; base-colour factor
-//! and texture (embedded or external, decoded), with its wrap modes.
+//! applied; POSITION, NORMAL, the base-colour texture's `TEXCOORD_n` (and
+//! `TEXCOORD_1` as [`TriMesh::uvs1`]) and indices; base-colour factor and
+//! texture (embedded or external, decoded), with its wrap modes.
+//!
+//! One decoder reads every accessor (glTF 2.0 Sec. 3.6.2): float and
+//! integer component types, normalized integers mapped to `[0, 1]` or
+//! `[-1, 1]` (Sec. 3.11), non-normalized integers as their values
+//! (`KHR_mesh_quantization`), and sparse substitution over a buffer view
+//! or over zeros. `KHR_texture_transform` on the base-colour texture is
+//! applied to the UVs. A file that requires any other extension is refused
+//! with an error naming it: a silently wrong mesh is worse than none.
 //!
 //! The `gltf` crate parses the JSON and GLB container; buffers and images
 //! are resolved here, so that a file cannot make the reader open anything
@@ -11,7 +20,8 @@
 
 use std::path::{Component, Path, PathBuf};
 
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use glam::{DVec3, Mat3, Mat4, Vec2, Vec3};
+use gltf::accessor::sparse::IndexType;
 use gltf::accessor::{Accessor, DataType, Dimensions};
 use gltf::mesh::Mode;
 use gltf::texture::WrappingMode;
@@ -65,6 +75,19 @@ pub fn from_bytes(bytes: &[u8], path: impl AsRef<Path>, options: Options) -> Res
     }
     .read(bytes)
 }
+
+/// The extensions a file may require: what they change is decoded.
+const HONOURED_EXTENSIONS: &[&str] = &["KHR_mesh_quantization", "KHR_texture_transform"];
+
+/// The most values (components) one accessor may decode to: 2^27, 1 GiB
+/// as the `f64` the decoder works in. An accessor backed by a buffer view
+/// is also bounded by its buffer.
+pub const MAX_ACCESSOR_VALUES: u64 = 1 << 27;
+
+/// The most elements an accessor without a buffer view (zeros, plus its
+/// sparse values) may declare: 2^24. Nothing in the file bounds its count,
+/// so a few bytes of JSON could otherwise ask for gigabytes.
+pub const MAX_ZERO_FILLED_ELEMENTS: u64 = 1 << 24;
 
 struct Reader<'a> {
     path: &'a Path,
@@ -147,7 +170,20 @@ impl Reader<'_> {
         if let Some(broken) = first_dangling_reference(document.as_json()) {
             return Err(self.invalid(broken));
         }
-        let document = gltf::Document::from_json(document.into_json()).map_err(codec)?;
+        let mut json = document.into_json();
+        if let Some(missing) = json
+            .extensions_required
+            .iter()
+            .find(|e| !HONOURED_EXTENSIONS.contains(&e.as_str()))
+        {
+            return Err(self.error(ErrorKind::Unsupported(format!(
+                "the required extension {missing}"
+            ))));
+        }
+        // Checked above; the gltf crate's validation would refuse the
+        // extensions it does not model itself (KHR_mesh_quantization).
+        json.extensions_required.clear();
+        let document = gltf::Document::from_json(json).map_err(codec)?;
         let mut buffers = Vec::new();
         for buffer in document.buffers() {
             let mut data = match buffer.source() {
@@ -170,9 +206,7 @@ impl Reader<'_> {
             buffers.push(data);
         }
 
-        let mut mesh = TriMesh::default();
-        let mut normals: Vec<Option<Vec3>> = Vec::new();
-        let mut uvs: Vec<Option<Vec2>> = Vec::new();
+        let mut parts = Parts::default();
         let mut material_map: Vec<Option<usize>> = vec![None; document.materials().len()];
         let scene = document
             .default_scene()
@@ -195,83 +229,160 @@ impl Reader<'_> {
                     &primitive,
                     global,
                     &buffers,
-                    &mut mesh,
-                    &mut normals,
-                    &mut uvs,
+                    &mut parts,
                     name,
                     &mut material_map,
                 )?;
             }
         }
-        let any_normal = normals.iter().any(Option::is_some);
-        let any_uv = uvs.iter().any(Option::is_some);
-        mesh.normals =
-            any_normal.then(|| normals.iter().map(|n| n.unwrap_or(Vec3::ZERO)).collect());
-        mesh.uvs = any_uv.then(|| uvs.iter().map(|t| t.unwrap_or(Vec2::ZERO)).collect());
-        Ok(mesh)
+        parts.finish(self.path)
     }
 
-    /// Checks that `accessor` has the layout its use requires (the gltf
-    /// reader only debug-asserts it; found by fuzzing) and lies inside its
-    /// buffer view and buffer.
-    fn check(
+    /// Decodes accessor `accessor` (glTF 2.0 Sec. 3.6.2) to `f64`
+    /// components, `dimensions` per element, after checking that its
+    /// layout is one `types` allows and that it lies inside its buffers:
+    /// the dense data (or zeros without a buffer view), integers
+    /// normalized when the accessor says so (Sec. 3.11), then the sparse
+    /// values substituted.
+    fn decode(
         &self,
         accessor: &Accessor<'_>,
         buffers: &[Vec<u8>],
+        what: &str,
         dimensions: Dimensions,
         types: &[DataType],
-    ) -> Result<()> {
-        // The spec requires count >= 1; the gltf reader computes count - 1
-        // (found by fuzzing).
-        if accessor.count() == 0 {
-            return Err(self.invalid(format!("accessor {} with count 0", accessor.index())));
-        }
+    ) -> Result<Vec<f64>> {
+        let index = accessor.index();
         if accessor.dimensions() != dimensions || !types.contains(&accessor.data_type()) {
             return Err(self.invalid(format!(
-                "accessor {} of type {:?} {:?} where {dimensions:?} of {types:?} is required",
-                accessor.index(),
+                "accessor {index} ({what}) of type {:?} {:?} where {dimensions:?} of {types:?} is required",
                 accessor.dimensions(),
                 accessor.data_type()
             )));
         }
-        if accessor.sparse().is_some() {
-            return Err(self.error(ErrorKind::Unsupported("sparse accessors".into())));
+        let count = accessor.count();
+        let width = components(dimensions);
+        let values = (count as u64).saturating_mul(width as u64);
+        if values > MAX_ACCESSOR_VALUES {
+            return Err(self.error(ErrorKind::LimitExceeded(format!(
+                "accessor {index} ({what}) declares {count} elements, {values} values, more than \
+                 the {MAX_ACCESSOR_VALUES} one accessor may decode to"
+            ))));
         }
-        let view = accessor.view().ok_or_else(|| {
-            self.error(ErrorKind::Unsupported(
-                "accessors without a buffer view".into(),
-            ))
-        })?;
+        if accessor.view().is_none() && count as u64 > MAX_ZERO_FILLED_ELEMENTS {
+            return Err(self.error(ErrorKind::LimitExceeded(format!(
+                "accessor {index} ({what}) has no buffer view and declares {count} elements, more \
+                 than the {MAX_ZERO_FILLED_ELEMENTS} allowed for one filled with zeros"
+            ))));
+        }
+        let kind = accessor.data_type();
+        let normalized = accessor.normalized();
+        let element = width * kind.size();
+        let mut out = vec![0.0f64; count * width];
+        if let Some(view) = accessor.view() {
+            let stride = view.stride().unwrap_or(element);
+            let bytes = self.view_bytes(&view, buffers, || format!("accessor {index} ({what})"))?;
+            let used = count
+                .checked_sub(1)
+                .and_then(|last| stride.checked_mul(last))
+                .and_then(|s| s.checked_add(element))
+                .and_then(|s| s.checked_add(accessor.offset()));
+            if count > 0 && used.is_none_or(|u| u > bytes.len()) {
+                return Err(self.error(ErrorKind::Truncated(format!(
+                    "accessor {index} ({what}, {count} elements) inside its buffer view"
+                ))));
+            }
+            for (e, chunk) in out.chunks_exact_mut(width).enumerate() {
+                let at = accessor.offset() + e * stride;
+                for (c, slot) in chunk.iter_mut().enumerate() {
+                    *slot = component(&bytes[at + c * kind.size()..], kind, normalized);
+                }
+            }
+        }
+        if let Some(sparse) = accessor.sparse() {
+            let n = sparse.count();
+            if n > count {
+                return Err(self.invalid(format!(
+                    "accessor {index} ({what}) with {n} sparse values for {count} elements"
+                )));
+            }
+            let indices = sparse.indices();
+            let index_size = match indices.index_type() {
+                IndexType::U8 => 1,
+                IndexType::U16 => 2,
+                IndexType::U32 => 4,
+            };
+            let index_kind = match indices.index_type() {
+                IndexType::U8 => DataType::U8,
+                IndexType::U16 => DataType::U16,
+                IndexType::U32 => DataType::U32,
+            };
+            let index_bytes = self.view_bytes(&indices.view(), buffers, || {
+                format!("the sparse indices of accessor {index}")
+            })?;
+            let value_bytes = self.view_bytes(&sparse.values().view(), buffers, || {
+                format!("the sparse values of accessor {index}")
+            })?;
+            let index_end = n
+                .checked_mul(index_size)
+                .and_then(|b| b.checked_add(indices.offset()));
+            let value_end = n
+                .checked_mul(element)
+                .and_then(|b| b.checked_add(sparse.values().offset()));
+            if index_end.is_none_or(|e| e > index_bytes.len())
+                || value_end.is_none_or(|e| e > value_bytes.len())
+            {
+                return Err(self.error(ErrorKind::Truncated(format!(
+                    "the {n} sparse indices and values of accessor {index} ({what}) inside their buffer views"
+                ))));
+            }
+            for k in 0..n {
+                let target = component(
+                    &index_bytes[indices.offset() + k * index_size..],
+                    index_kind,
+                    false,
+                );
+                if target >= count as f64 {
+                    return Err(self.invalid(format!(
+                        "sparse index {target} of accessor {index} ({what}), which has {count} elements"
+                    )));
+                }
+                let at = sparse.values().offset() + k * element;
+                let target = target as usize;
+                for c in 0..width {
+                    out[target * width + c] =
+                        component(&value_bytes[at + c * kind.size()..], kind, normalized);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The bytes of a buffer view, checked against its buffer.
+    fn view_bytes<'b>(
+        &self,
+        view: &gltf::buffer::View<'_>,
+        buffers: &'b [Vec<u8>],
+        what: impl Fn() -> String,
+    ) -> Result<&'b [u8]> {
         let buffer = &buffers[view.buffer().index()];
-        let view_end = view.offset().checked_add(view.length());
-        let size = accessor.size();
-        let stride = view.stride().unwrap_or(size);
-        let used = stride
-            .checked_mul(accessor.count() - 1)
-            .and_then(|s| s.checked_add(size))
-            .and_then(|s| s.checked_add(accessor.offset()));
-        match (view_end, used) {
-            (Some(end), Some(used)) if end <= buffer.len() && used <= view.length() => Ok(()),
+        match view.offset().checked_add(view.length()) {
+            Some(end) if end <= buffer.len() => Ok(&buffer[view.offset()..end]),
             _ => Err(self.error(ErrorKind::Truncated(format!(
-                "accessor {} ({} elements) inside its buffer view",
-                accessor.index(),
-                accessor.count()
+                "buffer view {} of {} inside buffer {}",
+                view.index(),
+                what(),
+                view.buffer().index()
             )))),
         }
     }
 
-    #[expect(
-        clippy::too_many_arguments,
-        reason = "the mesh under construction, in parts"
-    )]
     fn primitive(
         &self,
         primitive: &gltf::Primitive<'_>,
         global: Mat4,
         buffers: &[Vec<u8>],
-        mesh: &mut TriMesh,
-        normals: &mut Vec<Option<Vec3>>,
-        uvs: &mut Vec<Option<Vec2>>,
+        parts: &mut Parts,
         name: String,
         material_map: &mut [Option<usize>],
     ) -> Result<()> {
@@ -281,60 +392,135 @@ impl Reader<'_> {
         ) {
             return Ok(()); // points and lines have no surface
         }
-        let float = &[DataType::F32][..];
-        let uv_types = &[DataType::F32, DataType::U8, DataType::U16][..];
-        let layouts = [
-            (gltf::Semantic::Positions, Dimensions::Vec3, float),
-            (gltf::Semantic::Normals, Dimensions::Vec3, float),
-            (gltf::Semantic::TexCoords(0), Dimensions::Vec2, uv_types),
-        ];
-        for (semantic, dimensions, types) in layouts {
-            if let Some(accessor) = primitive.get(&semantic) {
-                self.check(&accessor, buffers, dimensions, types)?;
-            }
-        }
-        if let Some(accessor) = primitive.indices() {
-            let index_types = [DataType::U8, DataType::U16, DataType::U32];
-            self.check(&accessor, buffers, Dimensions::Scalar, &index_types)?;
-        }
-        let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| self.invalid("a primitive without POSITION".into()))?
-            .map(Vec3::from)
-            .collect();
-        let count = positions.len();
-        let base = mesh.positions.len();
+        use DataType::{F32, I8, I16, U8, U16, U32};
+        let positions = primitive
+            .get(&gltf::Semantic::Positions)
+            .ok_or_else(|| self.invalid("a primitive without POSITION".into()))?;
+        // KHR_mesh_quantization widens POSITION, NORMAL and TEXCOORD to
+        // 8- and 16-bit integers; the core allows normalized ones for UVs.
+        let positions = self.decode(
+            &positions,
+            buffers,
+            "POSITION",
+            Dimensions::Vec3,
+            &[F32, I8, U8, I16, U16],
+        )?;
+        let count = positions.len() / 3;
+        let base = parts.points.len();
         let normal_matrix = Mat3::from_mat4(global).inverse().transpose();
-        for (i, p) in positions.into_iter().enumerate() {
-            let q = global.transform_point3(p);
-            if !q.is_finite() {
-                let value = q
-                    .to_array()
-                    .into_iter()
-                    .find(|v| !v.is_finite())
-                    .unwrap_or(f32::NAN);
+        // In f64, so that a node translation far from the origin (a
+        // georeferenced tile) keeps the precision of the vertices; the
+        // shift is chosen once all primitives are in (TriMesh::origin).
+        let global64 = global.as_dmat4();
+        for (i, p) in positions.chunks_exact(3).enumerate() {
+            // The file's components are f32 (or integers); the decoder's
+            // f64 holds them exactly.
+            let q = global64.transform_point3(DVec3::new(p[0], p[1], p[2]));
+            if let Some(value) = q.to_array().into_iter().find(|v| !v.is_finite()) {
                 return Err(self.error(ErrorKind::NonFinite {
                     index: base + i,
-                    value: f64::from(value),
+                    value,
                 }));
             }
-            mesh.positions.push(q);
+            parts.points.push(q);
         }
-        match reader.read_normals() {
-            Some(iter) => normals
-                .extend(iter.map(|n| Some((normal_matrix * Vec3::from(n)).normalize_or_zero()))),
-            None => normals.extend(std::iter::repeat_n(None, count)),
+        let length_error = |what: &str, n: usize| {
+            self.invalid(format!(
+                "a primitive with {count} positions but {n} {what} values"
+            ))
+        };
+        match primitive.get(&gltf::Semantic::Normals) {
+            Some(a) => {
+                let values =
+                    self.decode(&a, buffers, "NORMAL", Dimensions::Vec3, &[F32, I8, I16])?;
+                if values.len() != 3 * count {
+                    return Err(length_error("NORMAL", values.len() / 3));
+                }
+                parts.normals.extend(values.chunks_exact(3).map(|n| {
+                    let n = Vec3::new(n[0] as f32, n[1] as f32, n[2] as f32);
+                    Some((normal_matrix * n).normalize_or_zero())
+                }));
+            }
+            None => parts.normals.extend(std::iter::repeat_n(None, count)),
         }
-        match reader.read_tex_coords(0) {
-            Some(iter) => uvs.extend(iter.into_f32().map(|t| Some(Vec2::from(t)))),
-            None => uvs.extend(std::iter::repeat_n(None, count)),
+
+        let material = primitive.material();
+        let texture_info = material.pbr_metallic_roughness().base_color_texture();
+        let transform = texture_info.as_ref().and_then(|t| t.texture_transform());
+        // The set the base colour texture reads (KHR_texture_transform may
+        // override the material's texCoord).
+        let set = texture_info
+            .as_ref()
+            .map(|t| {
+                transform
+                    .as_ref()
+                    .and_then(|x| x.tex_coord())
+                    .unwrap_or(t.tex_coord())
+            })
+            .unwrap_or(0);
+        let uv_types = &[F32, I8, U8, I16, U16][..];
+        let read_set = |set: u32| -> Result<Option<Vec<Vec2>>> {
+            let Some(a) = primitive.get(&gltf::Semantic::TexCoords(set)) else {
+                return Ok(None);
+            };
+            let values = self.decode(
+                &a,
+                buffers,
+                &format!("TEXCOORD_{set}"),
+                Dimensions::Vec2,
+                uv_types,
+            )?;
+            if values.len() != 2 * count {
+                return Err(length_error(&format!("TEXCOORD_{set}"), values.len() / 2));
+            }
+            Ok(Some(
+                values
+                    .chunks_exact(2)
+                    .map(|t| Vec2::new(t[0] as f32, t[1] as f32))
+                    .collect(),
+            ))
+        };
+        let mut uvs = read_set(set)?;
+        if texture_info.is_some() && uvs.is_none() {
+            return Err(self.invalid(format!(
+                "a primitive whose base colour texture reads TEXCOORD_{set}, which it does not have"
+            )));
         }
-        if normals.len() != base + count || uvs.len() != base + count {
-            return Err(self.invalid("attributes of different lengths in one primitive".into()));
+        if let (Some(uvs), Some(t)) = (uvs.as_mut(), transform.as_ref()) {
+            let (sin, cos) = t.rotation().sin_cos();
+            let [su, sv] = t.scale();
+            let [ou, ov] = t.offset();
+            // The extension's matrix: translation · rotation · scale, with
+            // the rotation's columns (cos, sin) and (-sin, cos).
+            for uv in uvs.iter_mut() {
+                let (u, v) = (uv.x * su, uv.y * sv);
+                *uv = Vec2::new(cos * u - sin * v + ou, sin * u + cos * v + ov);
+            }
         }
-        let raw: Vec<u32> = match reader.read_indices() {
-            Some(indices) => indices.into_u32().collect(),
+        if let Some(bad) = uvs.iter().flatten().position(|uv| !uv.is_finite()) {
+            return Err(self.invalid(format!(
+                "a non-finite texture coordinate at vertex {} (TEXCOORD_{set}, after any texture transform)",
+                base + bad
+            )));
+        }
+        match uvs {
+            Some(uvs) => parts.uvs.extend(uvs.into_iter().map(Some)),
+            None => parts.uvs.extend(std::iter::repeat_n(None, count)),
+        }
+        match read_set(1)? {
+            Some(uvs1) => parts.uvs1.extend(uvs1.into_iter().map(Some)),
+            None => parts.uvs1.extend(std::iter::repeat_n(None, count)),
+        }
+
+        if let Some(a) = primitive.indices().filter(|a| a.normalized()) {
+            return Err(self.invalid(format!("index accessor {} marked normalized", a.index())));
+        }
+        let raw: Vec<u32> = match primitive.indices() {
+            Some(a) => self
+                .decode(&a, buffers, "indices", Dimensions::Scalar, &[U8, U16, U32])?
+                .into_iter()
+                .map(|i| i as u32)
+                .collect(),
             None => (0..count as u32).collect(),
         };
         let triangles: Vec<[u32; 3]> = match primitive.mode() {
@@ -353,6 +539,7 @@ impl Reader<'_> {
             _ => raw.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
         };
         let mirrored = global.determinant() < 0.0;
+        let mesh = &mut parts.mesh;
         let start = mesh.indices.len();
         for (t, tri) in triangles.into_iter().enumerate() {
             if let Some(&bad) = tri.iter().find(|&&i| i as usize >= count) {
@@ -438,6 +625,86 @@ impl Reader<'_> {
         out.diffuse_texture = file;
         out.diffuse_image = Some(decoded);
         Ok(out)
+    }
+}
+
+/// The mesh under construction: per-vertex attributes that some
+/// primitives may lack.
+#[derive(Default)]
+struct Parts {
+    mesh: TriMesh,
+    /// Positions with the node transforms applied, in f64 until the
+    /// global shift is known.
+    points: Vec<DVec3>,
+    normals: Vec<Option<Vec3>>,
+    uvs: Vec<Option<Vec2>>,
+    uvs1: Vec<Option<Vec2>>,
+}
+
+impl Parts {
+    /// The mesh, with an attribute when any primitive has it (zeros for
+    /// the vertices of those that do not), positions relative to the
+    /// global shift.
+    fn finish(self, path: &Path) -> Result<TriMesh> {
+        fn fill<T: Copy + Default>(values: Vec<Option<T>>) -> Option<Vec<T>> {
+            values
+                .iter()
+                .any(Option::is_some)
+                .then(|| values.into_iter().map(Option::unwrap_or_default).collect())
+        }
+        let (origin, positions) = super::recenter(&self.points);
+        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::new(
+                path,
+                ErrorKind::OutOfRange(format!(
+                    "vertex {i} at {} is too far from the others for f32 positions",
+                    self.points[i]
+                )),
+            ));
+        }
+        Ok(TriMesh {
+            positions,
+            origin,
+            normals: fill(self.normals),
+            uvs: fill(self.uvs),
+            uvs1: fill(self.uvs1),
+            ..self.mesh
+        })
+    }
+}
+
+/// The number of components of an element.
+fn components(dimensions: Dimensions) -> usize {
+    match dimensions {
+        Dimensions::Scalar => 1,
+        Dimensions::Vec2 => 2,
+        Dimensions::Vec3 => 3,
+        Dimensions::Vec4 | Dimensions::Mat2 => 4,
+        Dimensions::Mat3 => 9,
+        Dimensions::Mat4 => 16,
+    }
+}
+
+/// One little-endian component at the start of `bytes` (the caller has
+/// checked the length), normalized to `[0, 1]` or `[-1, 1]` when asked
+/// (glTF 2.0 Sec. 3.11: `max(c / (2^(n-1) - 1), -1)` for signed types).
+fn component(bytes: &[u8], kind: DataType, normalized: bool) -> f64 {
+    let b = |i: usize| bytes[i];
+    let (value, scale) = match kind {
+        DataType::I8 => (f64::from(b(0) as i8), 127.0),
+        DataType::U8 => (f64::from(b(0)), 255.0),
+        DataType::I16 => (f64::from(i16::from_le_bytes([b(0), b(1)])), 32_767.0),
+        DataType::U16 => (f64::from(u16::from_le_bytes([b(0), b(1)])), 65_535.0),
+        DataType::U32 => (
+            f64::from(u32::from_le_bytes([b(0), b(1), b(2), b(3)])),
+            4_294_967_295.0,
+        ),
+        DataType::F32 => (f64::from(f32::from_le_bytes([b(0), b(1), b(2), b(3)])), 1.0),
+    };
+    if normalized && kind != DataType::F32 {
+        (value / scale).max(-1.0)
+    } else {
+        value
     }
 }
 

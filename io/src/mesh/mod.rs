@@ -26,8 +26,8 @@ pub mod ply;
 /// turn it back, which is the only place a flip happens. glTF UVs are kept
 /// as stored. Values outside `[0, 1]` (tiling) are kept; the material's
 /// [`Wrap`] says what they mean. Flipping in `f32` is exact for the values
-/// a texture atlas usually holds (multiples of powers of two) and within
-/// 2^-24 otherwise.
+/// a texture atlas usually holds (multiples of powers of two) and
+/// otherwise within half an `f32` step of `max(1, |v|)`.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TriMesh {
     /// Vertex positions, relative to [`origin`](Self::origin): the point a
@@ -42,8 +42,9 @@ pub struct TriMesh {
     /// triangles instead of collapsing them. Shifted when the largest
     /// coordinate magnitude is at least 10^5 (CloudCompare's default; the
     /// `f32` step there is 1/128) or more than 2^12 times the mesh's size.
-    /// Writers add it back in `f64`. glTF stores `f32`, so its meshes keep
-    /// a zero origin.
+    /// Writers add it back in `f64`. glTF stores `f32` vertices, but its
+    /// node transforms may carry them far away (a georeferenced tile): the
+    /// reader applies them in `f64` and picks the shift the same way.
     pub origin: DVec3,
     /// Three 0-based vertex indices per triangle, counter-clockwise as the
     /// file orders them.
@@ -53,6 +54,10 @@ pub struct TriMesh {
     /// Per-vertex texture coordinates, when the file has them; v down,
     /// `v = 0` at image row 0 (see the [UV convention](#uv-convention)).
     pub uvs: Option<Vec<Vec2>>,
+    /// A second set of texture coordinates: glTF's `TEXCOORD_1` as stored
+    /// (lightmap or detail UVs; no texture transform applied), when the
+    /// file has it. OBJ and PLY have one set only.
+    pub uvs1: Option<Vec<Vec2>>,
     /// Consecutive triangle ranges per object, group or material.
     pub objects: Vec<Object>,
     /// Materials, indexed by [`Object::material`].
@@ -88,10 +93,13 @@ pub struct Material {
     pub wrap: [Wrap; 2],
 }
 
-/// Texture wrap mode (glTF sampler modes; OBJ/MTL textures repeat).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Texture wrap mode (glTF sampler modes; OBJ/MTL textures repeat unless
+/// `-clamp on`). The same enum, with the same meaning, is used by every
+/// trilux crate that has wrap modes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub enum Wrap {
     /// Tile the texture.
+    #[default]
     Repeat,
     /// Tile, mirroring every other copy.
     MirroredRepeat,
@@ -179,6 +187,7 @@ impl TriMesh {
                 let ply = ply::read(path)?;
                 Ok(TriMesh {
                     origin: ply.origin,
+                    uvs1: None,
                     objects: vec![Object {
                         name: String::new(),
                         triangles: 0..ply.triangles.len(),

@@ -41,28 +41,106 @@ pub fn read(path: impl AsRef<Path>) -> Result<TriMesh> {
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let (mut mesh, libraries) = parse(&data, path)?;
     let folder = path.parent().unwrap_or(Path::new("."));
+    let mut transforms: Vec<Option<UvTransform>> = vec![None; mesh.materials.len()];
     for names in libraries {
         for library in library_files(folder, &names) {
             let lib_path = folder.join(&library);
             let text = std::fs::read(&lib_path).map_err(|e| Error::io(&lib_path, e))?;
-            for found in parse_mtl(&text, &lib_path, folder)? {
-                if let Some(m) = mesh.materials.iter_mut().find(|m| m.name == found.name) {
-                    *m = found;
+            for (found, transform) in parse_mtl(&text, &lib_path, folder)? {
+                if let Some(i) = mesh.materials.iter().position(|m| m.name == found.name) {
+                    mesh.materials[i] = found;
+                    transforms.resize(mesh.materials.len(), None);
+                    transforms[i] = transform;
                 }
             }
         }
     }
+    apply_uv_transforms(&mut mesh, &transforms);
     Ok(mesh)
+}
+
+/// A `map_Kd` `-s` and `-o` (u and v; w only matters to 3D textures): the
+/// texture is looked up at `uv * scale + offset` in OBJ's v-up UVs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct UvTransform {
+    scale: Vec2,
+    offset: Vec2,
+}
+
+impl UvTransform {
+    /// Applies it to a UV in TriMesh's v-down convention.
+    fn apply(self, uv: Vec2) -> Vec2 {
+        let up = Vec2::new(uv.x, 1.0 - uv.y);
+        let t = up * self.scale + self.offset;
+        Vec2::new(t.x, 1.0 - t.y)
+    }
+}
+
+/// Applies each material's texture transform to the UVs of its triangles,
+/// so that `uvs` index the texture directly. A vertex shared by triangles
+/// whose materials transform differently is split first.
+fn apply_uv_transforms(mesh: &mut TriMesh, transforms: &[Option<UvTransform>]) {
+    if transforms.iter().all(Option::is_none) || mesh.uvs.is_none() {
+        return;
+    }
+    // The transform group of each vertex: the material index whose
+    // transform it takes, or usize::MAX for none.
+    const PLAIN: usize = usize::MAX;
+    let mut owner: Vec<Option<usize>> = vec![None; mesh.positions.len()];
+    let mut copies: HashMap<(u32, usize), u32> = HashMap::new();
+    for object in mesh.objects.clone() {
+        let group = object
+            .material
+            .filter(|&m| transforms.get(m).copied().flatten().is_some())
+            .unwrap_or(PLAIN);
+        for t in object.triangles.clone() {
+            for corner in 0..3 {
+                let v = mesh.indices[t][corner];
+                match owner[v as usize] {
+                    None => owner[v as usize] = Some(group),
+                    Some(g) if g == group => {}
+                    Some(_) => {
+                        let copy = *copies.entry((v, group)).or_insert_with(|| {
+                            let i = v as usize;
+                            mesh.positions.push(mesh.positions[i]);
+                            if let Some(uvs) = mesh.uvs.as_mut() {
+                                uvs.push(uvs[i]);
+                            }
+                            if let Some(normals) = mesh.normals.as_mut() {
+                                normals.push(normals[i]);
+                            }
+                            owner.push(Some(group));
+                            (mesh.positions.len() - 1) as u32
+                        });
+                        mesh.indices[t][corner] = copy;
+                    }
+                }
+            }
+        }
+    }
+    if let Some(uvs) = mesh.uvs.as_mut() {
+        for (uv, group) in uvs.iter_mut().zip(&owner) {
+            if let Some(transform) = group.and_then(|g| transforms.get(g).copied().flatten()) {
+                *uv = transform.apply(*uv);
+            }
+        }
+    }
 }
 
 /// The files an `mtllib` line names: the whole rest of the line when a
 /// file of that name exists (names with spaces), else its
-/// whitespace-separated words (the statement's list form).
+/// whitespace-separated words (the statement's list form). When none of
+/// the words exists either, the whole name, so that the error names what
+/// the line says.
 fn library_files(folder: &Path, names: &str) -> Vec<String> {
-    if folder.join(names).is_file() || !names.contains(char::is_whitespace) {
+    let words: Vec<String> = names.split_whitespace().map(str::to_string).collect();
+    if words.len() <= 1
+        || folder.join(names).is_file()
+        || !words.iter().any(|w| folder.join(w).is_file())
+    {
         return vec![names.to_string()];
     }
-    names.split_whitespace().map(str::to_string).collect()
+    words
 }
 
 /// Parses the contents of an `.obj` file; `path` names it in errors.
@@ -344,6 +422,7 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
     let mesh = TriMesh {
         positions,
         origin,
+        uvs1: None,
         uvs: has_uv.then(|| {
             vertices
                 .iter()
@@ -365,40 +444,48 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
 
 /// Parses an MTL library: `newmtl`, `Kd`, `map_Kd` (options parsed, the
 /// rest of the line is the file, spaces included). `-clamp on` makes the
-/// texture [`Wrap::ClampToEdge`]; `-o`/`-s` other than the identity are
-/// refused (a shifted or scaled texture read as unshifted would be a
-/// silently wrong mesh); the other options (`-bm`, `-blendu`, `-blendv`,
-/// `-boost`, `-cc`, `-imfchan`, `-mm`, `-t`, `-texres`, `-type`) do not
-/// affect a diffuse colour lookup and are skipped.
-fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<Vec<Material>> {
-    let mut materials: Vec<Material> = Vec::new();
+/// texture [`Wrap::ClampToEdge`]; `-s` and `-o` come back as the
+/// material's UV transform (applied to the UVs by [`read`]); the other
+/// options (`-bm`, `-blendu`, `-blendv`, `-boost`, `-cc`, `-imfchan`,
+/// `-mm`, `-t`, `-texres`, `-type`) do not change which texel a diffuse
+/// lookup reads and are skipped.
+fn parse_mtl(
+    data: &[u8],
+    path: &Path,
+    folder: &Path,
+) -> Result<Vec<(Material, Option<UvTransform>)>> {
+    let mut materials: Vec<(Material, Option<UvTransform>)> = Vec::new();
     for (line, text) in lines(data) {
         let at = At { path, line };
         let mut tokens = text.split_whitespace();
         match tokens.next() {
-            Some("newmtl") => materials.push(Material {
-                name: rest_of(&text).to_string(),
-                diffuse: DEFAULT_DIFFUSE,
-                diffuse_texture: None,
-                diffuse_image: None,
-                wrap: [Wrap::Repeat; 2],
-            }),
+            Some("newmtl") => materials.push((
+                Material {
+                    name: rest_of(&text).to_string(),
+                    diffuse: DEFAULT_DIFFUSE,
+                    diffuse_texture: None,
+                    diffuse_image: None,
+                    wrap: [Wrap::Repeat; 2],
+                },
+                None,
+            )),
             Some("Kd") => {
                 let kd = vec3(&at, &mut tokens, "a diffuse colour")?;
-                let current = materials
+                let (current, _) = materials
                     .last_mut()
                     .ok_or_else(|| at.syntax("newmtl before Kd", &text))?;
                 current.diffuse = kd.to_array();
             }
             Some("map_Kd") => {
                 let map = texture_map(&at, rest_of(&text))?;
-                let current = materials
+                let (current, transform) = materials
                     .last_mut()
                     .ok_or_else(|| at.syntax("newmtl before map_Kd", &text))?;
                 current.diffuse_texture = Some(folder.join(map.file));
                 if map.clamp {
                     current.wrap = [Wrap::ClampToEdge; 2];
                 }
+                *transform = map.transform;
             }
             _ => {}
         }
@@ -411,6 +498,8 @@ fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<Vec<Material>> {
 struct TextureMap<'a> {
     file: &'a str,
     clamp: bool,
+    /// `-s` and `-o`, when either is not the identity.
+    transform: Option<UvTransform>,
 }
 
 /// Parses `[options] file name` of a `map_*` statement (MTL spec, "Texture
@@ -418,6 +507,10 @@ struct TextureMap<'a> {
 /// `-s` and `-t` one to three numbers.
 fn texture_map<'a>(at: &At<'_>, mut rest: &'a str) -> Result<TextureMap<'a>> {
     let mut clamp = false;
+    let mut transform = UvTransform {
+        scale: Vec2::ONE,
+        offset: Vec2::ZERO,
+    };
     // The next word of `rest` and what follows it.
     fn word(rest: &str) -> (&str, &str) {
         let rest = rest.trim_start();
@@ -464,16 +557,24 @@ fn texture_map<'a>(at: &At<'_>, mut rest: &'a str) -> Result<TextureMap<'a>> {
                 args(1, 3, true)?;
             }
             "-o" | "-s" => {
-                let identity = if option == "-o" { 0.0 } else { 1.0 };
                 let values = args(1, 3, true)?;
-                if values
-                    .iter()
-                    .any(|v| v.parse::<f64>().ok() != Some(identity))
-                {
-                    return Err(at.error(ErrorKind::Unsupported(format!(
-                        "texture option {option} {} (a shifted or scaled texture)",
-                        values.join(" ")
-                    ))));
+                let default = if option == "-o" { 0.0 } else { 1.0 };
+                // Missing components take the spec's defaults (0 for -o,
+                // 1 for -s).
+                let number = |k: usize| {
+                    values
+                        .get(k)
+                        .and_then(|v| v.parse::<f32>().ok())
+                        .unwrap_or(default)
+                };
+                let pair = Vec2::new(number(0), number(1));
+                if !pair.is_finite() {
+                    return Err(at.syntax(&format!("finite numbers after {option}"), after.trim()));
+                }
+                if option == "-o" {
+                    transform.offset = pair;
+                } else {
+                    transform.scale = pair;
                 }
             }
             other => {
@@ -488,7 +589,12 @@ fn texture_map<'a>(at: &At<'_>, mut rest: &'a str) -> Result<TextureMap<'a>> {
     if file.is_empty() {
         return Err(at.error(ErrorKind::Truncated("a texture file name".into())));
     }
-    Ok(TextureMap { file, clamp })
+    let identity = transform.scale == Vec2::ONE && transform.offset == Vec2::ZERO;
+    Ok(TextureMap {
+        file,
+        clamp,
+        transform: (!identity).then_some(transform),
+    })
 }
 
 /// Writes an `.obj` file: positions (plus [`TriMesh::origin`], in `f64`),

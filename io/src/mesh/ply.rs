@@ -14,7 +14,7 @@ use crate::error::{Error, ErrorKind, Result};
 use crate::text::Cursor;
 
 /// A point cloud or triangle mesh with per-vertex attributes: what
-/// [`read`] returns and [`write`] takes. For sampled points, fill
+/// [`read()`] returns and [`write()`] takes. For sampled points, fill
 /// `positions` and whichever of `normals`, `uvs`, `face_ids` and `scalars`
 /// the samples have:
 ///

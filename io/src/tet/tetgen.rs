@@ -249,6 +249,9 @@ fn region_tags(attributes: &[Vec<f64>]) -> Vec<i32> {
 /// sets the allocation.
 const MAX_ATTRIBUTES: u64 = 64;
 
+/// Per-tetrahedron attributes, one column per attribute.
+type Columns = Vec<Vec<f64>>;
+
 /// Parses a `.ele` file: tetrahedra (0-based) and their attributes, one
 /// column per attribute.
 pub(crate) fn parse_elements(
@@ -256,7 +259,7 @@ pub(crate) fn parse_elements(
     path: &Path,
     first_index: i64,
     node_count: usize,
-) -> Result<(Vec<[u32; 4]>, Vec<Vec<f64>>)> {
+) -> Result<(Vec<[u32; 4]>, Columns)> {
     let mut c = Cursor::new(data, path, Some(b'#'));
     let declared = c.u64("the number of tetrahedra")?;
     let (at, per_tok) = c.expect_token("the number of nodes per tetrahedron")?;
