@@ -1,8 +1,9 @@
 //! Šik & Křivánek 2013, Fig. 10 and Table 1: sampling rate, preprocessing
 //! time and memory of rejection sampling and of adaptive subdivision
-//! (without and with the lookup table, and our exact mode), per mesh and
-//! density texture, on one and two threads; then the issue's bar, and the
-//! comparison with trimesh and Open3D at N = 10⁷ on the bunny.
+//! (the inversion layout without and with the lookup table, the alias
+//! layout, and our exact mode) against the uniform sampler, per mesh and
+//! density texture, on one and two threads; then the ratios between them,
+//! and the comparison with trimesh and Open3D at N = 10⁷ on the bunny.
 //!
 //! ```text
 //! cargo run --release -p mesh-sampling --example paper -- [--json] [--mesh FILE]
@@ -28,7 +29,7 @@ use std::time::Instant;
 use discrete_sampling::CdfBisection;
 use glam::{Vec2, Vec3};
 use mesh_sampling::{
-    Density, DensitySampler, DensityTexture, MeshRef, Mode, Options, RejectionSampler,
+    Density, DensitySampler, DensityTexture, Layout, MeshRef, Mode, Options, RejectionSampler,
     SurfaceSampler, UniformSampler, spherical_uvs,
 };
 use rand::{Rng, SeedableRng};
@@ -151,7 +152,7 @@ fn load_meshes(filter: Option<&str>) -> Result<Vec<TestMesh>, String> {
             .into_owned();
         let (positions, uvs, indices) = match m.uvs {
             Some(uvs) => (m.positions, uvs, m.indices),
-            None => spherical_uvs(&m.positions, &m.indices),
+            None => spherical_uvs(&m.positions, &m.indices).map_err(|e| e.to_string())?,
         };
         out.push(TestMesh {
             name,
@@ -226,7 +227,8 @@ fn icosphere(levels: u32) -> TestMesh {
         }
         indices = next;
     }
-    let (positions, uvs, indices) = spherical_uvs(&positions, &indices);
+    let (positions, uvs, indices) =
+        spherical_uvs(&positions, &indices).expect("the icosphere is a valid mesh");
     TestMesh {
         name: "icosphere".into(),
         positions,
@@ -528,8 +530,12 @@ fn measure_pair(
         m.indices.len(),
     )];
     let density = Density::Texture(texture);
+    let inversion = Options {
+        layout: Layout::Inversion,
+        ..Options::default()
+    };
     let (ms, no_table) =
-        build(|| DensitySampler::<CdfBisection>::with_table(mesh, density, &Options::default()));
+        build(|| DensitySampler::<CdfBisection>::with_table(mesh, density, &inversion));
     let no_table = no_table.map_err(|e| e.to_string())?;
     let bytes = no_table.memory_bytes();
     rows.push(row(
@@ -541,11 +547,11 @@ fn measure_pair(
         no_table.pieces(),
     ));
     drop(no_table);
-    let (ms, table) = build(|| DensitySampler::new(mesh, density));
+    let (ms, table) = build(|| DensitySampler::with_options(mesh, density, &inversion));
     let table = table.map_err(|e| e.to_string())?;
     let bytes = table.memory_bytes();
     rows.push(row(
-        "subdivision",
+        "subdivision-inversion",
         rate(&table),
         ms,
         bytes as f64 / 1e6,
@@ -553,6 +559,18 @@ fn measure_pair(
         table.pieces(),
     ));
     drop(table);
+    let (ms, alias) = build(|| DensitySampler::new(mesh, density));
+    let alias = alias.map_err(|e| e.to_string())?;
+    let bytes = alias.memory_bytes();
+    rows.push(row(
+        "subdivision",
+        rate(&alias),
+        ms,
+        bytes as f64 / 1e6,
+        1.0,
+        alias.pieces(),
+    ));
+    drop(alias);
     let exact_options = Options {
         mode: Mode::Exact,
         ..Options::default()
@@ -600,86 +618,84 @@ fn print_markdown(rows: &[Row]) {
     }
 }
 
-/// The issue's bar, from the rows of this run.
-fn print_bar(rows: &[Row]) {
-    println!("\n## Bar\n");
+/// The ratios that matter, from the rows of this run: each density's
+/// rate against the uniform sampler's on the same mesh and thread count
+/// (both layouts), against rejection, and two threads against one.
+fn print_summary(rows: &[Row]) {
     let find = |mesh: &str, density: &str, method: &str, threads: usize| {
         rows.iter().find(|r| {
             r.mesh == mesh && r.density == density && r.method == method && r.threads == threads
         })
     };
-    let mut worst_uniform: Option<(f64, &Row)> = None;
-    let mut worst_rejection: Option<(f64, &Row)> = None;
-    let mut worst_scaling: Option<(f64, &Row)> = None;
+    println!("\n## Density rate / uniform sampler rate (same mesh, same threads)\n");
+    println!("| mesh | density | threads | alias layout | inversion layout | speed-up over rejection |");
+    println!("|---|---|---:|---:|---:|---:|");
+    let mut worst: [Option<(f64, &Row)>; 2] = [None, None];
     for r in rows.iter().filter(|r| r.method == "subdivision") {
-        if let Some(u) = find(&r.mesh, "uniform", "subdivision", r.threads) {
-            let ratio = r.msamples_per_s / u.msamples_per_s;
-            if worst_uniform.is_none_or(|(w, _)| ratio < w) {
-                worst_uniform = Some((ratio, r));
+        let Some(u) = find(&r.mesh, "-", "uniform-sampler", r.threads) else {
+            continue;
+        };
+        let alias = r.msamples_per_s / u.msamples_per_s;
+        let inversion = find(&r.mesh, &r.density, "subdivision-inversion", r.threads)
+            .map(|i| i.msamples_per_s / u.msamples_per_s);
+        let rejection = find(&r.mesh, &r.density, "rejection", r.threads)
+            .map(|j| r.msamples_per_s / j.msamples_per_s);
+        println!(
+            "| {} | {} | {} | {:.0}% | {} | {} |",
+            r.mesh,
+            r.density,
+            r.threads,
+            100.0 * alias,
+            inversion.map_or("-".into(), |x| format!("{:.0}%", 100.0 * x)),
+            rejection.map_or("-".into(), |x| format!("{x:.1}×")),
+        );
+        for (slot, ratio) in worst.iter_mut().zip([Some(alias), inversion]) {
+            if let Some(ratio) = ratio
+                && slot.is_none_or(|(w, _)| ratio < w)
+            {
+                *slot = Some((ratio, r));
             }
         }
-        if let Some(rej) = find(&r.mesh, &r.density, "rejection", r.threads) {
-            let margin = (r.msamples_per_s / rej.msamples_per_s) / (0.5 * r.max_over_mean);
-            if worst_rejection.is_none_or(|(w, _)| margin < w) {
-                worst_rejection = Some((margin, r));
-            }
+    }
+    println!();
+    for (name, w) in ["alias", "inversion"].iter().zip(worst) {
+        if let Some((ratio, r)) = w {
+            println!(
+                "- Lowest density rate with the {name} layout: {:.0}% of the uniform sampler's ({}, {}, {} thread(s))",
+                100.0 * ratio,
+                r.mesh,
+                r.density,
+                r.threads
+            );
         }
-        if r.threads == 2
-            && let Some(one) = find(&r.mesh, &r.density, "subdivision", 1)
-        {
+    }
+    let mut worst_scaling: Option<(f64, &Row)> = None;
+    for r in rows.iter().filter(|r| r.method == "subdivision" && r.threads == 2) {
+        if let Some(one) = find(&r.mesh, &r.density, "subdivision", 1) {
             let s = r.msamples_per_s / one.msamples_per_s;
             if worst_scaling.is_none_or(|(w, _)| s < w) {
                 worst_scaling = Some((s, r));
             }
         }
     }
-    let verdict = |ok: bool| if ok { "met" } else { "MISSED" };
-    if let Some((ratio, r)) = worst_uniform {
-        println!(
-            "- Rate with any density / rate with the uniform density: worst {:.0}% ({}, {}, {} thread(s)); bar 65%: {}",
-            100.0 * ratio,
-            r.mesh,
-            r.density,
-            r.threads,
-            verdict(ratio >= 0.65)
-        );
-    }
-    if let Some((margin, r)) = worst_rejection {
-        let rej = find(&r.mesh, &r.density, "rejection", r.threads).expect("found above");
-        println!(
-            "- Speed-up over rejection / (max/mean ÷ 2): worst {:.2} ({}, {}: {:.1}× at max/mean {:.1}); bar 1: {}",
-            margin,
-            r.mesh,
-            r.density,
-            r.msamples_per_s / rej.msamples_per_s,
-            r.max_over_mean,
-            verdict(margin >= 1.0)
-        );
-    }
-    let bunny = rows
-        .iter()
-        .find(|r| r.mesh.contains("bunny"))
-        .map(|r| r.mesh.clone());
-    let rng = rows.iter().find(|r| r.method == "rng" && r.threads == 1);
-    if let (Some(b), Some(rng)) = (bunny, rng)
-        && let Some(s) = find(&b, "uniform", "subdivision", 1)
-    {
-        let cost = rng.msamples_per_s / s.msamples_per_s;
-        println!(
-            "- One thread, uniform density, {b}: {:.1} ns per point, {:.1} ns for its three random u64: {:.2}×; bar 3×: {}",
-            1e3 / s.msamples_per_s,
-            1e3 / rng.msamples_per_s,
-            cost,
-            verdict(cost <= 3.0)
-        );
-    }
     if let Some((s, r)) = worst_scaling {
         println!(
-            "- Two threads / one thread: worst {:.2}× ({}, {}); bar 1.8×: {}",
-            s,
-            r.mesh,
-            r.density,
-            verdict(s >= 1.8)
+            "- Two threads / one thread (alias layout): lowest {s:.2}× ({}, {})",
+            r.mesh, r.density
+        );
+    }
+    let rng = rows.iter().find(|r| r.method == "rng" && r.threads == 1);
+    if let Some(rng) = rng
+        && let Some(u) = rows
+            .iter()
+            .find(|r| r.method == "uniform-sampler" && r.threads == 1 && r.mesh.contains("bunny"))
+    {
+        println!(
+            "- One thread, {}: {:.1} ns per uniform point, {:.1} ns for its three random u64 ({:.2}×)",
+            u.mesh,
+            1e3 / u.msamples_per_s,
+            1e3 / rng.msamples_per_s,
+            rng.msamples_per_s / u.msamples_per_s
         );
     }
 }
@@ -753,12 +769,8 @@ fn peers(m: &TestMesh, file: &Path, threads: &[usize], json: bool) -> Result<(),
     }
     println!();
     for (peer, r) in &peer_rates {
-        for (t, ours) in &ours {
-            let x = ours / r;
-            println!(
-                "- {t} thread(s) vs {peer}: {x:.1}×; bar 15×: {}",
-                if x >= 15.0 { "met" } else { "MISSED" }
-            );
+        if let Some((_, ours)) = ours.iter().find(|(t, _)| *t == 1) {
+            println!("- one thread against {peer} (one thread): {:.1}×", ours / r);
         }
     }
     Ok(())
@@ -790,6 +802,28 @@ fn run() -> Result<(), String> {
         rows.push(rng_row);
     }
     for m in &meshes {
+        for &t in &args.threads {
+            let uniform = UniformSampler::new(m.mesh()).map_err(|e| e.to_string())?;
+            let (ms, _) = build(|| UniformSampler::new(m.mesh()));
+            let r = pool(t)?.install(|| rate(&uniform));
+            let row = Row {
+                mesh: m.name.clone(),
+                triangles: m.indices.len(),
+                density: "-".into(),
+                method: "uniform-sampler",
+                threads: t,
+                msamples_per_s: r,
+                preprocess_ms: ms,
+                memory_mb: uniform.memory_bytes() as f64 / 1e6,
+                max_over_mean: 1.0,
+                acceptance: 1.0,
+                pieces: m.indices.len(),
+            };
+            if args.json {
+                println!("{}", row.json());
+            }
+            rows.push(row);
+        }
         for (name, texture) in &textures {
             for &t in &args.threads {
                 eprintln!("{} / {name} / {t} thread(s)…", m.name);
@@ -806,7 +840,7 @@ fn run() -> Result<(), String> {
     if !args.json {
         println!("# mesh-sampling: Šik & Křivánek 2013, Fig. 10 and Table 1\n");
         print_markdown(&rows);
-        print_bar(&rows);
+        print_summary(&rows);
     }
     if args.peers
         && let Some(bunny) = meshes.iter().find(|m| m.name.contains("bunny"))

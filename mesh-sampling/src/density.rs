@@ -9,7 +9,7 @@ use rand::distr::Distribution;
 
 use crate::layout::{Piece, PieceAlias};
 use crate::parallel::{BLOCK, unit};
-use crate::point::{Frame, uniform_barycentric};
+use crate::point::Frame;
 use crate::subdivision::{self, MAX_LEVEL, Merge, SubTriangle, Values};
 use crate::{DensityTexture, Error, Layout, MeshRef, SurfacePoint, SurfaceSampler};
 
@@ -216,6 +216,9 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
     /// [`Error::WeightLength`], [`Error::InvalidWeight`] for weights;
     /// [`Error::InvalidOption`]; [`Error::TooManyPieces`] when one piece
     /// per triangle already exceeds [`Options::max_pieces`];
+    /// [`Error::IntegrationTooLarge`] in exact mode for UVs that tile a
+    /// varying texture too many times to integrate it exactly, and
+    /// [`Error::AcceptanceTooLow`] below [`MIN_ACCEPTANCE`];
     /// [`Error::ZeroDensity`] when the density is zero on every triangle
     /// of non-zero area.
     pub fn with_table(
@@ -248,6 +251,9 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
                 let levels = capped_levels(&wanted, options.max_pieces)?;
                 let build = |f: usize| texture_pieces(&mesh, uvs, texture, levels[f], options, f);
                 let per_face = map_faces(faces, build);
+                if options.mode == Mode::Exact {
+                    check_integration(&mesh, uvs, texture)?;
+                }
                 let exact = (options.mode == Mode::Exact).then(|| {
                     map_faces(faces, |f| exact_mass(&mesh, uvs, texture, f))
                         .iter()
@@ -310,6 +316,7 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         if mass.is_nan() || mass <= 0.0 {
             return Err(Error::ZeroDensity { triangles: faces });
         }
+        check_acceptance((mass / proposal_mass).min(1.0))?;
         Ok(Self {
             mesh,
             density,
@@ -461,8 +468,11 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         match piece.part.corner() {
             Some(corner) => linear_corner_barycentric(corner, xi1, xi2),
             None => {
-                let [_, a, b] = uniform_barycentric(xi1, xi2);
-                let (u, v) = piece.part.to_parent(f64::from(a), f64::from(b));
+                // The square-root map (Sec. 3.5) in the sub-triangle's own
+                // legs, kept in f64 up to the parent's barycentrics.
+                let s = xi1.sqrt();
+                let a = xi2 * s;
+                let (u, v) = piece.part.to_parent(a, s - a);
                 [(1.0 - u - v).max(0.0) as f32, u as f32, v as f32]
             }
         }
@@ -832,10 +842,49 @@ fn texture_pieces(
     out
 }
 
-/// The smallest `f32` not below `x`.
+/// The smallest `f32` not below `x`, at most `f32::MAX` (a bound of a
+/// density whose texels are at most that).
 fn round_up(x: f64) -> f32 {
     let y = x as f32;
-    if f64::from(y) < x { y.next_up() } else { y }
+    if f64::from(y) < x { y.next_up().min(f32::MAX) } else { y.min(f32::MAX) }
+}
+
+/// The lowest expected acceptance a rejection step may have: 10⁻⁹ (a
+/// billion proposals a point, about a minute of work), so that no draw
+/// runs unbounded.
+pub const MIN_ACCEPTANCE: f64 = 1e-9;
+
+/// `Ok` if a rejection step accepts at least [`MIN_ACCEPTANCE`].
+pub(crate) fn check_acceptance(acceptance: f64) -> Result<(), Error> {
+    if acceptance >= MIN_ACCEPTANCE {
+        Ok(())
+    } else {
+        Err(Error::AcceptanceTooLow {
+            acceptance,
+            minimum: MIN_ACCEPTANCE,
+        })
+    }
+}
+
+/// `Ok` if integrating `texture` exactly over the mesh stays within
+/// [`MAX_INTEGRATION_CELLS`](crate::MAX_INTEGRATION_CELLS) (checked in
+/// O(1) per face, before integrating).
+pub(crate) fn check_integration(
+    mesh: &MeshRef<'_>,
+    uvs: &[Vec2],
+    texture: &DensityTexture,
+) -> Result<(), Error> {
+    let cells: f64 = map_faces(mesh.indices.len(), |f| {
+        texture.cells_to_integrate(face_uvs(uvs, mesh.indices[f]))
+    })
+    .iter()
+    .sum();
+    let budget = crate::MAX_INTEGRATION_CELLS;
+    if cells <= budget as f64 {
+        Ok(())
+    } else {
+        Err(Error::IntegrationTooLarge { cells, budget })
+    }
 }
 
 /// The exact integral of the filtered texture over face `f` in 3D area:

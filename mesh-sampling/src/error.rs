@@ -157,6 +157,33 @@ pub enum Error {
         /// The budget, [`MAX_POINTS`](crate::MAX_POINTS).
         budget: usize,
     },
+    /// The exact integral of the density over the mesh would visit too
+    /// many texel cells (UV footprints that tile a varying texture many
+    /// times).
+    #[error(
+        "integrating the density exactly over the mesh would visit {cells} texel cells, more \
+         than the budget of {budget}: its UVs tile the texture too many times for the exact \
+         mode or rejection sampling (use the approximate mode)"
+    )]
+    IntegrationTooLarge {
+        /// Cells to visit.
+        cells: f64,
+        /// The budget, [`MAX_INTEGRATION_CELLS`](crate::MAX_INTEGRATION_CELLS).
+        budget: u64,
+    },
+    /// A rejection sampler would accept too few of its proposals to
+    /// finish in reasonable time.
+    #[error(
+        "the sampler would accept only {acceptance:e} of its proposals, below the minimum of \
+         {minimum:e}: the density's maximum is too far above its mean on this mesh (use the \
+         approximate mode)"
+    )]
+    AcceptanceTooLow {
+        /// The expected fraction of proposals accepted.
+        acceptance: f64,
+        /// The minimum, [`MIN_ACCEPTANCE`](crate::MIN_ACCEPTANCE).
+        minimum: f64,
+    },
     /// A triangle index that does not exist.
     #[error("there is no triangle {face}: the mesh has {count}")]
     NoSuchFace {

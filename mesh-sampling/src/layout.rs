@@ -105,26 +105,49 @@ impl PieceAlias {
     pub(crate) fn piece(&self, bits: u64) -> Piece {
         let x = u128::from(bits) * self.columns.len() as u128;
         let column = &self.columns[(x >> 64) as usize];
-        if (x as u64) < column.threshold {
-            column.own
-        } else {
-            column.alias
-        }
+        column.side(x as u64 >= column.threshold)
     }
 
-    /// Fills `out` with pieces, one `u64` of `rng` each, the random
-    /// numbers drawn first so that the column loads overlap.
+    /// Fills `out` with pieces, one `u64` of `rng` each. Three passes per
+    /// block: the columns and positions from the random numbers; then the
+    /// columns' thresholds alone, a loop of independent loads with nothing
+    /// between them, so that as many cache misses as the core allows are
+    /// in flight at once (and the lines are in L1 afterwards); then the
+    /// choice of side, reading the records from lines now cached.
     #[inline]
     pub(crate) fn fill<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [Piece]) {
-        let mut bits = [0u64; crate::parallel::BLOCK];
-        for block in out.chunks_mut(crate::parallel::BLOCK) {
-            let bits = &mut bits[..block.len()];
-            for b in bits.iter_mut() {
-                *b = rng.next_u64();
+        const B: usize = crate::parallel::BLOCK;
+        let n = self.columns.len() as u128;
+        let (mut index, mut frac, mut threshold) = ([0usize; B], [0u64; B], [0u64; B]);
+        for block in out.chunks_mut(B) {
+            let len = block.len();
+            for (i, f) in index[..len].iter_mut().zip(&mut frac[..len]) {
+                let x = u128::from(rng.next_u64()) * n;
+                (*i, *f) = ((x >> 64) as usize, x as u64);
             }
-            for (slot, &b) in block.iter_mut().zip(bits.iter()) {
-                *slot = self.piece(b);
+            for (t, &i) in threshold[..len].iter_mut().zip(&index[..len]) {
+                *t = self.columns[i].threshold;
             }
+            for (k, slot) in block.iter_mut().enumerate() {
+                let c = &self.columns[index[k]];
+                *slot = c.side(frac[k] >= threshold[k]);
+            }
+        }
+    }
+}
+
+impl Column {
+    /// `own` below the threshold, `alias` above, without a branch: which
+    /// side is a coin flip the predictor cannot learn.
+    #[inline]
+    fn side(&self, alias: bool) -> Piece {
+        let mask = 0u32.wrapping_sub(u32::from(alias));
+        let pick = |own: u32, alias: u32| own ^ ((own ^ alias) & mask);
+        let (own, alias) = (self.own, self.alias);
+        Piece {
+            face: pick(own.face, alias.face),
+            part: SubTriangle::from_bits(pick(own.part.bits(), alias.part.bits())),
+            value: f32::from_bits(pick(own.value.to_bits(), alias.value.to_bits())),
         }
     }
 }

@@ -72,7 +72,7 @@ mod texture;
 mod uniform;
 
 pub use batch::SurfaceSampler;
-pub use density::{DEFAULT_MAX_PIECES, Density, DensitySampler, Depth, Mode, Options};
+pub use density::{DEFAULT_MAX_PIECES, MIN_ACCEPTANCE, Density, DensitySampler, Depth, Mode, Options};
 pub use error::Error;
 pub use layout::Layout;
 pub use mesh::MeshRef;
@@ -82,5 +82,5 @@ pub use parallel::MAX_POINTS;
 pub use point::{SurfacePoint, uniform_barycentric};
 pub use projection::spherical_uvs;
 pub use rejection::RejectionSampler;
-pub use texture::{Channel, DensityTexture, Filter, Wrap, luminance};
+pub use texture::{Channel, DensityTexture, Filter, MAX_INTEGRATION_CELLS, Wrap, luminance};
 pub use uniform::UniformSampler;

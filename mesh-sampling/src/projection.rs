@@ -2,6 +2,8 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::{Error, MeshRef};
+
 /// A spherical projection about the bounding-box centre: `u` is the
 /// longitude (`atan2(z, x)`), `v` the polar angle from +y, both scaled to
 /// `[0, 1]`. Every corner gets its own vertex, so a triangle across the
@@ -9,10 +11,16 @@ use glam::{Vec2, Vec3};
 /// in UV space (with [`Wrap::Repeat`](crate::Wrap::Repeat) the texture
 /// continues across). Returns positions, UVs and indices of the new mesh,
 /// whose triangle `f` is triangle `f` of the input.
+///
+/// # Errors
+/// Those of [`MeshRef::validate`] (no triangles, an index out of range, a
+/// non-finite position).
+#[expect(clippy::type_complexity, reason = "the three arrays of a mesh")]
 pub fn spherical_uvs(
     positions: &[Vec3],
     indices: &[[u32; 3]],
-) -> (Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>) {
+) -> Result<(Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>), Error> {
+    MeshRef::new(positions, indices).validate()?;
     let (lo, hi) = positions
         .iter()
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
@@ -45,5 +53,5 @@ pub fn spherical_uvs(
         uvs.extend(uv);
         out_indices.push([base, base + 1, base + 2]);
     }
-    (out_positions, uvs, out_indices)
+    Ok((out_positions, uvs, out_indices))
 }

@@ -32,11 +32,14 @@ impl<'a> RejectionSampler<'a> {
     ///
     /// # Errors
     /// As for [`UniformSampler::new`]; [`Error::MissingUvs`],
-    /// [`Error::NonFiniteUv`]; [`Error::ZeroDensity`] when the texture is
-    /// zero on the whole mesh.
+    /// [`Error::NonFiniteUv`]; [`Error::IntegrationTooLarge`] for UVs that
+    /// tile a varying texture too many times to integrate it exactly;
+    /// [`Error::ZeroDensity`] when the texture is zero on the whole mesh;
+    /// [`Error::AcceptanceTooLow`] below [`MIN_ACCEPTANCE`](crate::MIN_ACCEPTANCE).
     pub fn new(mesh: MeshRef<'a>, texture: &'a DensityTexture) -> Result<Self, Error> {
         let uniform = UniformSampler::new(mesh)?;
         let uvs = crate::density::texture_uvs(&mesh)?;
+        crate::density::check_integration(&mesh, uvs, texture)?;
         let faces = mesh.indices.len();
         let mass: f64 = crate::density::map_faces(faces, |f| {
             crate::density::exact_mass(&mesh, uvs, texture, f)
@@ -47,8 +50,10 @@ impl<'a> RejectionSampler<'a> {
             return Err(Error::ZeroDensity { triangles: faces });
         }
         let bound = f64::from(texture.max());
+        let acceptance = mass / (uniform.total_area() * bound);
+        crate::density::check_acceptance(acceptance)?;
         Ok(Self {
-            acceptance: mass / (uniform.total_area() * bound),
+            acceptance,
             uniform,
             uvs,
             texture,

@@ -94,13 +94,26 @@ impl SubTriangle {
     /// legs.
     #[inline]
     pub(crate) fn to_parent(self, a: f64, b: f64) -> (f64, f64) {
-        let h = f64::from(1u32 << self.level()).recip();
+        // h = 2^-level from its exponent bits (no division), and the
+        // orientation as arithmetic (no branch: it is a coin flip the
+        // predictor cannot learn on a random draw).
+        let h = f64::from_bits((1023 - u64::from(self.level())) << 52);
         let (i, j) = (f64::from(self.i()), f64::from(self.j()));
-        if self.down() {
-            (h * (i + 1.0 - a), h * (j + 1.0 - b))
-        } else {
-            (h * (i + a), h * (j + b))
-        }
+        let d = f64::from((self.0 >> 26) & 1);
+        let s = 1.0 - 2.0 * d;
+        (h * (i + d + s * a), h * (j + d + s * b))
+    }
+
+    /// The code as bits (for branch-free selection).
+    #[inline]
+    pub(crate) fn bits(self) -> u32 {
+        self.0
+    }
+
+    /// The code from [`bits`](Self::bits).
+    #[inline]
+    pub(crate) fn from_bits(bits: u32) -> Self {
+        Self(bits)
     }
 
     /// The barycenter, as parent `(u, v)`.
@@ -233,7 +246,7 @@ fn visit<V, C>(
     let hi = values.iter().copied().fold(0.0f32, f32::max);
     if hi == lo || hi - lo <= tolerance * hi {
         let merged = match merge {
-            Merge::Mean => values.iter().map(|&v| f64::from(v)).sum::<f64>() as f32 * 0.25,
+            Merge::Mean => (values.iter().map(|&v| f64::from(v)).sum::<f64>() * 0.25) as f32,
             Merge::Max => hi,
         };
         out.truncate(start);

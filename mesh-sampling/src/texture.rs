@@ -13,6 +13,13 @@ use glam::DVec2;
 
 use crate::Error;
 
+/// The most texel cells an exact integral visits: 2³⁰ (about a minute of
+/// work). [`DensityTexture::integral`] returns NaN beyond it, and the
+/// samplers that integrate exactly ([`Mode::Exact`](crate::Mode::Exact),
+/// [`RejectionSampler`](crate::RejectionSampler)) refuse a mesh whose
+/// footprints add up to more with [`Error::IntegrationTooLarge`].
+pub const MAX_INTEGRATION_CELLS: u64 = 1 << 30;
+
 /// What happens outside `[0, 1]²`, with glTF's sampler semantics (the
 /// same enum, with the same meaning, as in `trilux-io` and `mesh-colors`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -134,11 +141,11 @@ impl DensityTexture {
         channels: usize,
         channel: Channel,
     ) -> Result<Self, Error> {
-        let needed = match channel {
-            Channel::Index(c) => c + 1,
-            Channel::Luminance => 3,
+        let enough = match channel {
+            Channel::Index(c) => c < channels,
+            Channel::Luminance => channels >= 3,
         };
-        if channels < needed {
+        if !enough {
             return Err(Error::InvalidChannel { channel, channels });
         }
         if !data.len().is_multiple_of(channels) {
@@ -386,12 +393,19 @@ impl DensityTexture {
 
     /// The exact integral of the filtered density over the UV triangle
     /// `uv`, in UV area (the unit square has area 1).
+    ///
+    /// Constant footprints cost O(1); others one clipping step per texel
+    /// cell of the triangle's bounding box ([`cells_to_integrate`](Self::cells_to_integrate)),
+    /// and beyond [`MAX_INTEGRATION_CELLS`] the answer is NaN (not computed).
     pub fn integral(&self, uv: [DVec2; 3]) -> f64 {
         let (lo, hi) = (uv[0].min(uv[1]).min(uv[2]), uv[0].max(uv[1]).max(uv[2]));
         if let Some(c) = self.constant_over_box(lo, hi) {
             // Constant over the footprint (say a tiled constant region):
             // the value times the UV area, without visiting its cells.
             return f64::from(c) * 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
+        }
+        if !(self.cells_to_integrate(uv) <= MAX_INTEGRATION_CELLS as f64) {
+            return f64::NAN;
         }
         let scale = 1.0 / (self.width as f64 * self.height as f64);
         let tri = uv.map(|p| self.to_cells(p));
@@ -400,6 +414,18 @@ impl DensityTexture {
             sum += integrate_piece(piece, |p| self.in_cell(cell, p));
         });
         sum * scale
+    }
+
+    /// The texel cells [`integral`](Self::integral) visits for the UV
+    /// triangle `uv`: 0 if the density is constant over its bounding box,
+    /// else the cells of that box (NaN or infinite for non-finite UVs).
+    pub fn cells_to_integrate(&self, uv: [DVec2; 3]) -> f64 {
+        let (lo, hi) = (uv[0].min(uv[1]).min(uv[2]), uv[0].max(uv[1]).max(uv[2]));
+        if self.constant_over_box(lo, hi).is_some() {
+            return 0.0;
+        }
+        let (a, b) = (self.to_cells(lo).floor(), self.to_cells(hi).ceil());
+        ((b.x - a.x).max(1.0)) * ((b.y - a.y).max(1.0))
     }
 
     /// The maximum of the filtered density over the UV box `[lo, hi]`,
@@ -456,7 +482,12 @@ impl DensityTexture {
         match self.filter {
             Filter::Nearest => self.texel(cell.0, cell.1),
             Filter::Bilinear => {
-                let (fx, fy) = (p.x - cell.0 as f64, p.y - cell.1 as f64);
+                // In [0, 1] inside the cell; clamped for coordinates so
+                // far out (beyond 2⁶³) that the cell index saturated.
+                let (fx, fy) = (
+                    (p.x - cell.0 as f64).clamp(0.0, 1.0),
+                    (p.y - cell.1 as f64).clamp(0.0, 1.0),
+                );
                 let x0 = self.wrap_index(cell.0, self.width);
                 let x1 = self.wrap_index(cell.0.saturating_add(1), self.width);
                 let row0 = self.wrap_index(cell.1, self.height) * self.width;

@@ -274,7 +274,7 @@ fn bad_meshes_are_errors() {
 
 /// The article's real-data check: on the Utah teapot (four parts, very
 /// unequal triangles) the uniform sampler passes the centroid test and the
-/// naive one does not. Skipped without `TRILUX_DATA`.
+/// naive one does not. Ignored without `TRILUX_DATA`.
 ///
 /// At 1.96 SEM a correct sampler fails some axis in one run of seven; on
 /// the teapot, seed 21 does (z = 2.1 on y). Over seeds 1..=20 the uniform
@@ -282,14 +282,13 @@ fn bad_meshes_are_errors() {
 /// 1.07 / 1.05 / 0.97 per axis, as an unbiased sampler's must. So this
 /// test uses the article's statistic at α = 0.001 per axis (3.29 SEM);
 /// the naive sampler is far beyond it.
+#[path = "../../io/tests/support/data_dir.rs"]
+mod data_dir;
+
 #[test]
+#[cfg_attr(not(trilux_data), ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)")]
 fn teapot_centroid_test_as_in_the_article() {
-    let Some(data) = std::env::var_os("TRILUX_DATA").map(std::path::PathBuf::from) else {
-        eprintln!("skipped: TRILUX_DATA is not set, so the teapot is not sampled");
-        return;
-    };
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let dir = if data.is_dir() { data } else { root.join(data) };
+    let dir = data_dir::data_dir().expect("TRILUX_DATA names the data folder");
     let teapot = trilux_io::mesh::TriMesh::read(dir.join("meshes/teapot.obj")).unwrap();
     let mesh = MeshRef::new(&teapot.positions, &teapot.indices);
     let uniform = z_scores(&UniformSampler::new(mesh).unwrap(), &mesh, 21);
