@@ -40,6 +40,19 @@
 //!   panic.
 //! - A fixed seed gives the same samples on every platform and `rand`
 //!   version: one `u64` makes one variate, by a conversion defined here.
+//! - Variates outside `[0, 1)` are clamped and NaN counts as 0, in every
+//!   sampler; a 2D point always lies inside the cell it was drawn from.
+//! - Weights are normalised by division, so subnormal weights keep their
+//!   ratios.
+//!
+//! # Environment maps
+//!
+//! [`Distribution2D::from_equirect`] builds the distribution of a
+//! latitude–longitude map; [`Distribution2D::sample_direction`] draws a
+//! direction with its density per steradian, and
+//! [`Distribution2D::pdf_direction`] gives that density for any direction
+//! (multiple importance sampling). [`equirect_direction`] and
+//! [`equirect_point`] convert between map points and directions.
 //!
 //! # Example
 //!
@@ -100,3 +113,8 @@ pub use luminance::luminance;
 /// re-exported so that callers use the same version.
 pub use rand;
 pub use sampler::{DiscreteSampler, InvertibleSampler};
+
+/// The README's examples, compiled as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -9,13 +9,25 @@
 mod data;
 
 use std::path::PathBuf;
+use std::process::ExitCode;
 
 use glam::Vec2;
 use mesh_colors::{Texture, Topology, atlas, convert, file};
 use trilux_io::image::{Image, PngDepth, linear_to_srgb, srgb_to_linear};
 use trilux_io::mesh::{Object, TriMesh};
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
+fn main() -> ExitCode {
+    // Errors print as the sentence their Display gives, not as Debug.
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("bake: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run() -> Result<(), Box<dyn std::error::Error>> {
     let Some(dir) = data::data_dir() else {
         eprintln!("TRILUX_DATA is not set: nothing to bake");
         return Ok(());
@@ -27,7 +39,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let spot = data::textured_meshes(&dir)
         .into_iter()
         .next()
-        .ok_or("no spot")?;
+        .ok_or("the data folder has no spot mesh")?;
     let topology = Topology::new(spot.positions.len(), &spot.faces)?;
     let colors = convert::from_texture(
         topology,
@@ -44,17 +56,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         },
     )?;
 
-    // One OBJ vertex per corner (the atlas gives every face its own UVs);
-    // OBJ's v points up, so flip it.
+    // One OBJ vertex per corner (the atlas gives every face its own UVs).
+    // TriMesh UVs follow the texture convention (v = 0 at image row 0),
+    // as the atlas's do; the OBJ writer converts to OBJ's v-up.
     let mut mesh = TriMesh::default();
     for (f, face) in spot.faces.iter().enumerate() {
         let base = mesh.positions.len() as u32;
         for (k, &v) in face.iter().enumerate() {
             mesh.positions.push(spot.positions[v as usize]);
             let uv = baked.corner_uvs[f][k];
-            mesh.uvs
-                .get_or_insert_with(Vec::new)
-                .push(Vec2::new(uv.x, 1.0 - uv.y));
+            mesh.uvs.get_or_insert_with(Vec::new).push(uv);
         }
         mesh.indices.push([base, base + 1, base + 2]);
     }
@@ -99,7 +110,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .flat_map(|p| [0, 1, 2].map(|c| linear_to_srgb(p[c])))
         .collect();
     let texture = Texture::new(png.width as usize, png.height as usize, 3, data)?;
-    let uvs = back.uvs.ok_or("no UVs read back")?;
+    let uvs = back
+        .uvs
+        .ok_or_else(|| format!("{}: the written OBJ reads back without UVs", obj.display()))?;
     let points = data::surface_points(&spot.positions, &spot.faces, 1_000_000, 5);
     let (mut a, mut b) = ([0.0f32; 3], [0.0f32; 3]);
     let mut se = 0.0f64;
@@ -111,7 +124,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
         let tri = back.indices[f as usize];
         let p: Vec2 = (0..3).map(|k| bary[k] * uvs[tri[k] as usize]).sum();
-        texture.bilinear([p.x, 1.0 - p.y], &mut b);
+        texture.bilinear(p.into(), &mut b);
         se += (0..3).map(|c| f64::from(a[c] - b[c]).powi(2)).sum::<f64>();
     }
     let psnr = 10.0 * (1.0 / (se / (3 * points.len()) as f64)).log10();

@@ -84,7 +84,7 @@ fn main() {
         let footprints: Vec<f32> = points
             .iter()
             .zip(&lods)
-            .map(|(&(f, _), &lod)| lod.exp2() / mc.face_resolution(f as usize) as f32)
+            .map(|(&(f, _), &lod)| lod.exp2() / mc.face_resolution(f as usize).unwrap() as f32)
             .collect();
         let mut texture = m.texture.clone();
         texture.build_mips();

@@ -49,7 +49,7 @@ pub struct Atlas {
     /// The texture, `channels()` of the mesh colours.
     pub texture: Texture,
     /// `corner_uvs[f][k]`: the UV of corner `k` of face `f` ([`Texture`]
-    /// convention: `v = 0` is row 0; flip for OBJ).
+    /// convention: `v = 0` is row 0, as in `trilux-io`'s `TriMesh`).
     pub corner_uvs: Vec<[Vec2; 3]>,
 }
 
@@ -72,6 +72,13 @@ impl Default for Options {
     }
 }
 
+/// The largest atlas side, in texels (the common GPU texture limit).
+pub const MAX_SIDE: u64 = 32_768;
+
+/// The largest gutter, in texels: wider gutters only waste texels (a
+/// MIP-safe gutter of `2^8` is the most [`Options::mip_levels`] asks for).
+pub const MAX_GUTTER: u32 = 4_096;
+
 struct Block {
     faces: [Option<usize>; 2],
     r: u32,
@@ -79,27 +86,37 @@ struct Block {
     y: u32,
 }
 
-fn round_up(x: u32, to: u32) -> u32 {
+fn round_up(x: u64, to: u64) -> u64 {
     x.div_ceil(to) * to
 }
 
 /// Bakes mesh colours into an atlas (see the module docs for the layout).
 ///
 /// # Errors
-/// [`Error::BadTexture`] if the atlas would exceed 32768 texels a side.
+/// [`Error::TooLarge`], before allocating the atlas: a gutter above
+/// [`MAX_GUTTER`], an atlas side above [`MAX_SIDE`], or texels × channels
+/// above [`MAX_SAMPLE_VALUES`](crate::MAX_SAMPLE_VALUES).
 pub fn bake(colors: &MeshColors, options: &Options) -> Result<Atlas, Error> {
+    if options.gutter > MAX_GUTTER {
+        return Err(Error::TooLarge {
+            what: "the atlas gutter",
+            requested: u64::from(options.gutter),
+            budget: u64::from(MAX_GUTTER),
+            unit: "texels",
+        });
+    }
     let k = options.mip_levels.min(8);
-    let align = 1u32 << k;
+    let align = 1u64 << k;
     let paired = k == 0;
-    let g = if paired {
+    let g = u64::from(if paired {
         options.gutter
     } else {
-        options.gutter.max(align)
-    };
+        options.gutter.max(1 << k)
+    });
     let n = colors.face_count();
     let mut by_level: Vec<Vec<usize>> = vec![Vec::new(); crate::MAX_LEVEL as usize + 1];
     for f in 0..n {
-        by_level[colors.face_level(f) as usize].push(f);
+        by_level[colors.level_at(f) as usize].push(f);
     }
     let mut blocks = Vec::new();
     for (l, faces) in by_level.iter().enumerate().rev() {
@@ -113,8 +130,11 @@ pub fn bake(colors: &MeshColors, options: &Options) -> Result<Atlas, Error> {
             });
         }
     }
+    // Sizes in u64: a block is at most 2^10 + 3 + 2 · 4096 texels wide, and
+    // the sums below cannot overflow.
     // Inner block: the lattice (and, paired, the second face).
     let inner = |r: u32| {
+        let r = u64::from(r);
         if paired {
             (r + 3, r + 2)
         } else {
@@ -125,41 +145,60 @@ pub fn bake(colors: &MeshColors, options: &Options) -> Result<Atlas, Error> {
         let (w, h) = inner(b.r);
         (round_up(w + 2 * g, align), round_up(h + 2 * g, align))
     };
-    let area: u64 = blocks
-        .iter()
-        .map(|b| u64::from(size(b).0) * u64::from(size(b).1))
-        .sum();
+    let area: u64 = blocks.iter().map(|b| size(b).0 * size(b).1).sum();
     let widest = blocks.iter().map(|b| size(b).0).max().unwrap_or(1);
     let width = round_up(
-        ((area as f64 * 1.05).sqrt().ceil() as u32)
+        ((area as f64 * 1.05).sqrt().ceil() as u64)
             .max(widest)
             .max(1),
         align,
     );
     // Shelf packing, tallest blocks first (they are sorted by level).
-    let (mut x, mut y, mut shelf) = (0u32, 0u32, 0u32);
-    for b in &mut blocks {
+    let (mut x, mut y, mut shelf) = (0u64, 0u64, 0u64);
+    let mut places = Vec::with_capacity(blocks.len());
+    for b in &blocks {
         let (w, h) = size(b);
         if x + w > width {
             x = 0;
             y += shelf;
             shelf = 0;
         }
-        b.x = x;
-        b.y = y;
+        places.push((x, y));
         x += w;
         shelf = shelf.max(h);
     }
     let height = round_up((y + shelf).max(1), align);
-    if width > 32_768 || height > 32_768 {
-        return Err(Error::BadTexture {
-            width: width as usize,
-            height: height as usize,
-            channels: colors.channels(),
-            expected: 32_768,
-            got: 0,
+    let side = width.max(height);
+    if side > MAX_SIDE {
+        return Err(Error::TooLarge {
+            what: "the atlas side",
+            requested: side,
+            budget: MAX_SIDE,
+            unit: "texels",
         });
     }
+    let values = width * height * colors.channels() as u64;
+    if values > crate::MAX_SAMPLE_VALUES {
+        return Err(Error::TooLarge {
+            what: "the atlas",
+            requested: values,
+            budget: crate::MAX_SAMPLE_VALUES,
+            unit: "f32 values",
+        });
+    }
+    // Every coordinate is below MAX_SIDE now: u32 from here on.
+    for (b, &(x, y)) in blocks.iter_mut().zip(&places) {
+        (b.x, b.y) = (x as u32, y as u32);
+    }
+    let (width, height, g) = (width as u32, height as u32, g as u32);
+    let size = |b: &Block| {
+        let (w, h) = size(b);
+        (w as u32, h as u32)
+    };
+    let inner = |r: u32| {
+        let (w, h) = inner(r);
+        (w as u32, h as u32)
+    };
     let c = colors.channels();
     let (w, h) = (width as usize, height as usize);
     let mut data = vec![0.0f32; w * h * c];
@@ -184,7 +223,7 @@ pub fn bake(colors: &MeshColors, options: &Options) -> Result<Atlas, Error> {
                     (ox + r + 2 - i, oy + r + 1 - j)
                 }
             };
-            let lf = colors.face_level(f);
+            let lf = colors.level_at(f);
             let mut lat = vec![0.0f32; ((r + 1) * (r + 2) / 2) as usize * c];
             let idx = |i: u32, j: u32| ((i * (2 * r + 3 - i) / 2 + j) as usize) * c;
             for i in 0..=r {
@@ -272,7 +311,7 @@ pub fn bake(colors: &MeshColors, options: &Options) -> Result<Atlas, Error> {
             }
         }
     }
-    let texture = Texture::new(w, h, c, data)?.with_wrap(crate::Wrap::Clamp);
+    let texture = Texture::new(w, h, c, data)?.with_wrap(crate::Wrap::ClampToEdge);
     Ok(Atlas {
         texture,
         corner_uvs,

@@ -206,7 +206,7 @@ pub fn fill(mc: &mut MeshColors, corner_uvs: &[[Vec2; 3]], texture: &Texture) ->
     let mut entries: Vec<(usize, [u32; 2])> =
         Vec::with_capacity(mc.sample_count() + mc.sample_count() / 2);
     for (f, uv) in corner_uvs.iter().enumerate() {
-        let r = mc.face_resolution(f);
+        let r = 1u32 << mc.level_at(f);
         let rf = f64::from(r);
         for a in lattice_points(r) {
             if let Some(i) = mc.lattice_index(f, a) {
@@ -234,7 +234,7 @@ pub fn fill(mc: &mut MeshColors, corner_uvs: &[[Vec2; 3]], texture: &Texture) ->
             end += 1;
         }
         let n = (end - start) as f64;
-        for (o, s) in mc.sample_mut(i).iter_mut().zip(&sum) {
+        for (o, s) in mc.sample_at_mut(i).iter_mut().zip(&sum) {
             *o = (s / n) as f32;
         }
         start = end;

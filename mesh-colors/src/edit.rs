@@ -128,7 +128,7 @@ impl MeshColors {
                         [0, 1, 2].map(|m| (0..3).map(|k| a[k] * corners[k][m]).sum::<u32>());
                     value.fill(0.0);
                     lattice(self, f, FINEST, lf, parent, 1.0, false, &mut value);
-                    colors.sample_mut(i).copy_from_slice(&value);
+                    colors.sample_at_mut(i).copy_from_slice(&value);
                 }
             }
         }
@@ -263,7 +263,7 @@ impl MeshColors {
                             false,
                             &mut value,
                         );
-                        out.sample_mut(first + s as usize - 1)
+                        out.sample_at_mut(first + s as usize - 1)
                             .copy_from_slice(&value);
                     }
                 }
@@ -278,7 +278,7 @@ impl MeshColors {
                             );
                             *v = (1.0 - t) * a + t * b;
                         }
-                        out.sample_mut(first + s as usize - 1)
+                        out.sample_at_mut(first + s as usize - 1)
                             .copy_from_slice(&value);
                     }
                 }
@@ -300,7 +300,7 @@ impl MeshColors {
                             let b = sample_position(r, i, j).map(|x| x as f32);
                             eval(self, f, b, FINEST, false, &mut value);
                             let at = first + crate::structure::interior_index(r, i, j);
-                            out.sample_mut(at).copy_from_slice(&value);
+                            out.sample_at_mut(at).copy_from_slice(&value);
                         }
                     }
                 }
@@ -317,7 +317,7 @@ impl MeshColors {
                                     .sum::<f64>() as f32;
                             }
                             let at = first + crate::structure::interior_index(r, i, j);
-                            out.sample_mut(at).copy_from_slice(&value);
+                            out.sample_at_mut(at).copy_from_slice(&value);
                         }
                     }
                 }

@@ -64,7 +64,7 @@ pub enum Error {
         got: usize,
     },
     /// A channel count of zero or above [`crate::MAX_CHANNELS`].
-    #[error("{0} channels (1..={max} supported)", max = crate::MAX_CHANNELS)]
+    #[error("a sample needs 1..={max} channels, got {0}", max = crate::MAX_CHANNELS)]
     BadChannels(usize),
     /// A face index out of range.
     #[error("face {face} does not exist (the mesh has {count})")]
@@ -95,7 +95,7 @@ pub enum Error {
         got: usize,
     },
     /// A non-finite UV or position.
-    #[error("{what} {index} is not finite")]
+    #[error("{what} {index} is not finite (NaN or infinite)")]
     NonFinite {
         /// "uv" or "position".
         what: &'static str,
@@ -111,6 +111,26 @@ pub enum Error {
         reason: String,
     },
     /// An I/O failure while writing or reading a `.meshcolors` stream.
-    #[error("I/O error: {0}")]
+    #[error("cannot read or write mesh colours: {0}")]
     Io(String),
+    /// An allocation sized by arguments (or a file) would exceed its budget.
+    #[error("{what} would need {requested} {unit}, more than the budget of {budget}")]
+    TooLarge {
+        /// What would be allocated.
+        what: &'static str,
+        /// How much it would need.
+        requested: u64,
+        /// The budget ([`crate::MAX_SAMPLE_VALUES`], [`crate::atlas::MAX_SIDE`]).
+        budget: u64,
+        /// The unit of both numbers.
+        unit: &'static str,
+    },
+    /// Mesh colours loaded for a mesh they do not belong to.
+    #[error("the mesh colours belong to a mesh with {stored}, but this mesh has {expected}")]
+    WrongMesh {
+        /// The fingerprint of the mesh the colours were made for.
+        stored: crate::Fingerprint,
+        /// The fingerprint of the mesh they were loaded for.
+        expected: crate::Fingerprint,
+    },
 }

@@ -3,12 +3,14 @@
 //! ```text
 //! offset  size             field
 //! 0       8                magic  b"MESHCOLR"
-//! 8       4                version (1)
+//! 8       4                version (2; 1 is read too)
 //! 12      4                channels (1..=64)
 //! 16      4                vertex count V
 //! 20      4                face count F
 //! 24      4                flags: bit 0 = MIP data present; others 0
-//! 28      12·F             faces: three u32 vertex indices each
+//! 28      8                topology hash of the mesh (version 2 only; see
+//!                          Fingerprint)
+//! 36      12·F             faces: three u32 vertex indices each (28 in v1)
 //! …       F                face levels n (R = 2^n), one byte each
 //! …       4·S·channels     samples (f32), S from the layout of MeshColors
 //! …       4·M              optional MIP data (f32), M from the layout of MipMap
@@ -16,22 +18,30 @@
 //!
 //! The reader checks every count against the bytes left before allocating,
 //! rebuilds the topology (so a face naming a missing vertex or a
-//! non-manifold edge is an error with its byte offset), and requires the
-//! file to end exactly after the data. Values are stored bit for bit.
+//! non-manifold edge is an error with its byte offset), checks the stored
+//! topology hash against the faces, and requires the file to end exactly
+//! after the data. Values are stored bit for bit.
+//!
+//! The counts and the hash are the [`Fingerprint`] of the mesh the colours
+//! belong to: [`load_for`] (and [`read_for`], [`from_bytes_for`]) refuse a
+//! file made for another mesh, which would otherwise colour the wrong
+//! faces without a word.
 
 use std::io::{Read, Write};
 use std::path::Path;
 
 use crate::mip::MipMap;
 use crate::structure::{MeshColors, layout_sample_count};
-use crate::topology::Topology;
+use crate::topology::{Fingerprint, Topology};
 use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
 
 /// The first eight bytes of every `.meshcolors` file.
 pub const MAGIC: [u8; 8] = *b"MESHCOLR";
-/// The format version this crate writes and reads.
-pub const VERSION: u32 = 1;
-const HEADER: usize = 28;
+/// The format version this crate writes (it reads 1 and 2).
+pub const VERSION: u32 = 2;
+/// Header bytes of version 1 and of version 2 (which adds the hash).
+const HEADER_V1: usize = 28;
+const HEADER_V2: usize = 36;
 const FLAG_MIP: u32 = 1;
 
 /// Encodes mesh colours, with their MIP pyramid if given (it must have been
@@ -51,7 +61,7 @@ pub fn to_bytes(colors: &MeshColors, mip: Option<&MipMap>) -> Result<Vec<u8>, Er
     }
     let t = &colors.topology;
     let mut out = Vec::with_capacity(
-        HEADER
+        HEADER_V2
             + 13 * t.faces.len()
             + 4 * colors.samples.len()
             + mip.map_or(0, |m| 4 * m.data.len()),
@@ -66,6 +76,7 @@ pub fn to_bytes(colors: &MeshColors, mip: Option<&MipMap>) -> Result<Vec<u8>, Er
     ] {
         out.extend_from_slice(&x.to_le_bytes());
     }
+    out.extend_from_slice(&t.fingerprint().topology_hash.to_le_bytes());
     for f in &t.faces {
         for v in f {
             out.extend_from_slice(&v.to_le_bytes());
@@ -120,11 +131,74 @@ pub fn read(mut from: impl Read) -> Result<(MeshColors, Option<MipMap>), Error> 
 /// Loads a `.meshcolors` file.
 ///
 /// # Errors
-/// [`Error::Io`] naming the path, or as for [`from_bytes`].
+/// [`Error::Io`] naming the path, or as for [`from_bytes`] (with the path
+/// in the message).
 pub fn load(path: impl AsRef<Path>) -> Result<(MeshColors, Option<MipMap>), Error> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
-    from_bytes(&bytes)
+    from_bytes(&bytes).map_err(|e| with_path(e, path))
+}
+
+/// Loads a `.meshcolors` file made for the mesh of fingerprint `mesh`
+/// (`Fingerprint::of(vertex_count, &faces)` of the welded mesh you draw).
+///
+/// # Errors
+/// [`Error::WrongMesh`] when the file belongs to another mesh, and the
+/// errors of [`load`].
+pub fn load_for(
+    path: impl AsRef<Path>,
+    mesh: &Fingerprint,
+) -> Result<(MeshColors, Option<MipMap>), Error> {
+    let loaded = load(path)?;
+    check_mesh(loaded, mesh)
+}
+
+/// Reads a `.meshcolors` stream made for the mesh of fingerprint `mesh`.
+///
+/// # Errors
+/// [`Error::WrongMesh`], and the errors of [`read`].
+pub fn read_for(
+    from: impl Read,
+    mesh: &Fingerprint,
+) -> Result<(MeshColors, Option<MipMap>), Error> {
+    check_mesh(read(from)?, mesh)
+}
+
+/// Decodes a `.meshcolors` file made for the mesh of fingerprint `mesh`.
+///
+/// # Errors
+/// [`Error::WrongMesh`], and the errors of [`from_bytes`].
+pub fn from_bytes_for(
+    bytes: &[u8],
+    mesh: &Fingerprint,
+) -> Result<(MeshColors, Option<MipMap>), Error> {
+    check_mesh(from_bytes(bytes)?, mesh)
+}
+
+fn check_mesh(
+    loaded: (MeshColors, Option<MipMap>),
+    mesh: &Fingerprint,
+) -> Result<(MeshColors, Option<MipMap>), Error> {
+    let stored = loaded.0.topology.fingerprint();
+    if stored == *mesh {
+        Ok(loaded)
+    } else {
+        Err(Error::WrongMesh {
+            stored,
+            expected: *mesh,
+        })
+    }
+}
+
+/// A file error with the file's name in front of its reason.
+fn with_path(e: Error, path: &Path) -> Error {
+    match e {
+        Error::File { offset, reason } => Error::File {
+            offset,
+            reason: format!("{}: {reason}", path.display()),
+        },
+        other => other,
+    }
 }
 
 fn bad(offset: usize, reason: impl Into<String>) -> Error {
@@ -161,12 +235,16 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(MeshColors, Option<MipMap>), Error> {
         return Err(bad(0, "not a .meshcolors file (wrong magic number)"));
     }
     let version = u32_at(bytes, 8)?;
-    if version != VERSION {
-        return Err(bad(
-            8,
-            format!("version {version} is not supported (this reader knows {VERSION})"),
-        ));
-    }
+    let header = match version {
+        1 => HEADER_V1,
+        2 => HEADER_V2,
+        _ => {
+            return Err(bad(
+                8,
+                format!("version {version} is not supported (this reader knows 1 and 2)"),
+            ));
+        }
+    };
     let channels = u32_at(bytes, 12)? as usize;
     if channels == 0 || channels > MAX_CHANNELS {
         return Err(bad(
@@ -180,7 +258,14 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(MeshColors, Option<MipMap>), Error> {
     if flags & !FLAG_MIP != 0 {
         return Err(bad(24, format!("unknown flags {flags:#x}")));
     }
-    let left = (bytes.len() - HEADER) as u64;
+    let stored_hash = if version >= 2 {
+        let lo = u64::from(u32_at(bytes, 28)?);
+        let hi = u64::from(u32_at(bytes, 32)?);
+        Some(lo | hi << 32)
+    } else {
+        None
+    };
+    let left = bytes.len().saturating_sub(header) as u64;
     // Every vertex has a sample and every face 13 bytes: refuse counts the
     // file cannot hold before allocating anything sized by them.
     let least = 13 * face_count as u64 + 4 * (vertex_count as u64) * channels as u64;
@@ -194,14 +279,14 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(MeshColors, Option<MipMap>), Error> {
     }
     let mut faces = Vec::with_capacity(face_count);
     for f in 0..face_count {
-        let at = HEADER + 12 * f;
+        let at = header + 12 * f;
         faces.push([
             u32_at(bytes, at)?,
             u32_at(bytes, at + 4)?,
             u32_at(bytes, at + 8)?,
         ]);
     }
-    let levels_at = HEADER + 12 * face_count;
+    let levels_at = header + 12 * face_count;
     let levels = bytes[levels_at..levels_at + face_count].to_vec();
     if let Some(f) = levels.iter().position(|&n| n > MAX_LEVEL) {
         return Err(bad(
@@ -215,8 +300,19 @@ pub fn from_bytes(bytes: &[u8]) -> Result<(MeshColors, Option<MipMap>), Error> {
             Error::NonManifoldEdge { faces, .. } => faces[2],
             _ => 0,
         };
-        bad(HEADER + 12 * face, e.to_string())
+        bad(header + 12 * face, e.to_string())
     })?;
+    if let Some(hash) = stored_hash {
+        let computed = topology.fingerprint().topology_hash;
+        if hash != computed {
+            return Err(bad(
+                28,
+                format!(
+                    "the stored topology hash {hash:016x} does not match the faces ({computed:016x}): the file is damaged"
+                ),
+            ));
+        }
+    }
     // The sample count from the layout, checked before allocating it.
     let count = layout_sample_count(&topology, &levels);
     let samples_at = levels_at + face_count;

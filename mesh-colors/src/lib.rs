@@ -38,7 +38,7 @@
 //! // 4 vertex + 3·1 (edges of face 1 and the shared edge, R_e = 2)
 //! // + 2·3 (the other edges of face 0) + 3 (inside face 0) samples:
 //! assert_eq!(colors.sample_count(), 4 + 3 + 6 + 3);
-//! colors.sample_mut(1).copy_from_slice(&[1.0, 0.5, 0.0]); // vertex 1
+//! colors.sample_mut(1).unwrap().copy_from_slice(&[1.0, 0.5, 0.0]); // vertex 1
 //!
 //! let mut rgb = [0.0; 3];
 //! colors.linear(0, [0.2, 0.5, 0.3], &mut rgb)?;
@@ -61,6 +61,7 @@ pub mod edit;
 mod error;
 pub mod file;
 mod filter;
+mod luminance;
 mod mip;
 mod paint;
 mod structure;
@@ -68,13 +69,18 @@ mod texture;
 mod topology;
 
 pub use error::Error;
+pub use luminance::luminance;
 pub use mip::{FINEST_LEVEL, MAX_PROBES, MipMap};
 pub use paint::{Blend, Brush, Painter, Stroke};
 pub use structure::{
     MeshColors, Site, lattice_points, level_of, sample_position, samples_per_edge, samples_per_face,
 };
 pub use texture::{Texture, Wrap};
-pub use topology::{NO_FACE, Topology, weld};
+pub use topology::{Fingerprint, NO_FACE, Topology, weld};
+
+/// The `glam` whose vector types this crate's API speaks, re-exported so
+/// that callers use the same version.
+pub use glam;
 
 /// The largest level `n`: face resolutions go up to `2^MAX_LEVEL` (a face
 /// at the cap holds about half a million samples).
@@ -82,3 +88,9 @@ pub const MAX_LEVEL: u8 = 10;
 
 /// The most channels a sample may have.
 pub const MAX_CHANNELS: usize = 64;
+
+/// The budget of `f32` values one [`MeshColors`] (samples × channels) may
+/// allocate: 2³⁰, 4 GiB. Layouts above it (a large mesh at a high
+/// resolution) are an [`Error::TooLarge`] that names the count, checked
+/// before allocating.
+pub const MAX_SAMPLE_VALUES: u64 = 1 << 30;

@@ -200,7 +200,7 @@ impl Painter {
         let examined = self.for_each_within(brush.center, brush.radius, |i, d| {
             touched += 1;
             let w = brush.weight(d);
-            let s = colors.sample_mut(i);
+            let s = colors.sample_at_mut(i);
             for (x, &c) in s.iter_mut().zip(brush.color) {
                 *x = match brush.blend {
                     Blend::Set => c,

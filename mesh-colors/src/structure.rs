@@ -135,6 +135,17 @@ impl MeshColors {
                 resolution: 1u64 << levels[f].min(63),
             });
         }
+        // The layout's size, checked against the budget before anything
+        // sized by it (or by the vertex count) is allocated.
+        let values = layout_sample_count(&topology, &levels).saturating_mul(channels as u64);
+        if values > crate::MAX_SAMPLE_VALUES {
+            return Err(Error::TooLarge {
+                what: "the mesh colours",
+                requested: values,
+                budget: crate::MAX_SAMPLE_VALUES,
+                unit: "f32 values",
+            });
+        }
         let (edge_level, vertex_level) = primitive_levels(&topology, &levels);
         let mut next = topology.vertex_count;
         let edge_offset = edge_level
@@ -185,20 +196,20 @@ impl MeshColors {
         self.samples.len() / self.channels
     }
 
-    /// Face `f`'s resolution `R`. The per-primitive accessors below panic
-    /// on an index out of range, like slice indexing; lookups return `Err`.
-    pub fn face_resolution(&self, f: usize) -> u32 {
-        1 << self.face_level[f]
+    /// Face `f`'s resolution `R`. The per-primitive accessors below return
+    /// `None` for an index out of range.
+    pub fn face_resolution(&self, f: usize) -> Option<u32> {
+        self.face_level.get(f).map(|&n| 1 << n)
     }
 
     /// Face `f`'s level `n` (`R = 2^n`).
-    pub fn face_level(&self, f: usize) -> u8 {
-        self.face_level[f]
+    pub fn face_level(&self, f: usize) -> Option<u8> {
+        self.face_level.get(f).copied()
     }
 
     /// Edge `e`'s resolution: the lowest of its faces (the continuity rule).
-    pub fn edge_resolution(&self, e: usize) -> u32 {
-        1 << self.edge_level[e]
+    pub fn edge_resolution(&self, e: usize) -> Option<u32> {
+        self.edge_level.get(e).map(|&n| 1 << n)
     }
 
     /// All samples, `channels()` values each, in the layout described on
@@ -213,35 +224,45 @@ impl MeshColors {
     }
 
     /// The index of vertex `v`'s sample (Fig. 10: the vertex index).
-    pub fn vertex_index(&self, v: usize) -> usize {
-        v
+    pub fn vertex_index(&self, v: usize) -> Option<usize> {
+        (v < self.topology.vertex_count).then_some(v)
     }
 
     /// The index of edge `e`'s first sample; the `R_e − 1` samples follow
     /// in canonical order.
-    pub fn edge_index(&self, e: usize) -> usize {
-        self.edge_offset[e]
+    pub fn edge_index(&self, e: usize) -> Option<usize> {
+        self.edge_offset.get(e).copied()
     }
 
     /// The index of face `f`'s first interior sample; the rest follow.
-    pub fn face_index(&self, f: usize) -> usize {
-        self.face_offset[f]
+    pub fn face_index(&self, f: usize) -> Option<usize> {
+        self.face_offset.get(f).copied()
     }
 
-    /// Sample `i`'s values.
-    ///
-    /// # Panics
-    /// If `i >= sample_count()`, like slice indexing.
-    pub fn sample(&self, i: usize) -> &[f32] {
-        &self.samples[i * self.channels..(i + 1) * self.channels]
+    /// Face `f`'s level, for indices the crate knows are in range.
+    #[inline]
+    pub(crate) fn level_at(&self, f: usize) -> u8 {
+        self.face_level[f]
     }
 
-    /// Sample `i`'s values, mutable.
-    ///
-    /// # Panics
-    /// If `i >= sample_count()`, like slice indexing.
-    pub fn sample_mut(&mut self, i: usize) -> &mut [f32] {
+    /// Sample `i`'s values, for indices the crate knows are in range.
+    #[inline]
+    pub(crate) fn sample_at_mut(&mut self, i: usize) -> &mut [f32] {
         &mut self.samples[i * self.channels..(i + 1) * self.channels]
+    }
+
+    /// Sample `i`'s values, `None` if `i >= sample_count()`.
+    pub fn sample(&self, i: usize) -> Option<&[f32]> {
+        let c = self.channels;
+        self.samples
+            .get(i.checked_mul(c)?..i.checked_add(1)?.checked_mul(c)?)
+    }
+
+    /// Sample `i`'s values, mutable; `None` if `i >= sample_count()`.
+    pub fn sample_mut(&mut self, i: usize) -> Option<&mut [f32]> {
+        let c = self.channels;
+        self.samples
+            .get_mut(i.checked_mul(c)?..i.checked_add(1)?.checked_mul(c)?)
     }
 
     /// The sample index of lattice point `a = (a0, a1, a2)` (Eq. 4 with
@@ -285,7 +306,7 @@ impl MeshColors {
             self.sample_count()
         ];
         for f in 0..self.face_count() {
-            let r = self.face_resolution(f);
+            let r = 1u32 << self.level_at(f);
             for a in lattice_points(r) {
                 if let Some(i) = self.lattice_index(f, a)
                     && sites[i].face == NO_FACE
@@ -333,17 +354,7 @@ impl MeshColors {
 /// Edge levels (minimum of the faces: the continuity rule) and vertex
 /// levels (maximum of the faces: the finest MIP level a vertex needs).
 pub(crate) fn primitive_levels(topology: &Topology, levels: &[u8]) -> (Vec<u8>, Vec<u8>) {
-    let edge_level = topology
-        .edge_faces
-        .iter()
-        .map(|fs| {
-            fs.iter()
-                .filter(|&&f| f != NO_FACE)
-                .map(|&f| levels[f as usize])
-                .min()
-                .unwrap_or(0)
-        })
-        .collect();
+    let edge_level = edge_levels(topology, levels).collect();
     let mut vertex_level = vec![0u8; topology.vertex_count];
     for (face, &n) in topology.faces.iter().zip(levels) {
         for &v in face {
@@ -353,20 +364,35 @@ pub(crate) fn primitive_levels(topology: &Topology, levels: &[u8]) -> (Vec<u8>, 
     (edge_level, vertex_level)
 }
 
+/// Each edge's level: the lowest of its faces' (Sec. 3.2).
+fn edge_levels<'a>(topology: &'a Topology, levels: &'a [u8]) -> impl Iterator<Item = u8> + 'a {
+    topology.edge_faces.iter().map(move |fs| {
+        fs.iter()
+            .filter(|&&f| f != NO_FACE)
+            .map(|&f| levels[f as usize])
+            .min()
+            .unwrap_or(0)
+    })
+}
+
 /// Total samples (Eq. 1–3 summed) for these face levels on this topology,
-/// without allocating them: the conversion's budget and the file reader's
-/// size check both need it.
+/// without allocating anything: the budget check, the conversion's budget
+/// and the file reader's size check all need it.
 pub(crate) fn layout_sample_count(topology: &Topology, levels: &[u8]) -> u64 {
-    let (edge_level, _) = primitive_levels(topology, levels);
-    topology.vertex_count as u64
-        + edge_level
-            .iter()
-            .map(|&n| u64::from(samples_per_edge(1 << n)))
-            .sum::<u64>()
-        + levels
-            .iter()
-            .map(|&n| u64::from(samples_per_face(1 << n)))
-            .sum::<u64>()
+    // Saturating: a vertex count near usize::MAX must come out as "too
+    // large", not overflow.
+    (topology.vertex_count as u64)
+        .saturating_add(
+            edge_levels(topology, levels)
+                .map(|n| u64::from(samples_per_edge(1 << n)))
+                .sum::<u64>(),
+        )
+        .saturating_add(
+            levels
+                .iter()
+                .map(|&n| u64::from(samples_per_face(1 << n)))
+                .sum::<u64>(),
+        )
 }
 
 /// The canonical position (in steps of `1/r` from the edge's smaller

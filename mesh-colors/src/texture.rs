@@ -4,19 +4,38 @@
 
 use crate::{Error, MAX_CHANNELS};
 
-/// How lookups outside `[0, 1]` behave.
+/// How lookups outside `[0, 1]` behave: glTF's sampler wrap modes, with
+/// the same names and meaning in every trilux crate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Wrap {
-    /// Tile the texture (glTF REPEAT, OBJ/MTL).
+    /// Tile the texture (glTF `REPEAT`, the OBJ/MTL default).
     #[default]
     Repeat,
-    /// Extend the border texels.
-    Clamp,
+    /// Tile, mirroring every other copy (glTF `MIRRORED_REPEAT`): texel
+    /// `-1` reads texel 0, texel `n` reads texel `n − 1`.
+    MirroredRepeat,
+    /// Extend the edge texels (glTF `CLAMP_TO_EDGE`).
+    ClampToEdge,
+}
+
+/// The texel that index `i` reads among `n` (≥ 1) under `wrap`.
+#[inline]
+pub(crate) fn wrap_index(wrap: Wrap, i: i64, n: usize) -> usize {
+    let n = n as i64;
+    match wrap {
+        Wrap::Repeat => i.rem_euclid(n) as usize,
+        Wrap::MirroredRepeat => {
+            let k = i.rem_euclid(2 * n);
+            (if k < n { k } else { 2 * n - 1 - k }) as usize
+        }
+        Wrap::ClampToEdge => i.clamp(0, n - 1) as usize,
+    }
 }
 
 /// A `width × height` texture of `channels` `f32` channels, row-major,
-/// row 0 at `v = 0`. Texel `(x, y)` has its centre at
-/// `((x + ½)/width, (y + ½)/height)`. (OBJ UVs have `v` up: pass `1 − v`.)
+/// row 0 at `v = 0` (glTF's convention, and `trilux-io`'s `TriMesh` UVs
+/// for every format it reads). Texel `(x, y)` has its centre at
+/// `((x + ½)/width, (y + ½)/height)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Texture {
     width: usize,
@@ -98,18 +117,18 @@ impl Texture {
         &self.data
     }
 
-    /// Texel `(x, y)`.
-    pub fn texel(&self, x: usize, y: usize) -> &[f32] {
+    /// Texel `(x, y)`, `None` outside the texture.
+    pub fn texel(&self, x: usize, y: usize) -> Option<&[f32]> {
+        if x >= self.width || y >= self.height {
+            return None;
+        }
         let i = (y * self.width + x) * self.channels;
-        &self.data[i..i + self.channels]
+        Some(&self.data[i..i + self.channels])
     }
 
     #[inline]
     fn wrap_index(&self, i: i64, n: usize) -> usize {
-        match self.wrap {
-            Wrap::Repeat => i.rem_euclid(n as i64) as usize,
-            Wrap::Clamp => i.clamp(0, n as i64 - 1) as usize,
-        }
+        wrap_index(self.wrap, i, n)
     }
 
     /// Bilinear lookup at `uv` into `out` (`channels()` values). Non-finite
@@ -127,9 +146,11 @@ impl Texture {
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
         let xa = self.wrap_index(x0, self.width);
-        let xb = self.wrap_index(x0 + 1, self.width);
+        // Wrapping: a coordinate beyond ±2⁶³ saturates the cast, and its
+        // neighbour must not overflow (such a lookup reads an edge texel).
+        let xb = self.wrap_index(x0.wrapping_add(1), self.width);
         let ya = self.wrap_index(y0, self.height);
-        let yb = self.wrap_index(y0 + 1, self.height);
+        let yb = self.wrap_index(y0.wrapping_add(1), self.height);
         let c = self.channels;
         let (ra, rb) = (ya * self.width, yb * self.width);
         let t00 = &self.data[(ra + xa) * c..(ra + xa + 1) * c];

@@ -115,6 +115,11 @@ impl Topology {
         &self.edge_faces
     }
 
+    /// The fingerprint of this connectivity (see [`Fingerprint`]).
+    pub fn fingerprint(&self) -> Fingerprint {
+        Fingerprint::of(self.vertex_count, &self.faces)
+    }
+
     /// The edge between two vertices, if there is one. Linear in the face
     /// count (no vertex-to-edge index is kept): for occasional queries.
     pub fn edge_between(&self, a: u32, b: u32) -> Option<u32> {
@@ -125,6 +130,58 @@ impl Topology {
                 (x.min(y) == lo && x.max(y) == hi).then_some(fe[k])
             })
         })
+    }
+}
+
+/// Identifies the mesh that mesh colours belong to: vertex and face counts
+/// and a 64-bit hash of the faces' vertex indices, in order. Positions are
+/// not part of it, so a deformed or animated mesh keeps its colours; any
+/// change of connectivity (a re-export that reorders or welds vertices)
+/// changes it. `.meshcolors` files store it, and
+/// [`file::load_for`](crate::file::load_for) refuses colours made for
+/// another mesh.
+///
+/// The hash is FNV-1a over the 32-bit vertex indices of the faces, each
+/// index one step (`h ← (h ⊕ v) · 0x100000001b3` from
+/// `0xcbf29ce484222325`), then a final avalanche (`h ⊕= h >> 33`,
+/// `h ·= 0xff51afd7ed558ccd`, `h ⊕= h >> 33`): stable across versions and
+/// platforms, since it is stored in files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Fingerprint {
+    /// Number of vertices.
+    pub vertices: u64,
+    /// Number of faces.
+    pub faces: u64,
+    /// Hash of the faces' vertex indices.
+    pub topology_hash: u64,
+}
+
+impl Fingerprint {
+    /// The fingerprint of a mesh with `vertex_count` vertices and these
+    /// faces (the welded faces that mesh colours are built on).
+    pub fn of(vertex_count: usize, faces: &[[u32; 3]]) -> Self {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for &v in faces.iter().flatten() {
+            h = (h ^ u64::from(v)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        h ^= h >> 33;
+        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^= h >> 33;
+        Self {
+            vertices: vertex_count as u64,
+            faces: faces.len() as u64,
+            topology_hash: h,
+        }
+    }
+}
+
+impl std::fmt::Display for Fingerprint {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} vertices and {} faces (topology hash {:016x})",
+            self.vertices, self.faces, self.topology_hash
+        )
     }
 }
 

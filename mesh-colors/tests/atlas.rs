@@ -140,11 +140,12 @@ fn mip_safe_atlas_levels_have_no_seams_for_affine_colours() {
 /// 50–59 dB against the mesh colours, so it cannot cost more than a
 /// fraction of a dB on top of the conversion error.
 #[test]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
 fn texture_round_trip_psnr_on_real_meshes() {
-    let Some(dir) = data::data_dir() else {
-        eprintln!("skipped: TRILUX_DATA is not set, so no round trip is measured");
-        return;
-    };
+    let dir = data::data_dir().expect("TRILUX_DATA must name the data folder for this test");
     for m in data::textured_meshes(&dir) {
         if m.name == "BoxTextured" {
             continue; // tiles its texture six times; see the convert test

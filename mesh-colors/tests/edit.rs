@@ -93,7 +93,7 @@ fn subdivision_leaves_every_lookup_unchanged() {
     // A face at R = 1 cannot be split without inventing samples.
     let coarse = colored(0, 5);
     let f = (0..coarse.face_count())
-        .find(|&f| coarse.face_resolution(f) == 1)
+        .find(|&f| coarse.face_resolution(f).unwrap() == 1)
         .unwrap();
     assert_eq!(coarse.subdivide(), Err(Error::CannotSubdivide { face: f }));
 }
@@ -119,14 +119,20 @@ fn deleting_and_adding_faces_keeps_the_other_colours() {
     }
     // Face interiors of the kept faces are copied bit for bit.
     for (k, &f) in kept.iter().enumerate() {
-        let n = mesh_colors::samples_per_face(mc.face_resolution(f)) as usize;
-        let (i, j) = (mc.face_index(f) * 3, fewer.face_index(k) * 3);
+        let n = mesh_colors::samples_per_face(mc.face_resolution(f).unwrap()) as usize;
+        let (i, j) = (
+            mc.face_index(f).unwrap() * 3,
+            fewer.face_index(k).unwrap() * 3,
+        );
         assert_eq!(&mc.samples()[i..i + 3 * n], &fewer.samples()[j..j + 3 * n]);
     }
     // Add them back at their resolutions: the old faces' lookups are
     // exactly the original ones again.
     let back_faces: Vec<[u32; 3]> = remove.iter().map(|&f| mc.topology().faces()[f]).collect();
-    let back_res: Vec<u32> = remove.iter().map(|&f| mc.face_resolution(f)).collect();
+    let back_res: Vec<u32> = remove
+        .iter()
+        .map(|&f| mc.face_resolution(f).unwrap())
+        .collect();
     let again = fewer
         .add_faces(&back_faces, &back_res, mc.topology().vertex_count())
         .unwrap();
@@ -154,18 +160,19 @@ fn deleting_and_adding_faces_keeps_the_other_colours() {
         let want: Vec<f32> = (0..3)
             .map(|c| {
                 (0..3)
-                    .map(|k| a[k] as f32 / 8.0 * grown.sample(face[k] as usize)[c])
+                    .map(|k| a[k] as f32 / 8.0 * grown.sample(face[k] as usize).unwrap()[c])
                     .sum()
             })
             .collect();
-        assert!(max_diff(grown.sample(i), &want) < 1e-6, "{a:?}");
+        assert!(max_diff(grown.sample(i).unwrap(), &want) < 1e-6, "{a:?}");
     }
     let e01 = mc.topology().edge_between(0, 1).unwrap() as usize;
-    let n01 = mc.edge_resolution(e01) as usize - 1;
+    let n01 = mc.edge_resolution(e01).unwrap() as usize - 1;
     let e01g = grown.topology().edge_between(0, 1).unwrap() as usize;
     assert_eq!(
-        &mc.samples()[mc.edge_index(e01) * 3..(mc.edge_index(e01) + n01) * 3],
-        &grown.samples()[grown.edge_index(e01g) * 3..(grown.edge_index(e01g) + n01) * 3]
+        &mc.samples()[mc.edge_index(e01).unwrap() * 3..(mc.edge_index(e01).unwrap() + n01) * 3],
+        &grown.samples()
+            [grown.edge_index(e01g).unwrap() * 3..(grown.edge_index(e01g).unwrap() + n01) * 3]
     );
     assert!(matches!(
         mc.delete_faces(&[999]),
@@ -179,9 +186,9 @@ fn deleting_and_adding_faces_keeps_the_other_colours() {
 fn changing_one_resolution_resamples_only_that_face() {
     let mc = colored(1, 6);
     let f = 12;
-    let r = mc.face_resolution(f);
+    let r = mc.face_resolution(f).unwrap();
     let finer = mc.set_face_resolution(f, 2 * r).unwrap();
-    assert_eq!(finer.face_resolution(f), 2 * r);
+    assert_eq!(finer.face_resolution(f).unwrap(), 2 * r);
     let mut rng = Rng(7);
     let (mut a, mut b) = ([0.0f32; 3], [0.0f32; 3]);
     for _ in 0..50_000 {
@@ -195,8 +202,11 @@ fn changing_one_resolution_resamples_only_that_face() {
     }
     // Other faces' interiors are untouched bit for bit.
     for g in (0..mc.face_count()).filter(|&g| g != f) {
-        let n = mesh_colors::samples_per_face(mc.face_resolution(g)) as usize;
-        let (i, j) = (mc.face_index(g) * 3, finer.face_index(g) * 3);
+        let n = mesh_colors::samples_per_face(mc.face_resolution(g).unwrap()) as usize;
+        let (i, j) = (
+            mc.face_index(g).unwrap() * 3,
+            finer.face_index(g).unwrap() * 3,
+        );
         assert_eq!(&mc.samples()[i..i + 3 * n], &finer.samples()[j..j + 3 * n]);
     }
     // Coarsening changes that face (it loses detail) but not the others

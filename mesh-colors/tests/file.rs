@@ -3,7 +3,7 @@
 
 mod support;
 
-use mesh_colors::{Error, MeshColors, Topology, file};
+use mesh_colors::{Error, Fingerprint, MeshColors, Topology, file};
 use support::Rng;
 
 fn sample_colors() -> MeshColors {
@@ -84,7 +84,7 @@ fn truncated_and_inconsistent_files_are_rejected_with_the_offset() {
         b
     };
     assert!(rejected(&set(0, 0)).to_string().contains("magic"));
-    assert!(rejected(&set(8, 2)).to_string().contains("version 2"));
+    assert!(rejected(&set(8, 3)).to_string().contains("version 3"));
     assert!(rejected(&set(12, 0)).to_string().contains("0 channels"));
     assert!(rejected(&set(24, 6)).to_string().contains("flags"));
     // Counts the file cannot hold are refused before allocating.
@@ -99,16 +99,16 @@ fn truncated_and_inconsistent_files_are_rejected_with_the_offset() {
             .contains("truncated")
     );
     // A face naming a missing vertex: the error gives the face's offset.
-    match rejected(&set(28 + 12 * 5, 10_000)) {
+    match rejected(&set(HEADER + 12 * 5, 10_000)) {
         Error::File { offset, reason } => {
-            assert_eq!(offset, 28 + 12 * 5);
+            assert_eq!(offset, (HEADER + 12 * 5) as u64);
             assert!(reason.contains("face 5"), "{reason}");
         }
         e => panic!("{e}"),
     }
     // A level above the cap, and one that changes the sample count.
     let faces = mc.face_count();
-    let levels_at = 28 + 12 * faces;
+    let levels_at = HEADER + 12 * faces;
     let mut b = bytes.clone();
     b[levels_at + 3] = 11;
     assert!(rejected(&b).to_string().contains("level 11"));
@@ -117,9 +117,72 @@ fn truncated_and_inconsistent_files_are_rejected_with_the_offset() {
     assert!(matches!(rejected(&b), Error::File { .. }));
     // A non-manifold edge: make face 1 repeat face 0's edge a third time.
     let mut b = bytes.clone();
-    let f0: Vec<u8> = b[28..40].to_vec();
-    b[40..52].copy_from_slice(&f0);
+    let f0: Vec<u8> = b[HEADER..HEADER + 12].to_vec();
+    b[HEADER + 12..HEADER + 24].copy_from_slice(&f0);
     assert!(matches!(rejected(&b), Error::File { .. }));
+    // Faces that no longer match the stored topology hash (two faces
+    // swapped: still a valid mesh, but not the one the file was made for).
+    let mut b = bytes.clone();
+    let (f0, f1) = (
+        b[HEADER..HEADER + 12].to_vec(),
+        b[HEADER + 12..HEADER + 24].to_vec(),
+    );
+    b[HEADER..HEADER + 12].copy_from_slice(&f1);
+    b[HEADER + 12..HEADER + 24].copy_from_slice(&f0);
+    let e = rejected(&b);
+    assert!(e.to_string().contains("topology hash"), "{e}");
+}
+
+/// Version 2's header: version 1's 28 bytes and the 8-byte topology hash.
+const HEADER: usize = 36;
+
+#[test]
+fn colours_load_only_for_the_mesh_they_belong_to() {
+    let mc = sample_colors();
+    let mine = mc.topology().fingerprint();
+    assert_eq!(
+        mine,
+        Fingerprint::of(mc.topology().vertex_count(), mc.topology().faces())
+    );
+    let bytes = file::to_bytes(&mc, None).unwrap();
+    assert!(file::from_bytes_for(&bytes, &mine).is_ok());
+
+    // The same counts, another connectivity (one face turned): refused.
+    let mut faces = mc.topology().faces().to_vec();
+    faces[3] = [faces[3][1], faces[3][2], faces[3][0]];
+    let other = Fingerprint::of(mc.topology().vertex_count(), &faces);
+    assert_eq!((other.vertices, other.faces), (mine.vertices, mine.faces));
+    assert_ne!(other.topology_hash, mine.topology_hash);
+    match file::from_bytes_for(&bytes, &other) {
+        Err(Error::WrongMesh { stored, expected }) => {
+            assert_eq!((stored, expected), (mine, other));
+        }
+        r => panic!("expected WrongMesh, got {:?}", r.map(|_| ())),
+    }
+    // Another vertex count, through a file on disk: the message names both.
+    let path = std::env::temp_dir().join(format!(
+        "mesh-colors-wrong-mesh-{}.meshcolors",
+        std::process::id()
+    ));
+    file::save(&path, &mc, None).unwrap();
+    let bigger = Fingerprint::of(mc.topology().vertex_count() + 1, mc.topology().faces());
+    let e = file::load_for(&path, &bigger).unwrap_err();
+    assert!(file::load_for(&path, &mine).is_ok());
+    std::fs::remove_file(&path).unwrap();
+    let message = e.to_string();
+    assert!(
+        message.contains(&format!("{} vertices", mine.vertices))
+            && message.contains(&format!("{} vertices", bigger.vertices)),
+        "{message}"
+    );
+
+    // Version 1 files (no stored hash) are read, and checked by their faces.
+    let mut v1 = bytes[..28].to_vec();
+    v1[8..12].copy_from_slice(&1u32.to_le_bytes());
+    v1.extend_from_slice(&bytes[HEADER..]);
+    let (back, _) = file::from_bytes_for(&v1, &mine).unwrap();
+    assert_eq!(back.samples().len(), mc.samples().len());
+    assert!(file::from_bytes_for(&v1, &other).is_err());
 }
 
 #[test]

@@ -26,7 +26,7 @@ fn a_dab_touches_exactly_the_samples_within_its_radius() {
     let mut inside = 0;
     for (i, p) in painter.sample_positions().iter().enumerate() {
         let d = p.distance(center);
-        let (old, new) = (before.sample(i), mc.sample(i));
+        let (old, new) = (before.sample(i).unwrap(), mc.sample(i).unwrap());
         if d <= brush.radius {
             inside += 1;
             let w = brush.weight(d);
@@ -60,7 +60,7 @@ fn a_dab_touches_exactly_the_samples_within_its_radius() {
     let near = (0..mc.sample_count())
         .find(|&i| painter.sample_positions()[i].distance(center) < 0.04)
         .unwrap();
-    assert_eq!(mc.sample(near), &[1.0, 0.0, 0.5]);
+    assert_eq!(mc.sample(near).unwrap(), &[1.0, 0.0, 0.5]);
     let add = Brush {
         blend: Blend::Add,
         color: &[0.5, 0.5, 0.5],
@@ -69,7 +69,7 @@ fn a_dab_touches_exactly_the_samples_within_its_radius() {
     };
     painter.paint(&mut mc, &add).unwrap();
     let w = add.weight(painter.sample_positions()[near].distance(center));
-    assert!((mc.sample(near)[1] - 0.5 * w).abs() < 1e-6);
+    assert!((mc.sample(near).unwrap()[1] - 0.5 * w).abs() < 1e-6);
     // A huge brush scans occupied cells instead of empty space.
     let all = Brush {
         radius: 100.0,

@@ -51,7 +51,7 @@ fn every_lattice_point_maps_to_one_sample_and_sites_follow_eq_4() {
     let mc = MeshColors::new(topology, &levels, 2).unwrap();
     let mut hits = vec![0u32; mc.sample_count()];
     for f in 0..mc.face_count() {
-        let r = mc.face_resolution(f);
+        let r = mc.face_resolution(f).unwrap();
         let mut seen = std::collections::HashSet::new();
         for a in lattice_points(r) {
             if let Some(i) = mc.lattice_index(f, a) {
@@ -75,9 +75,9 @@ fn every_lattice_point_maps_to_one_sample_and_sites_follow_eq_4() {
         );
     }
     // The layout of Fig. 10: vertices first, each edge's run, each face's.
-    assert_eq!(one.vertex_index(2), 2);
-    assert_eq!(one.edge_index(0), 3);
-    assert_eq!(one.face_index(0), 3 + 3 * 7);
+    assert_eq!(one.vertex_index(2).unwrap(), 2);
+    assert_eq!(one.edge_index(0).unwrap(), 3);
+    assert_eq!(one.face_index(0).unwrap(), 3 + 3 * 7);
     assert_eq!(one.lattice_index(0, [8, 0, 0]), Some(0));
     assert_eq!(one.lattice_index(0, [1, 1, 6]), Some(24));
     assert_eq!(

@@ -38,7 +38,10 @@ pub struct CascadeOptions {
     pub hierarchy: HierarchyOptions,
     /// Which coarse systems.
     pub system: CoarseSystem,
-    /// The coarsest level's solve ("to convergence").
+    /// The coarsest level's solve ("to convergence"). Its
+    /// `require_convergence` is not used: a coarsest level that does not
+    /// converge hands over to the next finer one (reported in
+    /// [`CascadeReport::fallbacks`]).
     pub coarsest: SolveOptions,
     /// BiCGSTAB iterations on each intermediate level.
     pub intermediate_iterations: usize,
@@ -117,7 +120,8 @@ impl Cascade {
     /// Builds the hierarchy of `m` and the coarse matrices of Eq. 17.
     ///
     /// # Errors
-    /// Those of [`Hierarchy::new`].
+    /// Those of [`Hierarchy::new`], and [`Error::NotSymmetric`] (the
+    /// cascade ends in CG on `m`).
     ///
     /// # Example
     /// ```
@@ -208,7 +212,11 @@ impl Cascade {
     /// coarsest level (by selection) and receives the solution.
     ///
     /// # Errors
-    /// Those of [`crate::cg`] for `m`, `b` and `x`.
+    /// Those of [`crate::cg`] for `m`, `b` and `x` (including
+    /// [`Error::NotSymmetric`]), and [`Error::CascadeNotConverged`] when the
+    /// final CG does not reach the tolerance and
+    /// [`SolveOptions::require_convergence`] is on (coarse levels that do
+    /// not converge are fallbacks, never errors).
     pub fn solve(
         &self,
         m: &CsMat<f64>,

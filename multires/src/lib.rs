@@ -8,6 +8,10 @@
 //! - [`cg`], [`bicgstab`], [`pcg`]: warm start, relative-residual
 //!   tolerance, iteration cap, and a [`Report`] that says whether they
 //!   converged, in how many iterations, with the true final residual.
+//!   Stopping short of the tolerance is an [`Error::NotConverged`]
+//!   carrying that report unless [`SolveOptions::require_convergence`] is
+//!   turned off; CG refuses non-symmetric matrices
+//!   ([`Error::NotSymmetric`]).
 //!   Mat-vecs and vector operations run in parallel with results that do
 //!   not depend on the number of threads.
 //! - [`Hierarchy`] (Sec. 4.1): per-vertex 32-bit codes (hashed random
@@ -32,6 +36,7 @@
 //!   operators, damped Jacobi, exact coarsest solve) preconditioning CG.
 //! - [`grid`]: the 7-point diffusion system on 3D grids, for tests and
 //!   benchmarks.
+//! - [`mtx`]: Matrix Market files, read and written.
 //!
 //! # Example
 //! ```
@@ -61,6 +66,11 @@ pub mod matrix;
 pub mod mtx;
 pub mod vcycle;
 pub mod vector;
+
+/// The README's examples, compiled as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
 
 pub use cascade::{Cascade, CascadeOptions, CascadeReport, CoarseSystem};
 pub use error::Error;

@@ -78,8 +78,8 @@ impl<'m> VCycle<'m> {
     /// (symmetric positive definite).
     ///
     /// # Errors
-    /// Those of [`Hierarchy::new`]; [`Error::BadDiagonal`] for a diagonal
-    /// entry ≤ 0; [`Error::NotPositiveDefinite`] if the coarsest operator
+    /// Those of [`Hierarchy::new`]; [`Error::NotSymmetric`];
+    /// [`Error::BadDiagonal`] for a diagonal entry ≤ 0; [`Error::NotPositiveDefinite`] if the coarsest operator
     /// cannot be factored; [`Error::InvalidOption`] for a damping outside
     /// (0, 1].
     pub fn new(
@@ -248,7 +248,9 @@ impl<'m> VCycle<'m> {
     /// CG on the original system preconditioned by this V-cycle.
     ///
     /// # Errors
-    /// Those of [`crate::pcg`].
+    /// Those of [`crate::pcg`] for `b` and `x`, and [`Error::NotConverged`]
+    /// when the tolerance is not reached and
+    /// [`SolveOptions::require_convergence`] is on.
     pub fn solve(&self, b: &[f64], x: &mut [f64], options: &SolveOptions) -> Result<Report, Error> {
         self.solve_monitored(b, x, options, &mut |_, _| {
             std::ops::ControlFlow::Continue(())

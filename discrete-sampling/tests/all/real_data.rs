@@ -69,3 +69,28 @@ fn hdr_environment_maps() {
         );
     }
 }
+
+/// The README's file-to-result path on a real map: read, build, sample a
+/// direction, evaluate the density of another.
+#[test]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
+fn readme_sky_example_on_a_real_map() {
+    let dir = crate::hdr::data_dir().expect("TRILUX_DATA must name the data folder");
+    let path = dir.join("hdr/kloppenheim_06_1k.hdr");
+    let map = trilux_io::image::read(&path).unwrap();
+    let env =
+        Distribution2D::from_equirect(&map.luminance(), map.width as usize, map.height as usize)
+            .unwrap();
+    let light = env.sample_direction([0.3, 0.6]);
+    let len: f64 = light.direction.iter().map(|c| c * c).sum::<f64>().sqrt();
+    assert!((len - 1.0).abs() < 1e-12 && light.pdf > 0.0);
+    assert!((env.pdf_direction(light.direction) - light.pdf).abs() < 1e-9 * light.pdf);
+    assert!(env.pdf_direction([0.0, 0.0, 1.0]) >= 0.0);
+    // The same luminance as this crate's own function.
+    let p = map.pixels[12345];
+    let ours = discrete_sampling::luminance([p[0], p[1], p[2]]);
+    assert!((map.luminance()[12345] - ours).abs() <= 1e-6 * ours.max(1.0));
+}

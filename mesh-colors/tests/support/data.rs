@@ -1,5 +1,5 @@
 //! The textured meshes of `$TRILUX_DATA`, as (name, welded positions,
-//! faces, per-corner UVs in texture convention, RGB texture): spot with its
+//! faces, per-corner UVs (v = 0 at image row 0, as `TriMesh` gives them), RGB texture): spot with its
 //! PNG, and every textured primitive of the glTF models. Shared by the
 //! tests and the `lookup` example.
 
@@ -41,7 +41,6 @@ fn rgb(image: &trilux_io::image::Image, wrap: Wrap) -> Texture {
 fn part(
     mesh: &TriMesh,
     range: std::ops::Range<usize>,
-    flip_v: bool,
 ) -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<[Vec2; 3]>) {
     let uvs = mesh.uvs.as_ref().expect("a textured mesh has UVs");
     let tris = &mesh.indices[range];
@@ -61,19 +60,9 @@ fn part(
             })
         })
         .collect();
-    let corner_uvs = tris
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                let uv = uvs[v as usize];
-                if flip_v {
-                    Vec2::new(uv.x, 1.0 - uv.y)
-                } else {
-                    uv
-                }
-            })
-        })
-        .collect();
+    // TriMesh UVs already follow the texture convention (v = 0 at image
+    // row 0) for OBJ and glTF alike: no flip here.
+    let corner_uvs = tris.iter().map(|t| t.map(|v| uvs[v as usize])).collect();
     (positions, faces, corner_uvs)
 }
 
@@ -82,7 +71,7 @@ pub(crate) fn textured_meshes(dir: &Path) -> Vec<Textured> {
     let mut out = Vec::new();
     let spot = TriMesh::read(dir.join("meshes/spot.obj")).unwrap();
     let image = trilux_io::image::read(dir.join("textures/spot_texture.png")).unwrap();
-    let (positions, faces, corner_uvs) = part(&spot, 0..spot.indices.len(), true);
+    let (positions, faces, corner_uvs) = part(&spot, 0..spot.indices.len());
     out.push(Textured {
         name: "spot".into(),
         positions,
@@ -109,10 +98,11 @@ pub(crate) fn textured_meshes(dir: &Path) -> Vec<Textured> {
                 continue;
             };
             let wrap = match material.wrap[0] {
-                trilux_io::mesh::Wrap::ClampToEdge => Wrap::Clamp,
-                _ => Wrap::Repeat,
+                trilux_io::mesh::Wrap::ClampToEdge => Wrap::ClampToEdge,
+                trilux_io::mesh::Wrap::MirroredRepeat => Wrap::MirroredRepeat,
+                trilux_io::mesh::Wrap::Repeat => Wrap::Repeat,
             };
-            let (positions, faces, corner_uvs) = part(&mesh, object.triangles.clone(), false);
+            let (positions, faces, corner_uvs) = part(&mesh, object.triangles.clone());
             let name = if mesh.objects.len() > 1 {
                 format!("{stem}/{k}")
             } else {
