@@ -63,13 +63,13 @@ pub fn texture_image(texture: &Texture) -> Image {
     }
 }
 
-/// mesh-colors' wrap mode for a material's (glTF sampler semantics;
-/// mirrored repeat is read as repeat where mesh-colors has no mirrored
-/// mode).
+/// mesh-colors' wrap mode for a material's (both follow glTF's sampler
+/// semantics).
 pub fn colors_wrap(wrap: trilux_io::mesh::Wrap) -> mesh_colors::Wrap {
     match wrap {
-        trilux_io::mesh::Wrap::ClampToEdge => mesh_colors::Wrap::Clamp,
-        _ => mesh_colors::Wrap::Repeat,
+        trilux_io::mesh::Wrap::Repeat => mesh_colors::Wrap::Repeat,
+        trilux_io::mesh::Wrap::MirroredRepeat => mesh_colors::Wrap::MirroredRepeat,
+        trilux_io::mesh::Wrap::ClampToEdge => mesh_colors::Wrap::ClampToEdge,
     }
 }
 
@@ -456,7 +456,9 @@ fn fill(
     let mut entries: Vec<(usize, u32, u32, u32)> =
         Vec::with_capacity(colors.sample_count() * 3 / 2);
     for (f, uv) in corner_uvs.iter().enumerate() {
-        let r = colors.face_resolution(f);
+        let Some(r) = colors.face_resolution(f) else {
+            continue;
+        };
         let rf = f64::from(r);
         for a in lattice_points(r) {
             let Some(i) = colors.lattice_index(f, a) else {
@@ -509,8 +511,10 @@ fn fill(
             end += 1;
         }
         let n = (end - start) as f64;
-        for (o, s) in colors.sample_mut(i).iter_mut().zip(sum) {
-            *o = (s / n) as f32;
+        if let Some(sample) = colors.sample_mut(i) {
+            for (o, s) in sample.iter_mut().zip(sum) {
+                *o = (s / n) as f32;
+            }
         }
         start = end;
     }
@@ -548,6 +552,7 @@ pub fn atlas_mesh(
     };
     let mesh = TriMesh {
         origin: surface.origin,
+        uvs1: None,
         positions,
         indices: (0..n as u32)
             .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
@@ -644,7 +649,9 @@ pub fn color_density(
     {
         return Err(Error::Invalid(format!(
             "mesh colour sample {i} gives density {} (densities must be finite and >= 0)",
-            density_of(colors.sample(i), channel)
+            colors
+                .sample(i)
+                .map_or(f32::NAN, |s| density_of(s, channel))
         )));
     }
     let atlas = mesh_colors::atlas::bake(colors, &Default::default())?;

@@ -99,7 +99,7 @@ fn sampling_mesh(data: Option<&Path>) -> Result<(String, TriMesh, Option<PathBuf
         }
         None => ("built-in blob".to_string(), trilux::shapes::blob(6), None),
     };
-    let (positions, uvs, indices) = mesh_sampling::spherical_uvs(&mesh.positions, &mesh.indices);
+    let (positions, uvs, indices) = mesh_sampling::spherical_uvs(&mesh.positions, &mesh.indices)?;
     Ok((
         name,
         TriMesh {

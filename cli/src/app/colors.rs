@@ -190,7 +190,7 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
         super::write_image(context, p, &image)?;
     }
     let (lo, hi) = (0..colors.face_count())
-        .map(|f| colors.face_resolution(f))
+        .filter_map(|f| colors.face_resolution(f))
         .fold((u32::MAX, 0), |(a, b), r| (a.min(r), b.max(r)));
     let text = format!(
         "{} faces, {} samples (face resolutions {lo}..{hi}), {} vertices after welding{}; PSNR against the texture {psnr:.2} dB; written to {}\n",

@@ -151,7 +151,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let torus = shapes::torus(128, 64);
     let sphere = {
         let ico = shapes::icosphere(5);
-        let (positions, uvs, indices) = mesh_sampling::spherical_uvs(&ico.positions, &ico.indices);
+        let (positions, uvs, indices) = mesh_sampling::spherical_uvs(&ico.positions, &ico.indices)?;
         TriMesh {
             normals: Some(positions.iter().map(|p| p.normalize()).collect()),
             positions,

@@ -279,8 +279,8 @@ fn meshcolors_info(context: &mut Context, path: &Path) -> Result<(String, Value)
         .step("reading the mesh colours", || mesh_colors::file::load(path))
         .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
     let mut histogram = std::collections::BTreeMap::new();
-    for f in 0..colors.face_count() {
-        *histogram.entry(colors.face_resolution(f)).or_insert(0usize) += 1;
+    for r in (0..colors.face_count()).filter_map(|f| colors.face_resolution(f)) {
+        *histogram.entry(r).or_insert(0usize) += 1;
     }
     let mut text = format!("{}: mesh colours\n", path.display());
     let _ = writeln!(text, "  channels: {}", colors.channels());
