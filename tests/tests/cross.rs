@@ -38,13 +38,44 @@ fn mesh_colours_feed_mesh_sampling_as_a_density() {
         let q = t[0] * p.barycentric[0] + t[1] * p.barycentric[1] + t[2] * p.barycentric[2];
         assert!((q - p.position).length() < 1e-5);
     }
-    // The same test rejects area-uniform points (mean x = 0).
+    // Chi-square on the counts per face against the exact masses: the
+    // density is affine on each flat face, so its mass is the area times
+    // its value at the centroid, and the subdivision's midpoint values are
+    // exact for it.
+    let masses: Vec<f64> = sphere
+        .indices
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| sphere.positions[v as usize].as_dvec3());
+            0.5 * (b - a).cross(c - a).length() * (1.0 + (a.x + b.x + c.x) / 3.0)
+        })
+        .collect();
+    let total: f64 = masses.iter().sum();
+    let chi_square = |points: &[mesh_sampling::SurfacePoint]| {
+        let mut counts = vec![0.0f64; masses.len()];
+        for p in points {
+            counts[p.face as usize] += 1.0;
+        }
+        counts
+            .iter()
+            .zip(&masses)
+            .map(|(o, m)| {
+                let e = m / total * points.len() as f64;
+                (o - e).powi(2) / e
+            })
+            .sum::<f64>()
+    };
+    let limit = trilux_tests::chi_square_quantile((masses.len() - 1) as f64, 3.09);
+    let x2 = chi_square(&pts);
+    assert!(x2 < limit, "chi-square {x2} over {limit}");
+    // The same tests reject area-uniform points (mean x = 0).
     let uniform = UniformSampler::new(trilux::mesh_ref(&sphere))
         .unwrap()
         .sample_n(9, n)
         .unwrap();
     let u: Vec<f64> = uniform.iter().map(|p| f64::from(p.position.x)).collect();
     assert!((mean(&u) - 1.0 / 3.0).abs() > 4.0 * se + 2e-3);
+    assert!(chi_square(&uniform) > limit);
 }
 
 /// A graph Laplacian (plus identity) of the tetrahedra's edges: the
