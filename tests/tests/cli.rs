@@ -311,6 +311,35 @@ fn colors_convert_bake_render_and_sample_by_mesh_colours() {
             .len(),
         2000
     );
+    trilux(d)
+        .args([
+            "colors",
+            "render",
+            torus,
+            "t.meshcolors",
+            "--size",
+            "32",
+            "--view",
+            "1,0,0",
+            "-o",
+            "side.png",
+        ])
+        .assert()
+        .success();
+    fails(
+        d,
+        &[
+            "colors",
+            "render",
+            torus,
+            "t.meshcolors",
+            "--view",
+            "0,0,0",
+            "-o",
+            "zero.png",
+        ],
+        &["--view"],
+    );
     // Mesh colours of another mesh are refused, naming the file.
     trilux::shapes::torus(20, 10)
         .write(d.join("other.obj"))

@@ -81,6 +81,10 @@ pub(crate) struct RenderArgs {
     /// Picture width and height in pixels.
     #[arg(long, default_value_t = 768)]
     pub(crate) size: u32,
+    /// Look from this direction (x,y,z from the mesh's centre toward the
+    /// camera; default a three-quarter view from +z, above and right).
+    #[arg(long, value_name = "X,Y,Z")]
+    pub(crate) view: Option<String>,
     /// The picture: .png or .exr.
     #[arg(short, long, value_name = "OUT.png")]
     pub(crate) output: PathBuf,
@@ -296,6 +300,17 @@ pub(crate) fn render_colors(
     filter: Filter,
     size: u32,
 ) -> trilux_io::image::Image {
+    render_colors_from(surface, colors, filter, size, None)
+}
+
+/// [`render_colors`] looking from direction `view` (towards the centre).
+pub(crate) fn render_colors_from(
+    surface: &ColorMesh,
+    colors: &MeshColors,
+    filter: Filter,
+    size: u32,
+    view: Option<glam::Vec3>,
+) -> trilux_io::image::Image {
     use trilux::preview::{Camera, Renderer, lambert};
     let Some((lo, hi)) = trilux::preview::bounds(&surface.positions) else {
         return trilux::preview::render_mesh(&[], &[], size, size);
@@ -303,7 +318,11 @@ pub(crate) fn render_colors(
     let mip: Option<MipMap> =
         matches!(filter, Filter::Mip | Filter::Aniso).then(|| colors.mip_map());
     let c = colors.channels();
-    let mut r = Renderer::new(size, size, Camera::fit(lo, hi));
+    let camera = match view {
+        Some(v) => Camera::fit_from(lo, hi, v),
+        None => Camera::fit(lo, hi),
+    };
+    let mut r = Renderer::new(size, size, camera);
     r.draw_mesh(&surface.positions, &surface.faces, |frag| {
         let mut out = [0.0f32; mesh_colors::MAX_CHANNELS];
         let out = &mut out[..c];
@@ -335,11 +354,28 @@ fn render(context: &mut Context, args: RenderArgs) -> Result<()> {
         )));
     }
     super::check_output(context, &args.output, &["png", "exr"])?;
+    let view = match &args.view {
+        None => None,
+        Some(spec) => {
+            let v: Vec<f32> = spec
+                .split(',')
+                .map(|x| x.trim().parse::<f32>())
+                .collect::<std::result::Result<_, _>>()
+                .ok()
+                .filter(|v: &Vec<f32>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
+                .ok_or_else(|| invalid(format!("--view {spec:?}: expected three numbers x,y,z")))?;
+            let v = glam::Vec3::new(v[0], v[1], v[2]);
+            if v.length_squared() == 0.0 {
+                return Err(invalid(format!("--view {spec:?}: the direction is zero")));
+            }
+            Some(v)
+        }
+    };
     let mesh = super::read_mesh(context, &args.mesh)?;
     let (surface, colors) =
         context.step("reading the mesh colours", || load_for(&mesh, &args.colors))?;
     let image = context.step("rendering", || {
-        render_colors(&surface, &colors, args.filter, args.size)
+        render_colors_from(&surface, &colors, args.filter, args.size, view)
     });
     super::write_image(context, &args.output, &image)?;
     let text = format!(
