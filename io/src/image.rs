@@ -128,17 +128,87 @@ pub fn decode(bytes: &[u8], name: impl AsRef<Path>, options: ReadOptions) -> Res
     // conversion before the decoder allocates anything.
     let mut probe = ImageReader::with_format(IoCursor::new(bytes), format);
     probe.limits(limits.clone());
-    let (width, height) = probe
-        .into_dimensions()
+    let (width, height) = contain_codec_panic(name, format, || probe.into_dimensions())?
         .map_err(|e| codec_error(name, format, e))?;
     check_conversion_budget(name, width, height, options)?;
+    if format == ImageFormat::OpenExr {
+        check_exr_blocks(bytes, name, options)?;
+    }
     let mut reader = ImageReader::with_format(IoCursor::new(bytes), format);
     reader.limits(limits);
-    let image = reader.decode().map_err(|e| codec_error(name, format, e))?;
+    let image = contain_codec_panic(name, format, || reader.decode())?
+        .map_err(|e| codec_error(name, format, e))?;
     // A decoder may report other dimensions than its header (it should
     // not); the budget is checked on what came out as well.
     check_conversion_budget(name, image.width(), image.height(), options)?;
     Ok(to_linear(image, options.raw))
+}
+
+/// Runs a codec, turning a panic inside it into an error: the decoders are
+/// other crates', and fuzzing found inputs on which one panics (an
+/// arithmetic overflow in OpenEXR's B44 decompression, with overflow
+/// checks on). Our own code never runs inside.
+fn contain_codec_panic<T>(
+    name: &Path,
+    format: ImageFormat,
+    codec: impl FnOnce() -> T,
+) -> Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(codec)).map_err(|payload| {
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "no message".to_string());
+        Error::new(
+            name,
+            ErrorKind::Codec {
+                format: format_name(format),
+                source: format!("the decoder panicked on this data: {message}").into(),
+            },
+        )
+    })
+}
+
+/// How many times its raw size a decoder may need for one block of an
+/// OpenEXR file (the compressed and the decompressed block, and the
+/// samples converted to f32).
+const EXR_BLOCK_FACTOR: u128 = 4;
+
+/// Checks every layer of an OpenEXR file against the budget before the
+/// codec allocates for it: the layer's pixels, and the largest block (a
+/// tile or a group of scan lines), which the header sets independently of
+/// the image size (found by fuzzing: a 3×2 image with 16,777,024×64
+/// tiles made the codec allocate gigabytes).
+fn check_exr_blocks(bytes: &[u8], name: &Path, options: ReadOptions) -> Result<()> {
+    let read = || exr::meta::MetaData::read_from_buffered(IoCursor::new(bytes), false);
+    let meta = contain_codec_panic(name, ImageFormat::OpenExr, read)?.map_err(|e| {
+        Error::new(
+            name,
+            ErrorKind::Codec {
+                format: "OpenEXR",
+                source: Box::new(e),
+            },
+        )
+    })?;
+    for (index, header) in meta.headers.iter().enumerate() {
+        let per_pixel = header.channels.bytes_per_pixel as u128;
+        let block = header.max_block_pixel_size();
+        let block_bytes = block.0 as u128 * block.1 as u128 * per_pixel * EXR_BLOCK_FACTOR;
+        let layer_bytes = header.layer_size.0 as u128 * header.layer_size.1 as u128 * per_pixel;
+        for (what, needed) in [("a block of", block_bytes), ("the pixels of", layer_bytes)] {
+            if needed > u128::from(options.max_bytes) {
+                return Err(Error::new(
+                    name,
+                    ErrorKind::LimitExceeded(format!(
+                        "decoding {what} layer {index} ({}×{} pixels a block) needs {needed} bytes, \
+                         more than the budget of {} bytes (ReadOptions::max_bytes)",
+                        block.0, block.1, options.max_bytes
+                    )),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Bytes per pixel at the peak of the conversion to linear RGBA: the

@@ -4,6 +4,8 @@
 
 mod support;
 
+use std::path::Path;
+
 use support::{data_dir, scratch};
 
 use trilux_io::ErrorKind;
@@ -317,4 +319,44 @@ fn write_picks_the_format_by_extension() {
     assert_eq!(image::read(dir.join("a.png")).unwrap().height, 3);
     let err = image::write(dir.join("a.tga"), &picture).unwrap_err();
     assert!(matches!(err.kind, ErrorKind::UnknownExtension(..)), "{err}");
+}
+
+/// An OpenEXR file of 3×2 pixels whose header declares 16,777,024×64
+/// tiles (found by fuzzing): refused from the header, with the bytes it
+/// would need, instead of letting the codec allocate gigabytes.
+#[test]
+fn exr_blocks_are_checked_against_the_budget() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz-regressions/image");
+    let file = dir.join("oom-b2b0ea4ec0adfb2e3826f7438fa9d496d9b0ef1c");
+    let data = std::fs::read(file).unwrap();
+    let err = image::decode(&data[1..], "tiles.exr", ReadOptions::default()).unwrap_err();
+    assert!(matches!(err.kind, ErrorKind::LimitExceeded(_)), "{err}");
+    assert!(err.to_string().contains("16777024×64"), "{err}");
+}
+
+/// A B44-compressed OpenEXR file on which the codec's decompression
+/// overflows (found by fuzzing): the panic inside the codec comes back as
+/// a codec error.
+#[test]
+fn a_codec_panic_is_an_error() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz-regressions/image");
+    let data = std::fs::read(dir.join("crash-cad39f76bdd3f9ffaed8ac4fdf5abf694d75a820")).unwrap();
+    let options = ReadOptions {
+        max_dimension: 4096,
+        max_bytes: 64 << 20,
+        ..ReadOptions::default()
+    };
+    // Overflow checks are on in test builds, as in the fuzzer.
+    if let Err(err) = image::decode(&data[1..], "b44.exr", options) {
+        assert!(
+            matches!(
+                err.kind,
+                ErrorKind::Codec {
+                    format: "OpenEXR",
+                    ..
+                }
+            ),
+            "{err}"
+        );
+    }
 }

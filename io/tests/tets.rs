@@ -610,3 +610,25 @@ fn tet_write_by_extension_keeps_real_attributes() {
     let err = trilux_io::tet::write(dir.join("m.off"), &mesh).unwrap_err();
     assert!(matches!(err.kind, ErrorKind::UnknownExtension(..)), "{err}");
 }
+
+/// Meshes built by hand may be inconsistent: the measures say NaN instead
+/// of panicking, and the boundary still comes out.
+#[test]
+fn inconsistent_hand_built_meshes_do_not_panic() {
+    let mesh = TetMesh {
+        positions: vec![glam::DVec3::ZERO, glam::DVec3::X],
+        tets: vec![[0, 1, 2, 3]],
+        ..TetMesh::default()
+    };
+    assert!(mesh.signed_volume6(0).is_nan());
+    assert!(mesh.signed_volume6(7).is_nan());
+    assert!(mesh.volume().is_nan());
+    assert_eq!(mesh.boundary().len(), 4);
+    assert!(trilux_io::tet::enclosed_volume(&mesh.positions, &[[0, 1, 9]]).is_nan());
+    let tri = trilux_io::mesh::TriMesh {
+        positions: vec![glam::Vec3::ZERO],
+        indices: vec![[0, 1, 2]],
+        ..Default::default()
+    };
+    assert!(tri.area().is_nan());
+}

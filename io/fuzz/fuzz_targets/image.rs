@@ -1,12 +1,17 @@
 //! Image bytes (the first byte picks PNG, JPEG, Radiance HDR or OpenEXR),
-//! decoded under a small memory budget: no panic, no allocation beyond
-//! the budget; an image must be consistent.
+//! decoded under a small memory budget: no panic escapes, no allocation
+//! beyond the budget; an image must be consistent.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
 use trilux_io::image::{ReadOptions, decode};
 
 fuzz_target!(|data: &[u8]| {
+    // libfuzzer-sys's panic hook aborts before `image::decode` can contain
+    // a panic inside a codec; the default hook lets it unwind there, and a
+    // panic anywhere else still aborts at the fuzzer's boundary.
+    static DEFAULT_HOOK: std::sync::Once = std::sync::Once::new();
+    DEFAULT_HOOK.call_once(|| drop(std::panic::take_hook()));
     let Some((&pick, bytes)) = data.split_first() else {
         return;
     };

@@ -237,13 +237,18 @@ impl TriMesh {
         }
     }
 
-    /// The total surface area.
+    /// The total surface area, in the square of the mesh's unit (summed in
+    /// `f64`). NaN when a triangle references a vertex that does not exist
+    /// (the readers never return such a mesh; one built by hand may).
     pub fn area(&self) -> f64 {
         self.indices
             .iter()
             .map(|t| {
-                let [a, b, c] = t.map(|i| self.positions[i as usize].as_dvec3());
-                0.5 * (b - a).cross(c - a).length()
+                let corner = |i: u32| self.positions.get(i as usize).map(|p| p.as_dvec3());
+                match (corner(t[0]), corner(t[1]), corner(t[2])) {
+                    (Some(a), Some(b), Some(c)) => 0.5 * (b - a).cross(c - a).length(),
+                    _ => f64::NAN,
+                }
             })
             .sum()
     }

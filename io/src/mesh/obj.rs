@@ -206,11 +206,13 @@ pub(crate) fn lines(data: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
                 continue;
             }
             joined.push_str(text);
-            let trimmed = joined.trim();
-            if trimmed.is_empty() {
+            // Trimmed in place: one allocation per line.
+            let start = joined.len() - joined.trim_start().len();
+            joined.drain(..start);
+            if joined.is_empty() {
                 continue;
             }
-            return Some((first, trimmed.to_string()));
+            return Some((first, joined));
         }
     })
 }

@@ -84,10 +84,17 @@ impl TetMesh {
     }
 
     /// Six times the signed volume of tetrahedron `t`: positive when its
-    /// nodes are ordered as TetGen and Gmsh order them.
+    /// nodes are ordered as TetGen and Gmsh order them. NaN when `t` or one
+    /// of its nodes does not exist (the readers never return such a mesh).
     pub fn signed_volume6(&self, t: usize) -> f64 {
-        let [a, b, c, d] = self.tets[t].map(|i| self.positions[i as usize]);
-        (b - a).dot((c - a).cross(d - a))
+        let Some(tet) = self.tets.get(t) else {
+            return f64::NAN;
+        };
+        let node = |i: u32| self.positions.get(i as usize).copied();
+        match (node(tet[0]), node(tet[1]), node(tet[2]), node(tet[3])) {
+            (Some(a), Some(b), Some(c), Some(d)) => (b - a).dot((c - a).cross(d - a)),
+            _ => f64::NAN,
+        }
     }
 
     /// The total volume of the tetrahedra.
@@ -158,13 +165,17 @@ impl TetMesh {
 }
 
 /// The volume enclosed by a closed, outward-oriented triangle surface
-/// (divergence theorem); used to check boundary orientation.
+/// (divergence theorem); used to check boundary orientation. NaN when a
+/// triangle references a missing position.
 pub fn enclosed_volume(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
     triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|i| positions[i as usize]);
-            a.dot(b.cross(c))
+            let p = |i: u32| positions.get(i as usize).copied();
+            match (p(t[0]), p(t[1]), p(t[2])) {
+                (Some(a), Some(b), Some(c)) => a.dot(b.cross(c)),
+                _ => f64::NAN,
+            }
         })
         .sum::<f64>()
         / 6.0
