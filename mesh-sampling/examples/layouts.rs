@@ -69,7 +69,10 @@ fn run() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mesh_name = args.first().map_or("stanford-bunny.obj", String::as_str);
     let density = args.get(1).map_or("noise", String::as_str);
-    let threads: usize = args.get(2).map_or(Ok(1), |t| t.parse()).map_err(|e| format!("{e}"))?;
+    let threads: usize = args
+        .get(2)
+        .map_or(Ok(1), |t| t.parse())
+        .map_err(|e| format!("{e}"))?;
     let max_pieces: usize = args
         .get(3)
         .map_or(Ok(mesh_sampling::DEFAULT_MAX_PIECES), |t| t.parse())
@@ -95,8 +98,8 @@ fn run() -> Result<(), String> {
         max_pieces,
         ..Options::default()
     };
-    let alias =
-        DensitySampler::with_options(mesh, Density::Texture(&t), &options).map_err(|e| e.to_string())?;
+    let alias = DensitySampler::with_options(mesh, Density::Texture(&t), &options)
+        .map_err(|e| e.to_string())?;
     let inversion = DensitySampler::with_options(
         mesh,
         Density::Texture(&t),

@@ -46,11 +46,15 @@ pub enum Mode {
 pub enum Depth {
     /// The level `L` with `4^L` nearest to the texel count `T` of the
     /// triangle (in log scale): sub-triangles of half a texel to two.
-    #[default]
     Nearest,
-    /// The paper's rule: the smallest `L` with `T / 4^L ≤ 1`, so every
-    /// sub-triangle covers at most one texel. Up to four times the pieces
-    /// of [`Nearest`](Self::Nearest).
+    /// The paper's rule (the default): the smallest `L` with
+    /// `T / 4^L ≤ 1`, so every sub-triangle covers at most one texel.
+    /// Measured on the six data meshes with a noise and an HDR density
+    /// (the `depth` example), it brings `p′` closer to the filtered
+    /// density than [`Nearest`](Self::Nearest) in every case (total
+    /// variation 1–7% lower) for 2–7% more pieces, since the edge rule
+    /// already subdivides most triangles that far.
+    #[default]
     AtMostOneTexel,
 }
 
@@ -99,7 +103,7 @@ impl Default for Options {
         Self {
             mode: Mode::Approximate,
             layout: Layout::Alias,
-            depth: Depth::Nearest,
+            depth: Depth::AtMostOneTexel,
             max_pieces: DEFAULT_MAX_PIECES,
             max_level: 11,
             extra_levels: 0,
@@ -240,67 +244,62 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
             )));
         }
         let faces = mesh.indices.len();
-        let (per_face, face_level, exact_mass) = match density {
+        // Threads pay off for large meshes or deep subdivisions; below
+        // that, waking them costs more than the work (a constant density
+        // builds as fast as the uniform sampler's table).
+        let many = faces >= PARALLEL_FACES;
+        let (pieces, face_start, face_level, exact_mass) = match density {
             Density::Texture(texture) => {
                 let uvs = texture_uvs(&mesh)?;
-                let wanted: Vec<(u8, bool)> = map_faces(faces, |f| {
+                // Per face: its level, and its value if the density is
+                // constant over its footprint (then it is one piece).
+                let wanted: Vec<(u8, Option<f32>)> = map_faces(many, faces, |f| {
                     let uv = face_uvs(uvs, mesh.indices[f]);
-                    let constant = uv_constant(texture, uv).is_some() || mesh.area(f) <= 0.0;
-                    (face_level(texture, uv, options), constant)
+                    (face_level(texture, uv, options), uv_constant(texture, uv))
                 });
-                let levels = capped_levels(&wanted, options.max_pieces)?;
-                let build = |f: usize| texture_pieces(&mesh, uvs, texture, levels[f], options, f);
-                let per_face = map_faces(faces, build);
+                let (levels, leaves) = capped_levels(&wanted, options.max_pieces)?;
+                let heavy = many || leaves >= PARALLEL_LEAVES;
+                let (pieces, starts) = collect_pieces(heavy, faces, |f, out| match wanted[f].1 {
+                    Some(c) if c > 0.0 && mesh.area(f) > 0.0 => out.push((SubTriangle::ROOT, c)),
+                    Some(_) => {}
+                    None => texture_pieces(&mesh, uvs, texture, levels[f], options, f, out),
+                });
                 if options.mode == Mode::Exact {
                     check_integration(&mesh, uvs, texture)?;
                 }
                 let exact = (options.mode == Mode::Exact).then(|| {
-                    map_faces(faces, |f| exact_mass(&mesh, uvs, texture, f))
+                    map_faces(heavy, faces, |f| exact_mass(&mesh, uvs, texture, f))
                         .iter()
                         .sum()
                 });
-                (per_face, levels, exact)
+                (pieces, starts, levels, exact)
             }
             Density::PerFace(w) => {
                 check_weights("face", w, faces)?;
-                let per_face = map_faces(faces, |f| {
-                    let ok = w[f] > 0.0 && mesh.area(f) > 0.0;
-                    ok.then_some((SubTriangle::ROOT, w[f]))
-                        .into_iter()
-                        .collect()
+                let (pieces, starts) = collect_pieces(many, faces, |f, out| {
+                    if w[f] > 0.0 && mesh.area(f) > 0.0 {
+                        out.push((SubTriangle::ROOT, w[f]));
+                    }
                 });
-                (per_face, vec![0; faces], None)
+                (pieces, starts, vec![0; faces], None)
             }
             Density::PerVertex(w) => {
                 check_weights("vertex", w, mesh.positions.len())?;
-                let per_face = map_faces(faces, |f| {
-                    if mesh.area(f) <= 0.0 {
-                        return Vec::new();
+                let (pieces, starts) = collect_pieces(many, faces, |f, out| {
+                    if mesh.area(f) > 0.0 {
+                        let tri = mesh.indices[f];
+                        for c in (0..3).filter(|&c| w[tri[c] as usize] > 0.0) {
+                            out.push((SubTriangle::vertex(c), w[tri[c] as usize]));
+                        }
                     }
-                    let tri = mesh.indices[f];
-                    (0..3)
-                        .filter(|&c| w[tri[c] as usize] > 0.0)
-                        .map(|c| (SubTriangle::vertex(c), w[tri[c] as usize]))
-                        .collect()
                 });
-                (per_face, vec![0; faces], None)
+                (pieces, starts, vec![0; faces], None)
             }
         };
-        let mut face_start = Vec::with_capacity(faces + 1);
-        let mut pieces = Vec::with_capacity(per_face.iter().map(Vec::len).sum());
-        for (f, parts) in per_face.into_iter().enumerate() {
-            face_start.push(pieces.len() as u32);
-            pieces.extend(parts.into_iter().map(|(part, value)| Piece {
-                face: f as u32,
-                part,
-                value,
-            }));
-        }
-        face_start.push(pieces.len() as u32);
         if pieces.len() > u32::MAX as usize {
             return Err(Error::TooLarge(pieces.len()));
         }
-        let areas: Vec<f64> = map_faces(faces, |f| mesh.area(f));
+        let areas: Vec<f64> = map_faces(many, faces, |f| mesh.area(f));
         let masses: Vec<f64> = pieces
             .iter()
             .map(|p| f64::from(p.value) * areas[p.face as usize] * piece_fraction(p.part))
@@ -774,14 +773,72 @@ fn uv_constant(texture: &DensityTexture, uv: [DVec2; 3]) -> Option<f32> {
     texture.constant_over_box(lo, hi)
 }
 
+/// Meshes with at least this many faces are processed on all threads.
+const PARALLEL_FACES: usize = 1 << 15;
+
+/// Subdivisions with at least this many leaves are built on all threads.
+const PARALLEL_LEAVES: u128 = 1 << 16;
+
+/// Faces per task of the parallel piece collection (fixed, so the split
+/// never depends on the number of threads; the result never does).
+const FACE_CHUNK: usize = 1 << 10;
+
+/// The pieces `fill(f, out)` appends for every face `f`, in face order,
+/// and where each face's pieces start (`faces + 1` entries). On all
+/// threads when `parallel` (and the `rayon` feature), in chunks of
+/// [`FACE_CHUNK`] faces, each appending to its own list.
+fn collect_pieces(
+    parallel: bool,
+    faces: usize,
+    fill: impl Fn(usize, &mut Vec<(SubTriangle, f32)>) + Sync + Send,
+) -> (Vec<Piece>, Vec<u32>) {
+    let chunk = |c: usize| {
+        let mut out = Vec::new();
+        let mut starts = Vec::new();
+        for f in c * FACE_CHUNK..((c + 1) * FACE_CHUNK).min(faces) {
+            starts.push(out.len());
+            fill(f, &mut out);
+        }
+        (out, starts)
+    };
+    let chunks = map_faces(parallel, faces.div_ceil(FACE_CHUNK), chunk);
+    let total = chunks.iter().map(|c| c.0.len()).sum();
+    let mut pieces = Vec::with_capacity(total);
+    let mut face_start = Vec::with_capacity(faces + 1);
+    for (c, (parts, starts)) in chunks.into_iter().enumerate() {
+        let base = pieces.len();
+        face_start.extend(starts.iter().map(|&s| (base + s) as u32));
+        let first = c * FACE_CHUNK;
+        let ends = starts
+            .iter()
+            .skip(1)
+            .copied()
+            .chain(std::iter::once(parts.len()));
+        for (k, (&start, end)) in starts.iter().zip(ends).enumerate() {
+            let face = (first + k) as u32;
+            pieces.extend(parts[start..end].iter().map(|&(part, value)| Piece {
+                face,
+                part,
+                value,
+            }));
+        }
+    }
+    face_start.push(pieces.len() as u32);
+    (pieces, face_start)
+}
+
 /// The levels to build: each face's wanted level, capped at the deepest
 /// common level `C` for which `Σ 4^min(L, C)` over the faces that are not
-/// constant (plus one per constant face) stays within `budget`.
-fn capped_levels(wanted: &[(u8, bool)], budget: usize) -> Result<Vec<u8>, Error> {
+/// constant (plus one per constant face) stays within `budget`; and that
+/// sum.
+fn capped_levels(wanted: &[(u8, Option<f32>)], budget: usize) -> Result<(Vec<u8>, u128), Error> {
     let count = |cap: u8| -> u128 {
         wanted
             .iter()
-            .map(|&(l, constant)| if constant { 1 } else { 1u128 << (2 * l.min(cap)) })
+            .map(|&(l, constant)| match constant {
+                Some(_) => 1,
+                None => 1u128 << (2 * l.min(cap)),
+            })
             .sum()
     };
     let deepest = wanted.iter().map(|w| w.0).max().unwrap_or(0);
@@ -792,7 +849,10 @@ fn capped_levels(wanted: &[(u8, bool)], budget: usize) -> Result<Vec<u8>, Error>
             needed: count(0),
             budget,
         })?;
-    Ok(wanted.iter().map(|&(l, _)| l.min(cap)).collect())
+    Ok((
+        wanted.iter().map(|&(l, _)| l.min(cap)).collect(),
+        count(cap),
+    ))
 }
 
 /// Sub-triangles of face `f` with their values (approximate mode: the
@@ -805,13 +865,14 @@ fn texture_pieces(
     level: u8,
     options: &Options,
     f: usize,
-) -> Vec<(SubTriangle, f32)> {
+    out: &mut Vec<(SubTriangle, f32)>,
+) {
     if mesh.area(f) <= 0.0 {
-        return Vec::new();
+        return;
     }
+    let start = out.len();
     let [a, b, c] = face_uvs(uvs, mesh.indices[f]);
     let at = |(u, v): (f64, f64)| a + (b - a) * u + (c - a) * v;
-    let mut out = Vec::new();
     // A node whose UV box is constant is one piece (its subtree would
     // merge into it): found from the texture's tables in O(1).
     let constant = |s: SubTriangle| uv_constant(texture, s.corners().map(at));
@@ -822,7 +883,7 @@ fn texture_pieces(
                 constant,
             };
             let tolerance = options.merge_tolerance;
-            subdivision::build(level, tolerance, Merge::Mean, &values, &mut out);
+            subdivision::build(level, tolerance, Merge::Mean, &values, out);
         }
         Mode::Exact => {
             // The maximum over the sub-triangle's UV bounding box, rounded
@@ -835,18 +896,29 @@ fn texture_pieces(
                 constant,
             };
             let tolerance = options.merge_tolerance;
-            subdivision::build(level, tolerance, Merge::Max, &values, &mut out);
+            subdivision::build(level, tolerance, Merge::Max, &values, out);
         }
     }
-    out.retain(|&(_, v)| v > 0.0);
-    out
+    // Zeros merged with their siblings first; now they go.
+    let mut kept = start;
+    for k in start..out.len() {
+        if out[k].1 > 0.0 {
+            out[kept] = out[k];
+            kept += 1;
+        }
+    }
+    out.truncate(kept);
 }
 
 /// The smallest `f32` not below `x`, at most `f32::MAX` (a bound of a
 /// density whose texels are at most that).
 fn round_up(x: f64) -> f32 {
     let y = x as f32;
-    if f64::from(y) < x { y.next_up().min(f32::MAX) } else { y.min(f32::MAX) }
+    if f64::from(y) < x {
+        y.next_up().min(f32::MAX)
+    } else {
+        y.min(f32::MAX)
+    }
 }
 
 /// The lowest expected acceptance a rejection step may have: 10⁻⁹ (a
@@ -874,7 +946,8 @@ pub(crate) fn check_integration(
     uvs: &[Vec2],
     texture: &DensityTexture,
 ) -> Result<(), Error> {
-    let cells: f64 = map_faces(mesh.indices.len(), |f| {
+    let faces = mesh.indices.len();
+    let cells: f64 = map_faces(faces >= PARALLEL_FACES, faces, |f| {
         texture.cells_to_integrate(face_uvs(uvs, mesh.indices[f]))
     })
     .iter()
@@ -910,14 +983,20 @@ pub(crate) fn exact_mass(
     }
 }
 
-/// `f(0..n)` collected in order, in parallel with the `rayon` feature.
-pub(crate) fn map_faces<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
+/// `f(0..n)` collected in order, in parallel when `parallel` and the
+/// `rayon` feature is on (the result is the same either way).
+pub(crate) fn map_faces<T: Send>(
+    parallel: bool,
+    n: usize,
+    f: impl Fn(usize) -> T + Sync + Send,
+) -> Vec<T> {
     #[cfg(feature = "rayon")]
-    {
+    if parallel {
         use rayon::prelude::*;
-        (0..n).into_par_iter().map(f).collect()
+        return (0..n).into_par_iter().map(f).collect();
     }
     #[cfg(not(feature = "rayon"))]
+    let _ = parallel;
     (0..n).map(f).collect()
 }
 

@@ -190,7 +190,11 @@ mod tests {
         let total: f64 = masses.iter().sum();
         let p = realised(&table, masses.len());
         for (k, (&m, &q)) in masses.iter().zip(&p).enumerate() {
-            assert!((q - m / total).abs() < 1e-12, "piece {k}: {q} for {}", m / total);
+            assert!(
+                (q - m / total).abs() < 1e-12,
+                "piece {k}: {q} for {}",
+                m / total
+            );
         }
         assert_eq!(p[1], 0.0);
         assert_eq!(p[6], 0.0);

@@ -20,8 +20,21 @@
 //!   (Eq. 2: the approximation `p′` of Eq. 1's `p(x) = f(m(x)) / ∫ f dA`).
 //!   [`Mode::Exact`] goes beyond the paper and samples Eq. 1 itself.
 //!   [`RejectionSampler`] is the paper's Sec. 3.2 baseline.
+//!   Pieces are drawn from an alias table whose columns hold the pieces'
+//!   records ([`Layout::Alias`], one cache miss a draw) or, order-preserving,
+//!   by the paper's lookup-table CDF ([`Layout::Inversion`]). A density
+//!   constant over a triangle's UV footprint is one piece, found in O(1)
+//!   from the texture's tables, so tiled UVs stay cheap, and
+//!   [`Options::max_pieces`] bounds the subdivision before it is built.
 //! - **Weights**: [`Density::PerFace`] and [`Density::PerVertex`] (linear
 //!   over each triangle), both sampled exactly.
+//!
+//! Conventions: texture coordinates are glTF's (v = 0 at the first image
+//! row, as `trilux-io`'s `TriMesh` holds them), [`Wrap`] has glTF's
+//! sampler modes, seeds are `u64`, and sizes from arguments are checked
+//! against stated budgets ([`MAX_POINTS`], [`Options::max_pieces`],
+//! [`MAX_INTEGRATION_CELLS`], [`MIN_ACCEPTANCE`]) before any allocation,
+//! so bad input is an [`Error`], never a panic or an abort.
 //!
 //! A point is a [`SurfacePoint`]: position, face, barycentrics, geometric
 //! and shading normal, UV, and its density. Stored as (face, barycentrics),
@@ -56,6 +69,13 @@
 
 #![forbid(unsafe_code)]
 
+// The foreign crates this API speaks, so that callers use the same
+// versions: glam for positions, rand for `Rng` and `Distribution`,
+// discrete-sampling for the 1D samplers `DensitySampler` can take.
+pub use discrete_sampling;
+pub use glam;
+pub use rand;
+
 mod batch;
 mod density;
 mod error;
@@ -72,7 +92,9 @@ mod texture;
 mod uniform;
 
 pub use batch::SurfaceSampler;
-pub use density::{DEFAULT_MAX_PIECES, MIN_ACCEPTANCE, Density, DensitySampler, Depth, Mode, Options};
+pub use density::{
+    DEFAULT_MAX_PIECES, Density, DensitySampler, Depth, MIN_ACCEPTANCE, Mode, Options,
+};
 pub use error::Error;
 pub use layout::Layout;
 pub use mesh::MeshRef;
@@ -84,3 +106,8 @@ pub use projection::spherical_uvs;
 pub use rejection::RejectionSampler;
 pub use texture::{Channel, DensityTexture, Filter, MAX_INTEGRATION_CELLS, Wrap, luminance};
 pub use uniform::UniformSampler;
+
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -41,7 +41,7 @@ impl<'a> RejectionSampler<'a> {
         let uvs = crate::density::texture_uvs(&mesh)?;
         crate::density::check_integration(&mesh, uvs, texture)?;
         let faces = mesh.indices.len();
-        let mass: f64 = crate::density::map_faces(faces, |f| {
+        let mass: f64 = crate::density::map_faces(faces >= 1 << 15, faces, |f| {
             crate::density::exact_mass(&mesh, uvs, texture, f)
         })
         .iter()

@@ -326,7 +326,13 @@ mod tests {
             let (u, v) = s.barycenter();
             SubTriangle::locate(1, u, v) == first
         };
-        let leaf = |s: SubTriangle| if inside(s) { 7.0 } else { (s.key(4) % 5) as f32 };
+        let leaf = |s: SubTriangle| {
+            if inside(s) {
+                7.0
+            } else {
+                (s.key(4) % 5) as f32
+            }
+        };
         let mut full = Vec::new();
         build(4, 0.0, Merge::Mean, &leaves_only(leaf), &mut full);
         let asked = std::cell::Cell::new(0);

@@ -312,7 +312,10 @@ impl DensityTexture {
                 if i1.saturating_sub(i0) >= last {
                     return all;
                 }
-                let (a, b) = (i0.rem_euclid(n as i64) as usize, i1.rem_euclid(n as i64) as usize);
+                let (a, b) = (
+                    i0.rem_euclid(n as i64) as usize,
+                    i1.rem_euclid(n as i64) as usize,
+                );
                 if a <= b {
                     [Some((a, b)), None]
                 } else {
@@ -404,7 +407,8 @@ impl DensityTexture {
             // the value times the UV area, without visiting its cells.
             return f64::from(c) * 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs();
         }
-        if !(self.cells_to_integrate(uv) <= MAX_INTEGRATION_CELLS as f64) {
+        let cells = self.cells_to_integrate(uv);
+        if cells.is_nan() || cells > MAX_INTEGRATION_CELLS as f64 {
             return f64::NAN;
         }
         let scale = 1.0 / (self.width as f64 * self.height as f64);
@@ -620,52 +624,53 @@ impl Pyramid {
 /// texture has fewer than 2³² texels.
 #[derive(Debug, Clone, PartialEq)]
 struct Changes {
-    /// `(width + 1) × (height + 1)`: changes between `(x, y)` and
-    /// `(x + 1, y)` summed over `x' < x, y' < y`.
-    across: Vec<u32>,
-    /// The same for `(x, y)` and `(x, y + 1)`.
-    down: Vec<u32>,
+    /// `(width + 1) × (height + 1)` pairs: changes between `(x, y)` and
+    /// `(x + 1, y)` summed over `x' < x, y' < y`, and the same for
+    /// `(x, y)` and `(x, y + 1)` (side by side: one cache line per corner).
+    sums: Vec<[u32; 2]>,
     width: usize,
 }
 
 impl Changes {
     fn new(width: usize, height: usize, texels: &[f32]) -> Self {
         let stride = width + 1;
-        let mut across = vec![0u32; stride * (height + 1)];
-        let mut down = vec![0u32; stride * (height + 1)];
+        let mut sums = vec![[0u32; 2]; stride * (height + 1)];
         for y in 0..height {
             let (mut row_a, mut row_d) = (0u32, 0u32);
             for x in 0..width {
                 let t = texels[y * width + x];
-                row_a = row_a.wrapping_add(u32::from(x + 1 < width && texels[y * width + x + 1] != t));
-                row_d = row_d.wrapping_add(u32::from(y + 1 < height && texels[(y + 1) * width + x] != t));
+                row_a =
+                    row_a.wrapping_add(u32::from(x + 1 < width && texels[y * width + x + 1] != t));
+                row_d = row_d.wrapping_add(u32::from(
+                    y + 1 < height && texels[(y + 1) * width + x] != t,
+                ));
                 let at = (y + 1) * stride + x + 1;
-                across[at] = across[at - stride].wrapping_add(row_a);
-                down[at] = down[at - stride].wrapping_add(row_d);
+                let above = sums[at - stride];
+                sums[at] = [above[0].wrapping_add(row_a), above[1].wrapping_add(row_d)];
             }
         }
-        Self { across, down, width }
+        Self { sums, width }
     }
 
     fn memory_bytes(&self) -> usize {
-        (self.across.len() + self.down.len()) * size_of::<u32>()
+        self.sums.len() * size_of::<[u32; 2]>()
     }
 
-    /// The sum of `table` over texels `x0..x1` × `y0..y1` (exclusive ends).
-    fn sum(&self, table: &[u32], (x0, x1): (usize, usize), (y0, y1): (usize, usize)) -> u32 {
+    /// The sum of table `k` over texels `x0..x1` × `y0..y1` (exclusive ends).
+    fn sum(&self, k: usize, (x0, x1): (usize, usize), (y0, y1): (usize, usize)) -> u32 {
         let s = self.width + 1;
-        table[y1 * s + x1]
-            .wrapping_sub(table[y0 * s + x1])
-            .wrapping_sub(table[y1 * s + x0])
-            .wrapping_add(table[y0 * s + x0])
+        let t = &self.sums;
+        t[y1 * s + x1][k]
+            .wrapping_sub(t[y0 * s + x1][k])
+            .wrapping_sub(t[y1 * s + x0][k])
+            .wrapping_add(t[y0 * s + x0][k])
     }
 
     /// Whether texels `x0..=x1` × `y0..=y1` are all equal.
     fn constant(&self, (x0, x1): (usize, usize), (y0, y1): (usize, usize)) -> bool {
         // Horizontal pairs starting at x0..x1 − 1 and vertical pairs
         // starting at y0..y1 − 1: those inside the block.
-        self.sum(&self.across, (x0, x1), (y0, y1 + 1)) == 0
-            && self.sum(&self.down, (x0, x1 + 1), (y0, y1)) == 0
+        self.sum(0, (x0, x1), (y0, y1 + 1)) == 0 && self.sum(1, (x0, x1 + 1), (y0, y1)) == 0
     }
 }
 
@@ -915,11 +920,20 @@ mod tests {
         assert_eq!(t.range_over_box(lo, hi), (2.0, 2.0));
         assert_eq!(t.constant_over_box(lo, hi), Some(2.0));
         // Repeat: the box wraps from the right half into the left one.
-        assert_eq!(t.constant_over_box(DVec2::new(0.9, 0.1), DVec2::new(1.2, 0.3)), None);
-        assert_eq!(t.constant_over_box(DVec2::new(1.05, 0.1), DVec2::new(1.4, 0.3)), Some(2.0));
+        assert_eq!(
+            t.constant_over_box(DVec2::new(0.9, 0.1), DVec2::new(1.2, 0.3)),
+            None
+        );
+        assert_eq!(
+            t.constant_over_box(DVec2::new(1.05, 0.1), DVec2::new(1.4, 0.3)),
+            Some(2.0)
+        );
         for clamp in [Wrap::ClampToEdge, Wrap::MirroredRepeat] {
             let c = t.clone().with_wrap(clamp);
-            assert_eq!(c.constant_over_box(DVec2::new(-0.3, 0.1), DVec2::new(0.2, 0.3)), Some(2.0));
+            assert_eq!(
+                c.constant_over_box(DVec2::new(-0.3, 0.1), DVec2::new(0.2, 0.3)),
+                Some(2.0)
+            );
         }
         assert_eq!(
             t.range_over_box(lo, DVec2::new(0.6, 0.9)),

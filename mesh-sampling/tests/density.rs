@@ -12,7 +12,7 @@ mod stats;
 
 use glam::{DVec2, Vec2, Vec3};
 use mesh_sampling::{
-    Density, DensitySampler, DensityTexture, Error, Filter, MeshRef, Mode, Options,
+    Density, DensitySampler, DensityTexture, Error, Filter, Layout, MeshRef, Mode, Options,
     RejectionSampler, SurfacePoint, SurfaceSampler, UniformSampler, Wrap,
 };
 
@@ -90,15 +90,15 @@ fn approximate_bin_masses(m: &Mesh, t: &DensityTexture) -> Vec<f64> {
     let mut bins = vec![0.0; w * h];
     for tri in &m.2 {
         let uv = tri.map(|i| m.1[i as usize].as_dvec2());
-        // 4^L ≈ texels covered (nearest power of 4), 2^L ≥ longest edge
-        // / 2 texels.
+        // Šik & Křivánek Sec. 3.4: sub-triangles no larger than a texel
+        // (texels / 4^L ≤ 1); and 2^L ≥ longest edge / 2 texels.
         let tx = uv.map(|p| p * DVec2::new(w as f64, h as f64));
         let texels = 0.5 * (tx[1] - tx[0]).perp_dot(tx[2] - tx[0]).abs();
         let longest = (0..3)
             .map(|k| (tx[(k + 1) % 3] - tx[k]).length())
             .fold(0.0, f64::max);
-        let mut level = texels.max(1.0).log(4.0).round() as u32;
-        while f64::from(1u32 << level) < longest / 2.0 {
+        let mut level = 0u32;
+        while texels / 4f64.powi(level as i32) > 1.0 || f64::from(1u32 << level) < longest / 2.0 {
             level += 1;
         }
         let n = 1u32 << level;
@@ -210,15 +210,106 @@ fn checkerboards_put_no_point_in_a_black_texel_and_split_white_by_area() {
 fn approximate_mode_samples_the_papers_p_prime() {
     let t = noise(16, 16);
     let m = grid(8, |uv| uv);
-    let sampler = DensitySampler::new(mesh_ref(&m), Density::Texture(&t)).unwrap();
-    assert!((0..m.2.len()).all(|f| sampler.level(f) == 1));
     let expected = approximate_bin_masses(&m, &t);
-    let counts = texel_counts(&m, &t, &sampler.sample_n(5, N).unwrap());
-    let test = stats::chi_square(&counts, &stats::probabilities(&expected), 20.0);
-    assert!(test.p_value > 1e-3, "{test:?}");
-    // The normalisation is Σ f_i |D_i| (Eq. 2).
-    let total: f64 = expected.iter().sum();
-    assert!((sampler.total_mass() - total).abs() < 1e-5 * total);
+    for layout in [Layout::Alias, Layout::Inversion] {
+        let options = Options {
+            layout,
+            ..Options::default()
+        };
+        let sampler =
+            DensitySampler::with_options(mesh_ref(&m), Density::Texture(&t), &options).unwrap();
+        assert_eq!(sampler.layout(), layout);
+        assert!((0..m.2.len()).all(|f| sampler.level(f) == 1));
+        let counts = texel_counts(&m, &t, &sampler.sample_n(5, N).unwrap());
+        let test = stats::chi_square(&counts, &stats::probabilities(&expected), 20.0);
+        assert!(test.p_value > 1e-3, "{layout:?}: {test:?}");
+        // The normalisation is Σ f_i |D_i| (Eq. 2).
+        let total: f64 = expected.iter().sum();
+        assert!((sampler.total_mass() - total).abs() < 1e-5 * total);
+    }
+}
+
+/// Šik & Křivánek Sec. 3.4: "each triangle is subdivided so that its
+/// sub-triangles are smaller than a texel of the density texture mapped
+/// on the triangle". The reference level is written from that sentence
+/// (and from the documented edge rule: no sub-triangle edge longer than
+/// two texels), by counting up, not from the implementation's logarithms.
+#[test]
+fn subdivision_depth_follows_the_papers_rule() {
+    let t = noise(256, 128);
+    let (w, h) = (256.0, 128.0);
+    // Triangles of many sizes and shapes in UV space.
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    let mut indices = Vec::new();
+    let mut rng = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as f32 / (1u64 << 53) as f32
+    };
+    for k in 0..300 {
+        let scale = 10f32.powf(-3.0 + 3.0 * k as f32 / 300.0);
+        let base = Vec2::new(next(), next());
+        let corners = [
+            base,
+            base + Vec2::new(next(), next() * 0.3) * scale,
+            base + Vec2::new(next() * 0.3, next()) * scale,
+        ];
+        for c in corners {
+            positions.push(Vec3::new(c.x, c.y, 0.0));
+            uvs.push(c);
+        }
+        let i = 3 * k as u32;
+        indices.push([i, i + 1, i + 2]);
+    }
+    let mesh = MeshRef {
+        uvs: Some(&uvs),
+        ..MeshRef::new(&positions, &indices)
+    };
+    for depth in [
+        mesh_sampling::Depth::AtMostOneTexel,
+        mesh_sampling::Depth::Nearest,
+    ] {
+        let options = Options {
+            depth,
+            max_level: 13,
+            max_pieces: usize::MAX,
+            ..Options::default()
+        };
+        let s = DensitySampler::with_options(mesh, Density::Texture(&t), &options).unwrap();
+        for (f, tri) in indices.iter().enumerate() {
+            let p = tri.map(|i| uvs[i as usize].as_dvec2() * DVec2::new(w, h));
+            let texels = 0.5 * (p[1] - p[0]).perp_dot(p[2] - p[0]).abs();
+            let longest = (0..3)
+                .map(|k| (p[(k + 1) % 3] - p[k]).length())
+                .fold(0.0, f64::max);
+            let mut by_edge = 0;
+            while 2.0 * f64::from(1u32 << by_edge) < longest {
+                by_edge += 1;
+            }
+            let fits = |l: i32| texels / 4f64.powi(l) <= 1.0;
+            let by_area = match depth {
+                // The smallest level whose sub-triangles fit in a texel.
+                mesh_sampling::Depth::AtMostOneTexel => (0..).find(|&l| fits(l)).unwrap(),
+                // One of the two levels around it: the one whose
+                // sub-triangle size is nearer a texel, in log scale.
+                _ => {
+                    let up = (0..).find(|&l| fits(l)).unwrap();
+                    let down = (up - 1).max(0);
+                    let (a, b) = (texels / 4f64.powi(down), 4f64.powi(up) / texels);
+                    if up > 0 && a < b { down } else { up }
+                }
+            };
+            let expected = by_area.max(by_edge).min(13) as u8;
+            assert_eq!(
+                s.level(f),
+                expected,
+                "{depth:?}, face {f}: {texels} texels, edge {longest}"
+            );
+        }
+    }
 }
 
 /// An affine UV map that aligns with nothing.
@@ -299,7 +390,8 @@ fn exact_mode_and_rejection_sample_the_same_distribution() {
     let mesh = mesh_ref(&m);
     let exact_points = DensitySampler::with_options(mesh, Density::Texture(&t), &exact())
         .unwrap()
-        .sample_n(9, N).unwrap();
+        .sample_n(9, N)
+        .unwrap();
     let rejection = RejectionSampler::new(mesh, &t).unwrap();
     let reject_points = rejection.sample_n(10, N).unwrap();
     let p = two_sample_p(
@@ -315,7 +407,8 @@ fn exact_mode_and_rejection_sample_the_same_distribution() {
     };
     let approximate = DensitySampler::with_options(mesh, Density::Texture(&t), &coarse)
         .unwrap()
-        .sample_n(11, N).unwrap();
+        .sample_n(11, N)
+        .unwrap();
     let p = two_sample_p(
         &texel_counts(&m, &t, &approximate),
         &texel_counts(&m, &t, &reject_points),
@@ -548,12 +641,24 @@ fn zero_area_triangles_are_never_sampled() {
     let t = noise(8, 8);
     for options in [Options::default(), exact()] {
         let sampler = DensitySampler::with_options(mesh, Density::Texture(&t), &options).unwrap();
-        assert!(sampler.sample_n(17, 10_000).unwrap().iter().all(|p| p.face == 0));
+        assert!(
+            sampler
+                .sample_n(17, 10_000)
+                .unwrap()
+                .iter()
+                .all(|p| p.face == 0)
+        );
         assert_eq!(sampler.pdf(1, [0.3, 0.3, 0.4]), 0.0);
     }
     let w = [1.0, 1.0];
     let sampler = DensitySampler::new(mesh, Density::PerFace(&w)).unwrap();
-    assert!(sampler.sample_n(18, 10_000).unwrap().iter().all(|p| p.face == 0));
+    assert!(
+        sampler
+            .sample_n(18, 10_000)
+            .unwrap()
+            .iter()
+            .all(|p| p.face == 0)
+    );
 }
 
 #[test]
@@ -721,7 +826,10 @@ use data_dir::data_dir;
 /// plane: the approximate mode against the from-scratch `p′` per texel,
 /// the exact mode against the exact integrals per triangle.
 #[test]
-#[cfg_attr(not(trilux_data), ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)")]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
 fn hdr_images_as_densities() {
     let dir = data_dir().expect("TRILUX_DATA names the data folder");
     let mut files: Vec<_> = std::fs::read_dir(dir.join("hdr"))
@@ -780,11 +888,15 @@ fn uniform_area(mesh: MeshRef<'_>) -> f64 {
 /// mapping; the approximate mode does near texel edges (that is the
 /// paper's approximation, documented).
 #[test]
-#[cfg_attr(not(trilux_data), ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)")]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
 fn bunny_checkerboard_exact_mode_never_lands_on_black() {
     let dir = data_dir().expect("TRILUX_DATA names the data folder");
     let bunny = trilux_io::mesh::TriMesh::read(dir.join("meshes/stanford-bunny.obj")).unwrap();
-    let (positions, uvs, indices) = mesh_sampling::spherical_uvs(&bunny.positions, &bunny.indices).unwrap();
+    let (positions, uvs, indices) =
+        mesh_sampling::spherical_uvs(&bunny.positions, &bunny.indices).unwrap();
     let mesh = MeshRef {
         uvs: Some(&uvs),
         ..MeshRef::new(&positions, &indices)

@@ -7,9 +7,8 @@
 use glam::{DVec2, Vec2, Vec3};
 use mesh_sampling::{
     Channel, Density, DensitySampler, DensityTexture, Depth, Error, Filter, Layout, MAX_POINTS,
-    MeshRef, Mode, MultiDensitySampler, MultiMeshSampler, NaiveSampler, Options,
-    RejectionSampler, SurfacePoint, SurfaceSampler, UniformSampler, Wrap, spherical_uvs,
-    uniform_barycentric,
+    MeshRef, Mode, MultiDensitySampler, MultiMeshSampler, NaiveSampler, Options, RejectionSampler,
+    SurfacePoint, SurfaceSampler, UniformSampler, Wrap, spherical_uvs, uniform_barycentric,
 };
 use rand::SeedableRng;
 
@@ -27,7 +26,16 @@ fn regression_sampling_huge_density() {
     let uniform = UniformSampler::new(mesh).unwrap();
     assert!((uniform.total_area() - 1.0).abs() < 1e-9);
     let err = uniform.sample_stable(1, 1e15).unwrap_err();
-    assert!(matches!(err, Error::TooManyPoints { budget: MAX_POINTS, .. }), "{err:?}");
+    assert!(
+        matches!(
+            err,
+            Error::TooManyPoints {
+                budget: MAX_POINTS,
+                ..
+            }
+        ),
+        "{err:?}"
+    );
     assert!(err.to_string().contains("too large"), "{err}");
     // The same through a density, and the right count below the budget.
     let weights = vec![1.0f32; square.indices.len()];
@@ -40,9 +48,18 @@ fn regression_sampling_huge_density() {
     assert!((990..=1002).contains(&points.len()), "{}", points.len());
     // Counts asked of the batch APIs are checked the same way.
     for n in [MAX_POINTS + 1, usize::MAX] {
-        assert!(matches!(uniform.sample_n(1, n), Err(Error::TooManyPoints { .. })));
-        assert!(matches!(uniform.sample_positions(1, n), Err(Error::TooManyPoints { .. })));
-        assert!(matches!(density.sample_n(1, n), Err(Error::TooManyPoints { .. })));
+        assert!(matches!(
+            uniform.sample_n(1, n),
+            Err(Error::TooManyPoints { .. })
+        ));
+        assert!(matches!(
+            uniform.sample_positions(1, n),
+            Err(Error::TooManyPoints { .. })
+        ));
+        assert!(matches!(
+            density.sample_n(1, n),
+            Err(Error::TooManyPoints { .. })
+        ));
     }
 }
 
@@ -75,7 +92,10 @@ const EXTREME_F64: [f64; 10] = [
 
 /// A valid mesh with UVs and normals, and variants with one extreme value
 /// in one place.
-fn meshes() -> Vec<(Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>)> {
+/// Positions, UVs and triangles.
+type Mesh = (Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>);
+
+fn meshes() -> Vec<Mesh> {
     let positions = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
     let uvs = vec![Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
     let indices = vec![[0, 1, 2], [1, 3, 2]];
@@ -88,7 +108,11 @@ fn meshes() -> Vec<(Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>)> {
         t[3] = Vec2::new(x, 2.0 * x);
         out.push((positions.clone(), t, indices.clone()));
         // Scaled: huge or tiny triangles, huge UV footprints.
-        let s = if x.is_finite() && x != 0.0 { x.abs() } else { 1.0 };
+        let s = if x.is_finite() && x != 0.0 {
+            x.abs()
+        } else {
+            1.0
+        };
         out.push((
             positions.iter().map(|&q| q * s).collect(),
             uvs.iter().map(|&q| q * s).collect(),
@@ -118,7 +142,13 @@ fn textures() -> Vec<Result<DensityTexture, Error>> {
     for &x in &EXTREME_F32 {
         out.push(DensityTexture::new(2, 2, vec![1.0, x, 0.5, 1.0]));
         out.push(DensityTexture::new(1, 1, vec![x]));
-        out.push(DensityTexture::from_channels(1, 1, &[x, 1.0, x, 1.0], 4, Channel::Luminance));
+        out.push(DensityTexture::from_channels(
+            1,
+            1,
+            &[x, 1.0, x, 1.0],
+            4,
+            Channel::Luminance,
+        ));
     }
     out
 }
@@ -166,7 +196,10 @@ fn option_sets() -> Vec<Options> {
 
 /// Draws, pdfs and the stable modes of a built sampler, with extreme
 /// seeds, counts, faces and barycentrics.
-fn exercise<S: SurfaceSampler + std::fmt::Debug>(sampler: &S, pdf: impl Fn(usize, [f32; 3]) -> f32) {
+fn exercise<S: SurfaceSampler + std::fmt::Debug>(
+    sampler: &S,
+    pdf: impl Fn(usize, [f32; 3]) -> f32,
+) {
     let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
     for _ in 0..20 {
         let p = sampler.sample(&mut rng);
@@ -256,7 +289,8 @@ fn no_public_function_panics_on_extreme_arguments() {
                             &all[1..3]
                         };
                         for options in options_here {
-                            let d = DensitySampler::with_options(mesh, Density::Texture(&t), options);
+                            let d =
+                                DensitySampler::with_options(mesh, Density::Texture(&t), options);
                             if let Ok(d) = d {
                                 exercise(&d, |f, b| d.pdf(f, b));
                                 let _ = d.sample_stable(1, 10.0);
@@ -321,8 +355,13 @@ fn errors_are_sentences() {
             },
         )
         .unwrap_err(),
-        SurfacePoint::on(&MeshRef::new(&positions, &[[0, 1, 2]]), 5, [1.0, 0.0, 0.0], 1.0)
-            .unwrap_err(),
+        SurfacePoint::on(
+            &MeshRef::new(&positions, &[[0, 1, 2]]),
+            5,
+            [1.0, 0.0, 0.0],
+            1.0,
+        )
+        .unwrap_err(),
     ];
     for e in errors {
         let text = e.to_string();

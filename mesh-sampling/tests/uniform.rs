@@ -286,7 +286,10 @@ fn bad_meshes_are_errors() {
 mod data_dir;
 
 #[test]
-#[cfg_attr(not(trilux_data), ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)")]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
 fn teapot_centroid_test_as_in_the_article() {
     let dir = data_dir::data_dir().expect("TRILUX_DATA names the data folder");
     let teapot = trilux_io::mesh::TriMesh::read(dir.join("meshes/teapot.obj")).unwrap();
