@@ -213,6 +213,7 @@ impl<S: DiscreteSampler> Distribution2D<S> {
     /// row, `u0` the column. The point always lies inside its cell, also
     /// for a variate just below 1, where `(row + v) / height` would round up
     /// onto the next cell's edge.
+    #[inline]
     pub fn sample_u(&self, u: [f64; 2]) -> Sample2D {
         let (row, v) = self.marginal.sample_remapped(u[1]);
         let conditional = &self.rows[row];
@@ -291,7 +292,22 @@ fn cell_of(x: f64, n: usize) -> usize {
 /// is inside. At most a few steps, and only for fractions next to 0 or 1.
 #[inline]
 fn place(index: usize, fraction: f64, n: usize, inv_n: f64) -> f64 {
-    let mut p = ((index as f64 + fraction) * inv_n).min(ONE_MINUS_EPSILON);
+    let i = index as f64;
+    let p = ((i + fraction) * inv_n).min(ONE_MINUS_EPSILON);
+    // The test `cell_of(p, n) == index` without its float-to-integer
+    // conversion (measured: that conversion and its branch made 2D
+    // sampling 1.4× slower): `⌊p · n⌋ = index` exactly when
+    // `index ≤ p · n < index + 1`, both sides exact floats.
+    let t = p * n as f64;
+    if t >= i && t < i + 1.0 {
+        return p;
+    }
+    step_into(p, index, n)
+}
+
+/// [`place`]'s slow path: ulp steps until `p` is in cell `index`.
+#[cold]
+fn step_into(mut p: f64, index: usize, n: usize) -> f64 {
     while p > 0.0 && cell_of(p, n) > index {
         p = p.next_down();
     }

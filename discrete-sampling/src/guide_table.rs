@@ -35,9 +35,10 @@ pub const DEFAULT_RATIO: f64 = 4.0;
 /// The largest table ratio [`GuideTable::with_ratio`] accepts.
 pub const MAX_RATIO: f64 = 1024.0;
 
-/// Largest table: cells are addressed with `usize` but the table must fit in
-/// memory; 2³¹ cells are 8 GiB.
-const MAX_CELLS: usize = 1 << 31;
+/// The table's memory budget: at most 2²⁸ cells (1 GiB). A larger
+/// `ratio · n` is clamped to it, which changes the speed only, never an
+/// index (the table is exact at any size).
+pub const MAX_CELLS: usize = 1 << 28;
 
 /// Tables at least this large are filled on several threads with `rayon`.
 #[cfg(feature = "rayon")]
@@ -117,7 +118,8 @@ impl GuideTable {
         Self::with_ratio(weights, DEFAULT_RATIO)
     }
 
-    /// Builds the distribution with `round(ratio · n)` cells (at least one).
+    /// Builds the distribution with `round(ratio · n)` cells (at least one,
+    /// at most [`MAX_CELLS`]).
     /// The paper's Fig. 7 varies this ratio from 1/4 to 16.
     ///
     /// # Errors

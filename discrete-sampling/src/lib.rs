@@ -107,7 +107,7 @@ pub use dist2d::{
     DirectionSample, Distribution2D, Sample2D, equirect_direction, equirect_point, pdf_solid_angle,
 };
 pub use error::Error;
-pub use guide_table::{DEFAULT_RATIO, GuideTable, MAX_RATIO};
+pub use guide_table::{DEFAULT_RATIO, GuideTable, MAX_CELLS, MAX_RATIO};
 pub use luminance::luminance;
 /// The `rand` this crate's API speaks (its `Rng` and `Distribution` traits),
 /// re-exported so that callers use the same version.
