@@ -1,0 +1,397 @@
+//! `trilux colors convert|bake|render`: textured meshes to mesh colours,
+//! mesh colours to an atlas, and pictures of mesh colours.
+
+use std::path::{Path, PathBuf};
+
+use clap::ValueEnum;
+use mesh_colors::{MeshColors, MipMap};
+use mesh_sampling::{SurfaceSampler, UniformSampler};
+use trilux::{ColorMesh, SurfaceTexture};
+use trilux_io::mesh::TriMesh;
+
+use super::{Context, Result, invalid};
+
+#[derive(Debug, clap::Subcommand)]
+#[command(about = "Mesh colours: convert a textured mesh, bake an atlas, render")]
+pub(crate) enum Command {
+    Convert(ConvertArgs),
+    Bake(BakeArgs),
+    Render(RenderArgs),
+}
+
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Convert a textured mesh to mesh colours (.meshcolors); seams are welded and averaged",
+    after_help = "Example:\n  trilux colors convert ../shared/data/meshes/spot.obj \\\n      --texture ../shared/data/textures/spot_texture.png -o spot.meshcolors"
+)]
+pub(crate) struct ConvertArgs {
+    /// The mesh: .obj, .gltf, .glb or .ply, with UVs.
+    pub(crate) mesh: PathBuf,
+    /// The texture (default: each material's base colour texture).
+    #[arg(long, value_name = "IMAGE")]
+    pub(crate) texture: Option<PathBuf>,
+    /// The highest face resolution, a power of two up to 1024.
+    #[arg(long, value_name = "R", default_value_t = 256)]
+    pub(crate) max_res: u32,
+    /// At most this many samples (default: the textures' texel count).
+    #[arg(long, value_name = "N")]
+    pub(crate) budget: Option<usize>,
+    /// The .meshcolors file to write.
+    #[arg(short, long, value_name = "OUT.meshcolors")]
+    pub(crate) output: PathBuf,
+    /// Also render a picture of the mesh colours.
+    #[arg(long, value_name = "OUT.png")]
+    pub(crate) preview: Option<PathBuf>,
+}
+
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Bake mesh colours to a texture atlas: an OBJ with UVs, its .mtl and a PNG",
+    after_help = "Example:\n  trilux colors bake ../shared/data/meshes/spot.obj spot.meshcolors -o spot_atlas.obj"
+)]
+pub(crate) struct BakeArgs {
+    /// The mesh the colours were made for.
+    pub(crate) mesh: PathBuf,
+    /// The mesh colours.
+    pub(crate) colors: PathBuf,
+    /// The OBJ to write; the atlas goes beside it as NAME.png and NAME.mtl.
+    #[arg(short, long, value_name = "OUT.obj")]
+    pub(crate) output: PathBuf,
+    /// MIP-safe packing for this many MIP levels (0: compact packing).
+    #[arg(long, value_name = "LEVELS", default_value_t = 0)]
+    pub(crate) mip: u32,
+    /// Texels of padding around each block.
+    #[arg(long, default_value_t = 2)]
+    pub(crate) gutter: u32,
+}
+
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Render mesh colours on their mesh to a PNG (8-bit sRGB) or EXR (linear)",
+    after_help = "Example:\n  trilux colors render ../shared/data/meshes/spot.obj spot.meshcolors --filter mip -o spot.png"
+)]
+pub(crate) struct RenderArgs {
+    /// The mesh the colours were made for.
+    pub(crate) mesh: PathBuf,
+    /// The mesh colours.
+    pub(crate) colors: PathBuf,
+    /// How colours are filtered per pixel.
+    #[arg(long, value_enum, default_value_t = Filter::Linear)]
+    pub(crate) filter: Filter,
+    /// Picture width and height in pixels.
+    #[arg(long, default_value_t = 768)]
+    pub(crate) size: u32,
+    /// Look from this direction (x,y,z from the mesh's centre toward the
+    /// camera; default a three-quarter view from +z, above and right).
+    #[arg(long, value_name = "X,Y,Z")]
+    pub(crate) view: Option<String>,
+    /// The picture: .png or .exr.
+    #[arg(short, long, value_name = "OUT.png")]
+    pub(crate) output: PathBuf,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum Filter {
+    Nearest,
+    Linear,
+    Mip,
+    Aniso,
+}
+
+pub(crate) fn run(context: &mut Context, command: Command) -> Result<()> {
+    match command {
+        Command::Convert(args) => convert(context, args),
+        Command::Bake(args) => bake(context, args),
+        Command::Render(args) => render(context, args),
+    }
+}
+
+/// `n` uniform surface points as `(face, barycentrics)`.
+pub(crate) fn surface_points(mesh: &TriMesh, n: usize, seed: u64) -> Result<Vec<(u32, [f32; 3])>> {
+    Ok(UniformSampler::new(trilux::mesh_ref(mesh))?
+        .sample_n(seed, n)?
+        .iter()
+        .map(|p| (p.face, p.barycentric))
+        .collect())
+}
+
+/// Converts, and measures the PSNR against the source at 200,000 points.
+pub(crate) fn convert_mesh(
+    context: &mut Context,
+    mesh: &TriMesh,
+    texture: Option<&trilux_io::image::Image>,
+    options: &trilux::ConvertOptions,
+) -> Result<(ColorMesh, MeshColors, f64)> {
+    let (surface, colors) = context.step("converting to mesh colours", || {
+        trilux::to_mesh_colors(mesh, texture, options)
+    })?;
+    let source = SurfaceTexture::new(mesh, texture)?;
+    let points = surface_points(mesh, 200_000, 1)?;
+    let psnr = context.step("measuring PSNR", || {
+        trilux::colors::psnr(
+            &points,
+            |f, b| source.color(f, b),
+            |f, b| {
+                let mut out = [0.0f32; 3];
+                let _ = colors.linear(f as usize, b, &mut out);
+                out
+            },
+        )
+    });
+    Ok((surface, colors, psnr))
+}
+
+fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
+    if !args.max_res.is_power_of_two() || args.max_res > 1 << mesh_colors::MAX_LEVEL {
+        return Err(invalid(format!(
+            "--max-res {}: must be a power of two from 1 to {}",
+            args.max_res,
+            1 << mesh_colors::MAX_LEVEL
+        )));
+    }
+    if args.budget == Some(0) {
+        return Err(invalid("--budget must be at least 1 sample"));
+    }
+    super::check_output(context, &args.output, &["meshcolors"])?;
+    if let Some(p) = &args.preview {
+        super::check_output(context, p, &["png", "exr"])?;
+    }
+    let mesh = super::read_mesh(context, &args.mesh)?;
+    if mesh.uvs.is_none() {
+        return Err(invalid(format!(
+            "{}: the mesh has no texture coordinates, so there is no texture to convert",
+            args.mesh.display()
+        )));
+    }
+    let texture = match &args.texture {
+        Some(p) => Some(super::read_image(context, p, false)?),
+        None => None,
+    };
+    let options = trilux::ConvertOptions {
+        max_level: args.max_res.trailing_zeros() as u8,
+        max_samples: args.budget,
+        ..Default::default()
+    };
+    let (surface, colors, psnr) = convert_mesh(context, &mesh, texture.as_ref(), &options)
+        .map_err(|e| match e {
+            trilux::Error::MissingTexture => invalid(format!(
+                "{}: the mesh's materials have no texture: give one with --texture IMAGE",
+                args.mesh.display()
+            )),
+            other => other,
+        })?;
+    let force = context.force;
+    context.step("writing the mesh colours", || {
+        trilux::output::write_atomic(&args.output, force, |tmp| {
+            mesh_colors::file::save(tmp, &colors, None)
+                .map_err(|e| invalid(format!("{}: {e}", args.output.display())))
+        })
+    })?;
+    if let Some(p) = &args.preview {
+        let image = context.step("rendering the preview", || {
+            render_colors(&surface, &colors, Filter::Linear, 768)
+        });
+        super::write_image(context, p, &image)?;
+    }
+    let (lo, hi) = (0..colors.face_count())
+        .filter_map(|f| colors.face_resolution(f))
+        .fold((u32::MAX, 0), |(a, b), r| (a.min(r), b.max(r)));
+    let text = format!(
+        "{} faces, {} samples (face resolutions {lo}..{hi}), {} vertices after welding{}; PSNR against the texture {psnr:.2} dB; written to {}\n",
+        colors.face_count(),
+        colors.sample_count(),
+        surface.positions.len(),
+        if surface.detached > 0 {
+            format!(
+                " ({} faces kept apart: degenerate or on a non-manifold edge)",
+                surface.detached
+            )
+        } else {
+            String::new()
+        },
+        args.output.display()
+    );
+    let json = serde_json::json!({
+        "command": "colors convert",
+        "mesh": super::shown(&args.mesh),
+        "faces": colors.face_count(),
+        "samples": colors.sample_count(),
+        "vertices": surface.positions.len(),
+        "detached_faces": surface.detached,
+        "resolution": [lo, hi],
+        "psnr_db": super::round(psnr, 3),
+        "output": super::shown(&args.output),
+        "seconds": context.timings_json(),
+    });
+    context.report(&text, json);
+    Ok(())
+}
+
+/// Loads mesh colours and checks they belong to the mesh.
+pub(crate) fn load_for(mesh: &TriMesh, path: &Path) -> Result<(ColorMesh, MeshColors)> {
+    let (colors, _) =
+        mesh_colors::file::load(path).map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+    let surface = ColorMesh::new(mesh)?;
+    surface.check(&colors, path)?;
+    Ok((surface, colors))
+}
+
+fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
+    let ext = super::extension(&args.output);
+    if ext == "gltf" || ext == "glb" {
+        return Err(invalid(format!(
+            "{}: trilux-io writes no glTF yet; write .obj (with .mtl and .png beside it)",
+            args.output.display()
+        )));
+    }
+    super::check_output(context, &args.output, &["obj"])?;
+    let mesh = super::read_mesh(context, &args.mesh)?;
+    let (surface, colors) =
+        context.step("reading the mesh colours", || load_for(&mesh, &args.colors))?;
+    let atlas = context.step("baking the atlas", || {
+        mesh_colors::atlas::bake(
+            &colors,
+            &mesh_colors::atlas::Options {
+                gutter: args.gutter,
+                mip_levels: args.mip,
+            },
+        )
+    })?;
+    // No texture file named: the OBJ writer writes the atlas image
+    // beside the .obj and .mtl as NAME_atlas.png.
+    let (baked, image) = trilux::atlas_mesh(&surface, &atlas, None);
+    let force = context.force;
+    let files = context.step("writing OBJ, MTL and PNG", || {
+        trilux::output::write_atomic_files(&args.output, force, |tmp| Ok(baked.write(tmp)?))
+    })?;
+    let text = format!(
+        "{} faces baked to a {}×{} atlas{}: {}\n",
+        colors.face_count(),
+        image.width,
+        image.height,
+        if args.mip > 0 {
+            format!(" (MIP-safe for {} levels)", args.mip)
+        } else {
+            String::new()
+        },
+        files
+            .iter()
+            .map(|f| f.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let json = serde_json::json!({
+        "command": "colors bake",
+        "faces": colors.face_count(),
+        "atlas": [image.width, image.height],
+        "mip_levels": args.mip,
+        "output": super::shown(&args.output),
+        "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
+        "seconds": context.timings_json(),
+    });
+    context.report(&text, json);
+    Ok(())
+}
+
+/// A picture of mesh colours on their surface, filtered per pixel.
+pub(crate) fn render_colors(
+    surface: &ColorMesh,
+    colors: &MeshColors,
+    filter: Filter,
+    size: u32,
+) -> trilux_io::image::Image {
+    render_colors_from(surface, colors, filter, size, None)
+}
+
+/// [`render_colors`] looking from direction `view` (towards the centre).
+pub(crate) fn render_colors_from(
+    surface: &ColorMesh,
+    colors: &MeshColors,
+    filter: Filter,
+    size: u32,
+    view: Option<glam::Vec3>,
+) -> trilux_io::image::Image {
+    use trilux::preview::{Camera, Renderer, lambert};
+    let Some((lo, hi)) = trilux::preview::bounds(&surface.positions) else {
+        return trilux::preview::render_mesh(&[], &[], size, size);
+    };
+    let mip: Option<MipMap> =
+        matches!(filter, Filter::Mip | Filter::Aniso).then(|| colors.mip_map());
+    let c = colors.channels();
+    let camera = match view {
+        Some(v) => Camera::fit_from(lo, hi, v),
+        None => Camera::fit(lo, hi),
+    };
+    let mut r = Renderer::new(size, size, camera);
+    r.draw_mesh(&surface.positions, &surface.faces, |frag| {
+        let mut out = [0.0f32; mesh_colors::MAX_CHANNELS];
+        let out = &mut out[..c];
+        let face = frag.face as usize;
+        let b = frag.barycentric;
+        let _ = match (filter, &mip) {
+            (Filter::Nearest, _) => colors.nearest(face, b, out),
+            (Filter::Mip, Some(m)) => {
+                let width = |d: [f32; 3]| d.iter().fold(0.0f32, |a, x| a.max(x.abs()));
+                m.trilinear(face, b, width(frag.db_dx).max(width(frag.db_dy)), out)
+            }
+            (Filter::Aniso, Some(m)) => m.anisotropic(face, b, frag.db_dx, frag.db_dy, 16, out),
+            _ => colors.linear(face, b, out),
+        };
+        let rgb = match c {
+            1 | 2 => [out[0]; 3],
+            _ => [out[0], out[1], out[2]],
+        };
+        lambert(rgb.map(|x| x.max(0.0) * 1.1), frag)
+    });
+    r.image()
+}
+
+fn render(context: &mut Context, args: RenderArgs) -> Result<()> {
+    if args.size == 0 || args.size > 8192 {
+        return Err(invalid(format!(
+            "--size {}: must be 1..=8192 pixels",
+            args.size
+        )));
+    }
+    super::check_output(context, &args.output, &["png", "exr"])?;
+    let view = match &args.view {
+        None => None,
+        Some(spec) => {
+            let v: Vec<f32> = spec
+                .split(',')
+                .map(|x| x.trim().parse::<f32>())
+                .collect::<std::result::Result<_, _>>()
+                .ok()
+                .filter(|v: &Vec<f32>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
+                .ok_or_else(|| invalid(format!("--view {spec:?}: expected three numbers x,y,z")))?;
+            let v = glam::Vec3::new(v[0], v[1], v[2]);
+            if v.length_squared() == 0.0 {
+                return Err(invalid(format!("--view {spec:?}: the direction is zero")));
+            }
+            Some(v)
+        }
+    };
+    let mesh = super::read_mesh(context, &args.mesh)?;
+    let (surface, colors) =
+        context.step("reading the mesh colours", || load_for(&mesh, &args.colors))?;
+    let image = context.step("rendering", || {
+        render_colors_from(&surface, &colors, args.filter, args.size, view)
+    });
+    super::write_image(context, &args.output, &image)?;
+    let text = format!(
+        "{}×{} picture of {} written to {}\n",
+        image.width,
+        image.height,
+        args.colors.display(),
+        args.output.display()
+    );
+    let json = serde_json::json!({
+        "command": "colors render",
+        "size": [image.width, image.height],
+        "filter": format!("{:?}", args.filter).to_lowercase(),
+        "output": super::shown(&args.output),
+        "seconds": context.timings_json(),
+    });
+    context.report(&text, json);
+    Ok(())
+}

@@ -1,0 +1,322 @@
+//! `trilux demo`: every pipeline on built-in data, with a preview each.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use mesh_sampling::Channel;
+use trilux::shapes;
+use trilux_io::mesh::TriMesh;
+
+use super::sample::{Method, Source, draw};
+use super::{Context, Result, invalid};
+
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Run every pipeline on built-in data (meshes and images made in code), writing outputs and a preview of each",
+    after_help = "Example:\n  trilux demo --out trilux-demo\n  (re-run into the same folder with --force)"
+)]
+pub(crate) struct Args {
+    /// The folder to write into (created if missing).
+    #[arg(long, default_value = "trilux-demo")]
+    pub(crate) out: PathBuf,
+    /// Preview size in pixels.
+    #[arg(long, default_value_t = 512)]
+    pub(crate) size: u32,
+}
+
+/// One pipeline's result for the summary.
+struct Done {
+    name: &'static str,
+    what: String,
+    seconds: f64,
+    files: Vec<PathBuf>,
+}
+
+struct Demo<'a> {
+    context: &'a mut Context,
+    out: PathBuf,
+    size: u32,
+    done: Vec<Done>,
+}
+
+impl Demo<'_> {
+    fn path(&self, name: &str) -> PathBuf {
+        self.out.join(name)
+    }
+
+    fn write_mesh(&self, name: &str, mesh: &TriMesh) -> Result<PathBuf> {
+        let path = self.path(name);
+        trilux::output::write_atomic_files(&path, self.context.force, |tmp| Ok(mesh.write(tmp)?))?;
+        Ok(path)
+    }
+
+    fn write_image(&self, name: &str, image: &trilux_io::image::Image) -> Result<PathBuf> {
+        let path = self.path(name);
+        super::write_image(self.context, &path, image)?;
+        Ok(path)
+    }
+
+    fn write_points(
+        &self,
+        name: &str,
+        mesh: &TriMesh,
+        points: &[mesh_sampling::SurfacePoint],
+    ) -> Result<PathBuf> {
+        let path = self.path(name);
+        let cloud = trilux::point_cloud(mesh, points);
+        trilux::output::write_atomic(&path, self.context.force, |tmp| {
+            Ok(trilux_io::mesh::ply::write(
+                tmp,
+                &cloud,
+                trilux_io::mesh::ply::Format::BinaryLittleEndian,
+            )?)
+        })?;
+        Ok(path)
+    }
+
+    /// Runs one pipeline under a spinner and records it.
+    fn run(
+        &mut self,
+        name: &'static str,
+        f: impl FnOnce(&Self) -> Result<(String, Vec<PathBuf>)>,
+    ) -> Result<()> {
+        let bar = self.context.spinner(name);
+        let start = Instant::now();
+        let result = f(self);
+        bar.finish_and_clear();
+        let (what, files) = result.map_err(|e| invalid(format!("demo pipeline {name}: {e}")))?;
+        self.done.push(Done {
+            name,
+            what,
+            seconds: start.elapsed().as_secs_f64(),
+            files,
+        });
+        Ok(())
+    }
+}
+
+/// The points pipeline: sample, write PLY and a preview.
+fn points_pipeline(
+    demo: &Demo<'_>,
+    stem: &str,
+    mesh: &TriMesh,
+    source: &Source,
+    method: Method,
+    n: usize,
+) -> Result<Vec<PathBuf>> {
+    let points = draw(mesh, source, method, 1, n)?;
+    let ply = demo.write_points(&format!("{stem}.ply"), mesh, &points)?;
+    let png = demo.write_image(
+        &format!("{stem}.png"),
+        &super::sample::preview(mesh, &points, demo.size, demo.size),
+    )?;
+    Ok(vec![ply, png])
+}
+
+pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    let out = args.out.clone();
+    if out.exists() && !out.is_dir() {
+        return Err(invalid(format!(
+            "--out {}: exists and is not a folder",
+            out.display()
+        )));
+    }
+    std::fs::create_dir_all(&out).map_err(|source| trilux::Error::File {
+        path: out.clone(),
+        source,
+    })?;
+    if !context.force
+        && std::fs::read_dir(&out)
+            .map(|mut d| d.next().is_some())
+            .unwrap_or(false)
+    {
+        return Err(invalid(format!(
+            "--out {}: the folder is not empty; pass --force to overwrite the demo's files in it, or choose another folder",
+            out.display()
+        )));
+    }
+    if args.size == 0 || args.size > 4096 {
+        return Err(invalid(format!("--size {}: must be 1..=4096", args.size)));
+    }
+    let start = Instant::now();
+    let mut demo = Demo {
+        context,
+        out,
+        size: args.size,
+        done: Vec::new(),
+    };
+
+    // Built-in inputs, written too so that every command can be re-run on them.
+    let blob = shapes::blob(5);
+    let torus = shapes::torus(128, 64);
+    let sphere = {
+        let ico = shapes::icosphere(5);
+        let (positions, uvs, indices) = mesh_sampling::spherical_uvs(&ico.positions, &ico.indices)?;
+        TriMesh {
+            normals: Some(positions.iter().map(|p| p.normalize()).collect()),
+            positions,
+            uvs: Some(uvs),
+            indices,
+            objects: ico.objects,
+            ..TriMesh::default()
+        }
+    };
+    let checker = shapes::checkerboard(512, 512, 8);
+    let noise = shapes::noise(256, 256, 7);
+    let sky = shapes::sky(512, 256);
+    demo.run("inputs", |d| {
+        let files = vec![
+            d.write_mesh("blob.obj", &blob)?,
+            d.write_mesh("torus.obj", &torus)?,
+            d.write_mesh("sphere.obj", &sphere)?,
+            d.write_image("checkerboard.png", &checker)?,
+            d.write_image("noise.png", &noise)?,
+            d.write_image("sky.exr", &sky)?,
+        ];
+        Ok((
+            "built-in meshes (blob, torus, UV sphere) and images (checkerboard, noise, HDR sky)"
+                .into(),
+            files,
+        ))
+    })?;
+
+    demo.run("uniform", |d| {
+        let n = 200_000;
+        let files = points_pipeline(
+            d,
+            "blob_uniform",
+            &blob,
+            &Source::Uniform,
+            Method::Uniform,
+            n,
+        )?;
+        Ok((format!("{n} points uniform by area on the blob"), files))
+    })?;
+
+    demo.run("density", |d| {
+        let n = 200_000;
+        let density = trilux::density_texture(&noise, Channel::Luminance)?;
+        let files = points_pipeline(
+            d,
+            "torus_noise",
+            &torus,
+            &Source::Texture(density),
+            Method::Subdivision,
+            n,
+        )?;
+        Ok((
+            format!("{n} points on the torus, density = noise texture (subdivision)"),
+            files,
+        ))
+    })?;
+
+    demo.run("sky", |d| {
+        let n = 100_000;
+        let density = trilux::density_texture(&sky, Channel::Luminance)?;
+        let files = points_pipeline(
+            d,
+            "sphere_sky",
+            &sphere,
+            &Source::Texture(density),
+            Method::Exact,
+            n,
+        )?;
+        Ok((
+            format!("{n} points on a sphere by the HDR sky's luminance (exact)"),
+            files,
+        ))
+    })?;
+
+    demo.run("colors", |d| {
+        let mut quiet = Context {
+            json: false,
+            force: d.context.force,
+            progress: false,
+            timings: Vec::new(),
+        };
+        let (surface, colors, psnr) =
+            super::colors::convert_mesh(&mut quiet, &torus, Some(&checker), &Default::default())?;
+        let file = d.path("torus.meshcolors");
+        trilux::output::write_atomic(&file, d.context.force, |tmp| {
+            mesh_colors::file::save(tmp, &colors, None).map_err(|e| invalid(format!("{}: {e}", file.display())))
+        })?;
+        let atlas = mesh_colors::atlas::bake(&colors, &Default::default())?;
+        let (baked, _) = trilux::atlas_mesh(&surface, &atlas, None);
+        let mut files = vec![file];
+        files.extend(trilux::output::write_atomic_files(
+            &d.path("torus_atlas.obj"),
+            d.context.force,
+            |tmp| Ok(baked.write(tmp)?),
+        )?);
+        files.push(d.write_image(
+            "torus_colors.png",
+            &super::colors::render_colors(&surface, &colors, super::colors::Filter::Mip, d.size),
+        )?);
+        let what = format!(
+            "checkerboard torus → {} mesh colours ({psnr:.1} dB) → {}×{} atlas OBJ; MIP-filtered render",
+            colors.sample_count(),
+            atlas.texture.width(),
+            atlas.texture.height()
+        );
+        Ok((what, files))
+    })?;
+
+    demo.run("colors-density", |d| {
+        let n = 200_000;
+        let file = d.path("torus.meshcolors");
+        let source = super::sample::meshcolors_source(&torus, &file, Channel::Luminance)?;
+        let files = points_pipeline(
+            d,
+            "torus_colors_points",
+            &torus,
+            &source,
+            Method::Subdivision,
+            n,
+        )?;
+        Ok((
+            format!("{n} points on the torus, density = its mesh colours' luminance"),
+            files,
+        ))
+    })?;
+
+    let total = start.elapsed().as_secs_f64();
+    let Demo {
+        context, done, out, ..
+    } = demo;
+    let mut text = format!(
+        "trilux demo: {} pipelines in {total:.1} s, written to {}\n\n",
+        done.len(),
+        out.display()
+    );
+    text.push_str("| pipeline | what | seconds | files |\n|---|---|---|---|\n");
+    for d in &done {
+        text.push_str(&format!(
+            "| {} | {} | {:.2} | {} |\n",
+            d.name,
+            d.what,
+            d.seconds,
+            d.files
+                .iter()
+                .map(|f| file_name(f))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    let json = serde_json::json!({
+        "command": "demo",
+        "out": super::shown(&out),
+        "seconds": super::round(total, 3),
+        "pipelines": done.iter().map(|d| serde_json::json!({
+            "name": d.name, "what": d.what, "seconds": super::round(d.seconds, 3),
+            "files": d.files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
+        })).collect::<Vec<_>>(),
+    });
+    context.report(&text, json);
+    Ok(())
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}

@@ -1,0 +1,312 @@
+//! `trilux info`: what a file holds, as a person checks an input before a
+//! long run.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use serde_json::{Value, json};
+
+use super::{Context, Result, invalid};
+
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Describe a mesh, tetrahedral mesh, image or .meshcolors file (counts, bounds, UVs, holes, quality)",
+    after_help = "Example:\n  trilux info ../shared/data/meshes/stanford-bunny.obj\n  trilux info ../shared/data/tets/bunny_50k.node --json"
+)]
+pub(crate) struct Args {
+    /// The file: .obj .gltf .glb .ply, .node .ele .msh .mesh, .png .jpg .hdr .exr, .meshcolors.
+    pub(crate) file: PathBuf,
+}
+
+pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    let path = &args.file;
+    if !path.exists() {
+        return Err(invalid(format!("{}: no such file", path.display())));
+    }
+    let (text, json) = match super::extension(path).as_str() {
+        "obj" | "gltf" | "glb" => mesh_info(context, path)?,
+        "ply" => ply_info(context, path)?,
+        "node" | "ele" | "msh" | "mesh" => tet_info(context, path)?,
+        "png" | "jpg" | "jpeg" | "hdr" | "exr" => image_info(context, path)?,
+        "meshcolors" => meshcolors_info(context, path)?,
+        other => {
+            return Err(invalid(format!(
+                "{}: unknown extension {other:?} (meshes .obj .gltf .glb .ply, tetrahedra .node .ele .msh .mesh, images .png .jpg .hdr .exr, .meshcolors)",
+                path.display()
+            )));
+        }
+    };
+    context.report(&text, json);
+    Ok(())
+}
+
+fn v3(v: glam::Vec3) -> Value {
+    json!([v.x, v.y, v.z])
+}
+
+fn mesh_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
+    let mesh = context.step("reading the mesh", || trilux_io::mesh::TriMesh::read(path))?;
+    Ok(describe_mesh(context, path, &mesh))
+}
+
+fn ply_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
+    let ply = context.step("reading the PLY file", || trilux_io::mesh::ply::read(path))?;
+    if !ply.triangles.is_empty() {
+        return mesh_info(context, path);
+    }
+    let (lo, hi) = trilux::preview::bounds(&ply.positions).unwrap_or_default();
+    let mut text = format!(
+        "{}: point cloud\n  points: {}\n  bounds: {lo} .. {hi}\n",
+        path.display(),
+        ply.positions.len()
+    );
+    let mut attributes = Vec::new();
+    if ply.normals.is_some() {
+        attributes.push("normals".to_string());
+    }
+    if ply.uvs.is_some() {
+        attributes.push("uvs".to_string());
+    }
+    if ply.colors.is_some() {
+        attributes.push("colors".to_string());
+    }
+    if ply.face_ids.is_some() {
+        attributes.push("face ids".to_string());
+    }
+    attributes.extend(ply.scalars.iter().map(|(n, _)| n.clone()));
+    let _ = writeln!(text, "  attributes: {}", attributes.join(", "));
+    Ok((
+        text,
+        json!({"file": super::shown(path), "kind": "point cloud", "points": ply.positions.len(),
+               "bounds": [v3(lo), v3(hi)], "attributes": attributes}),
+    ))
+}
+
+fn describe_mesh(
+    context: &mut Context,
+    path: &Path,
+    mesh: &trilux_io::mesh::TriMesh,
+) -> (String, Value) {
+    let shape = context.step("checking the topology", || trilux::mesh::shape(mesh));
+    let (lo, hi) = trilux::mesh::bounds(mesh).unwrap_or_default();
+    let diagonal = (hi - lo).length();
+    let used = {
+        let mut used = vec![false; mesh.positions.len()];
+        for &v in mesh.indices.iter().flatten() {
+            if let Some(u) = used.get_mut(v as usize) {
+                *u = true;
+            }
+        }
+        used.iter().filter(|&&u| u).count()
+    };
+    let mut text = format!("{}: triangle mesh\n", path.display());
+    let _ = writeln!(
+        text,
+        "  vertices: {} ({} used, {} after welding equal positions)",
+        mesh.positions.len(),
+        used,
+        shape.welded_vertices
+    );
+    let _ = writeln!(text, "  triangles: {}", mesh.indices.len());
+    let _ = writeln!(text, "  bounds: {lo} .. {hi} (size {})", hi - lo);
+    let _ = writeln!(
+        text,
+        "  diagonal: {diagonal} — units look like {}",
+        trilux::mesh::unit_guess(diagonal)
+    );
+    let _ = writeln!(text, "  area: {:.6}", mesh.area());
+    let closed = shape.boundary_edges == 0 && shape.non_manifold_edges == 0;
+    let _ = writeln!(
+        text,
+        "  parts: {}, holes: {} ({} boundary edges), non-manifold edges: {}{}",
+        shape.parts,
+        shape.holes,
+        shape.boundary_edges,
+        shape.non_manifold_edges,
+        if closed { " — closed" } else { "" }
+    );
+    let _ = writeln!(
+        text,
+        "  normals: {}",
+        if mesh.normals.is_some() { "yes" } else { "no" }
+    );
+    let uv_json = match &mesh.uvs {
+        Some(uvs) => {
+            let (ulo, uhi) = uvs.iter().fold(
+                (glam::Vec2::INFINITY, glam::Vec2::NEG_INFINITY),
+                |(a, b), &p| (a.min(p), b.max(p)),
+            );
+            let tiled = ulo.x < -0.01 || ulo.y < -0.01 || uhi.x > 1.01 || uhi.y > 1.01;
+            let _ = writeln!(
+                text,
+                "  UVs: u {:.4} .. {:.4}, v {:.4} .. {:.4}{}",
+                ulo.x,
+                uhi.x,
+                ulo.y,
+                uhi.y,
+                if tiled {
+                    " — outside [0, 1]: the texture tiles (repeat wrap)"
+                } else {
+                    ""
+                }
+            );
+            json!({"u": [ulo.x, uhi.x], "v": [ulo.y, uhi.y], "tiled": tiled})
+        }
+        None => {
+            let _ = writeln!(text, "  UVs: none");
+            Value::Null
+        }
+    };
+    let materials: Vec<Value> = mesh
+        .materials
+        .iter()
+        .map(|m| {
+            let texture = m
+                .diffuse_image
+                .as_ref()
+                .map(|i| format!("{}×{} image", i.width, i.height))
+                .or_else(|| m.diffuse_texture.as_ref().map(|p| p.display().to_string()));
+            let _ = writeln!(
+                text,
+                "  material {:?}: diffuse {:?}{}",
+                m.name,
+                m.diffuse,
+                texture
+                    .as_ref()
+                    .map(|t| format!(", texture {t}"))
+                    .unwrap_or_default()
+            );
+            json!({"name": m.name, "diffuse": m.diffuse, "texture": texture})
+        })
+        .collect();
+    let _ = writeln!(text, "  objects: {}", mesh.objects.len());
+    let json = json!({
+        "file": super::shown(path),
+        "kind": "triangle mesh",
+        "vertices": mesh.positions.len(),
+        "used_vertices": used,
+        "welded_vertices": shape.welded_vertices,
+        "triangles": mesh.indices.len(),
+        "bounds": [v3(lo), v3(hi)],
+        "diagonal": diagonal,
+        "unit_guess": trilux::mesh::unit_guess(diagonal),
+        "area": mesh.area(),
+        "parts": shape.parts,
+        "holes": shape.holes,
+        "boundary_edges": shape.boundary_edges,
+        "non_manifold_edges": shape.non_manifold_edges,
+        "closed": closed,
+        "normals": mesh.normals.is_some(),
+        "uvs": uv_json,
+        "objects": mesh.objects.len(),
+        "materials": materials,
+    });
+    (text, json)
+}
+
+fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
+    let mesh = context.step("reading the tetrahedra", || {
+        trilux_io::tet::TetMesh::read(path)
+    })?;
+    let (lo, hi) = mesh.positions.iter().fold(
+        (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY),
+        |(a, b), &p| (a.min(p), b.max(p)),
+    );
+    let inverted = (0..mesh.tets.len())
+        .filter(|&t| mesh.signed_volume6(t) <= 0.0)
+        .count();
+    let boundary = mesh.boundary().len();
+    let dihedral = context.step("measuring dihedral angles", || {
+        trilux::tet::dihedral_range(&mesh)
+    });
+    let volume = mesh.volume();
+    let mut text = format!("{}: tetrahedral mesh\n", path.display());
+    let _ = writeln!(text, "  nodes: {}", mesh.positions.len());
+    let _ = writeln!(text, "  tetrahedra: {}", mesh.tets.len());
+    let _ = writeln!(text, "  boundary triangles: {boundary}");
+    let _ = writeln!(text, "  bounds: {lo} .. {hi}");
+    let _ = writeln!(text, "  volume: {volume:.6e}");
+    let _ = writeln!(text, "  inverted or flat tetrahedra: {inverted}");
+    match dihedral {
+        Some((a, b)) => {
+            let _ = writeln!(text, "  dihedral angles: {a:.3}° .. {b:.3}°");
+        }
+        None => {
+            let _ = writeln!(text, "  dihedral angles: undefined (a flat tetrahedron)");
+        }
+    }
+    Ok((
+        text,
+        json!({"file": super::shown(path), "kind": "tetrahedral mesh", "nodes": mesh.positions.len(),
+               "tetrahedra": mesh.tets.len(), "boundary_triangles": boundary,
+               "bounds": [lo.to_array(), hi.to_array()], "volume": volume, "inverted": inverted,
+               "dihedral_degrees": dihedral.map(|(a, b)| [a, b])}),
+    ))
+}
+
+fn image_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
+    let image = context.step("reading the image", || trilux_io::image::read(path))?;
+    let mut lo = [f32::INFINITY; 4];
+    let mut hi = [f32::NEG_INFINITY; 4];
+    for p in &image.pixels {
+        for c in 0..4 {
+            lo[c] = lo[c].min(p[c]);
+            hi[c] = hi[c].max(p[c]);
+        }
+    }
+    let lum = image.luminance();
+    let mean = lum.iter().map(|&l| f64::from(l)).sum::<f64>() / lum.len().max(1) as f64;
+    let max = lum.iter().copied().fold(0.0f32, f32::max);
+    let zero = lum.iter().filter(|&&l| l <= 0.0).count();
+    let mut text = format!("{}: image\n", path.display());
+    let _ = writeln!(text, "  size: {}×{}", image.width, image.height);
+    for (c, name) in ["R", "G", "B", "A"].iter().enumerate() {
+        let _ = writeln!(text, "  {name} (linear): {} .. {}", lo[c], hi[c]);
+    }
+    let _ = writeln!(
+        text,
+        "  luminance (Rec. 709): mean {mean:.4}, max {max}, {zero} pixels at zero"
+    );
+    Ok((
+        text,
+        json!({"file": super::shown(path), "kind": "image", "width": image.width, "height": image.height,
+               "min": lo, "max": hi, "luminance": {"mean": mean, "max": max, "zero_pixels": zero}}),
+    ))
+}
+
+fn meshcolors_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
+    let (colors, mip) = context
+        .step("reading the mesh colours", || mesh_colors::file::load(path))
+        .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+    let mut histogram = std::collections::BTreeMap::new();
+    for r in (0..colors.face_count()).filter_map(|f| colors.face_resolution(f)) {
+        *histogram.entry(r).or_insert(0usize) += 1;
+    }
+    let mut text = format!("{}: mesh colours\n", path.display());
+    let _ = writeln!(text, "  channels: {}", colors.channels());
+    let _ = writeln!(text, "  vertices: {}", colors.topology().vertex_count());
+    let _ = writeln!(text, "  faces: {}", colors.face_count());
+    let _ = writeln!(text, "  samples: {}", colors.sample_count());
+    let _ = writeln!(
+        text,
+        "  face resolutions: {}",
+        histogram
+            .iter()
+            .map(|(r, n)| format!("R={r}: {n}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let _ = writeln!(
+        text,
+        "  MIP pyramid: {}",
+        if mip.is_some() { "yes" } else { "no" }
+    );
+    Ok((
+        text,
+        json!({"file": super::shown(path), "kind": "mesh colours", "channels": colors.channels(),
+               "vertices": colors.topology().vertex_count(), "faces": colors.face_count(),
+               "samples": colors.sample_count(),
+               "resolutions": histogram.iter().map(|(r, n)| (r.to_string(), json!(n))).collect::<serde_json::Map<_, _>>(),
+               "mip": mip.is_some()}),
+    ))
+}

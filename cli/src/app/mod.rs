@@ -1,0 +1,273 @@
+//! Arguments, the conventions every subcommand shares (progress on
+//! stderr, `--json` on stdout, readable errors, safe outputs), and the
+//! dispatch.
+
+use std::io::IsTerminal;
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use trilux::Error;
+
+mod bench;
+mod colors;
+mod demo;
+mod info;
+mod plot;
+mod sample;
+
+pub(crate) type Result<T> = std::result::Result<T, Error>;
+
+/// An error with a message of our own.
+pub(crate) fn invalid(message: impl Into<String>) -> Error {
+    Error::Invalid(message.into())
+}
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "trilux",
+    version,
+    about = "Sample meshes, convert textures to mesh colours and back, inspect files, preview, benchmark",
+    long_about = None,
+    after_help = "Start with `trilux demo`, which runs every pipeline on built-in data and writes previews."
+)]
+struct Cli {
+    /// No progress bars (they are also hidden when stderr is not a terminal).
+    #[arg(long, short, global = true)]
+    quiet: bool,
+    /// Print one JSON object with the results on stdout instead of text.
+    #[arg(long, global = true)]
+    json: bool,
+    /// Overwrite existing output files.
+    #[arg(long, global = true)]
+    force: bool,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    Info(info::Args),
+    Sample(sample::Args),
+    #[command(subcommand)]
+    Colors(colors::Command),
+    Demo(demo::Args),
+    Bench(bench::Args),
+}
+
+/// What every subcommand gets: the shared flags, progress, timings.
+pub(crate) struct Context {
+    pub(crate) json: bool,
+    pub(crate) force: bool,
+    progress: bool,
+    pub(crate) timings: Vec<(String, f64)>,
+}
+
+impl Context {
+    /// Runs `f` as a named step: a spinner with the elapsed time on stderr
+    /// (when shown), and its time recorded for the summary.
+    pub(crate) fn step<T>(&mut self, name: &str, f: impl FnOnce() -> T) -> T {
+        let bar = self.spinner(name);
+        let start = Instant::now();
+        let out = f();
+        let seconds = start.elapsed().as_secs_f64();
+        bar.finish_and_clear();
+        self.timings.push((name.to_string(), seconds));
+        out
+    }
+
+    /// A spinner (hidden when progress is off).
+    pub(crate) fn spinner(&self, message: &str) -> ProgressBar {
+        if !self.progress {
+            return ProgressBar::hidden();
+        }
+        let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+        );
+        bar.set_message(message.to_string());
+        bar.enable_steady_tick(Duration::from_millis(120));
+        bar
+    }
+
+    /// The recorded step times as a JSON object.
+    pub(crate) fn timings_json(&self) -> serde_json::Value {
+        serde_json::Value::Object(
+            self.timings
+                .iter()
+                .map(|(k, v)| (k.clone(), serde_json::json!(round(*v, 4))))
+                .collect(),
+        )
+    }
+
+    /// Prints `text` (human) or `json` (with `--json`) on stdout.
+    pub(crate) fn report(&self, text: &str, json: serde_json::Value) {
+        if self.json {
+            println!("{json}");
+        } else {
+            print!("{text}");
+        }
+    }
+}
+
+/// `x` rounded to `digits` decimals (for JSON and summaries).
+pub(crate) fn round(x: f64, digits: i32) -> f64 {
+    let p = 10f64.powi(digits);
+    (x * p).round() / p
+}
+
+/// Parses the arguments, runs the subcommand, prints an error as one
+/// readable paragraph on stderr (exit code 1; usage errors exit with 2).
+pub(crate) fn run() -> ExitCode {
+    let cli = Cli::parse();
+    let mut context = Context {
+        json: cli.json,
+        force: cli.force,
+        progress: !cli.quiet && std::io::stderr().is_terminal(),
+        timings: Vec::new(),
+    };
+    let result = match cli.command {
+        Command::Info(args) => info::run(&mut context, args),
+        Command::Sample(args) => sample::run(&mut context, args),
+        Command::Colors(command) => colors::run(&mut context, command),
+        Command::Demo(args) => demo::run(&mut context, args),
+        Command::Bench(args) => bench::run(&mut context, args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", message(&e));
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The error and its causes as one paragraph, without repeating a cause
+/// the message already contains.
+fn message(e: &Error) -> String {
+    let mut text = e.to_string();
+    let mut source = std::error::Error::source(e);
+    while let Some(s) = source {
+        let part = s.to_string();
+        if !text.contains(&part) {
+            text.push_str(": ");
+            text.push_str(&part);
+        }
+        source = s.source();
+    }
+    text
+}
+
+/// Reads a triangle mesh, naming the file in any error.
+pub(crate) fn read_mesh(context: &mut Context, path: &Path) -> Result<trilux_io::mesh::TriMesh> {
+    let mesh = context.step("reading the mesh", || trilux_io::mesh::TriMesh::read(path))?;
+    if mesh.indices.is_empty() {
+        return Err(invalid(format!(
+            "{}: the file has no triangles (a point cloud or an empty mesh)",
+            path.display()
+        )));
+    }
+    Ok(mesh)
+}
+
+/// Reads an image.
+pub(crate) fn read_image(
+    context: &mut Context,
+    path: &Path,
+    raw: bool,
+) -> Result<trilux_io::image::Image> {
+    let options = trilux_io::image::ReadOptions {
+        raw,
+        ..Default::default()
+    };
+    Ok(context.step("reading the image", || {
+        trilux_io::image::read_with(path, options)
+    })?)
+}
+
+/// Writes an image as PNG (8-bit sRGB) or EXR (linear, f32) by extension,
+/// atomically, refusing to overwrite without `--force`.
+pub(crate) fn write_image(
+    context: &Context,
+    path: &Path,
+    image: &trilux_io::image::Image,
+) -> Result<()> {
+    let ext = extension(path);
+    trilux::output::write_atomic(path, context.force, |tmp| match ext.as_str() {
+        "png" => Ok(trilux_io::image::write_png(
+            tmp,
+            image,
+            trilux_io::image::PngDepth::Eight,
+        )?),
+        "exr" => Ok(trilux_io::image::write_exr(
+            tmp,
+            image,
+            trilux_io::image::ExrPrecision::F32,
+        )?),
+        _ => Err(invalid(format!(
+            "{}: unknown image extension {ext:?} (write .png or .exr)",
+            path.display()
+        ))),
+    })
+}
+
+/// The lowercased extension.
+pub(crate) fn extension(path: &Path) -> String {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default()
+}
+
+/// Checks that an output's folder exists and the extension is one of
+/// `allowed`, before any long computation.
+pub(crate) fn check_output(context: &Context, path: &Path, allowed: &[&str]) -> Result<()> {
+    let ext = extension(path);
+    if !allowed.contains(&ext.as_str()) {
+        return Err(invalid(format!(
+            "{}: unknown output extension {ext:?} (expected {})",
+            path.display(),
+            allowed
+                .iter()
+                .map(|e| format!(".{e}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        return Err(invalid(format!(
+            "{}: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        )));
+    }
+    trilux::output::check_new(path, context.force)
+}
+
+/// Runs `f` on `threads` threads (all when `None`).
+pub(crate) fn with_threads<T: Send>(
+    threads: Option<usize>,
+    f: impl FnOnce() -> T + Send,
+) -> Result<T> {
+    match threads {
+        None => Ok(f()),
+        Some(0) => Err(invalid("--threads must be at least 1")),
+        Some(n) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| invalid(format!("--threads {n}: {e}")))?;
+            Ok(pool.install(f))
+        }
+    }
+}
+
+/// A path for display in summaries.
+pub(crate) fn shown(path: &Path) -> String {
+    path.display().to_string()
+}

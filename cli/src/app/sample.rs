@@ -1,0 +1,336 @@
+//! `trilux sample`: random points on a mesh, uniform or with a density
+//! (texture, per-face weights, or a mesh-colours channel), to a PLY point
+//! cloud.
+
+use std::path::{Path, PathBuf};
+
+use clap::ValueEnum;
+use glam::Vec3;
+use mesh_sampling::{
+    Channel, Density, DensitySampler, Mode, RejectionSampler, SurfacePoint, SurfaceSampler,
+    UniformSampler,
+};
+use trilux_io::mesh::TriMesh;
+use trilux_io::mesh::ply;
+
+use super::{Context, Result, invalid};
+
+/// The most points one run may ask for (about 100 bytes each while
+/// sampling and writing).
+pub(crate) const MAX_POINTS: u64 = 200_000_000;
+
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Scatter random points on a mesh (uniform or with a density) and write a PLY point cloud",
+    after_help = "Example:\n  trilux sample ../shared/data/meshes/spot.obj -n 1000000 \\\n      --density ../shared/data/textures/spot_texture.png -o spot.ply --preview spot.png"
+)]
+pub(crate) struct Args {
+    /// The mesh: .obj, .gltf, .glb or .ply.
+    pub(crate) mesh: PathBuf,
+    /// How many points.
+    #[arg(short = 'n', long = "count", value_name = "N")]
+    pub(crate) count: u64,
+    /// A density texture (PNG, JPEG, HDR, EXR), looked up at the mesh's UVs;
+    /// 8/16-bit values are used as stored (no sRGB decoding).
+    #[arg(long, value_name = "IMAGE", group = "density_source")]
+    pub(crate) density: Option<PathBuf>,
+    /// Which value of the density image (or mesh colours) is the density.
+    #[arg(long, value_enum, default_value_t = ChannelArg::Luminance)]
+    pub(crate) channel: ChannelArg,
+    /// One weight per triangle, one number per line (`#` comments allowed).
+    #[arg(long, value_name = "FILE", group = "density_source")]
+    pub(crate) face_weights: Option<PathBuf>,
+    /// Mesh colours of this mesh (`trilux colors convert`) as the density.
+    #[arg(long, value_name = "FILE.meshcolors", group = "density_source")]
+    pub(crate) density_meshcolors: Option<PathBuf>,
+    /// subdivision: Šik & Křivánek's approximation (default with a
+    /// density); exact: the filtered density exactly; rejection: the
+    /// paper's baseline; uniform: by area (default without a density).
+    #[arg(long, value_enum)]
+    pub(crate) method: Option<Method>,
+    /// The random seed (same seed, same points, on any number of threads).
+    #[arg(long, default_value_t = 0)]
+    pub(crate) seed: u64,
+    /// Threads to use (all by default).
+    #[arg(long)]
+    pub(crate) threads: Option<usize>,
+    /// The PLY file to write (positions, normals, UVs, face ids).
+    #[arg(short, long, value_name = "OUT.ply")]
+    pub(crate) output: PathBuf,
+    /// Write ASCII PLY instead of binary.
+    #[arg(long)]
+    pub(crate) ascii: bool,
+    /// Also render a PNG (or EXR) picture of the points on the mesh.
+    #[arg(long, value_name = "OUT.png")]
+    pub(crate) preview: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum ChannelArg {
+    Luminance,
+    R,
+    G,
+    B,
+    A,
+}
+
+impl ChannelArg {
+    pub(crate) fn channel(self) -> Channel {
+        match self {
+            Self::Luminance => Channel::Luminance,
+            Self::R => Channel::Index(0),
+            Self::G => Channel::Index(1),
+            Self::B => Channel::Index(2),
+            Self::A => Channel::Index(3),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum Method {
+    Subdivision,
+    Exact,
+    Rejection,
+    Uniform,
+}
+
+impl Method {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Subdivision => "subdivision",
+            Self::Exact => "exact",
+            Self::Rejection => "rejection",
+            Self::Uniform => "uniform",
+        }
+    }
+}
+
+/// The density a run samples.
+pub(crate) enum Source {
+    Uniform,
+    Texture(mesh_sampling::DensityTexture),
+    FaceWeights(Vec<f32>),
+    /// Mesh colours, as a texture over a mesh of per-corner vertices.
+    Atlas(trilux::colors::ColorDensity),
+}
+
+/// Draws `n` points of `source` on `mesh` with `method`.
+pub(crate) fn draw(
+    mesh: &TriMesh,
+    source: &Source,
+    method: Method,
+    seed: u64,
+    n: usize,
+) -> Result<Vec<SurfacePoint>> {
+    let base = trilux::mesh_ref(mesh);
+    let (mesh_ref, texture) = match source {
+        Source::Uniform => (base, None),
+        Source::Texture(t) => (base, Some(t)),
+        Source::FaceWeights(w) => {
+            let sampler = DensitySampler::new(base, Density::PerFace(w))?;
+            return Ok(sampler.sample_n(seed, n)?);
+        }
+        Source::Atlas(density) => (density.mesh_ref(), Some(&density.texture)),
+    };
+    let Some(texture) = texture else {
+        return Ok(UniformSampler::new(mesh_ref)?.sample_n(seed, n)?);
+    };
+    let points = match method {
+        Method::Uniform => UniformSampler::new(mesh_ref)?.sample_n(seed, n),
+        Method::Rejection => RejectionSampler::new(mesh_ref, texture)?.sample_n(seed, n),
+        Method::Subdivision | Method::Exact => {
+            let options = mesh_sampling::Options {
+                mode: if method == Method::Exact {
+                    Mode::Exact
+                } else {
+                    Mode::Approximate
+                },
+                ..Default::default()
+            };
+            DensitySampler::with_options(mesh_ref, Density::Texture(texture), &options)?
+                .sample_n(seed, n)
+        }
+    };
+    Ok(points?)
+}
+
+/// Reads per-face weights: one number per line, blank lines and `#`
+/// comments skipped, exactly one per triangle.
+pub(crate) fn read_face_weights(path: &Path, triangles: usize) -> Result<Vec<f32>> {
+    let text = std::fs::read_to_string(path).map_err(|source| trilux::Error::File {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut weights = Vec::with_capacity(triangles);
+    for (i, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let w: f32 = line.parse().map_err(|_| {
+            invalid(format!(
+                "{}: line {}: expected a weight (a number), found {line:?}",
+                path.display(),
+                i + 1
+            ))
+        })?;
+        if !(w.is_finite() && w >= 0.0) {
+            return Err(invalid(format!(
+                "{}: line {}: weight {w} is not finite and >= 0",
+                path.display(),
+                i + 1
+            )));
+        }
+        weights.push(w);
+    }
+    if weights.len() != triangles {
+        return Err(invalid(format!(
+            "{}: {} weights for a mesh of {triangles} triangles (one per triangle, in file order)",
+            path.display(),
+            weights.len()
+        )));
+    }
+    Ok(weights)
+}
+
+/// A density from one channel of mesh colours made for `mesh`.
+pub(crate) fn meshcolors_source(mesh: &TriMesh, path: &Path, channel: Channel) -> Result<Source> {
+    let (surface, colors) = super::colors::load_for(mesh, path)?;
+    let density = trilux::colors::color_density(&surface, &colors, channel)
+        .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+    Ok(Source::Atlas(density))
+}
+
+pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    if args.count == 0 || args.count > MAX_POINTS {
+        return Err(invalid(format!(
+            "-n {}: the number of points must be between 1 and {MAX_POINTS}",
+            args.count
+        )));
+    }
+    super::check_output(context, &args.output, &["ply"])?;
+    if let Some(p) = &args.preview {
+        super::check_output(context, p, &["png", "exr"])?;
+    }
+    let mesh = super::read_mesh(context, &args.mesh)?;
+    let has_density =
+        args.density.is_some() || args.face_weights.is_some() || args.density_meshcolors.is_some();
+    let method = args.method.unwrap_or(if has_density {
+        Method::Subdivision
+    } else {
+        Method::Uniform
+    });
+    if method != Method::Uniform && !has_density {
+        return Err(invalid(format!(
+            "--method {} needs a density (--density, --face-weights or --density-meshcolors)",
+            method.name()
+        )));
+    }
+    if method == Method::Uniform && has_density {
+        return Err(invalid(
+            "--method uniform samples by area and would ignore the density: choose subdivision, exact or rejection",
+        ));
+    }
+    let source = if let Some(path) = &args.density {
+        if mesh.uvs.is_none() {
+            return Err(invalid(format!(
+                "{}: a density texture is looked up at texture coordinates, and the mesh has none",
+                args.mesh.display()
+            )));
+        }
+        let image = super::read_image(context, path, true)?;
+        let wrap = mesh
+            .materials
+            .first()
+            .map_or(mesh_sampling::Wrap::Repeat, |m| {
+                trilux::sampling_wrap(m.wrap[0])
+            });
+        let texture = trilux::density_texture(&image, args.channel.channel())
+            .map_err(|e| invalid(format!("{}: {e}", path.display())))?
+            .with_wrap(wrap);
+        Source::Texture(texture)
+    } else if let Some(path) = &args.face_weights {
+        if method == Method::Rejection {
+            return Err(invalid(
+                "--method rejection needs a texture density; per-face weights are sampled exactly by subdivision",
+            ));
+        }
+        Source::FaceWeights(read_face_weights(path, mesh.indices.len())?)
+    } else if let Some(path) = &args.density_meshcolors {
+        context.step("baking the mesh colours", || {
+            meshcolors_source(&mesh, path, args.channel.channel())
+        })?
+    } else {
+        Source::Uniform
+    };
+    let n = args.count as usize;
+    let points = super::with_threads(args.threads, || {
+        context.step("sampling", || draw(&mesh, &source, method, args.seed, n))
+    })??;
+    let cloud = context.step("building the point cloud", || {
+        trilux::point_cloud(&mesh, &points)
+    });
+    let format = if args.ascii {
+        ply::Format::Ascii
+    } else {
+        ply::Format::BinaryLittleEndian
+    };
+    let force = context.force;
+    context.step("writing the PLY file", || {
+        trilux::output::write_atomic(&args.output, force, |tmp| {
+            Ok(ply::write(tmp, &cloud, format)?)
+        })
+    })?;
+    if let Some(path) = &args.preview {
+        let image = context.step("rendering the preview", || {
+            preview(&mesh, &points, 768, 768)
+        });
+        super::write_image(context, path, &image)?;
+    }
+    let text = format!(
+        "{} points ({}) on {} ({} triangles) written to {}{}\n",
+        points.len(),
+        method.name(),
+        args.mesh.display(),
+        mesh.indices.len(),
+        args.output.display(),
+        args.preview
+            .as_ref()
+            .map(|p| format!(", preview {}", p.display()))
+            .unwrap_or_default()
+    );
+    let json = serde_json::json!({
+        "command": "sample",
+        "mesh": super::shown(&args.mesh),
+        "triangles": mesh.indices.len(),
+        "points": points.len(),
+        "method": method.name(),
+        "seed": args.seed,
+        "output": super::shown(&args.output),
+        "preview": args.preview.as_deref().map(super::shown),
+        "seconds": context.timings_json(),
+    });
+    context.report(&text, json);
+    Ok(())
+}
+
+/// The mesh in grey with the points (at most 300,000 of them) as orange
+/// splats.
+pub(crate) fn preview(
+    mesh: &TriMesh,
+    points: &[SurfacePoint],
+    width: u32,
+    height: u32,
+) -> trilux_io::image::Image {
+    use trilux::preview::{Camera, Renderer, lambert};
+    let Some((lo, hi)) = trilux::mesh::bounds(mesh) else {
+        return trilux::preview::render_mesh(&[], &[], width, height);
+    };
+    let mut r = Renderer::new(width, height, Camera::fit(lo, hi));
+    r.draw_mesh(&mesh.positions, &mesh.indices, |f| lambert([0.55; 3], f));
+    let step = points.len().div_ceil(300_000).max(1);
+    let shown: Vec<Vec3> = points.iter().step_by(step).map(|p| p.position).collect();
+    let radius = (250.0 / (shown.len() as f32).sqrt()).clamp(0.5, 3.0);
+    r.draw_points(&shown, radius, |_| [1.0, 0.35, 0.05]);
+    r.image()
+}

@@ -1,0 +1,67 @@
+//! The one error type of the adapters.
+
+use std::path::PathBuf;
+
+/// Why an adapter could not turn a file's data into an algorithm crate's
+/// input (or back). Every message names the input and the problem.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// Reading or writing a file failed (the message names the file, the
+    /// line or byte, and the problem).
+    #[error(transparent)]
+    Io(#[from] trilux_io::Error),
+    /// mesh-sampling refused the mesh or the density.
+    #[error("sampling: {0}")]
+    Sampling(#[from] mesh_sampling::Error),
+    /// mesh-colors refused the mesh, the texture or the file.
+    #[error("mesh colours: {0}")]
+    Colors(#[from] mesh_colors::Error),
+    /// The mesh has no texture coordinates but the operation needs them.
+    #[error("{what} needs texture coordinates, and the mesh has none")]
+    MissingUvs {
+        /// The operation.
+        what: &'static str,
+    },
+    /// No texture was given and the mesh's materials have none.
+    #[error(
+        "the mesh has no material with a texture: give one (for the command line: --texture IMAGE)"
+    )]
+    MissingTexture,
+    /// A `.meshcolors` file was made for another mesh.
+    #[error(
+        "{path}: these mesh colours belong to a mesh of {file_vertices} vertices and {file_faces} faces, but the mesh (welded) has {mesh_vertices} vertices and {mesh_faces} faces{detail}"
+    )]
+    WrongMesh {
+        /// The `.meshcolors` file.
+        path: PathBuf,
+        /// Vertices the file's topology has.
+        file_vertices: usize,
+        /// Faces the file's topology has.
+        file_faces: usize,
+        /// Vertices of the welded mesh.
+        mesh_vertices: usize,
+        /// Faces of the welded mesh.
+        mesh_faces: usize,
+        /// Which face differs, when the counts agree.
+        detail: String,
+    },
+    /// An argument out of its range.
+    #[error("{0}")]
+    Invalid(String),
+    /// The output exists and overwriting was not asked for.
+    #[error("{0}: the file exists; pass --force to overwrite it")]
+    Exists(PathBuf),
+    /// An I/O failure outside trilux-io (temporary files, renames).
+    #[error("{path}: {source}")]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// Short for `Result<T, Error>`.
+pub type Result<T> = std::result::Result<T, Error>;

@@ -1,0 +1,724 @@
+//! End-to-end tests of the `trilux` binary: outputs exist, parse back with
+//! trilux-io and carry the right counts; bad inputs fail with a message
+//! naming the problem and the file; outputs are never clobbered or left
+//! half-written.
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use assert_cmd::Command;
+use trilux_io::mesh::TriMesh;
+use trilux_tests::{data, trilux_bin};
+
+fn trilux(dir: &Path) -> Command {
+    let mut c = Command::new(trilux_bin());
+    c.current_dir(dir);
+    c
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Runs and expects failure with exit code 1 or 2 and a one-paragraph
+/// message containing every `needle`, no panic and no backtrace.
+fn fails(dir: &Path, args: &[&str], needles: &[&str]) {
+    let out = trilux(dir).args(args).output().unwrap();
+    let err = stderr(&out);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert!(
+        matches!(out.status.code(), Some(1 | 2)),
+        "{args:?}: {:?}",
+        out.status
+    );
+    assert!(
+        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
+        "{err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: {n:?} not in {err:?}");
+    }
+}
+
+/// A built-in textured torus and a noise texture written as files.
+fn inputs(dir: &Path) -> (PathBuf, PathBuf) {
+    let torus = dir.join("torus.obj");
+    trilux::shapes::torus(48, 24).write(&torus).unwrap();
+    let noise = dir.join("noise.png");
+    trilux_io::image::write(&noise, &trilux::shapes::noise(64, 64, 1)).unwrap();
+    (torus, noise)
+}
+
+fn no_partial_files(dir: &Path) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(!name.contains(".partial"), "left behind: {name}");
+    }
+}
+
+#[test]
+fn every_subcommand_has_help_with_an_example() {
+    let dir = tempfile::tempdir().unwrap();
+    for sub in [
+        &["info"][..],
+        &["sample"],
+        &["colors", "convert"],
+        &["colors", "bake"],
+        &["colors", "render"],
+        &["demo"],
+        &["bench"],
+    ] {
+        let mut args = sub.to_vec();
+        args.push("--help");
+        let out = trilux(dir.path()).args(&args).output().unwrap();
+        assert!(out.status.success(), "{args:?}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("Example"), "{args:?}: {text}");
+    }
+}
+
+#[test]
+fn sample_writes_binary_or_ascii_ply_with_normals_uvs_and_faces() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, noise) = inputs(d);
+    let torus = torus.to_str().unwrap();
+    let out = trilux(d)
+        .args([
+            "sample",
+            torus,
+            "-n",
+            "5000",
+            "--density",
+            noise.to_str().unwrap(),
+            "-o",
+            "a.ply",
+            "--preview",
+            "a.png",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["points"], 5000);
+    assert_eq!(json["method"], "subdivision");
+    let ply = trilux_io::mesh::ply::read(d.join("a.ply")).unwrap();
+    assert_eq!(ply.positions.len(), 5000);
+    assert!(ply.normals.is_some() && ply.uvs.is_some());
+    let mesh = TriMesh::read(torus).unwrap();
+    assert!(
+        ply.face_ids
+            .as_ref()
+            .unwrap()
+            .iter()
+            .all(|&f| (f as usize) < mesh.indices.len())
+    );
+    assert!(
+        std::fs::read(d.join("a.ply"))
+            .unwrap()
+            .starts_with(b"ply\nformat binary_little_endian")
+    );
+    let preview = trilux_io::image::read(d.join("a.png")).unwrap();
+    assert_eq!((preview.width, preview.height), (768, 768));
+    // ASCII, other methods, same seed → same points on any thread count.
+    for (method, threads) in [("exact", "1"), ("rejection", "2"), ("subdivision", "1")] {
+        let out = trilux(d)
+            .args([
+                "-q",
+                "sample",
+                torus,
+                "-n",
+                "3000",
+                "--density",
+                noise.to_str().unwrap(),
+                "--method",
+                method,
+                "--threads",
+                threads,
+                "--ascii",
+                "-o",
+                &format!("{method}{threads}.ply"),
+            ])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = std::fs::read_to_string(d.join(format!("{method}{threads}.ply"))).unwrap();
+        assert!(text.starts_with("ply\nformat ascii"));
+        assert_eq!(
+            trilux_io::mesh::ply::read(d.join(format!("{method}{threads}.ply")))
+                .unwrap()
+                .positions
+                .len(),
+            3000
+        );
+    }
+    let one = trilux_io::mesh::ply::read(d.join("subdivision1.ply")).unwrap();
+    trilux(d)
+        .args([
+            "-q",
+            "sample",
+            torus,
+            "-n",
+            "3000",
+            "--density",
+            noise.to_str().unwrap(),
+            "--threads",
+            "2",
+            "--ascii",
+            "-o",
+            "two.ply",
+        ])
+        .assert()
+        .success();
+    assert_eq!(
+        one.positions,
+        trilux_io::mesh::ply::read(d.join("two.ply"))
+            .unwrap()
+            .positions
+    );
+    // Uniform and per-face weights.
+    let weights: String = (0..mesh.indices.len())
+        .map(|f| format!("{}\n", f % 3))
+        .collect();
+    std::fs::write(d.join("w.txt"), weights).unwrap();
+    trilux(d)
+        .args(["sample", torus, "-n", "100", "-o", "u.ply"])
+        .assert()
+        .success();
+    trilux(d)
+        .args([
+            "sample",
+            torus,
+            "-n",
+            "100",
+            "--face-weights",
+            "w.txt",
+            "-o",
+            "w.ply",
+        ])
+        .assert()
+        .success();
+    let w = trilux_io::mesh::ply::read(d.join("w.ply")).unwrap();
+    assert!(
+        w.face_ids.unwrap().iter().all(|f| f % 3 != 0),
+        "weight-0 faces get no points"
+    );
+    no_partial_files(d);
+}
+
+#[test]
+fn colors_convert_bake_render_and_sample_by_mesh_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, noise) = inputs(d);
+    let (torus, noise) = (torus.to_str().unwrap(), noise.to_str().unwrap());
+    let out = trilux(d)
+        .args([
+            "colors",
+            "convert",
+            torus,
+            "--texture",
+            noise,
+            "-o",
+            "t.meshcolors",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(json["psnr_db"].as_f64().unwrap() > 30.0, "{json}");
+    let (colors, _) = mesh_colors::file::load(d.join("t.meshcolors")).unwrap();
+    assert_eq!(colors.face_count(), 48 * 24 * 2);
+    trilux(d)
+        .args([
+            "colors",
+            "bake",
+            torus,
+            "t.meshcolors",
+            "-o",
+            "atlas.obj",
+            "--mip",
+            "2",
+        ])
+        .assert()
+        .success();
+    let baked = TriMesh::read(d.join("atlas.obj")).unwrap();
+    assert_eq!(baked.indices.len(), colors.face_count());
+    assert!(
+        baked.materials[0]
+            .diffuse_texture
+            .as_ref()
+            .unwrap()
+            .exists()
+    );
+    for filter in ["nearest", "linear", "mip", "aniso"] {
+        trilux(d)
+            .args([
+                "colors",
+                "render",
+                torus,
+                "t.meshcolors",
+                "--filter",
+                filter,
+                "--size",
+                "64",
+                "-o",
+                &format!("{filter}.png"),
+            ])
+            .assert()
+            .success();
+        assert_eq!(
+            trilux_io::image::read(d.join(format!("{filter}.png")))
+                .unwrap()
+                .width,
+            64
+        );
+    }
+    trilux(d)
+        .args([
+            "colors",
+            "render",
+            torus,
+            "t.meshcolors",
+            "--size",
+            "32",
+            "-o",
+            "r.exr",
+        ])
+        .assert()
+        .success();
+    trilux(d)
+        .args([
+            "sample",
+            torus,
+            "-n",
+            "2000",
+            "--density-meshcolors",
+            "t.meshcolors",
+            "--channel",
+            "r",
+            "-o",
+            "mc.ply",
+        ])
+        .assert()
+        .success();
+    assert_eq!(
+        trilux_io::mesh::ply::read(d.join("mc.ply"))
+            .unwrap()
+            .positions
+            .len(),
+        2000
+    );
+    trilux(d)
+        .args([
+            "colors",
+            "render",
+            torus,
+            "t.meshcolors",
+            "--size",
+            "32",
+            "--view",
+            "1,0,0",
+            "-o",
+            "side.png",
+        ])
+        .assert()
+        .success();
+    fails(
+        d,
+        &[
+            "colors",
+            "render",
+            torus,
+            "t.meshcolors",
+            "--view",
+            "0,0,0",
+            "-o",
+            "zero.png",
+        ],
+        &["--view"],
+    );
+    // Mesh colours of another mesh are refused, naming the file.
+    trilux::shapes::torus(20, 10)
+        .write(d.join("other.obj"))
+        .unwrap();
+    fails(
+        d,
+        &[
+            "colors",
+            "render",
+            "other.obj",
+            "t.meshcolors",
+            "-o",
+            "x.png",
+        ],
+        &["t.meshcolors", "belong to a mesh"],
+    );
+    no_partial_files(d);
+}
+
+#[test]
+fn info_describes_meshes_images_point_clouds_and_mesh_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, noise) = inputs(d);
+    let out = trilux(d)
+        .args(["info", torus.to_str().unwrap(), "--json"])
+        .output()
+        .unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["triangles"], 48 * 24 * 2);
+    assert_eq!(json["holes"], 0);
+    assert_eq!(json["parts"], 1);
+    assert_eq!(json["welded_vertices"], 48 * 24);
+    let out = trilux(d)
+        .args(["info", noise.to_str().unwrap(), "--json"])
+        .output()
+        .unwrap();
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["width"], 64);
+    let out = trilux(d)
+        .args(["info", torus.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stdout).contains("triangles: 2304"));
+}
+
+#[test]
+fn demo_writes_every_pipeline_with_a_preview_and_refuses_to_overwrite() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = trilux(d)
+        .args(["demo", "--out", "demo", "--size", "96", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let pipelines = json["pipelines"].as_array().unwrap();
+    assert!(pipelines.len() >= 6);
+    for p in pipelines {
+        let files = p["files"].as_array().unwrap();
+        assert!(
+            files.iter().any(|f| f.as_str().unwrap().ends_with(".png")),
+            "{p}"
+        );
+        for f in files {
+            let f = d.join(f.as_str().unwrap());
+            assert!(f.exists(), "{}", f.display());
+            match f.extension().unwrap().to_str().unwrap() {
+                "ply" => assert!(!trilux_io::mesh::ply::read(&f).unwrap().positions.is_empty()),
+                "obj" => assert!(!TriMesh::read(&f).unwrap().indices.is_empty()),
+                "png" | "exr" => assert!(trilux_io::image::read(&f).unwrap().width > 0),
+                "meshcolors" => assert!(mesh_colors::file::load(&f).unwrap().0.sample_count() > 0),
+                _ => {}
+            }
+        }
+    }
+    fails(d, &["demo", "--out", "demo"], &["demo", "--force"]);
+    trilux(d)
+        .args(["demo", "--out", "demo", "--size", "32", "--force"])
+        .assert()
+        .success();
+}
+
+#[test]
+fn bad_inputs_fail_with_a_message_naming_the_problem_and_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, _) = inputs(d);
+    let torus = torus.to_str().unwrap();
+    fails(
+        d,
+        &["sample", "missing.obj", "-n", "10", "-o", "a.ply"],
+        &["missing.obj"],
+    );
+    std::fs::write(
+        d.join("corrupt.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n",
+    )
+    .unwrap();
+    fails(
+        d,
+        &["sample", "corrupt.obj", "-n", "10", "-o", "a.ply"],
+        &["corrupt.obj", "line 4"],
+    );
+    std::fs::write(d.join("fake.png"), "this is not a PNG").unwrap();
+    fails(
+        d,
+        &[
+            "sample",
+            torus,
+            "-n",
+            "10",
+            "--density",
+            "fake.png",
+            "-o",
+            "a.ply",
+        ],
+        &["fake.png", "PNG"],
+    );
+    fails(d, &["info", "fake.png"], &["fake.png"]);
+    fails(d, &["sample", torus, "-n", "-5", "-o", "a.ply"], &["-5"]);
+    fails(d, &["sample", torus, "-n", "0", "-o", "a.ply"], &["-n 0"]);
+    fails(
+        d,
+        &[
+            "sample", torus, "-n", "10", "--method", "magic", "-o", "a.ply",
+        ],
+        &["magic"],
+    );
+    fails(
+        d,
+        &["sample", torus, "-n", "10", "-o", "a.txt"],
+        &["a.txt", ".ply"],
+    );
+    fails(
+        d,
+        &["sample", torus, "-n", "10", "-o", "nowhere/a.ply"],
+        &["nowhere"],
+    );
+    fails(
+        d,
+        &["sample", torus, "-n", "10", "--threads", "0", "-o", "a.ply"],
+        &["--threads"],
+    );
+    std::fs::write(d.join("w.txt"), "1\n2\nthree\n").unwrap();
+    fails(
+        d,
+        &[
+            "sample",
+            torus,
+            "-n",
+            "10",
+            "--face-weights",
+            "w.txt",
+            "-o",
+            "a.ply",
+        ],
+        &["w.txt", "line 3", "three"],
+    );
+    fails(
+        d,
+        &["colors", "convert", torus, "-o", "t.meshcolors"],
+        &["torus.obj", "--texture"],
+    );
+    fails(
+        d,
+        &[
+            "colors",
+            "convert",
+            torus,
+            "--texture",
+            "fake.png",
+            "--max-res",
+            "100",
+            "-o",
+            "t.meshcolors",
+        ],
+        &["--max-res 100"],
+    );
+    std::fs::write(d.join("bad.meshcolors"), "MESHCOLR garbage").unwrap();
+    fails(
+        d,
+        &["colors", "render", torus, "bad.meshcolors", "-o", "x.png"],
+        &["bad.meshcolors"],
+    );
+    fails(d, &["info", "notes.xyz"], &["notes.xyz"]);
+    no_partial_files(d);
+    assert!(!d.join("a.ply").exists());
+}
+
+#[test]
+fn an_existing_output_is_kept_without_force_and_replaced_with_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, _) = inputs(d);
+    let torus = torus.to_str().unwrap();
+    std::fs::write(d.join("out.ply"), "precious").unwrap();
+    fails(
+        d,
+        &["sample", torus, "-n", "10", "-o", "out.ply"],
+        &["out.ply", "--force"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.join("out.ply")).unwrap(),
+        "precious"
+    );
+    trilux(d)
+        .args(["sample", torus, "-n", "10", "-o", "out.ply", "--force"])
+        .assert()
+        .success();
+    assert_eq!(
+        trilux_io::mesh::ply::read(d.join("out.ply"))
+            .unwrap()
+            .positions
+            .len(),
+        10
+    );
+    no_partial_files(d);
+}
+
+#[test]
+fn an_interrupted_run_leaves_no_output_file_or_a_complete_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, _) = inputs(d);
+    let mut child = std::process::Command::new(trilux_bin())
+        .current_dir(d)
+        .args([
+            "-q",
+            "sample",
+            torus.to_str().unwrap(),
+            "-n",
+            "3000000",
+            "-o",
+            "big.ply",
+        ])
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let _ = child.kill();
+    let _ = child.wait();
+    let out = d.join("big.ply");
+    if out.exists() {
+        assert_eq!(
+            trilux_io::mesh::ply::read(&out).unwrap().positions.len(),
+            3_000_000
+        );
+    }
+}
+
+#[test]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
+fn real_files_through_every_subcommand() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bunny = data("meshes/stanford-bunny.obj");
+    let spot = data("meshes/spot.obj");
+    let texture = data("textures/spot_texture.png");
+    let s = |p: &Path| p.to_str().unwrap().to_string();
+    trilux(d)
+        .args([
+            "sample",
+            &s(&bunny),
+            "-n",
+            "20000",
+            "-o",
+            "bunny.ply",
+            "--preview",
+            "bunny.png",
+        ])
+        .assert()
+        .success();
+    let ply = trilux_io::mesh::ply::read(d.join("bunny.ply")).unwrap();
+    assert_eq!(ply.positions.len(), 20000);
+    assert!(ply.uvs.is_none());
+    trilux(d)
+        .args([
+            "sample",
+            &s(&spot),
+            "-n",
+            "20000",
+            "--density",
+            &s(&texture),
+            "-o",
+            "spot.ply",
+        ])
+        .assert()
+        .success();
+    trilux(d)
+        .args([
+            "colors",
+            "convert",
+            &s(&spot),
+            "--texture",
+            &s(&texture),
+            "-o",
+            "spot.meshcolors",
+        ])
+        .assert()
+        .success();
+    trilux(d)
+        .args([
+            "colors",
+            "bake",
+            &s(&spot),
+            "spot.meshcolors",
+            "-o",
+            "spot_atlas.obj",
+        ])
+        .assert()
+        .success();
+    assert_eq!(
+        TriMesh::read(d.join("spot_atlas.obj"))
+            .unwrap()
+            .indices
+            .len(),
+        5856
+    );
+    trilux(d)
+        .args([
+            "colors",
+            "render",
+            &s(&spot),
+            "spot.meshcolors",
+            "--filter",
+            "aniso",
+            "-o",
+            "spot.png",
+        ])
+        .assert()
+        .success();
+    // A glTF with embedded texture converts without --texture.
+    let fox = data("gltf/Fox.glb");
+    trilux(d)
+        .args(["colors", "convert", &s(&fox), "-o", "fox.meshcolors"])
+        .assert()
+        .success();
+    for (file, key, value) in [
+        ("meshes/stanford-bunny.obj", "holes", 5),
+        ("meshes/teapot.obj", "welded_vertices", 3_241),
+        ("tets/sphere_20k.node", "tetrahedra", 19_443),
+        ("tets/bunny_500k.msh", "nodes", 93_375),
+    ] {
+        let out = trilux(d)
+            .args(["info", &s(&data(file)), "--json"])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{file}: {}", stderr(&out));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(json[key], value, "{file}: {json}");
+    }
+    // Mesh colours made for spot are refused for the bunny.
+    fails(
+        d,
+        &[
+            "colors",
+            "render",
+            &s(&bunny),
+            "spot.meshcolors",
+            "-o",
+            "x.png",
+        ],
+        &["spot.meshcolors"],
+    );
+    fails(
+        d,
+        &[
+            "sample",
+            &s(&bunny),
+            "-n",
+            "10",
+            "--density",
+            &s(&texture),
+            "-o",
+            "x.ply",
+        ],
+        &["stanford-bunny.obj", "texture coordinates"],
+    );
+}
