@@ -3,13 +3,14 @@
 //! Shewchuk 2007, Sec. 4; the transition tetrahedra here are our own
 //! construction, described below, not the paper's).
 //!
-//! * The lattice's cubes are the finest octree leaves. An octree cell of
-//!   size `s = 2^l` cubes (`l ≥ 1`) may stay a leaf only when every fine
-//!   cube within one cube of it is *safe*: its corners and centre are
-//!   inside, and so are all 14 lattice neighbours of each. Such cells are
-//!   never cut by the surface and none of their vertices is warped, so the
-//!   stencils only ever see pure BCC tetrahedra and the coarse tetrahedra
-//!   keep their exact, fixed shapes.
+//! * The lattice's cubes are the finest octree leaves. A lattice vertex is
+//!   *deep* when it and its 14 neighbours are inside (before warping): it
+//!   has no cut edge, so it is never warped. An octree cell of size
+//!   `s = 2^l` cubes (`l ≥ 1`) may stay a leaf only when every lattice
+//!   vertex in it (closed) is deep, and so is the centre of every cube
+//!   around it. Then every tetrahedron that touches a coarse leaf has deep
+//!   vertices only: it is never cut, never warped, and keeps its exact,
+//!   fixed shape, while the stencils only ever see pure BCC tetrahedra.
 //! * The leaves are 2:1 balanced across faces, edges and corners.
 //! * Tetrahedra: between two equal leaves sharing a face, the tetrahedra
 //!   spanned by the two leaf centres and each boundary segment of the face
@@ -42,14 +43,20 @@ pub(crate) struct Background {
 }
 
 /// Builds the octree over the lattice's cubes and its tetrahedra.
+///
+/// `signs` are the signs before warping.
 pub(crate) fn background(lattice: &Lattice, signs: &[Sign], levels: u32) -> Background {
     let n = lattice.n;
-    let safe = safe_cubes(lattice, signs);
-    let table = SummedArea::new(n, &safe);
+    let (safe, centre) = safe_cubes(lattice, signs);
+    let cubes = SummedArea::new(n, &safe);
+    let centres = SummedArea::new(n, &centre);
     let mut tree = Octree::build(n, levels, |l, a| {
         let s = 1usize << l;
-        // The cell and one cube around it, inside the lattice, all safe.
-        (0..3).all(|k| a[k] >= 1 && a[k] + s < n[k]) && table.unsafe_in(a, s) == 0
+        // Inside the lattice with a cube to spare; all vertices of the cell
+        // deep, and the centres of the cubes around it too.
+        (0..3).all(|k| a[k] >= 1 && a[k] + s < n[k])
+            && cubes.unsafe_in(a, s, 0) == 0
+            && centres.unsafe_in(a, s, 1) == 0
     });
     tree.balance();
     let fine = tree.level.iter().map(|&l| l == 0).collect();
@@ -62,8 +69,9 @@ fn cube_index(n: [usize; 3], c: [usize; 3]) -> usize {
     c[0] + n[0] * (c[1] + n[1] * c[2])
 }
 
-/// Per cube: corners and centre are inside with all their neighbours.
-fn safe_cubes(lattice: &Lattice, signs: &[Sign]) -> Vec<bool> {
+/// Per cube: whether its corners and centre are deep, and whether its
+/// centre is.
+fn safe_cubes(lattice: &Lattice, signs: &[Sign]) -> (Vec<bool>, Vec<bool>) {
     let nv = lattice.vertex_count();
     let deep: Vec<bool> = (0..nv)
         .into_par_iter()
@@ -77,7 +85,8 @@ fn safe_cubes(lattice: &Lattice, signs: &[Sign]) -> Vec<bool> {
         })
         .collect();
     let nb = lattice.black_count();
-    (0..lattice.red_count())
+    let centre = deep[nb..].to_vec();
+    let safe = (0..lattice.red_count())
         .into_par_iter()
         .with_min_len(4096)
         .map(|r| {
@@ -90,7 +99,8 @@ fn safe_cubes(lattice: &Lattice, signs: &[Sign]) -> Vec<bool> {
                         .is_some_and(|b| deep[b as usize])
                 })
         })
-        .collect()
+        .collect();
+    (safe, centre)
 }
 
 /// Counts of unsafe cubes in boxes, in O(1) per query.
@@ -122,13 +132,13 @@ impl SummedArea {
         SummedArea { n, sum }
     }
 
-    /// Unsafe cubes in the cell at `a` of size `s` grown by one cube (the
-    /// caller checks that the grown cell is inside the lattice).
-    fn unsafe_in(&self, a: [usize; 3], s: usize) -> u32 {
+    /// Unsafe cubes in the cell at `a` of size `s` grown by `grow` cubes
+    /// (the caller checks that the grown cell is inside the lattice).
+    fn unsafe_in(&self, a: [usize; 3], s: usize, grow: usize) -> u32 {
         let s1 = [self.n[0] + 1, self.n[1] + 1];
         let at = |x: usize, y: usize, z: usize| self.sum[x + s1[0] * (y + s1[1] * z)];
-        let (x0, y0, z0) = (a[0] - 1, a[1] - 1, a[2] - 1);
-        let (x1, y1, z1) = (a[0] + s + 1, a[1] + s + 1, a[2] + s + 1);
+        let (x0, y0, z0) = (a[0] - grow, a[1] - grow, a[2] - grow);
+        let (x1, y1, z1) = (a[0] + s + grow, a[1] + s + grow, a[2] + s + grow);
         let total = i64::from(at(x1, y1, z1))
             - i64::from(at(x0, y1, z1))
             - i64::from(at(x1, y0, z1))
@@ -381,6 +391,111 @@ fn mark(level: &mut [u8], n: [usize; 3], l: u32, a: [usize; 3]) {
             for x in a[0]..(a[0] + s).min(n[0]) {
                 level[cube_index(n, [x, y, z])] = l as u8;
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stuffing::quality::{dihedral_angles, signed_volume};
+    use glam::DVec3;
+
+    /// The graded background over a ball: fine BCC tetrahedra where both
+    /// cubes are fine leaves, plus the coarse ones.
+    fn ball_background(n: usize, radius: f64, levels: u32) -> (Lattice, Vec<[u32; 4]>) {
+        let lattice = Lattice {
+            origin: DVec3::ZERO,
+            h: 1.0,
+            n: [n, n, n],
+        };
+        let centre = DVec3::splat(n as f64 / 2.0);
+        let signs: Vec<Sign> = (0..lattice.vertex_count() as u32)
+            .map(|v| {
+                if lattice.position(v).distance(centre) < radius {
+                    Sign::In
+                } else {
+                    Sign::Out
+                }
+            })
+            .collect();
+        let bg = background(&lattice, &signs, levels);
+        let nb = lattice.black_count();
+        let mut tets = bg.coarse.clone();
+        let mut t = Vec::new();
+        for red in 0..lattice.red_count() {
+            lattice.red_tets(red, &mut t);
+            for tet in &t {
+                if bg.fine[red] && bg.fine[tet[1] as usize - nb] {
+                    tets.push(*tet);
+                }
+            }
+        }
+        (lattice, tets)
+    }
+
+    #[test]
+    fn graded_background_is_conforming_and_fills_the_same_volume() {
+        for levels in [1, 2, 3] {
+            let (lattice, tets) = ball_background(40, 18.0, levels);
+            let mut faces: Vec<[u32; 3]> = tets
+                .iter()
+                .flat_map(|t| {
+                    [
+                        [t[0], t[1], t[2]],
+                        [t[0], t[1], t[3]],
+                        [t[0], t[2], t[3]],
+                        [t[1], t[2], t[3]],
+                    ]
+                    .map(|mut f| {
+                        f.sort_unstable();
+                        f
+                    })
+                })
+                .collect();
+            faces.sort_unstable();
+            let mut i = 0;
+            while i < faces.len() {
+                let mut j = i;
+                while j < faces.len() && faces[j] == faces[i] {
+                    j += 1;
+                }
+                assert!(j - i <= 2, "face in {} tetrahedra", j - i);
+                if j - i == 1 {
+                    // A hull face: on the boundary of the region the fine
+                    // cubes' centres span, i.e. at least 0.5 from the centre
+                    // region: all its vertices are near the lattice's hull.
+                    let p = faces[i].map(|v| lattice.position(v));
+                    let inner = p.iter().all(|q| (0..3).all(|k| q[k] > 1.6 && q[k] < 38.4));
+                    assert!(
+                        !inner,
+                        "interior face {:?} at {p:?} in one tetrahedron",
+                        faces[i]
+                    );
+                }
+                i = j;
+            }
+            let volume: f64 = tets
+                .iter()
+                .map(|t| signed_volume(t.map(|v| lattice.position(v))).abs())
+                .sum();
+            // Same region as the uniform lattice's BCC tetrahedra.
+            let pairs = 3 * 39 * 40 * 40;
+            assert!(
+                (volume - pairs as f64 / 3.0).abs() < 1e-6,
+                "levels {levels}: {volume}"
+            );
+            let (mut lo, mut hi) = (180.0f64, 0.0f64);
+            for t in &tets {
+                for a in dihedral_angles(t.map(|v| lattice.position(v))) {
+                    lo = lo.min(a.to_degrees());
+                    hi = hi.max(a.to_degrees());
+                }
+            }
+            eprintln!(
+                "levels {levels}: {} tets, dihedral {lo:.3}..{hi:.3}",
+                tets.len()
+            );
         }
     }
 }

@@ -27,21 +27,21 @@
 //!   agree; a stencil table written in a tetrahedron's local vertex order
 //!   does not, and leaves overlapping and missing slivers between
 //!   neighbours.
-//! * otherwise (the long edge is `po` or `qo`) the quadrilateral is split
-//!   by its Delaunay diagonal: the one whose two triangles have the larger
-//!   smallest angle. It depends only on the face's four points, which both
-//!   neighbours share, so they agree. (The paper fixes these diagonals by
-//!   edge colour in its stencil figure; the two colour rules we tried —
-//!   the diagonal from the `+` end of the long or of the short cut edge —
-//!   each let one stencil case fall to 6.2° or 9.3° in the sampling test
-//!   below, the Delaunay rule does not.)
+//! * otherwise the long edge is `po` or `qo`, which both neighbours see
+//!   too: the diagonal ends at the cut point on the long edge and starts
+//!   at the other `+` vertex. (The opposite choice, from the `+` end of the
+//!   long edge, lets the (3, 0, 1) prism fall to 6.2° in the sampling test
+//!   below; a geometric Delaunay choice is conforming too but can make the
+//!   three diagonals of a prism cyclic.)
 //!
 //! A prism is split into 3 tetrahedra by coning from a vertex that two of
 //! its quadrilateral diagonals touch; among the valid choices (and both
 //! diagonals of the surface quadrilateral of a (2, 0, 2) prism, which no
 //! neighbour shares) the one with the best smallest dihedral-angle sine
-//! wins. If no vertex touches two diagonals the prism cannot be split
-//! without a Steiner point; this never happened in the sampling test.
+//! wins. With the rules above, the two lattice-face quadrilaterals of a
+//! (3, 0, 1) prism that are not symmetric both end at the long edge's cut
+//! point, and those of a (2, 0, 2) prism leave the surface quadrilateral
+//! free, so a vertex touching two diagonals always exists.
 //!
 //! The sampling test draws 400,000 lattice tetrahedra per parameter pair
 //! (random signs, cut points anywhere warping allows, warped vertices up to
@@ -107,20 +107,10 @@ fn diagonal_end(t: &LatticeTet, p: usize, q: usize, o: usize, rule: FaceRule) ->
             FaceRule::TetLocal => p.min(q),
         }
     } else {
-        // Delaunay: the split whose triangles have the larger smallest angle.
-        let (pp, pq) = (t.v[p].pos, t.v[q].pos);
-        let cq = cut(t, q, o).pos;
-        let cp = cut(t, p, o).pos;
-        let from_p = min_angle(pp, pq, cq).min(min_angle(pp, cq, cp));
-        let from_q = min_angle(pp, pq, cp).min(min_angle(pq, cq, cp));
-        if from_p >= from_q { p } else { q }
+        // The long edge is po or qo: the diagonal ends at the cut point on
+        // the long edge, from the inside vertex of the short cut edge.
+        if long(p, o) { q } else { p }
     }
-}
-
-/// Smallest angle of a triangle.
-fn min_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let ang = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p);
-    ang(a, b, c).min(ang(b, c, a)).min(ang(c, a, b))
 }
 
 /// Appends the output tetrahedra of `t` (not yet oriented).
@@ -234,7 +224,8 @@ fn prism(a: [Point; 3], b: [Point; 3], diag: [Option<bool>; 3], out: &mut Vec<[P
     }
     // The fixed diagonals never form a cycle (see the module docs), so
     // `best` is always set; a cycle would leave the cell empty rather
-    // than emit an invalid tetrahedron.
+    // than emit an invalid tetrahedron (and fails the tests).
+    debug_assert!(best.is_some(), "prism diagonals form a cycle");
     if let Some((tets, _)) = best {
         out.extend_from_slice(&tets);
     }
