@@ -1,0 +1,531 @@
+//! TransCut's Table 1 on every tetrahedral mesh in `$TRILUX_DATA/tets`
+//! (default `../shared/data/tets`), plus the P1 quadrature assembly of
+//! Arbree et al. beside TransCut's, the difference of their solutions, and
+//! the solvers compared to 1% error.
+//!
+//! ```sh
+//! cargo run --release -p tet-diffusion --example transcut -- [--json] [--export-mtx DIR] [--repeat R]
+//! ```
+//!
+//! The second table compares the solvers to 1% error for all three channels,
+//! hierarchy build included (built once, shared by the channels).
+//!
+//! Marble (Jensen et al. 2001), η = 1.3. The bunnies are in metres
+//! (1 unit = 1000 mm); the unit spheres are taken as 20 mm in radius
+//! (1 unit = 20 mm). One directional light from above (one-sided). Times
+//! are medians of `R` runs (default 3) in ms:
+//!
+//! - T_b: neighbourhoods (the validated mesh) + the V-cycle hierarchy;
+//! - T_m: TransCut's three RGB matrices (cotangent weights and Eq. 10–14);
+//! - T_s: per RGB channel (a third of the three-channel time), CG
+//!   preconditioned by the V-cycle (one hierarchy shared by the channels)
+//!   from φ = 0 to 1% relative error `‖φ − φ*‖/‖φ*‖` against a reference
+//!   solved to a residual of 10⁻¹⁰;
+//! - T_cut: a plane cut through the centre with 5 relaxation sweeps, the
+//!   rebuild (mesh, matrices, shadows) and the warm-started three-channel
+//!   re-solve to a relative residual of 10⁻³;
+//! - T_paint: a 10-point ketchup stroke, the rows it changes, and the
+//!   warm-started three-channel re-solve to 10⁻³;
+//! - P1 quad: the P1 matrices by 27-point quadrature;
+//! - max diff: `max_i |φ_i − φ_P1,i| / max_i φ_P1,i` over the boundary
+//!   vertices, red channel, both solved to 10⁻¹⁰.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use tet_diffusion::glam::DVec3;
+use tet_diffusion::multires::{
+    self, Cascade, CascadeOptions, SolveOptions, VCycle, VCycleOptions, Weights,
+};
+use tet_diffusion::sprs::CsMat;
+use tet_diffusion::{Cut, Integration, Light, Medium, Object, Stroke, TetMesh};
+
+struct Args {
+    json: bool,
+    export: Option<PathBuf>,
+    repeat: usize,
+}
+
+fn parse() -> Result<Args, String> {
+    let mut args = Args {
+        json: false,
+        export: None,
+        repeat: 3,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--json" => args.json = true,
+            "--export-mtx" => {
+                args.export = Some(it.next().ok_or("--export-mtx needs a folder")?.into())
+            }
+            "--repeat" => {
+                args.repeat = it
+                    .next()
+                    .and_then(|r| r.parse().ok())
+                    .filter(|&r| r > 0)
+                    .ok_or("--repeat needs a positive count")?
+            }
+            other => return Err(format!("unknown argument {other:?}")),
+        }
+    }
+    Ok(args)
+}
+
+fn main() {
+    let args = match parse() {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("transcut: {e}\nusage: transcut [--json] [--export-mtx DIR] [--repeat R]");
+            std::process::exit(2);
+        }
+    };
+    let data = std::env::var_os("TRILUX_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("../shared/data"));
+    let dir = data.join("tets");
+    let meshes = match list(&dir) {
+        Ok(m) if !m.is_empty() => m,
+        _ => {
+            eprintln!(
+                "transcut: no tetrahedral meshes in {} (set TRILUX_DATA to the data folder)",
+                dir.display()
+            );
+            std::process::exit(1);
+        }
+    };
+    if let Some(d) = &args.export {
+        if let Err(e) = std::fs::create_dir_all(d) {
+            eprintln!("transcut: cannot create {}: {e}", d.display());
+            std::process::exit(1);
+        }
+    }
+    let mut table = String::from(
+        "| mesh | #tets | #levels | T_b ms | T_m ms | T_s ms/channel | T_cut ms | T_paint ms | P1 quad ms | quad / T_m | max diff vs P1 | peak MB |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    let mut solvers = String::from(
+        "| mesh | solver | build ms | iterations to 1% (per channel) | 3-channel solve ms | build + solve ms | speed-up vs Jacobi-PCG |\n|---|---|---:|---:|---:|---:|---:|\n",
+    );
+    for path in meshes {
+        let name = path
+            .file_stem()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .to_string();
+        match bench(&name, &path, &args) {
+            Ok(row) => {
+                if args.json {
+                    println!("{}", row.json());
+                } else {
+                    table.push_str(&row.markdown());
+                    solvers.push_str(&row.solvers);
+                }
+            }
+            Err(e) => eprintln!("transcut: {name}: {e}"),
+        }
+        let _ = std::io::stdout().flush();
+    }
+    if !args.json {
+        println!("{table}\n{solvers}");
+    }
+}
+
+/// One mesh per name: TetGen `.node` first, then Gmsh `.msh` or MEDIT
+/// `.mesh` (the data's `bunny_500k.msh` is the same mesh as its `.node`).
+fn list(dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+    let mut by_stem: std::collections::BTreeMap<String, PathBuf> = Default::default();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .collect();
+    files.sort();
+    for ext in ["node", "msh", "mesh"] {
+        for f in &files {
+            if f.extension().is_some_and(|e| e == ext) {
+                let stem = f
+                    .file_stem()
+                    .unwrap_or_default()
+                    .to_string_lossy()
+                    .to_string();
+                if by_stem.contains_key(&stem) {
+                    eprintln!(
+                        "transcut: skipping {} (same mesh as the .node file)",
+                        f.display()
+                    );
+                } else {
+                    by_stem.insert(stem, f.clone());
+                }
+            }
+        }
+    }
+    let mut out: Vec<(u64, PathBuf)> = by_stem
+        .into_values()
+        .map(|p| (std::fs::metadata(&p).map(|m| m.len()).unwrap_or(0), p))
+        .collect();
+    out.sort();
+    Ok(out.into_iter().map(|p| p.1).collect())
+}
+
+struct Row {
+    mesh: String,
+    tets: usize,
+    levels: usize,
+    tb: f64,
+    tm: f64,
+    ts: f64,
+    tcut: f64,
+    tpaint: f64,
+    quad: f64,
+    diff: f64,
+    solver: &'static str,
+    peak_mb: f64,
+    solvers: String,
+}
+
+impl Row {
+    fn markdown(&self) -> String {
+        format!(
+            "| {} | {} | {} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.0} | {:.1}× | {:.2}% | {:.0} |\n",
+            self.mesh,
+            self.tets,
+            self.levels,
+            self.tb,
+            self.tm,
+            self.ts,
+            self.tcut,
+            self.tpaint,
+            self.quad,
+            self.quad / self.tm,
+            100.0 * self.diff,
+            self.peak_mb
+        )
+    }
+
+    fn json(&self) -> String {
+        format!(
+            "{{\"mesh\":\"{}\",\"tets\":{},\"levels\":{},\"tb_ms\":{:.3},\"tm_ms\":{:.3},\"ts_ms\":{:.3},\"tcut_ms\":{:.3},\"tpaint_ms\":{:.3},\"fem_quadrature_tm_ms\":{:.3},\"max_rel_diff_vs_fem\":{:.6},\"solver\":\"{}\",\"peak_mb\":{:.1}}}",
+            self.mesh,
+            self.tets,
+            self.levels,
+            self.tb,
+            self.tm,
+            self.ts,
+            self.tcut,
+            self.tpaint,
+            self.quad,
+            self.diff,
+            self.solver,
+            self.peak_mb
+        )
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Resets the kernel's peak-RSS counter (Linux ≥ 4.0); false elsewhere.
+fn reset_peak() -> bool {
+    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+}
+
+/// Peak resident memory, MB (`VmHWM`).
+fn peak_mb() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<f64>().ok())
+        })
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}
+
+fn relative_error(x: &[f64], reference: &[f64], norm: f64) -> f64 {
+    x.iter()
+        .zip(reference)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum::<f64>()
+        .sqrt()
+        / norm
+}
+
+fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
+    reset_peak();
+    let file = trilux_io::tet::TetMesh::read(path).map_err(|e| e.to_string())?;
+    let unit_mm = if name.starts_with("sphere") {
+        20.0
+    } else {
+        1000.0
+    };
+    let marble = Medium::measured("marble").map_err(|e| e.to_string())?;
+    // T_b: neighbourhoods (validated mesh) …
+    let mut mesh_ms = Vec::new();
+    let mut mesh = None;
+    for _ in 0..args.repeat {
+        let t = Instant::now();
+        mesh = Some(TetMesh::new(&file.positions, &file.tets).map_err(|e| e.to_string())?);
+        mesh_ms.push(ms(t));
+    }
+    let mesh = mesh.ok_or("no run")?;
+    let tets = mesh.tets().len();
+    let mut object = Object::homogeneous(mesh, unit_mm, marble, 1.3).map_err(|e| e.to_string())?;
+    for w in object.warnings() {
+        eprintln!("transcut: {name}: warning: {w}");
+    }
+    let light = Light::Directional {
+        to_light: DVec3::new(0.1, 1.0, 0.3),
+        irradiance: [1.0; 3],
+    };
+    object.add_light(light).map_err(|e| e.to_string())?;
+    // T_m.
+    let tm = median((0..args.repeat).map(|_| object.reassemble()).collect());
+    let positions: Vec<[f64; 3]> = object
+        .mesh()
+        .positions()
+        .iter()
+        .map(|p| p.to_array())
+        .collect();
+    let weights = Weights::Positions(&positions);
+    let matrices: [CsMat<f64>; 3] = std::array::from_fn(|c| object.matrix(c).clone());
+    let rhs: [Vec<f64>; 3] = std::array::from_fn(|c| object.rhs(c).to_vec());
+    // … + the hierarchy.
+    let vopts = VCycleOptions::default();
+    let mut hier_ms = Vec::new();
+    let mut vcycle = None;
+    for _ in 0..args.repeat {
+        let t = Instant::now();
+        vcycle = Some(VCycle::new(&matrices[1], weights, &vopts).map_err(|e| e.to_string())?);
+        hier_ms.push(ms(t));
+    }
+    let vcycle = vcycle.ok_or("no run")?;
+    let tb = median(mesh_ms) + median(hier_ms.clone());
+    let levels = vcycle.hierarchy().levels();
+    // Tight references.
+    let tight = SolveOptions {
+        tolerance: 1e-10,
+        max_iterations: 20_000,
+    };
+    let mut reference: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; positions.len()]);
+    for c in 0..3 {
+        multires::pcg(&matrices[c], &rhs[c], &mut reference[c], &vcycle, &tight)
+            .map_err(|e| e.to_string())?;
+    }
+    let norms: [f64; 3] = std::array::from_fn(|c| multires::vector::norm(&reference[c]));
+    // Iterations to 1% error for a solver, found with a monitor, then timed
+    // without it.
+    let to_one_percent = |solve: &dyn Fn(
+        usize,
+        &mut [f64],
+        usize,
+        Option<&mut dyn FnMut(usize, &[f64]) -> ControlFlow<()>>,
+    )|
+     -> (usize, f64) {
+        let mut total_iterations = 0;
+        let mut times = Vec::new();
+        let mut counts = [0usize; 3];
+        for c in 0..3 {
+            let mut x = vec![0.0; positions.len()];
+            let mut hit = usize::MAX;
+            let mut monitor = |k: usize, x: &[f64]| {
+                if relative_error(x, &reference[c], norms[c]) <= 0.01 {
+                    hit = k;
+                    ControlFlow::Break(())
+                } else {
+                    ControlFlow::Continue(())
+                }
+            };
+            solve(c, &mut x, 20_000, Some(&mut monitor));
+            counts[c] = hit;
+            total_iterations += hit;
+        }
+        for _ in 0..args.repeat {
+            let t = Instant::now();
+            for (c, &k) in counts.iter().enumerate() {
+                let mut x = vec![0.0; positions.len()];
+                solve(c, &mut x, k, None);
+            }
+            times.push(ms(t));
+        }
+        (total_iterations / 3, median(times))
+    };
+    let mut solvers = String::new();
+    let mut results: Vec<(&str, f64, usize, f64)> = Vec::new();
+    let zero_tol = |k: usize| SolveOptions {
+        tolerance: 0.0,
+        max_iterations: k,
+    };
+    // V-cycle-PCG (shared hierarchy).
+    let (it, ts) = to_one_percent(&|c, x, k, m| {
+        let _ = match m {
+            Some(m) => multires::pcg_monitored(&matrices[c], &rhs[c], x, &vcycle, &zero_tol(k), m),
+            None => multires::pcg(&matrices[c], &rhs[c], x, &vcycle, &zero_tol(k)),
+        };
+    });
+    results.push(("V-cycle-PCG", median(hier_ms), it, ts));
+    let ts = ts / 3.0;
+    // Jacobi-PCG.
+    let (it, tj) = to_one_percent(&|c, x, k, m| {
+        let _ = match m {
+            Some(m) => multires::cg_monitored(&matrices[c], &rhs[c], x, &zero_tol(k), m),
+            None => multires::cg(&matrices[c], &rhs[c], x, &zero_tol(k)),
+        };
+    });
+    results.push(("Jacobi-PCG", 0.0, it, tj));
+    // The paper's cascade and its Galerkin variant.
+    for (label, copts) in [
+        ("cascade (Eq. 17)", CascadeOptions::default()),
+        ("cascade, Galerkin", CascadeOptions::galerkin()),
+    ] {
+        let t = Instant::now();
+        let cascade = Cascade::new(&matrices[1], weights, &copts).map_err(|e| e.to_string())?;
+        let build = ms(t);
+        let (it, tc) = to_one_percent(&|c, x, k, m| {
+            let _ = match m {
+                Some(m) => cascade.solve_monitored(&matrices[c], &rhs[c], x, &zero_tol(k), m),
+                None => cascade.solve(&matrices[c], &rhs[c], x, &zero_tol(k)),
+            };
+        });
+        results.push((label, build, it, tc));
+    }
+    let jacobi_total = results[1].1 + results[1].3;
+    for (label, build, it, t) in &results {
+        let _ = writeln!(
+            solvers,
+            "| {name} | {label} | {build:.0} | {it} | {t:.0} | {:.0} | {:.2}× |",
+            build + t,
+            jacobi_total / (build + t)
+        );
+    }
+    // P1 by quadrature, and the difference of the solutions.
+    let quad_ms: Vec<f64> = (0..args.repeat)
+        .map(|_| {
+            let t = Instant::now();
+            let p1 = object.fem_reference(Integration::Quadrature);
+            let e = ms(t);
+            drop(p1);
+            e
+        })
+        .collect();
+    let quad = median(quad_ms);
+    let diff = {
+        let p1 = object.fem_reference(Integration::ClosedForm);
+        let a = object.boundary_factor();
+        let system = p1.consistent(a);
+        let mesh = object.mesh();
+        let mut q = vec![0.0; positions.len()];
+        for (k, &v) in mesh.boundary_vertices().iter().enumerate() {
+            q[v as usize] = object.incident()[k][0];
+        }
+        let b = p1.load(&q, a, object.fdr());
+        let v = VCycle::new(&system[0], weights, &vopts).map_err(|e| e.to_string())?;
+        let mut x = vec![0.0; b.len()];
+        multires::pcg(&system[0], &b, &mut x, &v, &tight).map_err(|e| e.to_string())?;
+        let peak = mesh
+            .boundary_vertices()
+            .iter()
+            .map(|&i| x[i as usize].abs())
+            .fold(0.0, f64::max);
+        mesh.boundary_vertices()
+            .iter()
+            .map(|&i| (reference[0][i as usize] - x[i as usize]).abs() / peak)
+            .fold(0.0, f64::max)
+    };
+    if let Some(dir) = &args.export {
+        write_mtx(&dir.join(format!("{name}.A.mtx")), &matrices[0]).map_err(|e| e.to_string())?;
+        write_vector(&dir.join(format!("{name}.b.mtx")), &rhs[0]).map_err(|e| e.to_string())?;
+        write_vector(&dir.join(format!("{name}.x.mtx")), &reference[0])
+            .map_err(|e| e.to_string())?;
+    }
+    drop(vcycle);
+    // T_cut: cut, rebuild, warm re-solve (from the reference φ).
+    object
+        .set_phi(reference.clone())
+        .map_err(|e| e.to_string())?;
+    object.settings.tolerance = 1e-3;
+    let center = object.mesh().positions().iter().sum::<DVec3>() / positions.len() as f64;
+    let t = Instant::now();
+    object
+        .cut(
+            &Cut::Plane {
+                point: center,
+                normal: DVec3::new(1.0, 0.0, 0.2),
+            },
+            5,
+        )
+        .map_err(|e| e.to_string())?;
+    object.solve().map_err(|e| e.to_string())?;
+    let tcut = ms(t);
+    // T_paint: a stroke across the top of what is left, then a warm re-solve.
+    let (lo, hi) = object.mesh().positions().iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let size = (hi - lo).length();
+    let points = (0..10)
+        .map(|k| {
+            let s = k as f64 / 9.0;
+            DVec3::new(
+                lo.x + (0.3 + 0.4 * s) * (hi.x - lo.x),
+                hi.y - 0.05 * (hi.y - lo.y),
+                (lo.z + hi.z) / 2.0,
+            )
+        })
+        .collect();
+    let stroke = Stroke {
+        points,
+        radius: 0.03 * size,
+        medium: Medium::measured("ketchup").map_err(|e| e.to_string())?,
+        strength: 0.8,
+    };
+    let t = Instant::now();
+    object.paint(&stroke).map_err(|e| e.to_string())?;
+    object.solve().map_err(|e| e.to_string())?;
+    let tpaint = ms(t);
+    Ok(Row {
+        mesh: name.to_owned(),
+        tets,
+        levels,
+        tb,
+        tm,
+        ts,
+        tcut,
+        tpaint,
+        quad,
+        diff,
+        solver: "V-cycle-PCG",
+        peak_mb: peak_mb(),
+        solvers,
+    })
+}
+
+/// Matrix Market, coordinate real general, 1-based.
+fn write_mtx(path: &Path, a: &CsMat<f64>) -> std::io::Result<()> {
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(out, "%%MatrixMarket matrix coordinate real general")?;
+    writeln!(out, "{} {} {}", a.rows(), a.cols(), a.nnz())?;
+    for (i, row) in a.outer_iterator().enumerate() {
+        for (j, v) in row.iter() {
+            writeln!(out, "{} {} {:e}", i + 1, j + 1, v)?;
+        }
+    }
+    out.flush()
+}
+
+/// Matrix Market, array real general, n × 1.
+fn write_vector(path: &Path, x: &[f64]) -> std::io::Result<()> {
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(out, "%%MatrixMarket matrix array real general")?;
+    writeln!(out, "{} 1", x.len())?;
+    for v in x {
+        writeln!(out, "{v:e}")?;
+    }
+    out.flush()
+}

@@ -1,0 +1,694 @@
+//! The tetrahedral mesh: validation, one-ring neighbourhoods, face
+//! adjacency, the boundary surface with outward normals and per-vertex
+//! boundary areas `S_i` (TransCut Sec. 3.2), and a quality report.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::Error;
+
+/// "No neighbour" in [`TetMesh::tet_neighbors`].
+pub const NONE: u32 = u32::MAX;
+
+/// The faces of tetrahedron `(0, 1, 2, 3)` opposite each vertex, with
+/// outward normals (right-hand rule) when it is positively oriented,
+/// `det[p1 − p0, p2 − p0, p3 − p0] > 0`.
+pub const OUTWARD_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+
+/// The six edges of a tetrahedron as local vertex pairs; edge `e` and edge
+/// `5 − e` are opposite (they share no vertex).
+pub const EDGES: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
+
+/// Tets whose minimal dihedral angle is below this many degrees are
+/// "poorly shaped" (TransCut Sec. 6, Limitations).
+pub const POOR_DIHEDRAL_DEGREES: f64 = 0.5;
+
+/// Compressed rows: `items[offsets[i]..offsets[i + 1]]` belong to `i`.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub(crate) struct Csr {
+    pub(crate) offsets: Vec<usize>,
+    pub(crate) items: Vec<u32>,
+}
+
+impl Csr {
+    #[inline]
+    pub(crate) fn row(&self, i: usize) -> &[u32] {
+        &self.items[self.offsets[i]..self.offsets[i + 1]]
+    }
+}
+
+/// A validated tetrahedral mesh with its neighbourhoods and boundary.
+///
+/// Positions are in any length unit (the physics says how many
+/// millimetres one unit is, see [`crate::Object`]). Every tetrahedron is
+/// stored positively oriented: `det[p1 − p0, p2 − p0, p3 − p0] > 0`.
+#[derive(Debug, Clone)]
+pub struct TetMesh {
+    positions: Vec<DVec3>,
+    tets: Vec<[u32; 4]>,
+    original: Vec<u32>,
+    reoriented: usize,
+    vertex_tets: Csr,
+    neighbors: Csr,
+    tet_neighbors: Vec<[u32; 4]>,
+    boundary: Vec<[u32; 3]>,
+    boundary_vertices: Vec<u32>,
+    boundary_index: Vec<u32>,
+    vertex_area: Vec<f64>,
+    vertex_normal: Vec<DVec3>,
+}
+
+/// Shape statistics of a mesh (angles in degrees).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quality {
+    /// Smallest dihedral angle of any tetrahedron.
+    pub min_dihedral: f64,
+    /// Largest dihedral angle of any tetrahedron.
+    pub max_dihedral: f64,
+    /// Tetrahedra whose smallest dihedral angle is below
+    /// [`POOR_DIHEDRAL_DEGREES`] (0.5°): their cotangent weights are huge.
+    pub poor_tets: usize,
+    /// Smallest and largest geometric edge weight
+    /// `Σ_t −(1/6) |kl| cot θ_kl` (Eq. 10 without `κ`), in mesh units.
+    pub edge_weight_range: [f64; 2],
+    /// Shortest and longest edge, in mesh units.
+    pub edge_length_range: [f64; 2],
+    /// Mean edge length, in mesh units.
+    pub mean_edge_length: f64,
+}
+
+/// `det[b − a, c − a, d − a]`, six times the signed volume.
+#[inline]
+pub(crate) fn volume6(p: &[DVec3; 4]) -> f64 {
+    (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]))
+}
+
+/// The dihedral angle (radians) of a tetrahedron at edge `(a, b)`, between
+/// the faces `(a, b, c)` and `(a, b, d)`, with its cotangent.
+#[inline]
+pub(crate) fn dihedral(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> (f64, f64) {
+    let e = (b - a).normalize();
+    let u = (c - a) - e * (c - a).dot(e);
+    let v = (d - a) - e * (d - a).dot(e);
+    let cos = u.dot(v);
+    let sin = u.cross(v).length();
+    (sin.atan2(cos), cos / sin)
+}
+
+impl TetMesh {
+    /// Builds and validates a mesh from positions and four vertex indices
+    /// per tetrahedron (0-based): exactly the fields of a TetGen, Gmsh or
+    /// MEDIT file as `trilux_io::tet::TetMesh` reads them.
+    ///
+    /// Negatively oriented tetrahedra are re-oriented (two indices
+    /// swapped) and counted ([`reoriented`](Self::reoriented)).
+    ///
+    /// # Errors
+    /// [`Error::EmptyMesh`], [`Error::TooLarge`],
+    /// [`Error::NonFinitePosition`], [`Error::IndexOutOfRange`],
+    /// [`Error::RepeatedVertex`], [`Error::DegenerateTet`] (zero volume
+    /// relative to the tet's size, naming the tet),
+    /// [`Error::NonManifoldFace`].
+    ///
+    /// # Example
+    /// ```
+    /// use tet_diffusion::{glam::DVec3, TetMesh};
+    /// let p = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+    /// let mesh = TetMesh::new(&p, &[[0, 2, 1, 3]])?; // inverted: re-oriented
+    /// assert_eq!((mesh.reoriented(), mesh.boundary().len()), (1, 4));
+    /// # Ok::<(), tet_diffusion::Error>(())
+    /// ```
+    pub fn new(positions: &[DVec3], tets: &[[u32; 4]]) -> Result<Self, Error> {
+        let original = (0..tets.len() as u32).collect();
+        Self::with_original(positions.to_vec(), tets.to_vec(), original)
+    }
+
+    /// [`new`](Self::new) with each tet's id in the mesh it was cut from.
+    pub(crate) fn with_original(
+        positions: Vec<DVec3>,
+        mut tets: Vec<[u32; 4]>,
+        original: Vec<u32>,
+    ) -> Result<Self, Error> {
+        if positions.is_empty() || tets.is_empty() {
+            return Err(Error::EmptyMesh {
+                vertices: positions.len(),
+                tets: tets.len(),
+            });
+        }
+        if positions.len() >= NONE as usize {
+            return Err(Error::TooLarge {
+                what: "vertices",
+                count: positions.len(),
+            });
+        }
+        if tets.len() >= NONE as usize {
+            return Err(Error::TooLarge {
+                what: "tetrahedra",
+                count: tets.len(),
+            });
+        }
+        if let Some(v) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::NonFinitePosition {
+                vertex: v,
+                position: positions[v].to_array(),
+            });
+        }
+        let n = positions.len();
+        // Validate and orient in parallel; the first bad tet (lowest index)
+        // is reported, whatever the number of threads.
+        let results: Vec<Result<bool, Error>> = tets
+            .par_iter_mut()
+            .enumerate()
+            .map(|(t, tet)| orient(t, tet, &positions))
+            .collect();
+        let mut reoriented = 0;
+        for r in results {
+            if r? {
+                reoriented += 1;
+            }
+        }
+        debug_assert!(tets.iter().flatten().all(|&v| (v as usize) < n));
+        let vertex_tets = vertex_tets(n, &tets);
+        let neighbors = neighbors(&vertex_tets, &tets);
+        let (tet_neighbors, boundary) = faces(&tets)?;
+        let mut mesh = Self {
+            positions,
+            tets,
+            original,
+            reoriented,
+            vertex_tets,
+            neighbors,
+            tet_neighbors,
+            boundary,
+            boundary_vertices: Vec::new(),
+            boundary_index: Vec::new(),
+            vertex_area: Vec::new(),
+            vertex_normal: Vec::new(),
+        };
+        mesh.boundary_attributes();
+        Ok(mesh)
+    }
+
+    /// Boundary vertex list, per-vertex areas `S_i` and area-weighted
+    /// normals.
+    fn boundary_attributes(&mut self) {
+        let n = self.positions.len();
+        let mut area = vec![0.0; n];
+        let mut normal = vec![DVec3::ZERO; n];
+        for f in &self.boundary {
+            let [a, b, c] = f.map(|v| self.positions[v as usize]);
+            let cross = (b - a).cross(c - a);
+            for &v in f {
+                area[v as usize] += 0.5 * cross.length();
+                normal[v as usize] += cross;
+            }
+        }
+        let mut boundary_index = vec![NONE; n];
+        let mut boundary_vertices = Vec::new();
+        for v in 0..n {
+            if area[v] > 0.0 {
+                boundary_index[v] = boundary_vertices.len() as u32;
+                boundary_vertices.push(v as u32);
+            }
+        }
+        self.vertex_area = area;
+        self.vertex_normal = normal.into_iter().map(DVec3::normalize_or_zero).collect();
+        self.boundary_vertices = boundary_vertices;
+        self.boundary_index = boundary_index;
+    }
+
+    /// Vertex positions, in mesh units.
+    pub fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
+    /// Tetrahedra, positively oriented.
+    pub fn tets(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+
+    /// Each tetrahedron's id in the mesh this one was cut or split from
+    /// (its own index for a mesh made by [`new`](Self::new)).
+    pub fn original_ids(&self) -> &[u32] {
+        &self.original
+    }
+
+    /// How many tetrahedra were negatively oriented and re-oriented.
+    pub fn reoriented(&self) -> usize {
+        self.reoriented
+    }
+
+    /// Number of vertices.
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// The one-ring of vertex `v`: the vertices sharing an edge with it,
+    /// ascending.
+    pub fn one_ring(&self, v: usize) -> &[u32] {
+        self.neighbors.row(v)
+    }
+
+    /// The tetrahedra containing vertex `v`, ascending.
+    pub fn vertex_tets(&self, v: usize) -> &[u32] {
+        self.vertex_tets.row(v)
+    }
+
+    /// Number of edges.
+    pub fn edge_count(&self) -> usize {
+        self.neighbors.items.len() / 2
+    }
+
+    /// The edges `(i, j)` with `i < j`, in ascending order.
+    pub fn edges(&self) -> impl Iterator<Item = [u32; 2]> + '_ {
+        (0..self.vertex_count()).flat_map(move |i| {
+            self.one_ring(i)
+                .iter()
+                .filter(move |&&j| j as usize > i)
+                .map(move |&j| [i as u32, j])
+        })
+    }
+
+    /// Face adjacency: entry `k` of tet `t` is the tetrahedron across the
+    /// face opposite local vertex `k`, or [`NONE`] on the boundary.
+    pub fn tet_neighbors(&self) -> &[[u32; 4]] {
+        &self.tet_neighbors
+    }
+
+    /// The boundary triangles, oriented with outward normals (right-hand
+    /// rule), ordered by (tetrahedron, local face).
+    pub fn boundary(&self) -> &[[u32; 3]] {
+        &self.boundary
+    }
+
+    /// The vertices on the boundary, ascending.
+    pub fn boundary_vertices(&self) -> &[u32] {
+        &self.boundary_vertices
+    }
+
+    /// Position of vertex `v` in [`boundary_vertices`](Self::boundary_vertices),
+    /// or `None` for an interior vertex.
+    pub fn boundary_index(&self, v: usize) -> Option<usize> {
+        match self.boundary_index.get(v) {
+            Some(&i) if i != NONE => Some(i as usize),
+            _ => None,
+        }
+    }
+
+    /// `S_i`: the summed area of the boundary triangles sharing each vertex
+    /// (0 inside), in mesh units². The vertex's share is `S_i / 3`.
+    pub fn vertex_areas(&self) -> &[f64] {
+        &self.vertex_area
+    }
+
+    /// Area-weighted outward unit normals of the boundary vertices (zero
+    /// inside).
+    pub fn vertex_normals(&self) -> &[DVec3] {
+        &self.vertex_normal
+    }
+
+    /// The corners of tet `t`.
+    #[inline]
+    pub fn corners(&self, t: usize) -> [DVec3; 4] {
+        self.tets[t].map(|v| self.positions[v as usize])
+    }
+
+    /// Volume of tet `t`.
+    pub fn tet_volume(&self, t: usize) -> f64 {
+        volume6(&self.corners(t)) / 6.0
+    }
+
+    /// Total volume.
+    pub fn volume(&self) -> f64 {
+        (0..self.tets.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|t| self.tet_volume(t))
+            .sum()
+    }
+
+    /// Centre (mean of the corners) of tet `t`.
+    pub fn tet_center(&self, t: usize) -> DVec3 {
+        let c = self.corners(t);
+        (c[0] + c[1] + c[2] + c[3]) * 0.25
+    }
+
+    /// The six dihedral angles (radians) of tet `t`, at edges [`EDGES`].
+    pub fn dihedral_angles(&self, t: usize) -> [f64; 6] {
+        dihedral_angles(&self.corners(t))
+    }
+
+    /// The quality report: dihedral angles, poorly shaped tets, the range
+    /// of the cotangent edge weights and of the edge lengths.
+    pub fn quality(&self) -> Quality {
+        let (min, max, poor) = (0..self.tets.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|t| {
+                let a = self.dihedral_angles(t);
+                let lo = a.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = a.iter().copied().fold(0.0, f64::max);
+                (lo, hi, usize::from(lo.to_degrees() < POOR_DIHEDRAL_DEGREES))
+            })
+            .reduce(
+                || (f64::INFINITY, 0.0, 0),
+                |a, b| (a.0.min(b.0), a.1.max(b.1), a.2 + b.2),
+            );
+        let weights = crate::assembly::Geometry::new(self);
+        let mut w = [f64::INFINITY, f64::NEG_INFINITY];
+        let mut len = [f64::INFINITY, 0.0f64];
+        let mut total = 0.0;
+        for i in 0..self.vertex_count() {
+            for (k, &j) in self.one_ring(i).iter().enumerate() {
+                if (j as usize) > i {
+                    let g = weights.edge_weight(self, i, k);
+                    w = [w[0].min(g), w[1].max(g)];
+                    let l = self.positions[i].distance(self.positions[j as usize]);
+                    len = [len[0].min(l), len[1].max(l)];
+                    total += l;
+                }
+            }
+        }
+        Quality {
+            min_dihedral: min.to_degrees(),
+            max_dihedral: max.to_degrees(),
+            poor_tets: poor,
+            edge_weight_range: w,
+            edge_length_range: len,
+            mean_edge_length: total / self.edge_count().max(1) as f64,
+        }
+    }
+
+    /// Mean edge length (mesh units).
+    pub fn mean_edge_length(&self) -> f64 {
+        let mut total = 0.0;
+        for e in self.edges() {
+            total += self.positions[e[0] as usize].distance(self.positions[e[1] as usize]);
+        }
+        total / self.edge_count().max(1) as f64
+    }
+}
+
+/// The six dihedral angles of a tetrahedron at [`EDGES`].
+pub(crate) fn dihedral_angles(c: &[DVec3; 4]) -> [f64; 6] {
+    EDGES.map(|[a, b]| {
+        let [o1, o2] = EDGES[5 - edge_index(a, b)];
+        dihedral(c[a], c[b], c[o1], c[o2]).0
+    })
+}
+
+/// Index in [`EDGES`] of the local edge `(a, b)`, `a < b`.
+#[inline]
+pub(crate) fn edge_index(a: usize, b: usize) -> usize {
+    match (a, b) {
+        (0, 1) => 0,
+        (0, 2) => 1,
+        (0, 3) => 2,
+        (1, 2) => 3,
+        (1, 3) => 4,
+        _ => 5,
+    }
+}
+
+/// Checks one tet and orients it positively; `Ok(true)` if it was flipped.
+fn orient(t: usize, tet: &mut [u32; 4], positions: &[DVec3]) -> Result<bool, Error> {
+    let n = positions.len();
+    for &v in tet.iter() {
+        if v as usize >= n {
+            return Err(Error::IndexOutOfRange {
+                tet: t,
+                index: v,
+                vertices: n,
+            });
+        }
+    }
+    for a in 0..4 {
+        for b in a + 1..4 {
+            if tet[a] == tet[b] {
+                return Err(Error::RepeatedVertex {
+                    tet: t,
+                    index: tet[a],
+                });
+            }
+        }
+    }
+    let p = tet.map(|v| positions[v as usize]);
+    let det = volume6(&p);
+    // Zero volume relative to the tet's size: a flat tet has cot weights
+    // of ±∞.
+    let longest = EDGES
+        .iter()
+        .map(|&[a, b]| p[a].distance_squared(p[b]))
+        .fold(0.0, f64::max)
+        .sqrt();
+    if !(det.abs() > 1e-12 * longest.powi(3)) {
+        return Err(Error::DegenerateTet {
+            tet: t,
+            vertices: *tet,
+            volume: det / 6.0,
+        });
+    }
+    if det < 0.0 {
+        tet.swap(0, 1);
+        return Ok(true);
+    }
+    Ok(false)
+}
+
+/// Vertex → tetrahedra, ascending, by counting.
+fn vertex_tets(n: usize, tets: &[[u32; 4]]) -> Csr {
+    let mut offsets = vec![0usize; n + 1];
+    for tet in tets {
+        for &v in tet {
+            offsets[v as usize + 1] += 1;
+        }
+    }
+    for i in 0..n {
+        offsets[i + 1] += offsets[i];
+    }
+    let mut fill = offsets.clone();
+    let mut items = vec![0u32; offsets[n]];
+    for (t, tet) in tets.iter().enumerate() {
+        for &v in tet {
+            items[fill[v as usize]] = t as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    Csr { offsets, items }
+}
+
+/// The one-rings, ascending, built per vertex in parallel.
+fn neighbors(vertex_tets: &Csr, tets: &[[u32; 4]]) -> Csr {
+    let n = vertex_tets.offsets.len() - 1;
+    let rows: Vec<Vec<u32>> = (0..n)
+        .into_par_iter()
+        .with_min_len(512)
+        .map(|i| {
+            let mut row: Vec<u32> = vertex_tets
+                .row(i)
+                .iter()
+                .flat_map(|&t| tets[t as usize])
+                .filter(|&v| v as usize != i)
+                .collect();
+            row.sort_unstable();
+            row.dedup();
+            row
+        })
+        .collect();
+    let mut offsets = Vec::with_capacity(n + 1);
+    offsets.push(0);
+    for r in &rows {
+        offsets.push(offsets[offsets.len() - 1] + r.len());
+    }
+    Csr {
+        offsets,
+        items: rows.concat(),
+    }
+}
+
+/// Face adjacency and the outward boundary triangles, by sorting the
+/// faces' sorted vertex triples.
+fn faces(tets: &[[u32; 4]]) -> Result<(Vec<[u32; 4]>, Vec<[u32; 3]>), Error> {
+    let mut keys: Vec<([u32; 3], u32)> = tets
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(t, tet)| {
+            (0..4).map(move |k| {
+                let f = OUTWARD_FACES[k].map(|l| tet[l]);
+                let mut s = f;
+                s.sort_unstable();
+                (s, (t * 4 + k) as u32)
+            })
+        })
+        .collect();
+    keys.par_sort_unstable();
+    let mut adjacency = vec![[NONE; 4]; tets.len()];
+    let mut boundary = Vec::new();
+    let mut i = 0;
+    while i < keys.len() {
+        let mut j = i + 1;
+        while j < keys.len() && keys[j].0 == keys[i].0 {
+            j += 1;
+        }
+        match j - i {
+            1 => {
+                let (t, k) = ((keys[i].1 / 4) as usize, (keys[i].1 % 4) as usize);
+                boundary.push((keys[i].1, OUTWARD_FACES[k].map(|l| tets[t][l])));
+            }
+            2 => {
+                let (a, b) = (keys[i].1, keys[i + 1].1);
+                adjacency[(a / 4) as usize][(a % 4) as usize] = b / 4;
+                adjacency[(b / 4) as usize][(b % 4) as usize] = a / 4;
+            }
+            _ => {
+                return Err(Error::NonManifoldFace {
+                    face: keys[i].0,
+                    tet: (keys[i + 2].1 / 4) as usize,
+                });
+            }
+        }
+        i = j;
+    }
+    boundary.sort_unstable_by_key(|b| b.0);
+    Ok((adjacency, boundary.into_iter().map(|b| b.1).collect()))
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// An `n³`-cube lattice of `[0, size]³`, each cube split into six tets
+    /// around its main diagonal (Kuhn): conforming and well shaped.
+    pub(crate) fn cube(n: usize, size: f64) -> (Vec<DVec3>, Vec<[u32; 4]>) {
+        let m = n + 1;
+        let id = |x: usize, y: usize, z: usize| (x + m * (y + m * z)) as u32;
+        let mut p = Vec::new();
+        for z in 0..m {
+            for y in 0..m {
+                for x in 0..m {
+                    p.push(DVec3::new(x as f64, y as f64, z as f64) * (size / n as f64));
+                }
+            }
+        }
+        let mut tets = Vec::new();
+        // The six monotone paths from corner 000 to corner 111.
+        const PATHS: [[usize; 3]; 6] = [
+            [0, 1, 2],
+            [0, 2, 1],
+            [1, 0, 2],
+            [1, 2, 0],
+            [2, 0, 1],
+            [2, 1, 0],
+        ];
+        for z in 0..n {
+            for y in 0..n {
+                for x in 0..n {
+                    for path in PATHS {
+                        let mut c = [x, y, z];
+                        let mut tet = [id(x, y, z); 4];
+                        for (k, &axis) in path.iter().enumerate() {
+                            c[axis] += 1;
+                            tet[k + 1] = id(c[0], c[1], c[2]);
+                        }
+                        tets.push(tet);
+                    }
+                }
+            }
+        }
+        (p, tets)
+    }
+
+    #[test]
+    fn cube_topology() {
+        let (p, t) = cube(3, 1.0);
+        let mesh = TetMesh::new(&p, &t).unwrap();
+        // Half of Kuhn's tets are negatively oriented as listed.
+        assert_eq!(mesh.reoriented(), 27 * 3);
+        assert_eq!(mesh.boundary().len(), 6 * 9 * 2);
+        assert!((mesh.volume() - 1.0).abs() < 1e-12);
+        let area: f64 = mesh.vertex_areas().iter().sum::<f64>() / 3.0;
+        assert!((area - 6.0).abs() < 1e-12);
+        // Outward normals: the boundary encloses the volume positively.
+        let enclosed: f64 = mesh
+            .boundary()
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|v| p[v as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum();
+        assert!((enclosed - 1.0).abs() < 1e-12);
+        // Interior vertex (1,1,1) of a 3-lattice: 14 neighbours in Kuhn's split.
+        assert_eq!(mesh.one_ring(21).len(), 14);
+        assert!(mesh.boundary_index(21).is_none());
+        // Euler: V − E + F − T = 1 for a ball.
+        let faces = (4 * t.len() + mesh.boundary().len()) / 2;
+        assert_eq!(
+            p.len() as i64 - mesh.edge_count() as i64 + faces as i64 - t.len() as i64,
+            1
+        );
+        // Every interior face has a neighbour back.
+        for (a, nb) in mesh.tet_neighbors().iter().enumerate() {
+            for &b in nb {
+                if b != NONE {
+                    assert!(mesh.tet_neighbors()[b as usize].contains(&(a as u32)));
+                }
+            }
+        }
+        let q = mesh.quality();
+        assert!((q.min_dihedral - 45.0).abs() < 1e-9 && (q.max_dihedral - 90.0).abs() < 1e-9);
+        assert_eq!(q.poor_tets, 0);
+    }
+
+    #[test]
+    fn bad_meshes_are_errors_naming_the_element() {
+        let p = [
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::Z,
+            DVec3::new(1.0, 1.0, 0.0),
+        ];
+        assert!(matches!(
+            TetMesh::new(&p, &[[0, 1, 2, 3], [0, 1, 2, 9]]),
+            Err(Error::IndexOutOfRange {
+                tet: 1,
+                index: 9,
+                ..
+            })
+        ));
+        assert!(matches!(
+            TetMesh::new(&p, &[[0, 1, 2, 4]]),
+            Err(Error::DegenerateTet { tet: 0, .. })
+        ));
+        assert!(matches!(
+            TetMesh::new(&p, &[[0, 1, 1, 3]]),
+            Err(Error::RepeatedVertex { tet: 0, index: 1 })
+        ));
+        let mut q = p;
+        q[2].y = f64::NAN;
+        assert!(matches!(
+            TetMesh::new(&q, &[[0, 1, 2, 3]]),
+            Err(Error::NonFinitePosition { vertex: 2, .. })
+        ));
+        assert!(matches!(
+            TetMesh::new(&p, &[]),
+            Err(Error::EmptyMesh { .. })
+        ));
+        let e = TetMesh::new(&p, &[[0, 1, 2, 4]]).unwrap_err().to_string();
+        assert!(e.contains("tetrahedron 0"), "{e}");
+    }
+
+    #[test]
+    fn dihedral_of_regular_tet() {
+        let c = [
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ];
+        for a in dihedral_angles(&c) {
+            assert!((a.cos() - 1.0 / 3.0).abs() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,665 @@
+//! A translucent object: a tet mesh, its materials and lights, TransCut's
+//! three RGB systems, and their solution `φ`.
+
+use std::time::Instant;
+
+use glam::{DAffine3, DVec3};
+use multires::{
+    Cascade, CascadeOptions, Report, SolveOptions, VCycle, VCycleOptions, Weights, cg, pcg,
+};
+use sprs::CsMat;
+
+use crate::assembly::{self, Coefficients, Geometry};
+use crate::fem::{self, Integration, P1Matrices};
+use crate::light::{LitLight, Shadows};
+use crate::material::ResolutionWarning;
+use crate::{Error, Light, Medium, TetMesh, fresnel};
+
+/// Which solver [`Object::solve`] uses (all from `multires`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Method {
+    /// CG preconditioned by an algebraic V-cycle on TransCut's hierarchy
+    /// (the fastest on these systems; see the crate's benchmark).
+    #[default]
+    VCyclePcg,
+    /// The paper's multi-resolution cascade (Sec. 4.2, Eq. 17).
+    Cascade,
+    /// The cascade with Galerkin coarse systems.
+    CascadeGalerkin,
+    /// Jacobi-preconditioned CG (the baseline).
+    JacobiPcg,
+}
+
+/// How [`Object::solve`] solves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverSettings {
+    /// The solver.
+    pub method: Method,
+    /// Relative residual `‖b − M φ‖ / ‖b‖` to reach.
+    pub tolerance: f64,
+    /// Iteration cap per channel.
+    pub max_iterations: usize,
+    /// Build one hierarchy (from the green channel's matrix) and use it for
+    /// all three channels, instead of one per channel.
+    pub share_hierarchy: bool,
+}
+
+impl Default for SolverSettings {
+    /// V-cycle-PCG to a relative residual of 10⁻⁶, one shared hierarchy.
+    fn default() -> Self {
+        Self {
+            method: Method::VCyclePcg,
+            tolerance: 1e-6,
+            max_iterations: 5_000,
+            share_hierarchy: true,
+        }
+    }
+}
+
+/// What a solve did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolveReport {
+    /// Per channel: the solver's report (iterations, true final residual).
+    pub channels: [Report; 3],
+    /// Levels of the hierarchy (1 for Jacobi-PCG).
+    pub levels: usize,
+    /// Time to build the hierarchy (and coarse operators), ms.
+    pub hierarchy_ms: f64,
+    /// Time of the iterations, ms.
+    pub solve_ms: f64,
+}
+
+/// Where a fractured piece came from, to recombine it exactly.
+#[derive(Debug, Clone)]
+pub(crate) struct Lineage {
+    pub(crate) token: u64,
+    pub(crate) parent_vertices: usize,
+    pub(crate) parent_tets: usize,
+    /// Piece vertex → parent vertex.
+    pub(crate) vertex: Vec<u32>,
+    /// Piece tet → parent tet.
+    pub(crate) tet: Vec<u32>,
+    /// The parent's own lineage (pieces can be split again).
+    pub(crate) parent: Option<Box<Lineage>>,
+    /// The parent's original tet ids.
+    pub(crate) parent_original: Vec<u32>,
+}
+
+/// A translucent object ready to light, solve, shade, cut, paint and
+/// fracture.
+///
+/// Lengths are in the mesh's unit; `length_unit_mm` says how many
+/// millimetres one unit is (1000 for a mesh in metres), because the
+/// materials are in mm⁻¹. `φ` is per vertex and per RGB channel.
+#[derive(Debug)]
+pub struct Object {
+    pub(crate) mesh: TetMesh,
+    pub(crate) length_unit_mm: f64,
+    pub(crate) eta: f64,
+    /// Indexed by original tet id.
+    pub(crate) media: Vec<Medium>,
+    pub(crate) geometry: Geometry,
+    pub(crate) coefficients: Coefficients,
+    pub(crate) matrices: [CsMat<f64>; 3],
+    pub(crate) lights: Vec<LitLight>,
+    pub(crate) shadows_enabled: bool,
+    pub(crate) shadows: Option<Shadows>,
+    pub(crate) incident: Option<Vec<[f64; 3]>>,
+    pub(crate) q: Vec<[f64; 3]>,
+    pub(crate) rhs: [Vec<f64>; 3],
+    pub(crate) phi: [Vec<f64>; 3],
+    /// Solver settings, used by [`solve`](Self::solve).
+    pub settings: SolverSettings,
+    pub(crate) transform: DAffine3,
+    pub(crate) lineage: Option<Lineage>,
+    pub(crate) assembly_ms: f64,
+}
+
+impl Object {
+    /// An object of one material.
+    ///
+    /// # Errors
+    /// As [`new`](Self::new).
+    ///
+    /// # Example
+    /// ```
+    /// use tet_diffusion::{glam::DVec3, Light, Medium, Object, TetMesh};
+    /// let p = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+    /// let mesh = TetMesh::new(&p, &[[0, 1, 2, 3]])?;
+    /// let mut marble = Object::homogeneous(mesh, 10.0, Medium::measured("marble")?, 1.3)?;
+    /// marble.add_light(Light::Directional { to_light: DVec3::ONE, irradiance: [1.0; 3] })?;
+    /// marble.solve()?;
+    /// assert!(marble.radiance(None).iter().all(|l| l[0] >= 0.0));
+    /// # Ok::<(), tet_diffusion::Error>(())
+    /// ```
+    pub fn homogeneous(
+        mesh: TetMesh,
+        length_unit_mm: f64,
+        medium: Medium,
+        eta: f64,
+    ) -> Result<Self, Error> {
+        let n = mesh
+            .original_ids()
+            .iter()
+            .max()
+            .map_or(0, |&m| m as usize + 1);
+        Self::new(mesh, length_unit_mm, vec![medium; n], eta)
+    }
+
+    /// An object with one medium per tet (indexed by the mesh's
+    /// [`original_ids`](TetMesh::original_ids), so by tet index for a mesh
+    /// made by [`TetMesh::new`]); `eta` is the relative index of refraction
+    /// of its boundary.
+    ///
+    /// # Errors
+    /// [`Error::BadArgument`] for a unit or `eta` that is not positive and
+    /// finite, or a bad coefficient (naming the tet and channel);
+    /// [`Error::LengthMismatch`] when `media` is too short.
+    pub fn new(
+        mesh: TetMesh,
+        length_unit_mm: f64,
+        media: Vec<Medium>,
+        eta: f64,
+    ) -> Result<Self, Error> {
+        if !(length_unit_mm.is_finite() && length_unit_mm > 0.0) {
+            return Err(Error::BadArgument {
+                what: "length_unit_mm".into(),
+                value: length_unit_mm,
+                need: "millimetres per mesh unit must be positive and finite",
+            });
+        }
+        check_eta(eta)?;
+        let needed = mesh
+            .original_ids()
+            .iter()
+            .max()
+            .map_or(0, |&m| m as usize + 1);
+        if media.len() < needed {
+            return Err(Error::LengthMismatch {
+                what: "the media (one per tetrahedron)",
+                expected: needed,
+                found: media.len(),
+            });
+        }
+        for &t in mesh.original_ids() {
+            media[t as usize].check(&format!("tetrahedron {t}"))?;
+        }
+        let n = mesh.vertex_count();
+        let nb = mesh.boundary_vertices().len();
+        let mut object = Self {
+            geometry: Geometry {
+                volume: Vec::new(),
+                weights: Vec::new(),
+            },
+            coefficients: Coefficients {
+                kappa: Vec::new(),
+                mu: Vec::new(),
+            },
+            matrices: std::array::from_fn(|_| CsMat::zero((0, 0))),
+            mesh,
+            length_unit_mm,
+            eta,
+            media,
+            lights: Vec::new(),
+            shadows_enabled: true,
+            shadows: None,
+            incident: None,
+            q: vec![[0.0; 3]; nb],
+            rhs: std::array::from_fn(|_| vec![0.0; n]),
+            phi: std::array::from_fn(|_| vec![0.0; n]),
+            settings: SolverSettings::default(),
+            transform: DAffine3::IDENTITY,
+            lineage: None,
+            assembly_ms: 0.0,
+        };
+        object.rebuild();
+        Ok(object)
+    }
+
+    /// Recomputes everything that depends on the mesh: geometry, matrices,
+    /// shadows, visibility, `q` and `b`.
+    pub(crate) fn rebuild(&mut self) {
+        self.reassemble();
+        let lights: Vec<Light> = self.lights.drain(..).map(|l| l.light).collect();
+        self.shadows = None;
+        for light in lights {
+            self.trace(light);
+        }
+        self.incident = None;
+        self.update_rhs();
+    }
+
+    /// Per-tet coefficients in mesh units.
+    pub(crate) fn coefficients_of_media(&self) -> Coefficients {
+        let (kappa, mu) = self
+            .mesh
+            .original_ids()
+            .iter()
+            .map(|&id| self.tet_coefficients(id))
+            .unzip();
+        Coefficients { kappa, mu }
+    }
+
+    /// `κ` (mesh units) and `μa` (per mesh unit) of original tet `id`.
+    pub(crate) fn tet_coefficients(&self, id: u32) -> ([f64; 3], [f64; 3]) {
+        let unit = self.length_unit_mm;
+        let m = &self.media[id as usize];
+        let k = m.kappa();
+        ([0, 1, 2].map(|c| k[c] / unit), m.sigma_a.map(|a| a * unit))
+    }
+
+    fn trace(&mut self, light: Light) {
+        if self.shadows_enabled && self.shadows.is_none() {
+            self.shadows = Some(Shadows::new(&self.mesh));
+        }
+        let shadows = if self.shadows_enabled {
+            self.shadows.as_ref()
+        } else {
+            None
+        };
+        self.lights.push(LitLight::trace(
+            light,
+            &self.mesh,
+            shadows,
+            self.length_unit_mm,
+        ));
+    }
+
+    /// Recomputes `q` from the lights (and the extra incident light) and
+    /// the right-hand sides; no ray is traced.
+    pub(crate) fn update_rhs(&mut self) {
+        let nb = self.mesh.boundary_vertices().len();
+        let mut q = self.incident.clone().unwrap_or_else(|| vec![[0.0; 3]; nb]);
+        for l in &self.lights {
+            l.add_q(&self.mesh, self.eta, self.length_unit_mm, &mut q);
+        }
+        self.rhs = assembly::rhs(&self.mesh, &q, self.boundary_factor(), self.fdr());
+        self.q = q;
+    }
+
+    /// Adds a light; its shadow rays are traced once, now. Returns its
+    /// index.
+    ///
+    /// # Errors
+    /// [`Error::BadArgument`] for a non-finite value or a zero direction.
+    pub fn add_light(&mut self, light: Light) -> Result<usize, Error> {
+        light.check()?;
+        self.trace(light);
+        self.update_rhs();
+        Ok(self.lights.len() - 1)
+    }
+
+    /// Changes light `index`'s colour (irradiance or intensity; ignored for
+    /// environment maps) without re-tracing its shadows.
+    ///
+    /// # Errors
+    /// [`Error::BadArgument`] for a bad index or a non-finite value.
+    pub fn set_light_color(&mut self, index: usize, rgb: [f64; 3]) -> Result<(), Error> {
+        for (c, v) in rgb.into_iter().enumerate() {
+            crate::error::finite(|| format!("colour[{c}] of light {index}"), v)?;
+        }
+        let n = self.lights.len();
+        let light = self.lights.get_mut(index).ok_or(Error::BadArgument {
+            what: "the light index".into(),
+            value: index as f64,
+            need: if n == 0 {
+                "the object has no lights"
+            } else {
+                "it must be below the number of lights"
+            },
+        })?;
+        light.set_color(rgb);
+        self.update_rhs();
+        Ok(())
+    }
+
+    /// Removes all lights (and the extra incident light).
+    pub fn clear_lights(&mut self) {
+        self.lights.clear();
+        self.incident = None;
+        self.update_rhs();
+    }
+
+    /// Whether lights cast shadows (on by default). Changing it re-traces
+    /// the lights.
+    pub fn set_shadows(&mut self, on: bool) {
+        if on != self.shadows_enabled {
+            self.shadows_enabled = on;
+            let lights: Vec<Light> = self.lights.drain(..).map(|l| l.light).collect();
+            for light in lights {
+                self.trace(light);
+            }
+            self.update_rhs();
+        }
+    }
+
+    /// Sets an extra diffused incoming light `q` (Eq. 2; W/mm², RGB) per
+    /// boundary vertex, in the order of
+    /// [`TetMesh::boundary_vertices`], added to the lights' (for tests,
+    /// closed forms and lights computed elsewhere). It is cleared by a cut.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`], [`Error::BadArgument`] for a non-finite
+    /// value.
+    pub fn set_incident(&mut self, q: Vec<[f64; 3]>) -> Result<(), Error> {
+        let nb = self.mesh.boundary_vertices().len();
+        if q.len() != nb {
+            return Err(Error::LengthMismatch {
+                what: "the incident light (one per boundary vertex)",
+                expected: nb,
+                found: q.len(),
+            });
+        }
+        for (k, v) in q.iter().enumerate() {
+            for (c, &x) in v.iter().enumerate() {
+                crate::error::finite(|| format!("q[{k}][{c}]"), x)?;
+            }
+        }
+        self.incident = Some(q);
+        self.update_rhs();
+        Ok(())
+    }
+
+    /// The mesh.
+    pub fn mesh(&self) -> &TetMesh {
+        &self.mesh
+    }
+
+    /// Millimetres per mesh unit.
+    pub fn length_unit_mm(&self) -> f64 {
+        self.length_unit_mm
+    }
+
+    /// Relative index of refraction of the boundary.
+    pub fn eta(&self) -> f64 {
+        self.eta
+    }
+
+    /// `F_dr(η)`.
+    pub fn fdr(&self) -> f64 {
+        fresnel::diffuse_reflectance(self.eta)
+    }
+
+    /// `A = (1 + F_dr) / (1 − F_dr)`.
+    pub fn boundary_factor(&self) -> f64 {
+        fresnel::boundary_factor(self.eta)
+    }
+
+    /// The media, indexed by original tet id.
+    pub fn media(&self) -> &[Medium] {
+        &self.media
+    }
+
+    /// The medium of the mesh's tet `t`.
+    pub fn medium(&self, t: usize) -> Option<&Medium> {
+        let id = *self.mesh.original_ids().get(t)?;
+        self.media.get(id as usize)
+    }
+
+    /// TransCut's matrix `M` of channel `c` (0 red, 1 green, 2 blue), mesh
+    /// units.
+    pub fn matrix(&self, c: usize) -> &CsMat<f64> {
+        &self.matrices[c.min(2)]
+    }
+
+    /// The right-hand side `b` (Eq. 12) of channel `c`.
+    pub fn rhs(&self, c: usize) -> &[f64] {
+        &self.rhs[c.min(2)]
+    }
+
+    /// `q` (Eq. 2) per boundary vertex, RGB.
+    pub fn incident(&self) -> &[[f64; 3]] {
+        &self.q
+    }
+
+    /// The fluence `φ` of channel `c` per vertex (the last solution; the
+    /// warm start of the next solve).
+    pub fn phi(&self, c: usize) -> &[f64] {
+        &self.phi[c.min(2)]
+    }
+
+    /// `φ` per vertex, RGB.
+    pub fn fluence(&self) -> Vec<[f64; 3]> {
+        (0..self.mesh.vertex_count())
+            .map(|i| [self.phi[0][i], self.phi[1][i], self.phi[2][i]])
+            .collect()
+    }
+
+    /// Replaces `φ` (the warm start), e.g. with a solution computed
+    /// elsewhere.
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`].
+    pub fn set_phi(&mut self, phi: [Vec<f64>; 3]) -> Result<(), Error> {
+        for p in &phi {
+            if p.len() != self.mesh.vertex_count() {
+                return Err(Error::LengthMismatch {
+                    what: "phi",
+                    expected: self.mesh.vertex_count(),
+                    found: p.len(),
+                });
+            }
+        }
+        self.phi = phi;
+        Ok(())
+    }
+
+    /// Re-computes the cotangent weights and re-assembles the three
+    /// matrices from the mesh and the media (what a cut does after
+    /// rebuilding the mesh) and returns the time it took, ms.
+    pub fn reassemble(&mut self) -> f64 {
+        let start = Instant::now();
+        self.geometry = Geometry::new(&self.mesh);
+        self.coefficients = self.coefficients_of_media();
+        self.matrices = assembly::assemble(
+            &self.mesh,
+            &self.geometry,
+            &self.coefficients,
+            self.boundary_factor(),
+        );
+        self.assembly_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.assembly_ms
+    }
+
+    /// Time of the last full matrix assembly, ms.
+    pub fn assembly_ms(&self) -> f64 {
+        self.assembly_ms
+    }
+
+    /// Warnings for channels whose diffusion length `1/√(3 μa (μa + σs′))`
+    /// is below the mesh's mean edge length (one per distinct medium and
+    /// channel).
+    pub fn warnings(&self) -> Vec<ResolutionWarning> {
+        let edge_mm = self.mesh.mean_edge_length() * self.length_unit_mm;
+        let mut seen: Vec<(usize, u32)> = Vec::new();
+        let mut out = Vec::new();
+        for (t, &id) in self.mesh.original_ids().iter().enumerate() {
+            let l = self.media[id as usize].diffusion_length();
+            for (c, &lc) in l.iter().enumerate() {
+                if lc < edge_mm {
+                    let key = (c, id);
+                    let same = seen.iter().any(|&(sc, sid)| {
+                        sc == c && self.media[sid as usize] == self.media[id as usize]
+                    });
+                    if !same {
+                        seen.push(key);
+                        out.push(ResolutionWarning {
+                            tet: t,
+                            channel: c,
+                            diffusion_length_mm: lc,
+                            edge_length_mm: edge_mm,
+                        });
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Solves the three systems `M φ = b` with [`settings`](Self::settings),
+    /// starting from the current `φ` (warm start).
+    ///
+    /// # Errors
+    /// [`Error::NotConverged`] with the true residual when a channel does
+    /// not reach the tolerance (`φ` then holds the last iterate);
+    /// [`Error::Solver`] for an error of `multires`.
+    pub fn solve(&mut self) -> Result<SolveReport, Error> {
+        let s = self.settings;
+        let options = SolveOptions {
+            tolerance: s.tolerance,
+            max_iterations: s.max_iterations,
+        };
+        let positions: Vec<[f64; 3]> = self.mesh.positions().iter().map(|p| p.to_array()).collect();
+        let weights = Weights::Positions(&positions);
+        let mut hierarchy_ms = 0.0;
+        let mut solve_ms = 0.0;
+        let mut levels = 1;
+        let mut reports = Vec::with_capacity(3);
+        let matrices = &self.matrices;
+        let clock = Instant::now;
+        match s.method {
+            Method::JacobiPcg => {
+                let t = clock();
+                for c in 0..3 {
+                    reports.push(cg(&matrices[c], &self.rhs[c], &mut self.phi[c], &options)?);
+                }
+                solve_ms += ms(t);
+            }
+            Method::VCyclePcg => {
+                let vopts = VCycleOptions::default();
+                if s.share_hierarchy {
+                    let t = clock();
+                    let v = VCycle::new(&matrices[1], weights, &vopts)?;
+                    hierarchy_ms += ms(t);
+                    levels = v.hierarchy().levels();
+                    let t = clock();
+                    for c in 0..3 {
+                        reports.push(pcg(
+                            &matrices[c],
+                            &self.rhs[c],
+                            &mut self.phi[c],
+                            &v,
+                            &options,
+                        )?);
+                    }
+                    solve_ms += ms(t);
+                } else {
+                    for c in 0..3 {
+                        let t = clock();
+                        let v = VCycle::new(&matrices[c], weights, &vopts)?;
+                        hierarchy_ms += ms(t);
+                        levels = v.hierarchy().levels();
+                        let t = clock();
+                        reports.push(v.solve(&self.rhs[c], &mut self.phi[c], &options)?);
+                        solve_ms += ms(t);
+                    }
+                }
+            }
+            Method::Cascade | Method::CascadeGalerkin => {
+                let copts = if s.method == Method::Cascade {
+                    CascadeOptions::default()
+                } else {
+                    CascadeOptions::galerkin()
+                };
+                let t = clock();
+                let cascade = Cascade::new(&matrices[1], weights, &copts)?;
+                hierarchy_ms += ms(t);
+                levels = cascade.hierarchy().levels();
+                let t = clock();
+                for c in 0..3 {
+                    let r =
+                        cascade.solve(&matrices[c], &self.rhs[c], &mut self.phi[c], &options)?;
+                    reports.push(r.finest);
+                }
+                solve_ms += ms(t);
+            }
+        }
+        let channels: [Report; 3] = [reports[0], reports[1], reports[2]];
+        for (c, r) in channels.iter().enumerate() {
+            if !r.converged() {
+                return Err(Error::NotConverged {
+                    channel: ["red", "green", "blue"][c],
+                    residual: r.residual,
+                    iterations: r.iterations,
+                    stop: format!("{:?}", r.stop),
+                    tolerance: s.tolerance,
+                });
+            }
+        }
+        Ok(SolveReport {
+            channels,
+            levels,
+            hierarchy_ms,
+            solve_ms,
+        })
+    }
+
+    /// Outgoing radiance (Eq. 3) at each boundary vertex, in the order of
+    /// [`TetMesh::boundary_vertices`]:
+    /// `L_o = F_t(ω_o) / (4π) · [(1 + 1/A) φ − 4 q / (1 + F_dr)]`,
+    /// with `F_t` at the angle between the vertex normal and `toward` (the
+    /// unit direction to the viewer, in mesh coordinates), or at normal
+    /// exitance when `None`. Clamped at 0.
+    pub fn radiance(&self, toward: Option<DVec3>) -> Vec<[f64; 3]> {
+        let a = self.boundary_factor();
+        let fdr = self.fdr();
+        let mesh = &self.mesh;
+        let toward = toward.map(|d| d.normalize_or_zero());
+        mesh.boundary_vertices()
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| {
+                let cos = toward.map_or(1.0, |d| mesh.vertex_normals()[v as usize].dot(d));
+                let ft = fresnel::transmittance(cos, self.eta);
+                [0, 1, 2].map(|c| {
+                    let l = ft / (4.0 * std::f64::consts::PI)
+                        * ((1.0 + 1.0 / a) * self.phi[c][v as usize]
+                            - 4.0 * self.q[k][c] / (1.0 + fdr));
+                    l.max(0.0)
+                })
+            })
+            .collect()
+    }
+
+    /// The P1 finite-element reference system of this object (Arbree et
+    /// al.), assembled by `how`; see [`crate::fem`].
+    pub fn fem_reference(&self, how: Integration) -> P1Matrices {
+        fem::assemble(&self.mesh, &self.coefficients, how)
+    }
+
+    /// The rigid transform used for display (fractured pieces moved
+    /// apart); the physics stays in the mesh's own frame.
+    pub fn transform(&self) -> DAffine3 {
+        self.transform
+    }
+
+    /// Sets the display transform.
+    pub fn set_transform(&mut self, transform: DAffine3) {
+        self.transform = transform;
+    }
+
+    /// The vertex positions moved by the display transform.
+    pub fn display_positions(&self) -> Vec<DVec3> {
+        self.mesh
+            .positions()
+            .iter()
+            .map(|&p| self.transform.transform_point3(p))
+            .collect()
+    }
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// `η` must be positive and finite.
+pub(crate) fn check_eta(eta: f64) -> Result<(), Error> {
+    if !(eta.is_finite() && eta > 0.0) {
+        return Err(Error::BadArgument {
+            what: "the index of refraction eta".into(),
+            value: eta,
+            need: "it must be positive and finite",
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,240 @@
+//! Cutting, painting, fracture and recombination.
+
+mod common;
+
+use common::*;
+use tet_diffusion::glam::{DAffine3, DVec3};
+use tet_diffusion::{Cut, Error, Light, Medium, Object, Stroke, TetMesh};
+
+fn lit_ball(n: usize) -> Object {
+    let mut o =
+        Object::homogeneous(ball(n, 5.0), 1.0, Medium::measured("marble").unwrap(), 1.3).unwrap();
+    o.add_light(Light::Directional {
+        to_light: DVec3::new(0.3, 1.0, 0.2),
+        irradiance: [1.0; 3],
+    })
+    .unwrap();
+    o
+}
+
+fn min_dihedral(mesh: &TetMesh) -> Vec<f64> {
+    (0..mesh.tets().len())
+        .map(|t| {
+            mesh.dihedral_angles(t)
+                .into_iter()
+                .fold(f64::INFINITY, f64::min)
+                .to_degrees()
+        })
+        .collect()
+}
+
+fn check_cut(before: &Object, after: &Object, cut: &Cut) {
+    let (old, new) = (before.mesh(), after.mesh());
+    // Tet ids preserved: each remaining tet is the original tet of its id
+    // (same vertices by position, up to the relaxation moving cut-side ones).
+    for (t, &id) in new.original_ids().iter().enumerate() {
+        let a = new.tets()[t].map(|v| new.positions()[v as usize]);
+        let b = old.tets()[id as usize].map(|v| old.positions()[v as usize]);
+        for k in 0..4 {
+            assert!(a[k] == b[k] || cut.side(b[k]) > 0.0, "tet {t} (id {id})");
+        }
+    }
+    // No orphaned vertex.
+    let mut used = vec![false; new.vertex_count()];
+    new.tets()
+        .iter()
+        .flatten()
+        .for_each(|&v| used[v as usize] = true);
+    assert!(used.iter().all(|&u| u));
+    // No dihedral angle below 0.5° created.
+    let before_min = min_dihedral(old);
+    for (t, m) in min_dihedral(new).into_iter().enumerate() {
+        let was = before_min[new.original_ids()[t] as usize];
+        assert!(m >= 0.5f64.min(was) - 1e-9, "tet {t}: {m}° (was {was}°)");
+    }
+    // The new surface lies on the cut side: every boundary face that was not
+    // a boundary face before has all its vertices on the cut side.
+    for f in new.boundary() {
+        let p = f.map(|v| new.positions()[v as usize]);
+        let on_old_surface = p.iter().all(|x| x.length() > 5.0 - 1e-9);
+        if !on_old_surface {
+            assert!(p.iter().all(|x| cut.side(*x) >= 0.0), "{p:?}");
+        }
+    }
+}
+
+#[test]
+fn plane_cut() {
+    let mut o = lit_ball(8);
+    o.solve().unwrap();
+    let before = Object::new(o.mesh().clone(), 1.0, o.media().to_vec(), 1.3).unwrap();
+    let cut = Cut::Plane {
+        point: DVec3::new(0.0, 0.0, 1.0),
+        normal: DVec3::new(0.2, 0.1, 1.0),
+    };
+    let report = o.cut(&cut, 10).unwrap();
+    assert!(report.removed_tets > 0 && report.removed_vertices > 0 && report.moved_vertices > 0);
+    assert_eq!(
+        o.mesh().tets().len() + report.removed_tets,
+        before.mesh().tets().len()
+    );
+    check_cut(&before, &o, &cut);
+    // Warm start from the carried φ beats a cold start.
+    let warm = o.solve().unwrap();
+    let mut cold = Object::new(o.mesh().clone(), 1.0, o.media().to_vec(), 1.3).unwrap();
+    cold.add_light(Light::Directional {
+        to_light: DVec3::new(0.3, 1.0, 0.2),
+        irradiance: [1.0; 3],
+    })
+    .unwrap();
+    let c = cold.solve().unwrap();
+    assert!(warm.channels[1].iterations <= c.channels[1].iterations);
+    // The cut object is a valid object for the manufactured solution too:
+    // its matrix equals a fresh assembly on the cut mesh.
+    for ch in 0..3 {
+        assert_eq!(o.matrix(ch).data(), cold.matrix(ch).data());
+    }
+}
+
+#[test]
+fn stroke_cut() {
+    let mut o = lit_ball(8);
+    let before = Object::new(o.mesh().clone(), 1.0, o.media().to_vec(), 1.3).unwrap();
+    // Looking down −Z, a stroke from left to right at y = 1 removes y > 1.
+    let cut = Cut::Stroke {
+        points: vec![
+            DVec3::new(-9.0, 1.0, 9.0),
+            DVec3::new(0.0, 1.5, 9.0),
+            DVec3::new(9.0, 1.0, 9.0),
+        ],
+        view: DVec3::NEG_Z,
+    };
+    assert!(cut.side(DVec3::new(0.0, 4.0, 0.0)) > 0.0);
+    assert!(cut.side(DVec3::new(0.0, -4.0, 0.0)) < 0.0);
+    let report = o.cut(&cut, 5).unwrap();
+    assert!(report.removed_tets > 0);
+    check_cut(&before, &o, &cut);
+    o.solve().unwrap();
+}
+
+#[test]
+fn bad_cuts_are_errors() {
+    let mut o = lit_ball(3);
+    let everything = Cut::Plane {
+        point: DVec3::splat(-100.0),
+        normal: DVec3::X,
+    };
+    assert!(matches!(
+        o.cut(&everything, 1),
+        Err(Error::CutRemovesEverything { .. })
+    ));
+    let zero = Cut::Plane {
+        point: DVec3::ZERO,
+        normal: DVec3::ZERO,
+    };
+    assert!(o.cut(&zero, 1).is_err());
+    let nan = Cut::Stroke {
+        points: vec![DVec3::ZERO, DVec3::NAN],
+        view: DVec3::Z,
+    };
+    assert!(o.cut(&nan, 1).is_err());
+    // Nothing was lost.
+    assert_eq!(o.mesh().tets().len(), 3 * 3 * 3 * 6);
+}
+
+#[test]
+fn painting_updates_rows_exactly_as_a_full_assembly() {
+    let mut o = lit_ball(8);
+    o.solve().unwrap();
+    let stroke = Stroke {
+        points: vec![DVec3::new(0.0, 4.0, 0.0), DVec3::new(1.0, 4.0, 1.0)],
+        radius: 1.0,
+        medium: Medium::measured("ketchup").unwrap(),
+        strength: 0.8,
+    };
+    let report = o.paint(&stroke).unwrap();
+    assert!(report.tets > 0 && report.rows < o.mesh().vertex_count());
+    let full = Object::new(o.mesh().clone(), 1.0, o.media().to_vec(), 1.3).unwrap();
+    for c in 0..3 {
+        assert_eq!(o.matrix(c).data(), full.matrix(c).data(), "channel {c}");
+    }
+    let before: Vec<f64> = o.phi(2).to_vec();
+    o.solve().unwrap();
+    // Ketchup absorbs blue: the painted side gets darker.
+    let v = o
+        .mesh()
+        .boundary_vertices()
+        .iter()
+        .copied()
+        .find(|&v| o.mesh().positions()[v as usize].distance(DVec3::new(0.0, 5.0, 0.0)) < 1.5);
+    let v = v.unwrap() as usize;
+    assert!(o.phi(2)[v] < before[v]);
+    // Bad strokes.
+    let mut bad = stroke.clone();
+    bad.radius = 0.0;
+    assert!(o.paint(&bad).is_err());
+    bad = stroke.clone();
+    bad.points[0].x = f64::NAN;
+    assert!(o.paint(&bad).is_err());
+    bad = stroke;
+    bad.strength = 2.0;
+    assert!(o.paint(&bad).is_err());
+}
+
+#[test]
+fn fracture_and_recombine() {
+    let mut o = lit_ball(6);
+    o.solve().unwrap();
+    let [mut a, mut b] = o.fracture(DVec3::ZERO, DVec3::new(1.0, 0.2, 0.1)).unwrap();
+    assert_eq!(
+        a.mesh().tets().len() + b.mesh().tets().len(),
+        o.mesh().tets().len()
+    );
+    // The faces between the pieces are duplicated.
+    assert!(a.mesh().vertex_count() + b.mesh().vertex_count() > o.mesh().vertex_count());
+    // Each piece solves on its own (its light now also enters the crack).
+    a.solve().unwrap();
+    b.solve().unwrap();
+    b.set_transform(DAffine3::from_translation(DVec3::new(3.0, 0.0, 0.0)));
+    assert!(
+        (b.display_positions()[0] - b.mesh().positions()[0] - DVec3::new(3.0, 0.0, 0.0)).length()
+            < 1e-12
+    );
+    let back = Object::recombine(&a, &b).unwrap();
+    assert_eq!(back.mesh().positions(), o.mesh().positions());
+    assert_eq!(back.mesh().tets(), o.mesh().tets());
+    for c in 0..3 {
+        assert_eq!(back.matrix(c).data(), o.matrix(c).data());
+        assert_eq!(back.matrix(c).indices(), o.matrix(c).indices());
+        assert_eq!(back.rhs(c), o.rhs(c));
+    }
+    // Pieces of different fractures do not recombine.
+    let [c, _] = o.fracture(DVec3::ZERO, DVec3::Y).unwrap();
+    assert!(matches!(
+        Object::recombine(&a, &c),
+        Err(Error::NotMatchingPieces)
+    ));
+    assert!(matches!(
+        o.fracture(DVec3::splat(100.0), DVec3::X),
+        Err(Error::EmptyPiece { .. })
+    ));
+}
+
+#[test]
+fn paint_on_a_piece_survives_recombination() {
+    let o = lit_ball(5);
+    let [mut a, b] = o.fracture(DVec3::ZERO, DVec3::X).unwrap();
+    a.paint(&Stroke {
+        points: vec![DVec3::new(-3.0, 0.0, 0.0)],
+        radius: 1.0,
+        medium: Medium::measured("skin1").unwrap(),
+        strength: 1.0,
+    })
+    .unwrap();
+    let back = Object::recombine(&a, &b).unwrap();
+    let fresh = Object::new(o.mesh().clone(), 1.0, back.media().to_vec(), 1.3).unwrap();
+    for c in 0..3 {
+        assert_eq!(back.matrix(c).data(), fresh.matrix(c).data());
+    }
+    assert_ne!(back.media(), o.media());
+}
