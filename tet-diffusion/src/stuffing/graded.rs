@@ -3,14 +3,16 @@
 //! Shewchuk 2007, Sec. 4; the transition tetrahedra here are our own
 //! construction, described below, not the paper's).
 //!
-//! * The lattice's cubes are the finest octree leaves. A lattice vertex is
-//!   *deep* when it and its 14 neighbours are inside (before warping): it
-//!   has no cut edge, so it is never warped. An octree cell of size
-//!   `s = 2^l` cubes (`l ≥ 1`) may stay a leaf only when every lattice
-//!   vertex in it (closed) is deep, and so is the centre of every cube
-//!   around it. Then every tetrahedron that touches a coarse leaf has deep
-//!   vertices only: it is never cut, never warped, and keeps its exact,
-//!   fixed shape, while the stencils only ever see pure BCC tetrahedra.
+//! * The lattice's cubes are the finest octree leaves. A lattice vertex
+//!   that is still inside after warping was never warped (warped vertices
+//!   are on the surface). An octree cell of size `s = 2^l` cubes (`l ≥ 1`)
+//!   may stay a leaf only when every lattice vertex in it (closed) is
+//!   inside, and so is the centre of every cube around it. Then every
+//!   tetrahedron that touches a coarse leaf has unwarped inside vertices
+//!   only: it is never cut and keeps its exact, fixed shape, while the
+//!   stencils only ever see pure BCC tetrahedra. Where a fine BCC
+//!   tetrahedron meets a coarse one, their common face has three inside
+//!   vertices, which every stencil keeps whole, so the two still match.
 //! * The leaves are 2:1 balanced across faces, edges and corners.
 //! * Tetrahedra: between two equal leaves sharing a face, the tetrahedra
 //!   spanned by the two leaf centres and each boundary segment of the face
@@ -44,7 +46,7 @@ pub(crate) struct Background {
 
 /// Builds the octree over the lattice's cubes and its tetrahedra.
 ///
-/// `signs` are the signs before warping.
+/// `signs` are the signs after warping.
 pub(crate) fn background(lattice: &Lattice, signs: &[Sign], levels: u32) -> Background {
     let n = lattice.n;
     let (safe, centre) = safe_cubes(lattice, signs);
@@ -69,21 +71,10 @@ fn cube_index(n: [usize; 3], c: [usize; 3]) -> usize {
     c[0] + n[0] * (c[1] + n[1] * c[2])
 }
 
-/// Per cube: whether its corners and centre are deep, and whether its
-/// centre is.
+/// Per cube: whether its corners and centre are inside (after warping:
+/// so never warped), and whether its centre is.
 fn safe_cubes(lattice: &Lattice, signs: &[Sign]) -> (Vec<bool>, Vec<bool>) {
-    let nv = lattice.vertex_count();
-    let deep: Vec<bool> = (0..nv)
-        .into_par_iter()
-        .with_min_len(4096)
-        .map_init(Vec::new, |nbrs, v| {
-            if signs[v] != Sign::In {
-                return false;
-            }
-            lattice.neighbors(v as u32, nbrs);
-            nbrs.len() == 14 && nbrs.iter().all(|&(u, _)| signs[u as usize] == Sign::In)
-        })
-        .collect();
+    let deep: Vec<bool> = signs.iter().map(|&s| s == Sign::In).collect();
     let nb = lattice.black_count();
     let centre = deep[nb..].to_vec();
     let safe = (0..lattice.red_count())

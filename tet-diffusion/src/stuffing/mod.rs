@@ -300,8 +300,6 @@ fn run<P: Position>(
         return Err(Error::EmptyVolume { h });
     }
     let mut cut_list = cuts::cut_points(&lattice, &wn, &signs);
-    // The graded background needs the signs before warping.
-    let unwarped = options.graded.then(|| signs.clone());
     let warped = warp::warp(
         &lattice,
         &mut signs,
@@ -309,9 +307,9 @@ fn run<P: Position>(
         options.params.alpha_long(),
         options.params.alpha_short(),
     );
-    let background = unwarped
-        .as_ref()
-        .map(|s| graded::background(&lattice, s, options.graded_levels));
+    let background = options
+        .graded
+        .then(|| graded::background(&lattice, &signs, options.graded_levels));
     let ctx = Context {
         lattice: &lattice,
         signs: &signs,
