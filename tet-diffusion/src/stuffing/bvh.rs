@@ -1,5 +1,5 @@
 //! A bounding volume hierarchy over triangles: the tree the fast winding
-//! number walks (Barill et al. 2018, Sec. 3.2) and the segment queries that
+//! number walks (Barill et al. 2018) and the segment queries that
 //! place cut points on lattice edges.
 //!
 //! Built top-down by median split of the triangle centroids along the
@@ -39,8 +39,8 @@ impl Aabb {
         let hi = t0.max(t1);
         let enter = lo.x.max(lo.y).max(lo.z).max(0.0);
         let exit = hi.x.min(hi.y).min(hi.z).min(1.0);
-        // NaN (0 * inf) compares false, which keeps the box: conservative.
-        !(enter > exit)
+        // NaN (0 * inf) is unordered, which keeps the box: conservative.
+        enter.partial_cmp(&exit) != Some(std::cmp::Ordering::Greater)
     }
 }
 

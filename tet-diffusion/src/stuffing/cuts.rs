@@ -1,5 +1,5 @@
 //! Inside/outside at the lattice vertices and the cut points on lattice
-//! edges (Labelle & Shewchuk 2007, Sec. 2, steps 1 and 2).
+//! edges (Labelle & Shewchuk 2007, the algorithm's first two steps).
 //!
 //! The implicit function is `f = w - 1/2`, with `w` the generalized winding
 //! number: a vertex is inside where `f > 0`. A *cut point* is placed on

@@ -1,6 +1,6 @@
 //! The graded background mesh: fine BCC tetrahedra near the surface,
 //! octree cells of up to `2^levels · h` deep inside (the idea of Labelle &
-//! Shewchuk 2007, Sec. 4; the transition tetrahedra here are our own
+//! Shewchuk 2007, whose graded variant uses an octree; the transition tetrahedra here are our own
 //! construction, described below, not the paper's).
 //!
 //! * The lattice's cubes are the finest octree leaves. A lattice vertex
@@ -24,9 +24,12 @@
 //!
 //! All vertices are lattice vertices: leaf corners and centres of cells of
 //! even size are black lattice vertices, centres of fine cubes are red.
-//! The coarse shapes are a finite set whose dihedral angles lie within the
-//! uniform bounds (the `graded` tests enumerate them); the tetrahedra near
-//! the surface are the uniform mesh's.
+//! The coarse tetrahedra are a finite set of shapes (similar at every
+//! level) with dihedral angles between 45° and 120° (the tests enumerate
+//! them over octrees of up to 3 levels); the tetrahedra near the surface
+//! are the uniform mesh's, so a graded mesh keeps the uniform bounds
+//! [`super::Params::dihedral_bounds_deg`]. The paper's own graded
+//! construction has its own bounds, which this one does not claim.
 
 use rayon::prelude::*;
 

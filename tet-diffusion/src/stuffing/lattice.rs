@@ -1,4 +1,4 @@
-//! The body-centred cubic (BCC) lattice of Labelle & Shewchuk 2007, Sec. 2:
+//! The body-centred cubic (BCC) lattice of Labelle & Shewchuk 2007:
 //! the corners of a cubic grid of spacing `h` ("black" vertices) plus the
 //! cube centres ("red" vertices). Its edges are the grid's axis-parallel
 //! edges and the centre-to-centre edges (both of length `h`, the *long*

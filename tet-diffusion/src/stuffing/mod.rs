@@ -70,14 +70,16 @@ use stencils::{FaceRule, LatticeTet, Point};
 
 /// The warping thresholds `(α_long, α_short)` of Labelle & Shewchuk 2007.
 ///
-/// The paper (abstract; Sec. 5 proves the bounds by a computer search over
-/// its stencils) gives two parameter choices: dihedral angles within
+/// The paper (its abstract; the bounds are proved by a computer-assisted
+/// search over its stencils) gives two parameter choices: dihedral angles within
 /// 10.7°–164.8°, or within 8.9°–158.8°. `α_long = 0.24999`,
 /// `α_short = 0.41189` is the pair of the first bound. The second variant
 /// uses `α_short = 0.42978`, the companion value of two independent
 /// implementations of the paper (SOFA's `MeshTetraStuffing` defaults and a
-/// sound-synthesis mesher's settings); the paper's full text was not
-/// available to check it.
+/// sound-synthesis mesher's settings). Only the paper's abstract was
+/// available here, so neither the section nor the table that lists the
+/// pairs could be checked; the measured bounds below are what this module
+/// guarantees.
 ///
 /// The bounds that hold for *this* module's stencils (which split the
 /// asymmetric quadrilaterals by a Delaunay rule, see the `stencils` module)
@@ -247,10 +249,18 @@ impl Position for [f64; 3] {
 /// outside) form any triangle soup: inside is where its generalized winding
 /// number exceeds 1/2, so holes, separate or overlapping parts and flipped
 /// patches are accepted. The result has every dihedral angle within
-/// [`Params::dihedral_bounds_deg`] for uniform meshes; graded meshes add
-/// interior tetrahedra from a fixed set of shapes (see [`Options::graded`]
-/// and the `graded` module docs). Same input, same output, on any number
-/// of threads.
+/// [`Params::dihedral_bounds_deg`], uniform or graded (the graded interior
+/// adds tetrahedra of fixed shapes with angles between 45° and 120°).
+/// Same input, same output, on any number of threads.
+///
+/// # Performance
+/// Linear in the number of lattice vertices (about `2 V / h³` over the
+/// padded bounding box) times the cost of a fast winding number (about
+/// `O(log n)` for `n` triangles), plus a few winding numbers per lattice
+/// edge that crosses the surface; parallel over fixed chunks. On the
+/// 43k-triangle closed bunny, 500k tetrahedra take about 3 s on 2 busy
+/// cores, 5× less than TetGen `-pq1.2` for the same count in the same run
+/// (the `stuffing` example).
 ///
 /// # Errors
 /// [`Error::NoTriangles`], [`Error::IndexOutOfRange`],

@@ -133,8 +133,8 @@ mod tests {
         let p = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
         let a = dihedral_angles(p);
         // Edges (0,1), (0,2), (0,3) lie on the axes: 90°.
-        for k in 0..3 {
-            assert!((a[k] - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+        for angle in &a[..3] {
+            assert!((angle - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
         }
         // Edge (1,2): between the face z = 0 and the slanted face.
         assert!((a[3] - (1.0f64 / 3f64.sqrt()).acos()).abs() < 1e-12);

@@ -1,5 +1,5 @@
 //! The stencils that fill one BCC tetrahedron with the part of it inside
-//! the surface (Labelle & Shewchuk 2007, Sec. 2, step 4, and Fig. 3).
+//! the surface (Labelle & Shewchuk 2007, the stencil step).
 //!
 //! After warping, every lattice vertex is inside (`+`), outside (`-`) or on
 //! the surface (`0`), and every edge between a `+` and a `-` vertex carries

@@ -6,8 +6,13 @@ use glam::DVec3;
 
 use super::*;
 
+/// A triangle soup: positions and counter-clockwise triangles.
+type Soup = (Vec<DVec3>, Vec<[u32; 3]>);
+/// A surface to check boundary vertices against, with a tolerance.
+type Reference<'a> = (&'a [DVec3], &'a [[u32; 3]], f64);
+
 /// An outward-oriented UV sphere.
-pub(crate) fn sphere(n: u32, radius: f64, centre: DVec3) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+pub(crate) fn sphere(n: u32, radius: f64, centre: DVec3) -> Soup {
     let mut p = vec![centre + DVec3::new(0.0, 0.0, radius)];
     for i in 1..n {
         let th = PI * f64::from(i) / f64::from(n);
@@ -36,7 +41,7 @@ pub(crate) fn sphere(n: u32, radius: f64, centre: DVec3) -> (Vec<DVec3>, Vec<[u3
 }
 
 /// An outward-oriented torus around the z axis.
-pub(crate) fn torus(n: u32, m: u32, major: f64, minor: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+pub(crate) fn torus(n: u32, m: u32, major: f64, minor: f64) -> Soup {
     let mut p = Vec::new();
     for i in 0..n {
         let u = 2.0 * PI * f64::from(i) / f64::from(n);
@@ -58,7 +63,7 @@ pub(crate) fn torus(n: u32, m: u32, major: f64, minor: f64) -> (Vec<DVec3>, Vec<
 }
 
 /// An outward-oriented axis-aligned box.
-pub(crate) fn cuboid(lo: DVec3, hi: DVec3) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+pub(crate) fn cuboid(lo: DVec3, hi: DVec3) -> Soup {
     let p: Vec<DVec3> = (0..8)
         .map(|i| {
             DVec3::new(
@@ -83,10 +88,7 @@ pub(crate) fn cuboid(lo: DVec3, hi: DVec3) -> (Vec<DVec3>, Vec<[u32; 3]>) {
     (p, t)
 }
 
-fn join(
-    a: (Vec<DVec3>, Vec<[u32; 3]>),
-    b: (Vec<DVec3>, Vec<[u32; 3]>),
-) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+fn join(a: (Vec<DVec3>, Vec<[u32; 3]>), b: (Vec<DVec3>, Vec<[u32; 3]>)) -> Soup {
     let (mut p, mut t) = a;
     let off = p.len() as u32;
     p.extend(b.0);
@@ -147,7 +149,7 @@ pub(crate) fn point_triangle_distance(q: DVec3, a: DVec3, b: DVec3, c: DVec3) ->
 /// * every dihedral angle within `bounds`.
 pub(crate) fn check_mesh(
     m: &TetMesh,
-    surface: Option<(&[DVec3], &[[u32; 3]], f64)>,
+    surface: Option<Reference<'_>>,
     bounds: (f64, f64),
 ) -> Result<(), String> {
     let n = m.positions.len();
@@ -254,7 +256,7 @@ fn mesh_volume(m: &TetMesh) -> f64 {
         .sum()
 }
 
-fn shapes() -> Vec<(&'static str, (Vec<DVec3>, Vec<[u32; 3]>), f64)> {
+fn shapes() -> Vec<(&'static str, Soup, f64)> {
     vec![
         ("sphere", sphere(24, 1.0, DVec3::ZERO), 0.23),
         ("torus", torus(48, 24, 1.0, 0.4), 0.17),

@@ -1,4 +1,4 @@
-//! Warping (Labelle & Shewchuk 2007, Sec. 2, step 3): a lattice vertex is
+//! Warping (Labelle & Shewchuk 2007): a lattice vertex is
 //! *violated* by a cut point on one of its edges that lies closer to it
 //! than `α` times the edge's length (`α_long` on long edges, `α_short` on
 //! short ones). A violated vertex moves onto its closest violating cut
