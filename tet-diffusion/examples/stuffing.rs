@@ -91,8 +91,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         inputs.retain(|(name, _, _)| name.contains(only.as_str()));
     }
 
-    let mut rows = Vec::new();
+    let mut rows: Vec<Row> = Vec::new();
     let mut winding_rows = Vec::new();
+    if !json {
+        println!(
+            "| mesh | h | graded | tool | tets | ms (median of 3) | tets/s | min dihedral | max dihedral | cot weight / mean edge | note |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    }
+    let mut printed = 0;
     for (name, positions, triangles) in &inputs {
         let (lo, hi) = bounds(positions, triangles);
         let diag = lo.distance(hi);
@@ -117,52 +124,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     ours_volume,
                 ));
             }
+            // Rows as they come, so that a long run shows its progress.
+            for r in &rows[printed..] {
+                if json {
+                    print_json(r);
+                } else {
+                    print_row(r);
+                }
+            }
+            printed = rows.len();
         }
     }
 
     if json {
-        for r in &rows {
-            println!(
-                "{{\"mesh\":{},\"h\":{},\"graded\":{},\"tool\":\"{}\",\"tets\":{},\"ms\":{:.3},\"min_dihedral_deg\":{},\"max_dihedral_deg\":{},\"error\":{}}}",
-                quote(&r.mesh),
-                r.h,
-                r.graded,
-                r.tool,
-                r.tets,
-                r.ms,
-                num(r.min_deg),
-                num(r.max_deg),
-                r.error.as_deref().map_or("null".to_string(), quote)
-            );
-        }
         return Ok(());
-    }
-
-    println!(
-        "| mesh | h | graded | tool | tets | ms (median of 3) | tets/s | min dihedral | max dihedral | cot weight / mean edge | note |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
-    for r in &rows {
-        let rate = if r.ms > 0.0 {
-            r.tets as f64 / (r.ms / 1000.0)
-        } else {
-            0.0
-        };
-        println!(
-            "| {} | {:.4} | {} | {} | {} | {:.0} | {:.0} | {:.2}° | {:.2}° | {:.2} … {:.2} | {} |",
-            r.mesh,
-            r.h,
-            if r.graded { "yes" } else { "no" },
-            r.tool,
-            r.tets,
-            r.ms,
-            rate,
-            r.min_deg,
-            r.max_deg,
-            r.weights[0],
-            r.weights[1],
-            r.error.as_deref().unwrap_or("")
-        );
     }
     println!();
     println!(
@@ -181,6 +156,44 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!();
     summary(&rows);
     Ok(())
+}
+
+fn print_json(r: &Row) {
+    println!(
+        "{{\"mesh\":{},\"h\":{},\"graded\":{},\"tool\":\"{}\",\"tets\":{},\"ms\":{:.3},\"min_dihedral_deg\":{},\"max_dihedral_deg\":{},\"error\":{}}}",
+        quote(&r.mesh),
+        r.h,
+        r.graded,
+        r.tool,
+        r.tets,
+        r.ms,
+        num(r.min_deg),
+        num(r.max_deg),
+        r.error.as_deref().map_or("null".to_string(), quote)
+    );
+}
+
+fn print_row(r: &Row) {
+    let rate = if r.ms > 0.0 {
+        r.tets as f64 / (r.ms / 1000.0)
+    } else {
+        0.0
+    };
+    println!(
+        "| {} | {:.4} | {} | {} | {} | {:.0} | {:.0} | {:.2}° | {:.2}° | {:.2} … {:.2} | {} |",
+        r.mesh,
+        r.h,
+        if r.graded { "yes" } else { "no" },
+        r.tool,
+        r.tets,
+        r.ms,
+        rate,
+        r.min_deg,
+        r.max_deg,
+        r.weights[0],
+        r.weights[1],
+        r.error.as_deref().unwrap_or("")
+    );
 }
 
 /// The bars, computed from the table.
@@ -266,7 +279,8 @@ fn inputs(data: &Path) -> Result<Vec<Surface>, Box<dyn std::error::Error>> {
             })
         })
         .collect();
-    out.push(("bunny_500k boundary".to_string(), positions, triangles));
+    // The closed bunny first: it carries the comparison with TetGen.
+    out.insert(0, ("bunny_500k boundary".to_string(), positions, triangles));
     Ok(out)
 }
 
