@@ -431,7 +431,9 @@ fn run_tetgen(
         // Calibration runs once; the final run is timed 3 times.
         let repeats = 1;
         let switches = format!("pq1.2a{max_volume:.6e}Q");
+        // In the work folder: TetGen leaves debug files where it fails.
         let out = Command::new(python)
+            .current_dir(work)
             .arg(&script)
             .arg(prefix.to_string_lossy().as_ref())
             .arg(&switches)
@@ -471,6 +473,7 @@ fn run_tetgen(
         if (0.8..=1.2).contains(&ratio) || attempt == 2 {
             // Time it: the median of 3 runs.
             let out = Command::new(python)
+                .current_dir(work)
                 .arg(&script)
                 .arg(prefix.to_string_lossy().as_ref())
                 .arg(&switches)
