@@ -1,0 +1,73 @@
+//! The stuffing module's own error type (it depends on nothing else of the
+//! crate, so that it could become a crate of its own).
+
+/// Why a surface could not be turned into tetrahedra.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// The triangle list is empty.
+    #[error("the surface has no triangles: there is nothing to fill")]
+    NoTriangles,
+    /// A vertex used by a triangle has a NaN or infinite coordinate.
+    #[error("vertex {vertex} has a NaN or infinite coordinate")]
+    NonFinitePosition {
+        /// Index into the position slice.
+        vertex: usize,
+    },
+    /// A triangle refers to a vertex that does not exist.
+    #[error("triangle {triangle} refers to vertex {index}, but there are only {vertices} vertices")]
+    IndexOutOfRange {
+        /// Index of the triangle.
+        triangle: usize,
+        /// The offending vertex index.
+        index: u32,
+        /// Number of positions given.
+        vertices: usize,
+    },
+    /// The lattice spacing is zero, negative, NaN or infinite.
+    #[error("the lattice spacing h = {h} is not a positive finite length")]
+    InvalidSpacing {
+        /// The spacing given.
+        h: f64,
+    },
+    /// The winding-number accuracy parameter is out of range.
+    #[error("the winding-number accuracy beta = {beta} must be finite and at least 1")]
+    InvalidBeta {
+        /// The value given.
+        beta: f64,
+    },
+    /// The lattice at this spacing would exceed the memory bound.
+    #[error(
+        "a lattice of spacing h = {h} over this surface needs {vertices} vertices, more than the \
+         limit of {limit} (about {limit_mib} MiB); choose a larger h or raise \
+         Options::max_lattice_vertices"
+    )]
+    LatticeTooLarge {
+        /// The spacing given.
+        h: f64,
+        /// Lattice vertices that spacing needs.
+        vertices: u128,
+        /// The limit ([`super::Options::max_lattice_vertices`]).
+        limit: usize,
+        /// The limit's approximate memory, in MiB.
+        limit_mib: usize,
+    },
+    /// No lattice vertex lies inside the surface at this spacing: the input
+    /// is an open sheet, a single triangle, or thinner than the lattice.
+    #[error(
+        "the surface encloses no volume at h = {h} (winding number above 1/2 at no lattice \
+         vertex): it is open, flat, or thinner than h"
+    )]
+    EmptyVolume {
+        /// The spacing used.
+        h: f64,
+    },
+    /// A grading option is out of range.
+    #[error("the graded lattice's {what} is out of range: {value}")]
+    InvalidGrading {
+        /// Which setting.
+        what: &'static str,
+        /// Its value.
+        value: f64,
+    },
+}
