@@ -67,6 +67,8 @@ fn every_subcommand_has_help_with_an_example() {
         &["colors", "render"],
         &["demo"],
         &["bench"],
+        &["tetra"],
+        &["diffuse"],
     ] {
         let mut args = sub.to_vec();
         args.push("--help");
