@@ -394,7 +394,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
 /// The objects' boundaries with per-vertex radiance (Eq. 3, toward the
 /// camera) interpolated per pixel, plus a Blinn–Phong specular term of
 /// the directional and point lights.
-fn render(objects: &[Object], lights: &[Light], size: u32) -> trilux_io::image::Image {
+pub(crate) fn render(objects: &[Object], lights: &[Light], size: u32) -> trilux_io::image::Image {
     use trilux::preview::{Camera, Renderer};
     let shapes: Vec<Shape> = objects
         .iter()
@@ -466,7 +466,7 @@ fn render(objects: &[Object], lights: &[Light], size: u32) -> trilux_io::image::
 
 /// Exposure so that the brightest 1 % of the object's pixels reach white,
 /// then the PNG writer's sRGB encoding.
-fn tone_map(image: &trilux_io::image::Image) -> trilux_io::image::Image {
+pub(crate) fn tone_map(image: &trilux_io::image::Image) -> trilux_io::image::Image {
     let mut lum: Vec<f32> = image
         .pixels
         .iter()
