@@ -56,6 +56,11 @@ pub(crate) struct Args {
     pub(crate) vtu: Option<PathBuf>,
 }
 
+/// Sweeps of TransCut's relaxation of the cross-section after a cut: the
+/// cut removes whole tetrahedra, so the fresh face is as jagged as the
+/// mesh until its vertices are pulled toward the plane.
+pub(crate) const CUT_RELAX_SWEEPS: usize = 20;
+
 /// The per-tetrahedron media for a mesh, given the noise's feature size.
 type MediaFn = Box<dyn Fn(&tet_diffusion::TetMesh, f64) -> Result<Vec<Medium>>>;
 
@@ -295,7 +300,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                         point: *point,
                         normal: *normal,
                     },
-                    2,
+                    CUT_RELAX_SWEEPS,
                 )
             })
             .map_err(|e| invalid(format!("--cut: {e}")))?;
