@@ -219,6 +219,36 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
     for field in ["phi_r", "phi_g", "phi_b", "radiance"] {
         assert!(vtu.contains(&format!("Name=\"{field}\"")), "{field}");
     }
+    // Paint a ball of skin into the marble, then break the blob in two.
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "0.5,0,0:0.4:skin1",
+            "--fracture",
+            "plane:1,0,0,0",
+            "--size",
+            "64",
+            "-o",
+            "broken.png",
+        ],
+    );
+    assert_eq!(report["objects"], 2);
+    assert_eq!(report["tetrahedra"], tets.tets.len());
+    fails(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "0,0,0:-1:skin1",
+            "-o",
+            "p.png",
+        ],
+        &["--paint", "radius"],
+    );
     // A surface is tetrahedralized first; noise between two materials.
     let report = json(
         d,
