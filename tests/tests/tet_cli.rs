@@ -229,6 +229,7 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
             "0.5,0,0:0.4:skin1",
             "--fracture",
             "plane:1,0,0,0",
+            "--view=0,0.3,1",
             "--size",
             "64",
             "-o",
@@ -297,6 +298,11 @@ fn diffuse_names_a_bad_material_light_cut_or_mesh() {
         d,
         &["diffuse", blob, "--cut", "plane:0,0,0,1", "-o", "a.png"],
         &["--cut", "zero"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--view", "0,0,0", "-o", "a.png"],
+        &["--view", "zero"],
     );
     fails(
         d,

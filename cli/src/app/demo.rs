@@ -310,7 +310,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             )
             .map_err(solver)?;
         let report = object.solve().map_err(solver)?;
-        let image = super::diffuse::render(std::slice::from_ref(&object), &[light], d.size);
+        let image = super::diffuse::render(std::slice::from_ref(&object), &[light], d.size, None);
         let mut files = files;
         files.push(d.write_image("blob_marble.png", &super::diffuse::tone_map(&image))?);
         let r = &stuffed.report;

@@ -42,6 +42,10 @@ pub(crate) struct Args {
     /// plane:nx,ny,nz,d breaks the object in two along the plane.
     #[arg(long, value_name = "SPEC")]
     pub(crate) fracture: Option<String>,
+    /// Look from this direction (x,y,z from the mesh's centre toward the
+    /// camera; default a three-quarter view from +z, above and right).
+    #[arg(long, value_name = "X,Y,Z")]
+    pub(crate) view: Option<String>,
     /// Picture width and height in pixels.
     #[arg(long, default_value_t = 768)]
     pub(crate) size: u32,
@@ -209,6 +213,16 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
+    let view = match &args.view {
+        None => None,
+        Some(spec) => {
+            let v = vec3(&numbers(spec, "--view", 3)?);
+            if v.length_squared() == 0.0 {
+                return Err(invalid(format!("--view {spec:?}: the direction is zero")));
+            }
+            Some(v.as_vec3())
+        }
+    };
     let material = args.material.clone();
     let media: MediaFn = match material.strip_prefix("noise:") {
         Some(pair) => {
@@ -323,7 +337,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                 .map_err(|e| invalid(format!("solving: {e}")))?,
         );
     }
-    let image = context.step("rendering", || render(&objects, &lights, args.size));
+    let image = context.step("rendering", || render(&objects, &lights, args.size, view));
     super::write_image(context, &args.output, &tone_map(&image))?;
     if let Some(p) = &args.exr {
         super::write_image(context, p, &image)?;
@@ -399,7 +413,12 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
 /// The objects' boundaries with per-vertex radiance (Eq. 3, toward the
 /// camera) interpolated per pixel, plus a Blinn–Phong specular term of
 /// the directional and point lights.
-pub(crate) fn render(objects: &[Object], lights: &[Light], size: u32) -> trilux_io::image::Image {
+pub(crate) fn render(
+    objects: &[Object],
+    lights: &[Light],
+    size: u32,
+    view: Option<Vec3>,
+) -> trilux_io::image::Image {
     use trilux::preview::{Camera, Renderer};
     let shapes: Vec<Shape> = objects
         .iter()
@@ -418,7 +437,10 @@ pub(crate) fn render(objects: &[Object], lights: &[Light], size: u32) -> trilux_
     let Some((lo, hi)) = trilux::preview::bounds(&all) else {
         return trilux::preview::render_mesh(&[], &[], size, size);
     };
-    let camera = Camera::fit(lo, hi);
+    let camera = match view {
+        Some(from) => Camera::fit_from(lo, hi, from),
+        None => Camera::fit(lo, hi),
+    };
     let toward = (camera.eye - camera.target).normalize().as_dvec3();
     let mut r = Renderer::new(size, size, camera);
     for (o, (positions, faces, _, normals)) in objects.iter().zip(&shapes) {
