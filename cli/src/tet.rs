@@ -86,3 +86,21 @@ pub fn dihedral_range(mesh: &TetMesh) -> Option<(f64, f64)> {
     }
     range
 }
+
+/// The mesh as tet-diffusion takes it (absolute positions in the file's
+/// unit): inverted tetrahedra re-oriented, degenerate ones an error.
+///
+/// # Errors
+/// tet-diffusion's, naming the tetrahedron.
+pub fn diffusion_mesh(mesh: &TetMesh) -> Result<tet_diffusion::TetMesh, tet_diffusion::Error> {
+    tet_diffusion::TetMesh::new(&mesh.positions, &mesh.tets)
+}
+
+/// A stuffed mesh (`tet_diffusion::stuffing`) as trilux-io's, to write.
+pub fn from_stuffing(mesh: &tet_diffusion::stuffing::TetMesh, origin: DVec3) -> TetMesh {
+    TetMesh {
+        positions: mesh.positions.iter().map(|&p| p + origin).collect(),
+        tets: mesh.tets.clone(),
+        ..TetMesh::default()
+    }
+}

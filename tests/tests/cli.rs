@@ -67,6 +67,8 @@ fn every_subcommand_has_help_with_an_example() {
         &["colors", "render"],
         &["demo"],
         &["bench"],
+        &["tetra"],
+        &["diffuse"],
     ] {
         let mut args = sub.to_vec();
         args.push("--help");
@@ -397,7 +399,11 @@ fn demo_writes_every_pipeline_with_a_preview_and_refuses_to_overwrite() {
     assert!(out.status.success(), "{}", stderr(&out));
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let pipelines = json["pipelines"].as_array().unwrap();
-    assert!(pipelines.len() >= 6);
+    assert!(pipelines.len() >= 7);
+    assert!(
+        pipelines.iter().any(|p| p["name"] == "translucent"),
+        "no translucent pipeline"
+    );
     for p in pipelines {
         let files = p["files"].as_array().unwrap();
         assert!(
@@ -412,6 +418,7 @@ fn demo_writes_every_pipeline_with_a_preview_and_refuses_to_overwrite() {
                 "obj" => assert!(!TriMesh::read(&f).unwrap().indices.is_empty()),
                 "png" | "exr" => assert!(trilux_io::image::read(&f).unwrap().width > 0),
                 "meshcolors" => assert!(mesh_colors::file::load(&f).unwrap().0.sample_count() > 0),
+                "node" => assert!(!trilux_io::tet::read(&f).unwrap().tets.is_empty()),
                 _ => {}
             }
         }

@@ -14,9 +14,11 @@ use trilux::Error;
 mod bench;
 mod colors;
 mod demo;
+mod diffuse;
 mod info;
 mod plot;
 mod sample;
+mod tetra;
 
 pub(crate) type Result<T> = std::result::Result<T, Error>;
 
@@ -53,6 +55,8 @@ enum Command {
     Sample(sample::Args),
     #[command(subcommand)]
     Colors(colors::Command),
+    Tetra(tetra::Args),
+    Diffuse(diffuse::Args),
     Demo(demo::Args),
     Bench(bench::Args),
 }
@@ -133,6 +137,8 @@ pub(crate) fn run() -> ExitCode {
         Command::Info(args) => info::run(&mut context, args),
         Command::Sample(args) => sample::run(&mut context, args),
         Command::Colors(command) => colors::run(&mut context, command),
+        Command::Tetra(args) => tetra::run(&mut context, args),
+        Command::Diffuse(args) => diffuse::run(&mut context, args),
         Command::Demo(args) => demo::run(&mut context, args),
         Command::Bench(args) => bench::run(&mut context, args),
     };

@@ -1,0 +1,524 @@
+//! `trilux diffuse`: TransCut's diffusion on a tetrahedral mesh (lights,
+//! materials, cuts, paint, fracture), shaded with Eq. 3's outgoing
+//! radiance plus a specular term, and rendered.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use glam::{DVec3, Vec3};
+use tet_diffusion::{Cut, Light, Medium, Noise, Object, Stroke};
+
+use super::{Context, Result, invalid};
+
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Solve TransCut's diffusion on a tetrahedral mesh (or a surface, tetrahedralized first) and render it",
+    after_help = "Example:\n  trilux diffuse ../shared/data/tets/bunny_500k.msh --material marble \\\n      --light dir:0.3,1,0.6 --cut plane:0,0,1,0.01 -o bunny_marble.png\n\nMaterials: apple chicken1 chicken2 cream ketchup marble potato skimmilk skin1 skin2\nspectralon wholemilk, or noise:A,B (fractal noise between two of them)."
+)]
+pub(crate) struct Args {
+    /// A tetrahedral mesh (.node, .ele, .msh, .mesh) or a closed surface
+    /// (.obj, .gltf, .glb, .ply), which is tetrahedralized first.
+    pub(crate) input: PathBuf,
+    /// A measured material (Jensen et al. 2001) or noise:A,B.
+    #[arg(long, default_value = "marble")]
+    pub(crate) material: String,
+    /// Millimetres per mesh unit (default: 1000 when the mesh's diagonal is
+    /// under 5 units, as for scans in metres; 1 otherwise).
+    #[arg(long, value_name = "X")]
+    pub(crate) unit_mm: Option<f64>,
+    /// dir:x,y,z[:r,g,b] (toward the light) or point:x,y,z[:r,g,b];
+    /// repeatable. Default: one light from the upper front.
+    #[arg(long, value_name = "SPEC")]
+    pub(crate) light: Vec<String>,
+    /// An equirectangular environment map as a light.
+    #[arg(long, value_name = "IMAGE")]
+    pub(crate) envmap: Option<PathBuf>,
+    /// plane:nx,ny,nz,d removes the side n·x > d; repeatable.
+    #[arg(long, value_name = "SPEC")]
+    pub(crate) cut: Vec<String>,
+    /// x,y,z:radius:material paints a material into a ball; repeatable.
+    #[arg(long, value_name = "SPEC")]
+    pub(crate) paint: Vec<String>,
+    /// plane:nx,ny,nz,d breaks the object in two along the plane.
+    #[arg(long, value_name = "SPEC")]
+    pub(crate) fracture: Option<String>,
+    /// Look from this direction (x,y,z from the mesh's centre toward the
+    /// camera; default a three-quarter view from +z, above and right).
+    #[arg(long, value_name = "X,Y,Z")]
+    pub(crate) view: Option<String>,
+    /// Picture width and height in pixels.
+    #[arg(long, default_value_t = 768)]
+    pub(crate) size: u32,
+    /// The picture (tone-mapped, 8-bit sRGB PNG).
+    #[arg(short, long, value_name = "OUT.png")]
+    pub(crate) output: PathBuf,
+    /// Also the linear radiance as EXR.
+    #[arg(long, value_name = "OUT.exr")]
+    pub(crate) exr: Option<PathBuf>,
+    /// Also φ and the radiance per node as VTU, for ParaView.
+    #[arg(long, value_name = "OUT.vtu")]
+    pub(crate) vtu: Option<PathBuf>,
+}
+
+/// Sweeps of TransCut's relaxation of the cross-section after a cut: the
+/// cut removes whole tetrahedra, so the fresh face is as jagged as the
+/// mesh until its vertices are pulled toward the plane.
+pub(crate) const CUT_RELAX_SWEEPS: usize = 20;
+
+/// The per-tetrahedron media for a mesh, given the noise's feature size.
+type MediaFn = Box<dyn Fn(&tet_diffusion::TetMesh, f64) -> Result<Vec<Medium>>>;
+
+/// A boundary to draw: positions, triangles, (unused) colours, normals.
+type Shape = (Vec<Vec3>, Vec<[u32; 3]>, Vec<[f32; 3]>, Vec<Vec3>);
+
+fn numbers(spec: &str, what: &str, n: usize) -> Result<Vec<f64>> {
+    let v: Vec<f64> = spec
+        .split(',')
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| {
+            invalid(format!(
+                "{what} {spec:?}: expected {n} comma-separated numbers"
+            ))
+        })?;
+    if v.len() != n || v.iter().any(|x| !x.is_finite()) {
+        return Err(invalid(format!(
+            "{what} {spec:?}: expected {n} finite comma-separated numbers"
+        )));
+    }
+    Ok(v)
+}
+
+fn vec3(v: &[f64]) -> DVec3 {
+    DVec3::new(v[0], v[1], v[2])
+}
+
+/// `kind:x,y,z[:r,g,b]`.
+pub(crate) fn parse_light(spec: &str) -> Result<Light> {
+    let parts: Vec<&str> = spec.split(':').collect();
+    let what = "--light";
+    let (kind, xyz, rgb) = match parts.as_slice() {
+        [k, xyz] => (*k, *xyz, None),
+        [k, xyz, rgb] => (*k, *xyz, Some(*rgb)),
+        _ => {
+            return Err(invalid(format!(
+                "--light {spec:?}: expected dir:x,y,z[:r,g,b] or point:x,y,z[:r,g,b]"
+            )));
+        }
+    };
+    let p = vec3(&numbers(xyz, what, 3)?);
+    let c = match rgb {
+        Some(rgb) => {
+            let c = numbers(rgb, what, 3)?;
+            [c[0], c[1], c[2]]
+        }
+        None => [1.0; 3],
+    };
+    match kind {
+        "dir" => Ok(Light::Directional {
+            to_light: p,
+            irradiance: c,
+        }),
+        "point" => Ok(Light::Point {
+            position: p,
+            intensity: c,
+        }),
+        other => Err(invalid(format!(
+            "--light {spec:?}: unknown kind {other:?} (dir or point)"
+        ))),
+    }
+}
+
+/// `plane:nx,ny,nz,d` as (point, unit normal).
+fn parse_plane(spec: &str, what: &str) -> Result<(DVec3, DVec3)> {
+    let rest = spec
+        .strip_prefix("plane:")
+        .ok_or_else(|| invalid(format!("{what} {spec:?}: expected plane:nx,ny,nz,d")))?;
+    let v = numbers(rest, what, 4)?;
+    let n = vec3(&v);
+    if n.length_squared() == 0.0 {
+        return Err(invalid(format!("{what} {spec:?}: the normal is zero")));
+    }
+    let unit = n.normalize();
+    Ok((unit * (v[3] / n.length()), unit))
+}
+
+fn medium(name: &str) -> Result<Medium> {
+    Medium::measured(name).map_err(|_| {
+        invalid(format!(
+            "unknown material {name:?}: one of {}",
+            tet_diffusion::MEASURED
+                .iter()
+                .map(|m| m.0)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    })
+}
+
+pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    super::check_output(context, &args.output, &["png"])?;
+    if let Some(p) = &args.exr {
+        super::check_output(context, p, &["exr"])?;
+    }
+    if let Some(p) = &args.vtu {
+        super::check_output(context, p, &["vtu"])?;
+    }
+    if args.size == 0 || args.size > 8192 {
+        return Err(invalid(format!(
+            "--size {}: must be 1..=8192 pixels",
+            args.size
+        )));
+    }
+    // Arguments first: a typo fails before any long step.
+    let mut lights = args
+        .light
+        .iter()
+        .map(|s| parse_light(s))
+        .collect::<Result<Vec<_>>>()?;
+    let cuts = args
+        .cut
+        .iter()
+        .map(|s| parse_plane(s, "--cut"))
+        .collect::<Result<Vec<_>>>()?;
+    let fracture = args
+        .fracture
+        .as_deref()
+        .map(|s| parse_plane(s, "--fracture"))
+        .transpose()?;
+    let paints = args
+        .paint
+        .iter()
+        .map(|s| {
+            let parts: Vec<&str> = s.split(':').collect();
+            let [xyz, r, m] = parts.as_slice() else {
+                return Err(invalid(format!(
+                    "--paint {s:?}: expected x,y,z:radius:material"
+                )));
+            };
+            let radius: f64 = r
+                .parse()
+                .ok()
+                .filter(|r: &f64| r.is_finite() && *r > 0.0)
+                .ok_or_else(|| {
+                    invalid(format!(
+                        "--paint {s:?}: the radius must be a positive number"
+                    ))
+                })?;
+            Ok(Stroke {
+                points: vec![vec3(&numbers(xyz, "--paint", 3)?)],
+                radius,
+                medium: medium(m)?,
+                strength: 1.0,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let view = match &args.view {
+        None => None,
+        Some(spec) => {
+            let v = vec3(&numbers(spec, "--view", 3)?);
+            if v.length_squared() == 0.0 {
+                return Err(invalid(format!("--view {spec:?}: the direction is zero")));
+            }
+            Some(v.as_vec3())
+        }
+    };
+    let material = args.material.clone();
+    let media: MediaFn = match material.strip_prefix("noise:") {
+        Some(pair) => {
+            let names: Vec<&str> = pair.split(',').collect();
+            let [a, b] = names.as_slice() else {
+                return Err(invalid(format!(
+                    "--material {material:?}: expected noise:A,B"
+                )));
+            };
+            let (a, b) = (medium(a)?, medium(b)?);
+            Box::new(move |mesh, scale| {
+                Noise {
+                    a,
+                    b,
+                    scale,
+                    octaves: 4,
+                    seed: 1,
+                }
+                .media(mesh)
+                .map_err(|e| invalid(format!("--material: {e}")))
+            })
+        }
+        None => {
+            let m = medium(&material)?;
+            Box::new(move |mesh, _| Ok(vec![m; mesh.tets().len()]))
+        }
+    };
+
+    let ext = super::extension(&args.input);
+    let (positions, tets) = if ["node", "ele", "msh", "mesh"].contains(&ext.as_str()) {
+        let tet = context.step("reading the tetrahedra", || {
+            trilux_io::tet::TetMesh::read(&args.input)
+        })?;
+        (tet.positions, tet.tets)
+    } else {
+        let surface = super::read_mesh(context, &args.input)?;
+        let stuffed = context.step("tetrahedralizing", || {
+            super::tetra::stuff(&surface, &args.input, None, false)
+        })?;
+        let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
+        (out.positions, out.tets)
+    };
+    let mesh = tet_diffusion::TetMesh::new(&positions, &tets)
+        .map_err(|e| invalid(format!("{}: {e}", args.input.display())))?;
+    let (lo, hi) = positions
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| {
+            (a.min(p), b.max(p))
+        });
+    let diagonal = (hi - lo).length();
+    let unit_mm = args
+        .unit_mm
+        .unwrap_or(if diagonal < 5.0 { 1000.0 } else { 1.0 });
+    let media = media(&mesh, diagonal / 6.0)?;
+    let mut object = context
+        .step("assembling", || Object::new(mesh, unit_mm, media, 1.3))
+        .map_err(|e| invalid(format!("{}: {e}", args.input.display())))?;
+    if lights.is_empty() && args.envmap.is_none() {
+        lights.push(Light::Directional {
+            to_light: DVec3::new(0.4, 1.0, 0.7),
+            irradiance: [1.0; 3],
+        });
+    }
+    for light in &lights {
+        object
+            .add_light(light.clone())
+            .map_err(|e| invalid(format!("--light: {e}")))?;
+    }
+    if let Some(path) = &args.envmap {
+        let image = super::read_image(context, path, false)?;
+        let rgb: Vec<[f32; 3]> = image.pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
+        let env =
+            tet_diffusion::Environment::new(&rgb, image.width as usize, image.height as usize, 256)
+                .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+        object
+            .add_light(Light::Environment(Arc::new(env)))
+            .map_err(|e| invalid(format!("--envmap: {e}")))?;
+    }
+    for stroke in &paints {
+        object
+            .paint(stroke)
+            .map_err(|e| invalid(format!("--paint: {e}")))?;
+    }
+    for (point, normal) in &cuts {
+        context
+            .step("cutting", || {
+                object.cut(
+                    &Cut::Plane {
+                        point: *point,
+                        normal: *normal,
+                    },
+                    CUT_RELAX_SWEEPS,
+                )
+            })
+            .map_err(|e| invalid(format!("--cut: {e}")))?;
+    }
+    let mut objects = match fracture {
+        Some((point, normal)) => {
+            let [a, mut b] = object
+                .fracture(point, normal)
+                .map_err(|e| invalid(format!("--fracture: {e}")))?;
+            b.set_transform(glam::DAffine3::from_translation(normal * diagonal * 0.15));
+            vec![a, b]
+        }
+        None => vec![object],
+    };
+    let mut reports = Vec::new();
+    for o in &mut objects {
+        reports.push(
+            context
+                .step("solving", || o.solve())
+                .map_err(|e| invalid(format!("solving: {e}")))?,
+        );
+    }
+    let image = context.step("rendering", || render(&objects, &lights, args.size, view));
+    super::write_image(context, &args.output, &tone_map(&image))?;
+    if let Some(p) = &args.exr {
+        super::write_image(context, p, &image)?;
+    }
+    if let Some(p) = &args.vtu {
+        let o = &objects[0];
+        let m = o.mesh();
+        let io_mesh = trilux_io::tet::TetMesh {
+            positions: m.positions().to_vec(),
+            tets: m.tets().to_vec(),
+            ..Default::default()
+        };
+        let radiance = o.radiance(None);
+        let mut lum = vec![0.0; m.vertex_count()];
+        for (k, &v) in m.boundary_vertices().iter().enumerate() {
+            let l = radiance[k];
+            lum[v as usize] = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
+        }
+        use trilux_io::tet::vtu::{Encoding, Field};
+        let fields = [
+            Field {
+                name: "phi_r",
+                values: o.phi(0),
+            },
+            Field {
+                name: "phi_g",
+                values: o.phi(1),
+            },
+            Field {
+                name: "phi_b",
+                values: o.phi(2),
+            },
+            Field {
+                name: "radiance",
+                values: &lum,
+            },
+        ];
+        trilux::output::write_atomic(p, context.force, |tmp| {
+            Ok(trilux_io::tet::vtu::write(
+                tmp,
+                &io_mesh,
+                &fields,
+                &[],
+                Encoding::Base64,
+            )?)
+        })?;
+    }
+    let tets: usize = objects.iter().map(|o| o.mesh().tets().len()).sum();
+    let levels = reports.first().map_or(0, |r| r.levels);
+    let text = format!(
+        "{} tetrahedra ({} object{}), {} mm per unit, solved ({} levels); picture written to {}\n",
+        tets,
+        objects.len(),
+        if objects.len() > 1 { "s" } else { "" },
+        unit_mm,
+        levels,
+        args.output.display()
+    );
+    let json = serde_json::json!({
+        "command": "diffuse",
+        "input": super::shown(&args.input),
+        "tetrahedra": tets,
+        "objects": objects.len(),
+        "unit_mm": unit_mm,
+        "material": args.material,
+        "output": super::shown(&args.output),
+        "seconds": context.timings_json(),
+    });
+    context.report(&text, json);
+    Ok(())
+}
+
+/// The objects' boundaries with per-vertex radiance (Eq. 3, toward the
+/// camera) interpolated per pixel, plus a Blinn–Phong specular term of
+/// the directional and point lights.
+pub(crate) fn render(
+    objects: &[Object],
+    lights: &[Light],
+    size: u32,
+    view: Option<Vec3>,
+) -> trilux_io::image::Image {
+    use trilux::preview::{Camera, Renderer};
+    let shapes: Vec<Shape> = objects
+        .iter()
+        .map(|o| {
+            let m = o.mesh();
+            let positions: Vec<Vec3> = o.display_positions().iter().map(|p| p.as_vec3()).collect();
+            (
+                positions,
+                m.boundary().to_vec(),
+                Vec::new(),
+                m.vertex_normals().iter().map(|n| n.as_vec3()).collect(),
+            )
+        })
+        .collect();
+    let all: Vec<Vec3> = shapes.iter().flat_map(|s| s.0.iter().copied()).collect();
+    let Some((lo, hi)) = trilux::preview::bounds(&all) else {
+        return trilux::preview::render_mesh(&[], &[], size, size);
+    };
+    let camera = match view {
+        Some(from) => Camera::fit_from(lo, hi, from),
+        None => Camera::fit(lo, hi),
+    };
+    let toward = (camera.eye - camera.target).normalize().as_dvec3();
+    let mut r = Renderer::new(size, size, camera);
+    for (o, (positions, faces, _, normals)) in objects.iter().zip(&shapes) {
+        let m = o.mesh();
+        let radiance = o.radiance(Some(toward));
+        let mut per_vertex = vec![[0.0f32; 3]; m.vertex_count()];
+        for (k, &v) in m.boundary_vertices().iter().enumerate() {
+            per_vertex[v as usize] = radiance[k].map(|x| x as f32);
+        }
+        let scale = (1.0 / (4.0 * std::f64::consts::PI)) as f32;
+        r.draw_mesh(positions, faces, |f| {
+            let t = faces[f.face as usize];
+            let b = f.barycentric;
+            let mut c = [0.0f32; 3];
+            for k in 0..3 {
+                for (ch, x) in c.iter_mut().enumerate() {
+                    *x += b[k] * per_vertex[t[k] as usize][ch];
+                }
+            }
+            let n = (normals[t[0] as usize] * b[0]
+                + normals[t[1] as usize] * b[1]
+                + normals[t[2] as usize] * b[2])
+                .normalize_or(f.normal);
+            for light in lights {
+                let (l, rgb) = match light {
+                    Light::Directional {
+                        to_light,
+                        irradiance,
+                    } => (to_light.as_vec3().normalize_or_zero(), *irradiance),
+                    Light::Point {
+                        position,
+                        intensity,
+                    } => (
+                        (position.as_vec3() - f.position).normalize_or_zero(),
+                        *intensity,
+                    ),
+                    Light::Environment(_) => continue,
+                };
+                let h = (l + f.to_eye).normalize_or_zero();
+                let spec = 0.04 * n.dot(h).max(0.0).powf(80.0) * f32::from(n.dot(l) > 0.0) * scale;
+                for (x, c) in c.iter_mut().zip(rgb) {
+                    *x += spec * c as f32;
+                }
+            }
+            c
+        });
+    }
+    r.image()
+}
+
+/// Exposure so that the brightest 1 % of the object's pixels reach white,
+/// then the PNG writer's sRGB encoding.
+pub(crate) fn tone_map(image: &trilux_io::image::Image) -> trilux_io::image::Image {
+    let mut lum: Vec<f32> = image
+        .pixels
+        .iter()
+        .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
+        .filter(|l| *l > 0.0)
+        .collect();
+    lum.sort_by(f32::total_cmp);
+    let white = lum
+        .get(lum.len() * 99 / 100)
+        .copied()
+        .unwrap_or(1.0)
+        .max(1e-12);
+    let background = image.pixels.first().copied().unwrap_or([0.0; 4]);
+    trilux_io::image::Image {
+        pixels: image
+            .pixels
+            .iter()
+            .map(|p| {
+                if *p == background {
+                    *p
+                } else {
+                    [p[0] / white, p[1] / white, p[2] / white, 1.0]
+                }
+            })
+            .collect(),
+        ..image.clone()
+    }
+}

@@ -1,0 +1,350 @@
+//! End-to-end tests of `trilux tetra` and `trilux diffuse`: the files they
+//! write parse back with trilux-io and carry the counts the command
+//! reported; bad inputs fail with a message naming the problem and the
+//! file or argument; outputs are not clobbered without `--force`.
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+use assert_cmd::Command;
+use glam::Vec3;
+use trilux_io::mesh::TriMesh;
+use trilux_tests::{data, trilux_bin};
+
+fn trilux(dir: &Path) -> Command {
+    let mut c = Command::new(trilux_bin());
+    c.current_dir(dir);
+    c
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Runs and expects failure with exit code 1 or 2 and a message containing
+/// every `needle`, without a panic.
+fn fails(dir: &Path, args: &[&str], needles: &[&str]) {
+    let out = trilux(dir).args(args).output().unwrap();
+    let err = stderr(&out);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert!(
+        matches!(out.status.code(), Some(1 | 2)),
+        "{args:?}: {:?}",
+        out.status
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: {n:?} not in {err:?}");
+    }
+}
+
+/// Runs with `--json` and returns the result object.
+fn json(dir: &Path, args: &[&str]) -> serde_json::Value {
+    let out = trilux(dir).args(args).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// The built-in bumpy blob (closed, about unit size) written as OBJ.
+fn blob(dir: &Path) -> PathBuf {
+    let path = dir.join("blob.obj");
+    trilux::shapes::blob(2).write(&path).unwrap();
+    path
+}
+
+#[test]
+fn tetra_writes_tetgen_medit_and_vtu_with_the_reported_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    for out in ["blob.node", "blob.mesh"] {
+        let report = json(d, &["tetra", blob, "--size", "0.15", "-o", out]);
+        let mesh = trilux_io::tet::read(d.join(out)).unwrap();
+        assert!(!mesh.tets.is_empty());
+        assert_eq!(report["tetrahedra"], mesh.tets.len());
+        assert_eq!(report["vertices"], mesh.positions.len());
+        let [lo, hi] = [
+            &report["dihedral_degrees"][0],
+            &report["dihedral_degrees"][1],
+        ]
+        .map(|v| v.as_f64().unwrap());
+        assert!(0.0 < lo && lo <= hi && hi < 180.0, "{lo} {hi}");
+    }
+    // The same lattice gives the same mesh in every format.
+    let report = json(d, &["tetra", blob, "--size", "0.15", "-o", "blob.vtu"]);
+    let vtu = std::fs::read_to_string(d.join("blob.vtu")).unwrap();
+    let cells = format!("NumberOfCells=\"{}\"", report["tetrahedra"]);
+    assert!(vtu.contains(&cells), "{cells} not in the VTU header");
+    // Grading keeps the surface's resolution with fewer tetrahedra inside.
+    let graded = json(
+        d,
+        &["tetra", blob, "--size", "0.05", "--graded", "-o", "g.node"],
+    );
+    let uniform = json(d, &["tetra", blob, "--size", "0.05", "-o", "u.node"]);
+    assert!(
+        graded["tetrahedra"].as_u64() < uniform["tetrahedra"].as_u64(),
+        "graded {} vs uniform {}",
+        graded["tetrahedra"],
+        uniform["tetrahedra"]
+    );
+}
+
+#[test]
+fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let triangle = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices: vec![[0, 1, 2]],
+        ..TriMesh::default()
+    };
+    triangle.write(d.join("triangle.obj")).unwrap();
+    fails(
+        d,
+        &["tetra", "triangle.obj", "--size", "0.1", "-o", "t.node"],
+        &["triangle.obj", "encloses nothing"],
+    );
+    assert!(!d.join("t.node").exists() && !d.join("t.ele").exists());
+    // An open sheet: a grid of triangles in a plane.
+    let n = 8u32;
+    let sheet = TriMesh {
+        positions: (0..=n)
+            .flat_map(|j| (0..=n).map(move |i| Vec3::new(i as f32, j as f32, 0.0) / n as f32))
+            .collect(),
+        indices: (0..n)
+            .flat_map(|j| {
+                (0..n).flat_map(move |i| {
+                    let a = j * (n + 1) + i;
+                    [[a, a + 1, a + n + 2], [a, a + n + 2, a + n + 1]]
+                })
+            })
+            .collect(),
+        ..TriMesh::default()
+    };
+    sheet.write(d.join("sheet.obj")).unwrap();
+    fails(
+        d,
+        &["tetra", "sheet.obj", "--size", "0.1", "-o", "s.node"],
+        &["sheet.obj", "encloses nothing"],
+    );
+    fails(
+        d,
+        &["tetra", "missing.obj", "-o", "m.node"],
+        &["missing.obj"],
+    );
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    fails(
+        d,
+        &["tetra", blob, "--size=-1", "-o", "neg.node"],
+        &["--size"],
+    );
+    // An existing output is kept without --force, replaced with it.
+    std::fs::write(d.join("kept.mesh"), "precious").unwrap();
+    fails(
+        d,
+        &["tetra", blob, "--size", "0.2", "-o", "kept.mesh"],
+        &["kept.mesh", "--force"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.join("kept.mesh")).unwrap(),
+        "precious"
+    );
+    trilux(d)
+        .args(["tetra", blob, "--size", "0.2", "-o", "kept.mesh", "--force"])
+        .assert()
+        .success();
+    assert!(
+        !trilux_io::tet::read(d.join("kept.mesh"))
+            .unwrap()
+            .tets
+            .is_empty()
+    );
+}
+
+#[test]
+fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    trilux(d)
+        .args(["tetra", blob, "--size", "0.12", "-o", "blob.node"])
+        .assert()
+        .success();
+    let tets = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--material",
+            "marble",
+            "--unit-mm",
+            "20",
+            "--light",
+            "dir:0.3,1,0.6",
+            "--light",
+            "point:2,2,2:0.5,0.5,1",
+            "--cut",
+            "plane:0,0,1,0.2",
+            "--size",
+            "96",
+            "-o",
+            "marble.png",
+            "--exr",
+            "marble.exr",
+            "--vtu",
+            "marble.vtu",
+        ],
+    );
+    assert_eq!(report["objects"], 1);
+    // The cut removes the cap above z = 0.2 (splitting the tetrahedra it
+    // crosses): fewer remain than were stuffed, but most of the blob.
+    let cut = report["tetrahedra"].as_u64().unwrap();
+    let stuffed = tets.tets.len() as u64;
+    assert!(stuffed / 3 < cut && cut < stuffed, "{cut} of {stuffed}");
+    let png = trilux_io::image::read(d.join("marble.png")).unwrap();
+    assert_eq!((png.width, png.height), (96, 96));
+    let lit = png
+        .pixels
+        .iter()
+        .filter(|p| p[0] + p[1] + p[2] > 0.05 && **p != png.pixels[0])
+        .count();
+    assert!(lit > 96 * 96 / 20, "only {lit} lit pixels");
+    let exr = trilux_io::image::read(d.join("marble.exr")).unwrap();
+    assert_eq!((exr.width, exr.height), (96, 96));
+    let vtu = std::fs::read_to_string(d.join("marble.vtu")).unwrap();
+    for field in ["phi_r", "phi_g", "phi_b", "radiance"] {
+        assert!(vtu.contains(&format!("Name=\"{field}\"")), "{field}");
+    }
+    // Paint a ball of skin into the marble, then break the blob in two.
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "0.5,0,0:0.4:skin1",
+            "--fracture",
+            "plane:1,0,0,0",
+            "--view=0,0.3,1",
+            "--size",
+            "64",
+            "-o",
+            "broken.png",
+        ],
+    );
+    assert_eq!(report["objects"], 2);
+    assert_eq!(report["tetrahedra"], tets.tets.len());
+    fails(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "0,0,0:-1:skin1",
+            "-o",
+            "p.png",
+        ],
+        &["--paint", "radius"],
+    );
+    // A surface is tetrahedralized first; noise between two materials.
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            blob,
+            "--material",
+            "noise:marble,skin1",
+            "--size",
+            "64",
+            "-o",
+            "noise.png",
+        ],
+    );
+    assert!(report["tetrahedra"].as_u64().unwrap() > 100);
+    assert!(d.join("noise.png").exists());
+}
+
+#[test]
+fn diffuse_names_a_bad_material_light_cut_or_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    fails(
+        d,
+        &["diffuse", blob, "--material", "jade", "-o", "a.png"],
+        &["jade", "marble"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--material", "noise:marble", "-o", "a.png"],
+        &["noise:A,B"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--light", "sun:0,1,0", "-o", "a.png"],
+        &["--light", "sun"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--light", "dir:0,1", "-o", "a.png"],
+        &["--light", "3"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--cut", "plane:0,0,0,1", "-o", "a.png"],
+        &["--cut", "zero"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--view", "0,0,0", "-o", "a.png"],
+        &["--view", "zero"],
+    );
+    fails(
+        d,
+        &["diffuse", "missing.node", "-o", "a.png"],
+        &["missing.node"],
+    );
+    assert!(!d.join("a.png").exists());
+}
+
+#[test]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
+fn tetra_stuffs_the_raw_bunny_and_diffuse_accepts_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bunny = data("meshes/stanford-bunny.obj");
+    let report = json(d, &["tetra", bunny.to_str().unwrap(), "-o", "bunny.node"]);
+    let min = report["dihedral_degrees"][0].as_f64().unwrap();
+    assert!(min >= 8.9, "minimum dihedral {min}°");
+    let mesh = trilux_io::tet::read(d.join("bunny.node")).unwrap();
+    assert_eq!(report["tetrahedra"], mesh.tets.len());
+    trilux(d)
+        .args([
+            "diffuse",
+            "bunny.node",
+            "--material",
+            "marble",
+            "--unit-mm",
+            "1000",
+            "--cut",
+            "plane:0,0,1,0",
+            "--size",
+            "128",
+            "-o",
+            "bunny.png",
+        ])
+        .assert()
+        .success();
+    assert_eq!(
+        trilux_io::image::read(d.join("bunny.png")).unwrap().width,
+        128
+    );
+}
