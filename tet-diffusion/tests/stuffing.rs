@@ -4,6 +4,9 @@
 //! near the surface, fast against exact winding numbers, and the files
 //! `trilux-io` writes.
 
+#[path = "../../io/tests/support/data_dir.rs"]
+mod data_dir;
+
 use std::path::PathBuf;
 
 use tet_diffusion::glam::DVec3;
@@ -16,8 +19,10 @@ struct Surface {
     closed: bool,
 }
 
+/// The data folder (a relative `TRILUX_DATA`, as CI gives it, is taken
+/// from the workspace root by the shared helper).
 fn data() -> PathBuf {
-    PathBuf::from(std::env::var_os("TRILUX_DATA").expect("TRILUX_DATA is set"))
+    data_dir::data_dir().expect("TRILUX_DATA is set")
 }
 
 /// Every mesh of the data folder, plus the TetGen bunny's boundary.
