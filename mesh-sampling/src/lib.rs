@@ -74,10 +74,12 @@
 
 // The foreign crates this API speaks, so that callers use the same
 // versions: glam for positions, rand for `Rng` and `Distribution`,
-// discrete-sampling for the 1D samplers `DensitySampler` can take.
+// discrete-sampling for the 1D samplers `DensitySampler` can take, and
+// rand_pcg, the generator the batches use, for seeding your own.
 pub use discrete_sampling;
 pub use glam;
 pub use rand;
+pub use rand_pcg;
 
 mod batch;
 #[cfg(feature = "blue-noise")]
