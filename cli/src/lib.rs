@@ -67,3 +67,9 @@ pub use glam;
 pub use mesh_colors;
 pub use mesh_sampling;
 pub use trilux_io;
+
+// The README's file-to-result programs are compiled with the doctests, so
+// that they keep working as the crates change.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

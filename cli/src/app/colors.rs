@@ -54,7 +54,7 @@ pub(crate) struct BakeArgs {
     pub(crate) mesh: PathBuf,
     /// The mesh colours.
     pub(crate) colors: PathBuf,
-    /// The OBJ to write; the atlas goes beside it as NAME.png and NAME.mtl.
+    /// The OBJ to write; the atlas goes beside it as NAME_0.png and NAME.mtl.
     #[arg(short, long, value_name = "OUT.obj")]
     pub(crate) output: PathBuf,
     /// MIP-safe packing for this many MIP levels (0: compact packing).

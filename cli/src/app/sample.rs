@@ -27,9 +27,15 @@ pub(crate) const MAX_POINTS: u64 = 200_000_000;
 pub(crate) struct Args {
     /// The mesh: .obj, .gltf, .glb or .ply.
     pub(crate) mesh: PathBuf,
-    /// How many points.
-    #[arg(short = 'n', long = "count", value_name = "N")]
-    pub(crate) count: u64,
+    /// How many points. Signed, so that `-n -5` reaches the range check
+    /// and its message instead of being taken for an unknown option.
+    #[arg(
+        short = 'n',
+        long = "count",
+        value_name = "N",
+        allow_negative_numbers = true
+    )]
+    pub(crate) count: i64,
     /// A density texture (PNG, JPEG, HDR, EXR), looked up at the mesh's UVs;
     /// 8/16-bit values are used as stored (no sRGB decoding).
     #[arg(long, value_name = "IMAGE", group = "density_source")]
@@ -202,7 +208,7 @@ pub(crate) fn meshcolors_source(mesh: &TriMesh, path: &Path, channel: Channel) -
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
-    if args.count == 0 || args.count > MAX_POINTS {
+    if args.count <= 0 || args.count.unsigned_abs() > MAX_POINTS {
         return Err(invalid(format!(
             "-n {}: the number of points must be between 1 and {MAX_POINTS}",
             args.count
