@@ -4,41 +4,12 @@
 //! half-written.
 
 use std::path::{Path, PathBuf};
-use std::process::Output;
 
-use assert_cmd::Command;
 use trilux_io::mesh::TriMesh;
 use trilux_tests::{data, trilux_bin};
 
-fn trilux(dir: &Path) -> Command {
-    let mut c = Command::new(trilux_bin());
-    c.current_dir(dir);
-    c
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-/// Runs and expects failure with exit code 1 or 2 and a one-paragraph
-/// message containing every `needle`, no panic and no backtrace.
-fn fails(dir: &Path, args: &[&str], needles: &[&str]) {
-    let out = trilux(dir).args(args).output().unwrap();
-    let err = stderr(&out);
-    assert!(!out.status.success(), "{args:?} succeeded");
-    assert!(
-        matches!(out.status.code(), Some(1 | 2)),
-        "{args:?}: {:?}",
-        out.status
-    );
-    assert!(
-        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
-        "{err}"
-    );
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: {n:?} not in {err:?}");
-    }
-}
+mod common;
+use common::{fails, stderr, trilux};
 
 /// A built-in textured torus and a noise texture written as files.
 fn inputs(dir: &Path) -> (PathBuf, PathBuf) {

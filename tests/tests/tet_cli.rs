@@ -4,46 +4,13 @@
 //! file or argument; outputs are not clobbered without `--force`.
 
 use std::path::{Path, PathBuf};
-use std::process::Output;
 
-use assert_cmd::Command;
 use glam::Vec3;
 use trilux_io::mesh::TriMesh;
-use trilux_tests::{data, trilux_bin};
+use trilux_tests::data;
 
-fn trilux(dir: &Path) -> Command {
-    let mut c = Command::new(trilux_bin());
-    c.current_dir(dir);
-    c
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-/// Runs and expects failure with exit code 1 or 2 and a message containing
-/// every `needle`, without a panic.
-fn fails(dir: &Path, args: &[&str], needles: &[&str]) {
-    let out = trilux(dir).args(args).output().unwrap();
-    let err = stderr(&out);
-    assert!(!out.status.success(), "{args:?} succeeded");
-    assert!(
-        matches!(out.status.code(), Some(1 | 2)),
-        "{args:?}: {:?}",
-        out.status
-    );
-    assert!(!err.contains("panicked"), "{err}");
-    for n in needles {
-        assert!(err.contains(n), "{args:?}: {n:?} not in {err:?}");
-    }
-}
-
-/// Runs with `--json` and returns the result object.
-fn json(dir: &Path, args: &[&str]) -> serde_json::Value {
-    let out = trilux(dir).args(args).arg("--json").output().unwrap();
-    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
-    serde_json::from_slice(&out.stdout).unwrap()
-}
+mod common;
+use common::{fails, json, trilux};
 
 /// The built-in bumpy blob (closed, about unit size) written as OBJ.
 fn blob(dir: &Path) -> PathBuf {

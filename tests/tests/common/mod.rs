@@ -1,0 +1,47 @@
+//! Helpers shared by the end-to-end tests of the `trilux` binary.
+
+#![allow(dead_code, reason = "each test binary uses a subset")]
+
+use std::path::Path;
+use std::process::Output;
+
+use assert_cmd::Command;
+use trilux_tests::trilux_bin;
+
+/// The `trilux` binary, run in `dir`.
+pub(crate) fn trilux(dir: &Path) -> Command {
+    let mut c = Command::new(trilux_bin());
+    c.current_dir(dir);
+    c
+}
+
+pub(crate) fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Runs and expects failure with exit code 1 or 2 and a one-paragraph
+/// message containing every `needle`, no panic and no backtrace.
+pub(crate) fn fails(dir: &Path, args: &[&str], needles: &[&str]) {
+    let out = trilux(dir).args(args).output().unwrap();
+    let err = stderr(&out);
+    assert!(!out.status.success(), "{args:?} succeeded");
+    assert!(
+        matches!(out.status.code(), Some(1 | 2)),
+        "{args:?}: {:?}",
+        out.status
+    );
+    assert!(
+        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
+        "{err}"
+    );
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: {n:?} not in {err:?}");
+    }
+}
+
+/// Runs with `--json` and returns the result object.
+pub(crate) fn json(dir: &Path, args: &[&str]) -> serde_json::Value {
+    let out = trilux(dir).args(args).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
