@@ -72,6 +72,11 @@ mod object;
 pub mod paint;
 pub mod stuffing;
 
+// Test meshes built in code, shared with the integration tests.
+#[cfg(test)]
+#[path = "../tests/common/kuhn.rs"]
+mod kuhn;
+
 pub use cut::{Cut, CutReport};
 pub use error::Error;
 pub use fem::{Integration, P1Matrices};

@@ -4,44 +4,13 @@
 use tet_diffusion::glam::DVec3;
 use tet_diffusion::{Medium, Object, TetMesh};
 
+mod kuhn;
+
 /// An `n³` lattice of `[-1, 1]³`, each cube split into six tets around its
 /// main diagonal.
 pub(crate) fn cube(n: usize) -> (Vec<DVec3>, Vec<[u32; 4]>) {
-    let m = n + 1;
-    let id = |x: usize, y: usize, z: usize| (x + m * (y + m * z)) as u32;
-    let mut p = Vec::new();
-    for z in 0..m {
-        for y in 0..m {
-            for x in 0..m {
-                p.push(DVec3::new(x as f64, y as f64, z as f64) * (2.0 / n as f64) - DVec3::ONE);
-            }
-        }
-    }
-    const PATHS: [[usize; 3]; 6] = [
-        [0, 1, 2],
-        [0, 2, 1],
-        [1, 0, 2],
-        [1, 2, 0],
-        [2, 0, 1],
-        [2, 1, 0],
-    ];
-    let mut tets = Vec::new();
-    for z in 0..n {
-        for y in 0..n {
-            for x in 0..n {
-                for path in PATHS {
-                    let mut c = [x, y, z];
-                    let mut tet = [id(x, y, z); 4];
-                    for (k, &axis) in path.iter().enumerate() {
-                        c[axis] += 1;
-                        tet[k + 1] = id(c[0], c[1], c[2]);
-                    }
-                    tets.push(tet);
-                }
-            }
-        }
-    }
-    (p, tets)
+    let (p, tets) = kuhn::cube(n, 2.0);
+    (p.into_iter().map(|x| x - DVec3::ONE).collect(), tets)
 }
 
 /// A ball of radius `r`: the cube lattice mapped radially,
