@@ -125,14 +125,6 @@ impl Lattice {
         (0..3).any(|a| c[a] <= 1 || c[a] >= 2 * self.n[a] as i64 - 1)
     }
 
-    /// Parity of a vertex: `(i + j + k) mod 2` of its cube indices. The two
-    /// ends of a long edge always have different parity, which is what the
-    /// parity rule for quadrilateral faces uses.
-    pub(crate) fn parity(&self, id: u32) -> u32 {
-        let c = self.coords(id);
-        (((c[0] >> 1) + (c[1] >> 1) + (c[2] >> 1)) & 1) as u32
-    }
-
     /// The 14 lattice neighbours of a vertex (those that exist), with
     /// `true` for long edges.
     pub(crate) fn neighbors(&self, id: u32, out: &mut Vec<(u32, bool)>) {
@@ -227,8 +219,10 @@ mod tests {
                 let v = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
                 assert!((v.abs() - l.h.powi(3) / 12.0).abs() < 1e-12);
                 volume += v.abs();
-                assert_ne!(l.parity(t[0]), l.parity(t[1]));
-                assert_ne!(l.parity(t[2]), l.parity(t[3]));
+                // The order the stencils rely on: cube centres (odd doubled
+                // coordinates) first, then cube corners.
+                assert!(t[..2].iter().all(|&v| l.coords(v)[0] & 1 == 1));
+                assert!(t[2..].iter().all(|&v| l.coords(v)[0] & 1 == 0));
             }
         }
         // Each pair of face-adjacent cubes owns a bipyramid of volume h³/3.

@@ -70,31 +70,34 @@ use stencils::{FaceRule, LatticeTet, Point};
 
 /// The warping thresholds `(α_long, α_short)` of Labelle & Shewchuk 2007.
 ///
-/// The paper (its abstract; the bounds are proved by a computer-assisted
-/// search over its stencils) gives two parameter choices: dihedral angles within
-/// 10.7°–164.8°, or within 8.9°–158.8°. `α_long = 0.24999`,
-/// `α_short = 0.41189` is the pair of the first bound. The second variant
-/// uses `α_short = 0.42978`, the companion value of two independent
-/// implementations of the paper (SOFA's `MeshTetraStuffing` defaults and a
-/// sound-synthesis mesher's settings). Only the paper's abstract was
-/// available here, so neither the section nor the table that lists the
-/// pairs could be checked; the measured bounds below are what this module
-/// guarantees.
+/// The paper's abstract gives two parameter choices, with dihedral angles
+/// within 10.7°–164.8° or within 8.9°–158.8°, proved by a computer-assisted
+/// search over its stencils. `α_long = 0.24999`, `α_short = 0.41189` is the
+/// pair of the first bound as independent implementations of the paper
+/// carry it; the second variant here uses `α_short = 0.42978`, the value
+/// two of them (SOFA's `MeshTetraStuffing` defaults, a sound-synthesis
+/// mesher's settings) pair with it. Only the abstract was available, so
+/// the pairs could not be checked against the paper's table.
 ///
-/// The bounds that hold for *this* module's stencils (which split the
-/// asymmetric quadrilaterals by a Delaunay rule, see the `stencils` module)
-/// are [`Params::dihedral_bounds_deg`], measured by enumerating every
-/// stencil case on a grid of warp distances and cut positions plus 400,000
-/// random ones; they differ from the paper's.
+/// What this module guarantees is measured instead
+/// ([`Params::dihedral_bounds_deg`]): the stencil test enumerates every
+/// sign pattern and warp direction of a lattice tetrahedron on a grid of
+/// warp distances and cut positions, plus 400,000 random ones, with the
+/// paper's stencils and parity rule. It finds 9.32°–161.64° for the first
+/// pair and 7.34°–164.58° for the second, so neither reproduces the
+/// paper's numbers: either the pairs are not the paper's, or the paper's
+/// analysis excludes configurations this test allows. The worst case of
+/// the first pair is a pyramid stencil (two inside vertices, one warped,
+/// one outside) whose two tetrahedra are fixed by the stencil, not a
+/// choice of ours. On every data mesh the smallest angle is above 14°.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Params {
     /// `α_long = 0.24999`, `α_short = 0.41189` (the paper's 10.7°–164.8°
-    /// pair). Measured for these stencils: 9.22°–161.64°.
+    /// pair, see the type's docs). Measured: 9.32°–161.64°.
     #[default]
     Angles10_7,
     /// `α_long = 0.24999`, `α_short = 0.42978` (see the type's docs).
-    /// Measured for these stencils: 7.30°–164.58°: warps more, which here
-    /// does not pay off.
+    /// Measured: 7.34°–164.58°: warps more, which here does not pay off.
     Angles8_9,
 }
 
@@ -478,7 +481,7 @@ impl Context<'_> {
             pos: self.position(id),
         });
         let sign = t.map(|id| self.signs[id as usize]);
-        let parity = t.map(|id| self.lattice.parity(id));
+        let coords = t.map(|id| self.lattice.coords(id));
         let mut cut = [[None; 4]; 4];
         for i in 0..4 {
             for j in i + 1..4 {
@@ -499,7 +502,7 @@ impl Context<'_> {
         LatticeTet {
             v,
             sign,
-            parity,
+            coords,
             cut,
         }
     }

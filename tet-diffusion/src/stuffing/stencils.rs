@@ -20,19 +20,24 @@
 //! vertex `o`; the diagonal runs from one of `p`, `q` to the cut point on
 //! the other's edge to `o`. Every BCC face has exactly one long edge:
 //!
-//! * if the long edge is `pq` the face is symmetric and the lattice alone
-//!   must decide: the **parity rule** takes the diagonal from the end of
-//!   `pq` with even parity (`i + j + k` even for its cube indices). Both
-//!   tetrahedra that share the face see the same two vertices, so they
-//!   agree; a stencil table written in a tetrahedron's local vertex order
-//!   does not, and leaves overlapping and missing slivers between
-//!   neighbours.
+//! * if the long edge is `pq`, the lattice alone must decide, by the
+//!   paper's **parity rule** (Labelle & Shewchuk 2007, Sec. 3.3 and the
+//!   last stencils of its Fig. 3): the diagonal from `A ∈ {p, q}` to the
+//!   cut point `C` on the other `+` vertex's edge points along
+//!   `sign(A - C) = sign(A - o)` (per axis, in lattice coordinates), and
+//!   exactly one of the two candidates has an odd number of positive
+//!   components. A long edge between two cube corners (black vertices)
+//!   takes the odd one, a long edge between two cube centres (red
+//!   vertices) the even one. Both tetrahedra that share the face see the
+//!   same `p`, `q`, `o`, so they agree. The rule also makes the two
+//!   lattice-face quadrilaterals of a `++--` tetrahedron start at
+//!   different `+` vertices, as in the paper's stencil for that case. (The
+//!   rule is read from the paper's stencil figure as two independent
+//!   implementations reproduce it, since the paper's text was not
+//!   available here.)
 //! * otherwise the long edge is `po` or `qo`, which both neighbours see
 //!   too: the diagonal ends at the cut point on the long edge and starts
-//!   at the other `+` vertex. (The opposite choice, from the `+` end of the
-//!   long edge, lets the (3, 0, 1) prism fall to 6.2° in the sampling test
-//!   below; a geometric Delaunay choice is conforming too but can make the
-//!   three diagonals of a prism cyclic.)
+//!   at the other `+` vertex (the paper's stencils do the same).
 //!
 //! A prism is split into 3 tetrahedra by coning from a vertex that two of
 //! its quadrilateral diagonals touch; among the valid choices (and both
@@ -45,9 +50,9 @@
 //!
 //! The sampling test draws 400,000 lattice tetrahedra per parameter pair
 //! (random signs, cut points anywhere warping allows, warped vertices up to
-//! α along any of their 14 edges, extremes drawn often) and checks the
-//! bounds [`super::Params::dihedral_bounds_deg`] states for *these*
-//! stencils.
+//! α along any of their 14 edges but never both ends of one edge along it,
+//! extremes drawn often) and checks the bounds
+//! [`super::Params::dihedral_bounds_deg`] states for *these* stencils.
 
 use glam::DVec3;
 
@@ -68,8 +73,9 @@ pub(crate) struct Point {
 pub(crate) struct LatticeTet {
     pub(crate) v: [Point; 4],
     pub(crate) sign: [Sign; 4],
-    /// Parity of each lattice vertex (see [`super::lattice::Lattice::parity`]).
-    pub(crate) parity: [u32; 4],
+    /// Doubled lattice coordinates of each vertex (before warping): even
+    /// for cube corners (black), odd for cube centres (red).
+    pub(crate) coords: [[i64; 3]; 4],
     /// The cut point on edge (i, j), for `+`/`-` edges.
     pub(crate) cut: [[Option<Point>; 4]; 4],
 }
@@ -80,6 +86,7 @@ pub(crate) enum FaceRule {
     /// The paper's parity rule: a property of the face, shared by both
     /// tetrahedra that contain it.
     Parity,
+
     /// Deliberately wrong, for the tests: the diagonal from whichever end
     /// comes first in this tetrahedron's vertex list, as a stencil table
     /// in local vertex order would do. Neighbours disagree.
@@ -97,12 +104,14 @@ fn diagonal_end(t: &LatticeTet, p: usize, q: usize, o: usize, rule: FaceRule) ->
     if long(p, q) {
         match rule {
             FaceRule::Parity => {
-                if t.parity[p] == 0 {
+                let black = t.coords[p][0] & 1 == 0;
+                if (positive_components(t.coords[p], t.coords[o]) % 2 == 1) == black {
                     p
                 } else {
                     q
                 }
             }
+
             #[cfg(test)]
             FaceRule::TetLocal => p.min(q),
         }
@@ -111,6 +120,11 @@ fn diagonal_end(t: &LatticeTet, p: usize, q: usize, o: usize, rule: FaceRule) ->
         // the long edge, from the inside vertex of the short cut edge.
         if long(p, o) { q } else { p }
     }
+}
+
+/// The number of axes along which `a` lies above `b`.
+fn positive_components(a: [i64; 3], b: [i64; 3]) -> u32 {
+    (0..3).map(|k| u32::from(a[k] > b[k])).sum()
 }
 
 /// Appends the output tetrahedra of `t` (not yet oriented).
@@ -356,31 +370,52 @@ pub(crate) mod tests {
     /// distances and cut points, then `samples` random ones. Warped
     /// vertices move up to α along any of their 14 edges; cut points lie
     /// anywhere warping allows.
-    pub(crate) fn worst_angles(params: Params, samples: usize, seed: u64) -> (f64, f64) {
-        let (al, as_) = (params.alpha_long(), params.alpha_short());
+    pub(crate) fn worst_angles(
+        params: Params,
+        rule: FaceRule,
+        samples: usize,
+        seed: u64,
+    ) -> (f64, f64) {
+        worst_angles_ab(
+            params.alpha_long(),
+            params.alpha_short(),
+            rule,
+            samples,
+            seed,
+        )
+    }
+
+    pub(crate) fn worst_angles_ab(
+        al: f64,
+        as_: f64,
+        rule: FaceRule,
+        samples: usize,
+        seed: u64,
+    ) -> (f64, f64) {
         let mut worst = (180.0f64, 0.0f64);
         let mut grid = Chooser::Grid {
             digits: Vec::new(),
             at: 0,
         };
         loop {
-            one_config(al, as_, &mut grid, &mut worst);
+            one_config(al, as_, rule, &mut grid, &mut worst);
             if !grid.next_combination() {
                 break;
             }
         }
         let mut random = Chooser::Random(Rng(seed));
         for _ in 0..samples {
-            one_config(al, as_, &mut random, &mut worst);
+            one_config(al, as_, rule, &mut random, &mut worst);
         }
         worst
     }
 
-    fn one_config(al: f64, as_: f64, ch: &mut Chooser, worst: &mut (f64, f64)) {
+    fn one_config(al: f64, as_: f64, rule: FaceRule, ch: &mut Chooser, worst: &mut (f64, f64)) {
         let pos0 = TET.map(|c| DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) * 0.5);
-        let parity = TET.map(|c| (((c[0] >> 1) + (c[1] >> 1) + (c[2] >> 1)) & 1) as u32);
         let mut sign = [Sign::Out; 4];
         let mut pos = pos0;
+        // The tetrahedron vertex each warped vertex moved towards, if any.
+        let mut towards = [None; 4];
         for k in 0..4 {
             sign[k] = [Sign::In, Sign::Out, Sign::Zero][ch.pick(3)];
             if sign[k] == Sign::Zero {
@@ -391,9 +426,15 @@ pub(crate) mod tests {
                 } else {
                     (SHORT_DIRS[e - 6], as_)
                 };
+                towards[k] = (0..4).find(|&j| (0..3).all(|a| TET[j][a] - TET[k][a] == dir[a]));
                 let d = DVec3::new(dir[0] as f64, dir[1] as f64, dir[2] as f64) * 0.5;
                 pos[k] += d * ch.range(0.0, alpha);
             }
+        }
+        // An edge has one cut point, and warping one end onto it discards
+        // it: the two ends of an edge never both warp along that edge.
+        if (0..4).any(|k| towards[k].is_some_and(|j| towards[j] == Some(k))) {
+            return;
         }
         let mut v = [Point {
             id: 0,
@@ -428,11 +469,11 @@ pub(crate) mod tests {
         let t = LatticeTet {
             v,
             sign,
-            parity,
+            coords: TET,
             cut,
         };
         let mut out = Vec::new();
-        fill(&t, FaceRule::Parity, &mut out);
+        fill(&t, rule, &mut out);
         for tet in &out {
             let p = tet.map(|x| x.pos);
             assert!(signed_volume(p).abs() > 1e-9, "flat output tetrahedron");
@@ -447,7 +488,7 @@ pub(crate) mod tests {
     fn stencils_keep_the_stated_angle_bounds_for_both_parameter_pairs() {
         let mut ok = true;
         for params in [Params::Angles10_7, Params::Angles8_9] {
-            let (lo, hi) = worst_angles(params, 400_000, 7);
+            let (lo, hi) = worst_angles(params, FaceRule::Parity, 400_000, 7);
             let (blo, bhi) = params.dihedral_bounds_deg();
             eprintln!(
                 "{params:?}: sampled worst angles {lo:.3}°, {hi:.3}° (bounds {blo}°, {bhi}°)"
@@ -461,7 +502,7 @@ pub(crate) mod tests {
     #[ignore = "long: 4 million samples per pair, for the bounds in the docs"]
     fn stencil_bounds_with_more_samples() {
         for params in [Params::Angles10_7, Params::Angles8_9] {
-            let (lo, hi) = worst_angles(params, 4_000_000, 11);
+            let (lo, hi) = worst_angles(params, FaceRule::Parity, 4_000_000, 11);
             eprintln!("{params:?}: {lo:.3}°, {hi:.3}°");
             let (blo, bhi) = params.dihedral_bounds_deg();
             assert!(lo >= blo && hi <= bhi);
