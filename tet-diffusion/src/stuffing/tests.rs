@@ -353,7 +353,7 @@ fn graded_meshes_are_valid_and_smaller() {
             graded.report.min_dihedral_deg,
             graded.report.max_dihedral_deg
         );
-        assert!(graded.report.tets < uniform.report.tets * 3 / 4);
+        assert!(graded.report.tets < uniform.report.tets * 3 / 5);
     }
 }
 
