@@ -11,7 +11,8 @@
 //! angle range and cotangent-weight range. TetGen (the Python package
 //! `tetgen`, run with `-pq1.2a<volume>` and a maximum volume tuned to give a
 //! similar tetrahedron count) runs on the same surfaces when a Python with
-//! `tetgen` is found (`$TETGEN_PYTHON`, else `target/venv/bin/python`);
+//! `tetgen` is found (`$TETGEN_PYTHON`, else a venv the example sets up
+//! under `target/peers-venv`, `--no-tetgen` to skip it);
 //! where it refuses an input the table says why. A second table measures
 //! the fast winding number against the exact sum.
 //!
@@ -360,17 +361,36 @@ fn cot_weights(p: &[DVec3], t: &[[u32; 4]]) -> [f64; 2] {
     }
 }
 
+/// A Python with the `tetgen` package: `$TETGEN_PYTHON`, else the peers'
+/// venv under `target/` (shared with mesh-sampling's peer benchmarks),
+/// created and filled with `pip install numpy tetgen` when missing.
 fn tetgen_python() -> Option<PathBuf> {
-    let candidates = [
-        std::env::var_os("TETGEN_PYTHON").map(PathBuf::from),
-        Some(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/venv/bin/python")),
-    ];
-    candidates.into_iter().flatten().find(|p| {
+    let has_tetgen = |p: &Path| {
         Command::new(p)
             .args(["-c", "import tetgen"])
             .output()
             .is_ok_and(|o| o.status.success())
-    })
+    };
+    if let Some(p) = std::env::var_os("TETGEN_PYTHON").map(PathBuf::from) {
+        return has_tetgen(&p).then_some(p);
+    }
+    let venv = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/peers-venv");
+    let python = venv.join("bin/python");
+    if has_tetgen(&python) {
+        return Some(python);
+    }
+    eprintln!(
+        "setting up TetGen: python3 -m venv {} && pip install numpy tetgen",
+        venv.display()
+    );
+    let run = |cmd: &mut Command| cmd.status().is_ok_and(|s| s.success());
+    let made = python.exists() || run(Command::new("python3").arg("-m").arg("venv").arg(&venv));
+    let installed = made
+        && run(Command::new(&python).args(["-m", "pip", "install", "--quiet", "numpy", "tetgen"]));
+    if !installed {
+        eprintln!("could not set up TetGen; the table has trilux only");
+    }
+    (installed && has_tetgen(&python)).then_some(python)
 }
 
 /// TetGen with `-pq1.2a<vol>`, the maximum volume tuned (once) so that the
