@@ -1,24 +1,27 @@
 //! The graded background mesh: fine BCC tetrahedra near the surface,
 //! octree cells of up to `2^levels · h` deep inside (the idea of Labelle &
-//! Shewchuk 2007, whose graded variant uses an octree; the transition tetrahedra here are our own
-//! construction, described below, not the paper's).
+//! Shewchuk 2007, whose graded variant uses an octree; the transition
+//! tetrahedra here are our own construction, described below, not the
+//! paper's).
 //!
-//! * The lattice's cubes are the finest octree leaves. A lattice vertex
-//!   that is still inside after warping was never warped (warped vertices
-//!   are on the surface). An octree cell of size `s = 2^l` cubes (`l ≥ 1`)
-//!   may stay a leaf only when every lattice vertex in it (closed) is
-//!   inside, and so is the centre of every cube across its faces. Then every
-//!   tetrahedron that touches a coarse leaf has unwarped inside vertices
-//!   only: it is never cut and keeps its exact, fixed shape, while the
-//!   stencils only ever see pure BCC tetrahedra. Where a fine BCC
-//!   tetrahedron meets a coarse one, their common face has three inside
-//!   vertices, which every stencil keeps whole, so the two still match.
-//! * A coarse leaf also needs the centres of the cubes across its faces
-//!   inside: they are the only vertices outside the leaf that its
-//!   tetrahedra (and its fine neighbours' tetrahedra towards it) use.
-//!   (An earlier version asked it of all 56 cubes around the leaf, edges
-//!   and corners included: 51% of the uniform count on the bunny instead
-//!   of 44%.)
+//! * The lattice's cubes are the finest octree leaves. An octree cell of
+//!   size `s = 2^l` cubes (`l ≥ 1`) may stay a leaf only when every lattice
+//!   vertex in it (closed) is inside after warping (so never warped: warped
+//!   vertices are on the surface), and the centre of every cube across its
+//!   faces is inside or warped onto the surface, not outside. Those centres
+//!   are the only vertices outside the leaf that its tetrahedra, and its
+//!   fine neighbours' tetrahedra towards it, use. So no tetrahedron that
+//!   touches a coarse leaf is ever cut, and the stencils only ever see pure
+//!   BCC tetrahedra. Where a fine BCC tetrahedron meets a coarse one, their
+//!   common face has two inside vertices and a third inside or on the
+//!   surface, which every stencil keeps whole, so the two still match.
+//! * A fine cube's tetrahedra towards a larger leaf are the two halves of
+//!   the pyramid from its centre over its face (45°–120°). With the centre
+//!   warped, up to `α` along any of its 14 edges, their dihedral angles
+//!   stay within 22.6°–148.5° (21.7°–149.7° with the second parameter
+//!   pair; a test enumerates them), inside the stencils' bounds. (An earlier version asked for inside centres in all
+//!   56 cubes around a leaf, edges and corners included: 51% of the
+//!   uniform count on the bunny instead of 42%.)
 //! * The leaves are 2:1 balanced across faces and edges, which is what
 //!   makes the face triangulations of the two sides match; corner
 //!   neighbours put no vertex on a leaf's faces or edges.
@@ -44,7 +47,7 @@
 //! corner), asks for the same fine cubes as the conditions above: the
 //! finest layer is at least the cubes the surface crosses plus the cubes
 //! that cannot join an aligned coarse cell, which on the bunny at 510k
-//! uniform tetrahedra is 44% of the uniform count.
+//! uniform tetrahedra is 42% of the uniform count.
 
 use rayon::prelude::*;
 
@@ -73,8 +76,9 @@ pub(crate) fn background(lattice: &Lattice, signs: &[Sign], levels: u32) -> Back
     let mut tree = Octree::build(n, levels, |l, a| {
         let s = 1usize << l;
         // Inside the lattice with a cube to spare; all vertices of the cell
-        // deep, and the centres of the cubes across its faces too (the
-        // only cubes outside the cell whose vertices its tetrahedra use).
+        // deep, and the centres of the cubes across its faces not outside
+        // (the only vertices outside the cell that its tetrahedra, and its
+        // fine neighbours' tetrahedra towards it, use).
         (0..3).all(|k| a[k] >= 1 && a[k] + s < n[k])
             && cubes.unsafe_in(a, s) == 0
             && centres.unsafe_across_faces(a, s) == 0
@@ -91,11 +95,12 @@ fn cube_index(n: [usize; 3], c: [usize; 3]) -> usize {
 }
 
 /// Per cube: whether its corners and centre are inside (after warping:
-/// so never warped), and whether its centre is.
+/// so never warped), and whether its centre is not outside (inside, or
+/// warped onto the surface).
 fn safe_cubes(lattice: &Lattice, signs: &[Sign]) -> (Vec<bool>, Vec<bool>) {
     let deep: Vec<bool> = signs.iter().map(|&s| s == Sign::In).collect();
     let nb = lattice.black_count();
-    let centre = deep[nb..].to_vec();
+    let centre = signs[nb..].iter().map(|&s| s != Sign::Out).collect();
     let safe = (0..lattice.red_count())
         .into_par_iter()
         .with_min_len(4096)
@@ -530,6 +535,44 @@ mod tests {
                 "levels {levels}: {} tets, dihedral {lo:.3}..{hi:.3}",
                 tets.len()
             );
+        }
+    }
+
+    /// The two halves of the pyramid from a fine cube's centre over its
+    /// face towards a larger leaf (the face centre of the leaf at `f`),
+    /// with the cube's centre warped by up to `α` along any of its 14
+    /// lattice edges: every dihedral angle within 22.6°–148.5° (21.7°–149.7°
+    /// with the second pair), inside the stencils' bounds, never inverted.
+    #[test]
+    fn half_pyramids_towards_a_larger_leaf_stay_within_the_bounds_when_warped() {
+        use crate::stuffing::Params;
+        use crate::stuffing::lattice::{LONG_DIRS, SHORT_DIRS};
+        // Doubled coordinates / 2: the cube's face is z = 0, its centre
+        // above it; f is the larger leaf's face centre, one face corner.
+        let (f, a, b, d) = (DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y);
+        for params in [Params::Angles10_7, Params::Angles8_9] {
+            let dirs = LONG_DIRS
+                .iter()
+                .map(|&v| (v, params.alpha_long()))
+                .chain(SHORT_DIRS.iter().map(|&v| (v, params.alpha_short())));
+            let (mut lo, mut hi) = (180.0f64, 0.0f64);
+            for (dir, alpha) in dirs {
+                let step = DVec3::new(dir[0] as f64, dir[1] as f64, dir[2] as f64) * 0.5;
+                for k in 0..=64 {
+                    let c = DVec3::splat(0.5) + step * (alpha * f64::from(k) / 64.0);
+                    for t in [[c, f, a, b], [c, f, b, d]] {
+                        assert!(signed_volume(t).abs() > 0.01, "flat at {c}");
+                        for x in dihedral_angles(t) {
+                            lo = lo.min(x.to_degrees());
+                            hi = hi.max(x.to_degrees());
+                        }
+                    }
+                }
+            }
+            let (blo, bhi) = params.dihedral_bounds_deg();
+            eprintln!("{params:?}: warped half pyramids {lo:.2}°..{hi:.2}°");
+            assert!(lo >= 21.7 && hi <= 149.7, "{lo} {hi}");
+            assert!(lo >= blo && hi <= bhi);
         }
     }
 }
