@@ -19,9 +19,10 @@
 //!   the pyramid from its centre over its face (45°–120°). With the centre
 //!   warped, up to `α` along any of its 14 edges, their dihedral angles
 //!   stay within 22.6°–148.5° (21.7°–149.7° with the second parameter
-//!   pair; a test enumerates them), inside the stencils' bounds. (An earlier version asked for inside centres in all
-//!   56 cubes around a leaf, edges and corners included: 51% of the
-//!   uniform count on the bunny instead of 42%.)
+//!   pair; a test enumerates them), inside the stencils' bounds. (An
+//!   earlier version asked for inside centres in all 56 cubes around a
+//!   leaf, edges and corners included: 51% of the uniform count on the
+//!   bunny instead of 42%.)
 //! * The leaves are 2:1 balanced across faces and edges, which is what
 //!   makes the face triangulations of the two sides match; corner
 //!   neighbours put no vertex on a leaf's faces or edges.
@@ -84,7 +85,7 @@ pub(crate) fn background(lattice: &Lattice, signs: &[Sign], levels: u32) -> Back
             && centres.unsafe_across_faces(a, s) == 0
     });
     tree.balance();
-    let fine: Vec<bool> = tree.level.iter().map(|&l| l == 0).collect();
+    let fine = tree.level.iter().map(|&l| l == 0).collect();
     let coarse = tree.tets(lattice);
     Background { fine, coarse }
 }

@@ -21,8 +21,8 @@
 //! the other's edge to `o`. Every BCC face has exactly one long edge:
 //!
 //! * if the long edge is `pq`, the lattice alone must decide, by the
-//!   paper's **parity rule** (Labelle & Shewchuk 2007, Sec. 3.3 and the
-//!   last stencils of its Fig. 3): the diagonal from `A ∈ {p, q}` to the
+//!   paper's **parity rule** (Labelle & Shewchuk 2007; its Sec. 3.3 and
+//!   Fig. 3, as implementations cite it): the diagonal from `A ∈ {p, q}` to the
 //!   cut point `C` on the other `+` vertex's edge points along
 //!   `sign(A - C) = sign(A - o)` (per axis, in lattice coordinates), and
 //!   exactly one of the two candidates has an odd number of positive
@@ -37,7 +37,9 @@
 //!   available here.)
 //! * otherwise the long edge is `po` or `qo`, which both neighbours see
 //!   too: the diagonal ends at the cut point on the long edge and starts
-//!   at the other `+` vertex (the paper's stencils do the same).
+//!   at the other `+` vertex, as in the paper's stencils. (The opposite
+//!   choice, from the `+` end of the long edge, lets the stencils fall to
+//!   6.2° in the sampling test below.)
 //!
 //! A prism is split into 3 tetrahedra by coning from a vertex that two of
 //! its quadrilateral diagonals touch; among the valid choices (and both
