@@ -9,7 +9,7 @@ use trilux_io::mesh::TriMesh;
 use trilux_tests::{data, trilux_bin};
 
 mod common;
-use common::{fails, stderr, trilux};
+use common::{fails, json, run, stderr, trilux};
 
 /// A built-in textured torus and a noise texture written as files.
 fn inputs(dir: &Path) -> (PathBuf, PathBuf) {
@@ -699,4 +699,26 @@ fn real_files_through_every_subcommand() {
         ],
         &["stanford-bunny.obj", "texture coordinates"],
     );
+}
+
+#[test]
+fn info_on_an_obj_without_faces_says_so_and_does_not_call_it_closed() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("empty.obj"), "").unwrap();
+    std::fs::write(d.join("points.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\n").unwrap();
+    for file in ["empty.obj", "points.obj"] {
+        let out = run(d, &["info", file]);
+        assert!(out.status.success(), "{file}: {}", stderr(&out));
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("no faces"), "{file}: {text}");
+        assert!(
+            !text.contains("closed") && !text.contains("watertight"),
+            "{file}: {text}"
+        );
+        assert!(!text.contains("-0"), "{file}: negative zero in {text}");
+        let report = json(d, &["info", file]);
+        assert_eq!(report["triangles"], 0, "{file}: {report}");
+        assert_eq!(report["closed"], false, "{file}: {report}");
+    }
 }

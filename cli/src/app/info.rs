@@ -88,7 +88,11 @@ fn describe_mesh(
     mesh: &trilux_io::mesh::TriMesh,
 ) -> (String, Value) {
     let shape = context.step("checking the topology", || trilux::mesh::shape(mesh));
-    let (lo, hi) = trilux::mesh::bounds(mesh).unwrap_or_default();
+    // A file without faces (empty, or points only) has no surface: no
+    // bounds of triangles, and it is neither closed nor open.
+    let faceless = mesh.indices.is_empty();
+    let bounds = trilux::mesh::bounds(mesh);
+    let (lo, hi) = bounds.unwrap_or_default();
     let diagonal = (hi - lo).length();
     let used = {
         let mut used = vec![false; mesh.positions.len()];
@@ -99,7 +103,13 @@ fn describe_mesh(
         }
         used.iter().filter(|&&u| u).count()
     };
-    let mut text = format!("{}: triangle mesh\n", path.display());
+    // `+ 0.0` turns the empty sum's -0 into 0.
+    let area = mesh.area() + 0.0;
+    let mut text = format!(
+        "{}: triangle mesh{}\n",
+        path.display(),
+        if faceless { " with no faces" } else { "" }
+    );
     let _ = writeln!(
         text,
         "  vertices: {} ({} used, {} after welding equal positions)",
@@ -107,24 +117,33 @@ fn describe_mesh(
         used,
         shape.welded_vertices
     );
-    let _ = writeln!(text, "  triangles: {}", mesh.indices.len());
-    let _ = writeln!(text, "  bounds: {lo} .. {hi} (size {})", hi - lo);
-    let _ = writeln!(
-        text,
-        "  diagonal: {diagonal} — units look like {}",
-        trilux::mesh::unit_guess(diagonal)
-    );
-    let _ = writeln!(text, "  area: {:.6}", mesh.area());
-    let closed = shape.boundary_edges == 0 && shape.non_manifold_edges == 0;
-    let _ = writeln!(
-        text,
-        "  parts: {}, holes: {} ({} boundary edges), non-manifold edges: {}{}",
-        shape.parts,
-        shape.holes,
-        shape.boundary_edges,
-        shape.non_manifold_edges,
-        if closed { " — closed" } else { "" }
-    );
+    if faceless {
+        let _ = writeln!(
+            text,
+            "  triangles: 0 — no faces (an empty file or points only), so no surface"
+        );
+    } else {
+        let _ = writeln!(text, "  triangles: {}", mesh.indices.len());
+        let _ = writeln!(text, "  bounds: {lo} .. {hi} (size {})", hi - lo);
+        let _ = writeln!(
+            text,
+            "  diagonal: {diagonal} — units look like {}",
+            trilux::mesh::unit_guess(diagonal)
+        );
+        let _ = writeln!(text, "  area: {area:.6}");
+    }
+    let closed = !faceless && shape.boundary_edges == 0 && shape.non_manifold_edges == 0;
+    if !faceless {
+        let _ = writeln!(
+            text,
+            "  parts: {}, holes: {} ({} boundary edges), non-manifold edges: {}{}",
+            shape.parts,
+            shape.holes,
+            shape.boundary_edges,
+            shape.non_manifold_edges,
+            if closed { " — closed" } else { "" }
+        );
+    }
     let _ = writeln!(
         text,
         "  normals: {}",
@@ -187,10 +206,10 @@ fn describe_mesh(
         "used_vertices": used,
         "welded_vertices": shape.welded_vertices,
         "triangles": mesh.indices.len(),
-        "bounds": [v3(lo), v3(hi)],
+        "bounds": bounds.map(|(lo, hi)| json!([v3(lo), v3(hi)])),
         "diagonal": diagonal,
         "unit_guess": trilux::mesh::unit_guess(diagonal),
-        "area": mesh.area(),
+        "area": area,
         "parts": shape.parts,
         "holes": shape.holes,
         "boundary_edges": shape.boundary_edges,
