@@ -9,7 +9,7 @@ use trilux_io::mesh::TriMesh;
 use trilux_tests::{data, trilux_bin};
 
 mod common;
-use common::{fails, json, run, stderr, trilux};
+use common::{fails, fails_with, json, run, stderr, trilux};
 
 /// A built-in textured torus and a noise texture written as files.
 fn inputs(dir: &Path) -> (PathBuf, PathBuf) {
@@ -721,4 +721,63 @@ fn info_on_an_obj_without_faces_says_so_and_does_not_call_it_closed() {
         assert_eq!(report["triangles"], 0, "{file}: {report}");
         assert_eq!(report["closed"], false, "{file}: {report}");
     }
+}
+
+#[test]
+fn sample_channel_without_a_density_image_or_mesh_colours_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (_, noise) = inputs(d);
+    let noise = noise.to_str().unwrap();
+    fails_with(
+        d,
+        2,
+        &[
+            "sample",
+            "torus.obj",
+            "-n",
+            "10",
+            "--channel",
+            "r",
+            "-o",
+            "a.ply",
+        ],
+        &["--channel"],
+    );
+    // Per-face weights have no channels either.
+    std::fs::write(d.join("w.txt"), "1\n".repeat(48 * 24 * 2)).unwrap();
+    fails_with(
+        d,
+        2,
+        &[
+            "sample",
+            "torus.obj",
+            "-n",
+            "10",
+            "--face-weights",
+            "w.txt",
+            "--channel",
+            "g",
+            "-o",
+            "a.ply",
+        ],
+        &["--channel", "--face-weights"],
+    );
+    assert!(!d.join("a.ply").exists());
+    let report = json(
+        d,
+        &[
+            "sample",
+            "torus.obj",
+            "-n",
+            "10",
+            "--density",
+            noise,
+            "--channel",
+            "r",
+            "-o",
+            "a.ply",
+        ],
+    );
+    assert_eq!(report["points"], 10);
 }

@@ -27,6 +27,12 @@ pub(crate) fn invalid(message: impl Into<String>) -> Error {
     Error::Invalid(message.into())
 }
 
+/// A wrong command line (exit code 2), found by a check of ours rather
+/// than by the parser.
+pub(crate) fn usage(message: impl Into<String>) -> Error {
+    Error::Usage(message.into())
+}
+
 #[derive(Debug, Parser)]
 #[command(
     name = "trilux",
@@ -124,7 +130,8 @@ pub(crate) fn round(x: f64, digits: i32) -> f64 {
 }
 
 /// Parses the arguments, runs the subcommand, prints an error as one
-/// readable paragraph on stderr (exit code 1; usage errors exit with 2).
+/// readable paragraph on stderr (exit code 1; usage errors, the parser's
+/// and [`Error::Usage`], exit with 2).
 pub(crate) fn run() -> ExitCode {
     let cli = Cli::parse();
     let mut context = Context {
@@ -146,9 +153,14 @@ pub(crate) fn run() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {}", message(&e));
-            ExitCode::FAILURE
+            ExitCode::from(exit_code(&e))
         }
     }
+}
+
+/// 2 for a wrong command line, 1 for anything else.
+fn exit_code(e: &Error) -> u8 {
+    if matches!(e, Error::Usage(_)) { 2 } else { 1 }
 }
 
 /// The error and its causes as one paragraph, without repeating a cause

@@ -13,7 +13,7 @@ use mesh_sampling::{
 use trilux_io::mesh::TriMesh;
 use trilux_io::mesh::ply;
 
-use super::{Context, Result, invalid};
+use super::{Context, Result, invalid, usage};
 
 /// The most points one run may ask for (about 100 bytes each while
 /// sampling and writing).
@@ -40,9 +40,10 @@ pub(crate) struct Args {
     /// 8/16-bit values are used as stored (no sRGB decoding).
     #[arg(long, value_name = "IMAGE", group = "density_source")]
     pub(crate) density: Option<PathBuf>,
-    /// Which value of the density image (or mesh colours) is the density.
-    #[arg(long, value_enum, default_value_t = ChannelArg::Luminance)]
-    pub(crate) channel: ChannelArg,
+    /// Which value of the density image (or mesh colours) is the density
+    /// (default: luminance); only with --density or --density-meshcolors.
+    #[arg(long, value_enum)]
+    pub(crate) channel: Option<ChannelArg>,
     /// One weight per triangle, one number per line (`#` comments allowed).
     #[arg(long, value_name = "FILE", group = "density_source")]
     pub(crate) face_weights: Option<PathBuf>,
@@ -81,6 +82,13 @@ pub(crate) enum ChannelArg {
 }
 
 impl ChannelArg {
+    /// The name on the command line.
+    fn name(self) -> String {
+        self.to_possible_value()
+            .map(|v| v.get_name().to_string())
+            .unwrap_or_default()
+    }
+
     pub(crate) fn channel(self) -> Channel {
         match self {
             Self::Luminance => Channel::Luminance,
@@ -214,6 +222,21 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             args.count
         )));
     }
+    if let Some(channel) = args.channel
+        && args.density.is_none()
+        && args.density_meshcolors.is_none()
+    {
+        return Err(usage(format!(
+            "--channel {}: a channel is read from --density IMAGE or --density-meshcolors FILE, and neither is given{}",
+            channel.name(),
+            if args.face_weights.is_some() {
+                " (--face-weights has one weight per triangle, no channels)"
+            } else {
+                ""
+            }
+        )));
+    }
+    let channel = args.channel.unwrap_or(ChannelArg::Luminance).channel();
     super::check_output(context, &args.output, &["ply"])?;
     if let Some(p) = &args.preview {
         super::check_output(context, p, &["png", "exr"])?;
@@ -251,7 +274,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             .map_or(mesh_sampling::Wrap::Repeat, |m| {
                 trilux::sampling_wrap(m.wrap[0])
             });
-        let texture = trilux::density_texture(&image, args.channel.channel())
+        let texture = trilux::density_texture(&image, channel)
             .map_err(|e| invalid(format!("{}: {e}", path.display())))?
             .with_wrap(wrap);
         Source::Texture(texture)
@@ -264,7 +287,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         Source::FaceWeights(read_face_weights(path, mesh.indices.len())?)
     } else if let Some(path) = &args.density_meshcolors {
         context.step("baking the mesh colours", || {
-            meshcolors_source(&mesh, path, args.channel.channel())
+            meshcolors_source(&mesh, path, channel)
         })?
     } else {
         Source::Uniform
