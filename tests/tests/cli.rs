@@ -781,3 +781,173 @@ fn sample_channel_without_a_density_image_or_mesh_colours_is_a_usage_error() {
     );
     assert_eq!(report["points"], 10);
 }
+
+/// Every error is one line, `error: WHERE: WHAT`, where WHERE is the file
+/// or the argument as typed (named once), with no closing full stop.
+#[test]
+fn errors_are_one_line_naming_the_file_or_argument_first_in_every_subcommand() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    inputs(d);
+    std::fs::write(d.join("bad.meshcolors"), "MESHCOLR garbage").unwrap();
+    std::fs::write(d.join("fake.png"), "this is not a PNG").unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        // A missing input, whichever subcommand and argument names it.
+        (&["info", "missing.obj"], "missing.obj: no such file"),
+        (
+            &["sample", "missing.obj", "-n", "10", "-o", "a.ply"],
+            "missing.obj: no such file",
+        ),
+        (
+            &[
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--density",
+                "missing.png",
+                "-o",
+                "a.ply",
+            ],
+            "missing.png: no such file",
+        ),
+        (
+            &[
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--face-weights",
+                "missing.txt",
+                "-o",
+                "a.ply",
+            ],
+            "missing.txt: no such file",
+        ),
+        (
+            &[
+                "colors",
+                "render",
+                "torus.obj",
+                "missing.meshcolors",
+                "-o",
+                "x.png",
+            ],
+            "missing.meshcolors: no such file",
+        ),
+        (
+            &[
+                "colors",
+                "convert",
+                "torus.obj",
+                "--texture",
+                "missing.png",
+                "-o",
+                "t.meshcolors",
+            ],
+            "missing.png: no such file",
+        ),
+        (
+            &["tetra", "missing.obj", "-o", "m.node"],
+            "missing.obj: no such file",
+        ),
+        (
+            &["diffuse", "missing.node", "-o", "a.png"],
+            "missing.node: no such file",
+        ),
+        // A bad file, named once.
+        (
+            &[
+                "colors",
+                "render",
+                "torus.obj",
+                "bad.meshcolors",
+                "-o",
+                "x.png",
+            ],
+            "bad.meshcolors: ",
+        ),
+        (&["info", "fake.png"], "fake.png: "),
+        // An argument as typed, then what is wrong with it.
+        (
+            &[
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--threads",
+                "0",
+                "-o",
+                "a.ply",
+            ],
+            "--threads 0: ",
+        ),
+        (
+            &[
+                "colors",
+                "convert",
+                "torus.obj",
+                "--budget",
+                "0",
+                "-o",
+                "t.meshcolors",
+            ],
+            "--budget 0: ",
+        ),
+        (&["bench", "sampling", "--repeats", "0"], "--repeats 0: "),
+        (
+            &["diffuse", "torus.obj", "--material", "jade", "-o", "a.png"],
+            "--material jade: ",
+        ),
+        (
+            &["diffuse", "torus.obj", "--light", "dir:0,1", "-o", "a.png"],
+            "--light dir:0,1: ",
+        ),
+        (
+            &[
+                "diffuse",
+                "torus.obj",
+                "--cut",
+                "plane:0,0,0,1",
+                "-o",
+                "a.png",
+            ],
+            "--cut plane:0,0,0,1: ",
+        ),
+        (
+            &["diffuse", "torus.obj", "--size", "0", "-o", "a.png"],
+            "--size 0: ",
+        ),
+        (&["demo", "--out", "demo", "--size", "0"], "--size 0: "),
+        (
+            &[
+                "colors",
+                "render",
+                "torus.obj",
+                "bad.meshcolors",
+                "--size",
+                "0",
+                "-o",
+                "x.png",
+            ],
+            "--size 0: ",
+        ),
+    ];
+    for &(args, start) in cases {
+        fails(d, args, &[start]);
+        let err = stderr(&run(d, args));
+        let line = err.strip_suffix('\n').unwrap_or(&err);
+        assert!(
+            !line.contains('\n'),
+            "{args:?}: more than one line: {err:?}"
+        );
+        assert!(
+            line.starts_with(&format!("error: {start}")),
+            "{args:?}: {line:?} does not start with {start:?}"
+        );
+        assert!(!line.ends_with('.'), "{args:?}: {line:?}");
+        let place = start.split(": ").next().unwrap();
+        assert_eq!(line.matches(place).count(), 1, "{args:?}: {line:?}");
+    }
+    assert!(!d.join("demo").exists(), "a refused demo made its folder");
+}

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 
-use super::{Context, Result, invalid};
+use super::{Context, Result, file_error};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -20,9 +20,7 @@ pub(crate) struct Args {
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let path = &args.file;
-    if !path.exists() {
-        return Err(invalid(format!("{}: no such file", path.display())));
-    }
+    super::check_input(path)?;
     let (text, json) = match super::extension(path).as_str() {
         "obj" | "gltf" | "glb" => mesh_info(context, path)?,
         "ply" => ply_info(context, path)?,
@@ -30,10 +28,12 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "png" | "jpg" | "jpeg" | "hdr" | "exr" => image_info(context, path)?,
         "meshcolors" => meshcolors_info(context, path)?,
         other => {
-            return Err(invalid(format!(
-                "{}: unknown extension {other:?} (meshes .obj .gltf .glb .ply, tetrahedra .node .ele .msh .mesh, images .png .jpg .hdr .exr, .meshcolors)",
-                path.display()
-            )));
+            return Err(file_error(
+                path,
+                format!(
+                    "unknown extension {other:?} (meshes .obj .gltf .glb .ply, tetrahedra .node .ele .msh .mesh, images .png .jpg .hdr .exr, .meshcolors)"
+                ),
+            ));
         }
     };
     context.report(&text, json);
@@ -224,9 +224,7 @@ fn describe_mesh(
 }
 
 fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
-    let mesh = context.step("reading the tetrahedra", || {
-        trilux_io::tet::TetMesh::read(path)
-    })?;
+    let mesh = super::read_tets(context, path)?;
     let (lo, hi) = mesh.positions.iter().fold(
         (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY),
         |(a, b), &p| (a.min(p), b.max(p)),
@@ -296,7 +294,7 @@ fn image_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
 fn meshcolors_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let (colors, mip) = context
         .step("reading the mesh colours", || mesh_colors::file::load(path))
-        .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+        .map_err(|e| file_error(path, e))?;
     let mut histogram = std::collections::BTreeMap::new();
     for r in (0..colors.face_count()).filter_map(|f| colors.face_resolution(f)) {
         *histogram.entry(r).or_insert(0usize) += 1;

@@ -2,6 +2,7 @@
 //! stderr, `--json` on stdout, readable errors, safe outputs), and the
 //! dispatch.
 
+use std::fmt::Display;
 use std::io::IsTerminal;
 use std::path::Path;
 use std::process::ExitCode;
@@ -31,6 +32,79 @@ pub(crate) fn invalid(message: impl Into<String>) -> Error {
 /// than by the parser.
 pub(crate) fn usage(message: impl Into<String>) -> Error {
     Error::Usage(message.into())
+}
+
+// Every error reads `WHERE: WHAT`: WHERE is a file, or an argument as it
+// was typed (`--light dir:0,1`), named once; WHAT says what is wrong, in
+// lower case, as one sentence without a closing full stop, a hint after
+// a semicolon or in parentheses. A file's problem exits with 1, an
+// argument's with 2.
+
+/// A problem with a file: `PATH: problem` (exit code 1).
+pub(crate) fn file_error(path: &Path, problem: impl Display) -> Error {
+    invalid(format!("{}: {problem}", path.display()))
+}
+
+/// A problem with an argument: `ARGUMENT: problem` (exit code 2), where
+/// `argument` is the option as typed, with its value (`--size 0`).
+pub(crate) fn arg_error(argument: impl Display, problem: impl Display) -> Error {
+    usage(format!("{argument}: {problem}"))
+}
+
+/// `e` with `place` (a file or an argument) in front, unless its message
+/// already starts with it; a usage error stays one.
+pub(crate) fn at(place: impl Display, e: impl Into<Error>) -> Error {
+    let e = e.into();
+    let place = place.to_string();
+    let text = message(&e);
+    if text.starts_with(&format!("{place}: ")) {
+        return e;
+    }
+    let text = format!("{place}: {text}");
+    if matches!(e, Error::Usage(_)) {
+        usage(text)
+    } else {
+        invalid(text)
+    }
+}
+
+/// Checks that an input file exists, so that every subcommand says so in
+/// the same words.
+pub(crate) fn check_input(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        Err(file_error(path, "a folder, not a file"))
+    } else if !path.exists() {
+        Err(file_error(path, "no such file"))
+    } else {
+        Ok(())
+    }
+}
+
+/// `x,y,z` as a non-zero direction, for `--view`.
+pub(crate) fn parse_view(spec: &str) -> Result<glam::Vec3> {
+    let v: Vec<f32> = spec
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<std::result::Result<_, _>>()
+        .ok()
+        .filter(|v: &Vec<f32>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
+        .ok_or_else(|| arg_error(format!("--view {spec}"), "expected three numbers x,y,z"))?;
+    let v = glam::Vec3::new(v[0], v[1], v[2]);
+    if v.length_squared() == 0.0 {
+        return Err(arg_error(format!("--view {spec}"), "the direction is zero"));
+    }
+    Ok(v)
+}
+
+/// Checks `--size` (pixels of a square picture) against `max`.
+pub(crate) fn check_size(size: u32, max: u32) -> Result<()> {
+    if size == 0 || size > max {
+        return Err(arg_error(
+            format!("--size {size}"),
+            format!("the picture must be 1 to {max} pixels wide"),
+        ));
+    }
+    Ok(())
 }
 
 #[derive(Debug, Parser)]
@@ -163,8 +237,10 @@ fn exit_code(e: &Error) -> u8 {
     if matches!(e, Error::Usage(_)) { 2 } else { 1 }
 }
 
-/// The error and its causes as one paragraph, without repeating a cause
-/// the message already contains.
+/// The error and its causes as one line, without repeating a cause the
+/// message already contains, naming its place (the text before the first
+/// `": "`) once even when a cause names it again, and without a closing
+/// full stop.
 fn message(e: &Error) -> String {
     let mut text = e.to_string();
     let mut source = std::error::Error::source(e);
@@ -176,19 +252,34 @@ fn message(e: &Error) -> String {
         }
         source = s.source();
     }
-    text
+    let mut text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    if let Some(end) = text.find(": ") {
+        let place = text[..end + 2].to_string();
+        let rest = text[end + 2..].replace(&place, "");
+        text = format!("{place}{rest}");
+    }
+    text.trim_end_matches('.').to_string()
 }
 
 /// Reads a triangle mesh, naming the file in any error.
 pub(crate) fn read_mesh(context: &mut Context, path: &Path) -> Result<trilux_io::mesh::TriMesh> {
+    check_input(path)?;
     let mesh = context.step("reading the mesh", || trilux_io::mesh::TriMesh::read(path))?;
     if mesh.indices.is_empty() {
-        return Err(invalid(format!(
-            "{}: the file has no triangles (a point cloud or an empty mesh)",
-            path.display()
-        )));
+        return Err(file_error(
+            path,
+            "the file has no triangles (a point cloud or an empty mesh)",
+        ));
     }
     Ok(mesh)
+}
+
+/// Reads a tetrahedral mesh, naming the file in any error.
+pub(crate) fn read_tets(context: &mut Context, path: &Path) -> Result<trilux_io::tet::TetMesh> {
+    check_input(path)?;
+    Ok(context.step("reading the tetrahedra", || {
+        trilux_io::tet::TetMesh::read(path)
+    })?)
 }
 
 /// Reads an image.
@@ -197,6 +288,7 @@ pub(crate) fn read_image(
     path: &Path,
     raw: bool,
 ) -> Result<trilux_io::image::Image> {
+    check_input(path)?;
     let options = trilux_io::image::ReadOptions {
         raw,
         ..Default::default()
@@ -225,10 +317,10 @@ pub(crate) fn write_image(
             image,
             trilux_io::image::ExrPrecision::F32,
         )?),
-        _ => Err(invalid(format!(
-            "{}: unknown image extension {ext:?} (write .png or .exr)",
-            path.display()
-        ))),
+        _ => Err(file_error(
+            path,
+            format!("unknown image extension {ext:?} (write .png or .exr)"),
+        )),
     })
 }
 
@@ -245,24 +337,25 @@ pub(crate) fn extension(path: &Path) -> String {
 pub(crate) fn check_output(context: &Context, path: &Path, allowed: &[&str]) -> Result<()> {
     let ext = extension(path);
     if !allowed.contains(&ext.as_str()) {
-        return Err(invalid(format!(
-            "{}: unknown output extension {ext:?} (expected {})",
-            path.display(),
-            allowed
-                .iter()
-                .map(|e| format!(".{e}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
+        return Err(file_error(
+            path,
+            format!(
+                "unknown output extension {ext:?} (expected {})",
+                allowed
+                    .iter()
+                    .map(|e| format!(".{e}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
     }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
         && !dir.is_dir()
     {
-        return Err(invalid(format!(
-            "{}: the folder {} does not exist",
-            path.display(),
-            dir.display()
-        )));
+        return Err(file_error(
+            path,
+            format!("the folder {} does not exist", dir.display()),
+        ));
     }
     trilux::output::check_new(path, context.force)
 }
@@ -274,7 +367,7 @@ pub(crate) fn with_threads<T: Send>(
 ) -> Result<T> {
     match threads {
         None => Ok(f()),
-        Some(0) => Err(invalid("--threads must be at least 1")),
+        Some(0) => Err(arg_error("--threads 0", "at least one thread is needed")),
         Some(n) => {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(n)
