@@ -951,3 +951,70 @@ fn errors_are_one_line_naming_the_file_or_argument_first_in_every_subcommand() {
     }
     assert!(!d.join("demo").exists(), "a refused demo made its folder");
 }
+
+#[test]
+fn with_json_a_failure_is_one_json_object_on_stdout_with_the_same_exit_code() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    inputs(d);
+    let cases: &[(&[&str], i32, &str)] = &[
+        // A run error, --json after or before the subcommand.
+        (&["info", "missing.obj", "--json"], 1, "missing.obj"),
+        (&["--json", "info", "missing.obj"], 1, "missing.obj"),
+        // A usage error found by trilux, and two found by the parser.
+        (
+            &[
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--channel",
+                "r",
+                "-o",
+                "a.ply",
+                "--json",
+            ],
+            2,
+            "--channel",
+        ),
+        (&["sample", "torus.obj", "--json"], 2, "--count"),
+        (
+            &[
+                "--json",
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--method",
+                "magic",
+                "-o",
+                "a.ply",
+            ],
+            2,
+            "magic",
+        ),
+        (&["--json", "frobnicate"], 2, "frobnicate"),
+    ];
+    for &(args, code, needle) in cases {
+        let out = run(d, args);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {}", stderr(&out));
+        let stdout = String::from_utf8(out.stdout.clone()).unwrap();
+        assert_eq!(stdout.lines().count(), 1, "{args:?}: {stdout:?}");
+        let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        assert_eq!(report.as_object().unwrap().len(), 2, "{report}");
+        assert_eq!(report["exit_code"], code, "{report}");
+        let message = report["error"].as_str().unwrap();
+        assert!(message.contains(needle), "{args:?}: {report}");
+        // The human message is on stderr too.
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+        // Without --json: the same exit code, and nothing on stdout.
+        let plain: Vec<&str> = args.iter().copied().filter(|a| *a != "--json").collect();
+        let out = run(d, &plain);
+        assert_eq!(out.status.code(), Some(code), "{plain:?}");
+        assert!(out.stdout.is_empty(), "{plain:?}");
+    }
+    // Help is still help.
+    let out = run(d, &["sample", "--help", "--json"]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("Example"));
+}

@@ -204,10 +204,15 @@ pub(crate) fn round(x: f64, digits: i32) -> f64 {
 }
 
 /// Parses the arguments, runs the subcommand, prints an error as one
-/// readable paragraph on stderr (exit code 1; usage errors, the parser's
-/// and [`Error::Usage`], exit with 2).
+/// readable line on stderr (exit code 1; usage errors, the parser's and
+/// [`Error::Usage`], exit with 2). With `--json` a failure is also one
+/// JSON object on stdout, `{"error": "...", "exit_code": N}`, where a
+/// success's result would have gone.
 pub(crate) fn run() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return parse_failure(&e),
+    };
     let mut context = Context {
         json: cli.json,
         force: cli.force,
@@ -226,10 +231,44 @@ pub(crate) fn run() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", message(&e));
-            ExitCode::from(exit_code(&e))
+            let text = message(&e);
+            let code = exit_code(&e);
+            eprintln!("error: {text}");
+            if cli.json {
+                json_error(&text, code);
+            }
+            ExitCode::from(code)
         }
     }
+}
+
+/// A failure as the one JSON object `--json` promises on stdout.
+fn json_error(text: &str, code: u8) {
+    println!("{}", serde_json::json!({"error": text, "exit_code": code}));
+}
+
+/// Prints the parser's message (help and version are not failures), and
+/// with `--json` anywhere before a `--` also the JSON object: the
+/// arguments did not parse, so `--json` is looked for in them as given.
+fn parse_failure(e: &clap::Error) -> ExitCode {
+    let _ = e.print();
+    if !e.use_stderr() {
+        return ExitCode::SUCCESS;
+    }
+    let code = u8::try_from(e.exit_code()).unwrap_or(2);
+    let json = std::env::args_os()
+        .skip(1)
+        .take_while(|a| a != "--")
+        .any(|a| a == "--json");
+    if json {
+        // The first paragraph of the parser's text (its usage and tips
+        // follow a blank line) as one line, without its "error: ".
+        let rendered = e.render().to_string();
+        let first = rendered.split("\n\n").next().unwrap_or_default();
+        let text = first.split_whitespace().collect::<Vec<_>>().join(" ");
+        json_error(text.strip_prefix("error: ").unwrap_or(&text), code);
+    }
+    ExitCode::from(code)
 }
 
 /// 2 for a wrong command line, 1 for anything else.
