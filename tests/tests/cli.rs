@@ -1018,3 +1018,46 @@ fn with_json_a_failure_is_one_json_object_on_stdout_with_the_same_exit_code() {
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("Example"));
 }
+
+#[test]
+fn global_options_are_listed_once_under_their_own_heading() {
+    let dir = tempfile::tempdir().unwrap();
+    for sub in [
+        &[][..],
+        &["info"],
+        &["sample"],
+        &["colors", "convert"],
+        &["colors", "render"],
+        &["tetra"],
+        &["diffuse"],
+        &["demo"],
+        &["bench"],
+    ] {
+        let mut args = sub.to_vec();
+        args.push("--help");
+        let out = run(dir.path(), &args);
+        assert!(out.status.success(), "{args:?}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        let lines: Vec<&str> = text.lines().collect();
+        let heading = lines
+            .iter()
+            .position(|l| *l == "Global options:")
+            .unwrap_or_else(|| panic!("{args:?}: no global options heading in\n{text}"));
+        for flag in ["--json", "--quiet", "--force"] {
+            let defined: Vec<usize> = (0..lines.len())
+                .filter(|&i| {
+                    let l = lines[i].trim_start();
+                    l.starts_with(flag) || l.starts_with(&format!("-q, {flag}"))
+                })
+                .collect();
+            assert_eq!(defined.len(), 1, "{args:?}: {flag} in\n{text}");
+            // Under the heading: after it, with no other heading between.
+            let at = defined[0];
+            assert!(at > heading, "{args:?}: {flag} above the heading\n{text}");
+            assert!(
+                lines[heading + 1..at].iter().all(|l| l.starts_with(' ')),
+                "{args:?}: {flag} not under the heading\n{text}"
+            );
+        }
+    }
+}

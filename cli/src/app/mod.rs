@@ -107,6 +107,10 @@ pub(crate) fn check_size(size: u32, max: u32) -> Result<()> {
     Ok(())
 }
 
+/// The help heading of the options every subcommand takes, so that a
+/// subcommand's help lists them once, apart from its own.
+const GLOBAL: &str = "Global options";
+
 #[derive(Debug, Parser)]
 #[command(
     name = "trilux",
@@ -117,13 +121,13 @@ pub(crate) fn check_size(size: u32, max: u32) -> Result<()> {
 )]
 struct Cli {
     /// No progress bars (they are also hidden when stderr is not a terminal).
-    #[arg(long, short, global = true)]
+    #[arg(long, short, global = true, help_heading = GLOBAL)]
     quiet: bool,
     /// Print one JSON object with the results on stdout instead of text.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, help_heading = GLOBAL)]
     json: bool,
     /// Overwrite existing output files.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, help_heading = GLOBAL)]
     force: bool,
     #[command(subcommand)]
     command: Command,
