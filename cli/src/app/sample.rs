@@ -27,8 +27,9 @@ pub(crate) const MAX_POINTS: u64 = 200_000_000;
 pub(crate) struct Args {
     /// The mesh: .obj, .gltf, .glb or .ply.
     pub(crate) mesh: PathBuf,
-    /// How many points. Signed, so that `-n -5` reaches the range check
-    /// and its message instead of being taken for an unknown option.
+    /// How many points (1 to 200,000,000).
+    // Signed, so that `-n -5` reaches the range check and its message
+    // instead of being taken for an unknown option.
     #[arg(
         short = 'n',
         long = "count",
