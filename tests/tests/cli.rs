@@ -663,6 +663,7 @@ fn real_files_through_every_subcommand() {
         ("meshes/teapot.obj", "welded_vertices", 3_241),
         ("tets/sphere_20k.node", "tetrahedra", 19_443),
         ("tets/bunny_500k.msh", "nodes", 93_375),
+        ("tets/bunny_50k.face", "faces", 7_108),
     ] {
         let out = trilux(d)
             .args(["info", &s(&data(file)), "--json"])

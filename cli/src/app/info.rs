@@ -10,11 +10,12 @@ use super::{Context, Result, file_error};
 
 #[derive(Debug, clap::Args)]
 #[command(
-    about = "Describe a mesh, tetrahedral mesh, image or .meshcolors file (counts, bounds, UVs, holes, quality)",
-    after_help = "Example:\n  trilux info ../shared/data/meshes/stanford-bunny.obj\n  trilux info ../shared/data/tets/bunny_50k.node --json"
+    about = "Describe a mesh, tetrahedral mesh, TetGen .face file, image or .meshcolors file (counts, bounds, UVs, holes, quality)",
+    after_help = "Example:\n  trilux info ../shared/data/meshes/stanford-bunny.obj\n  trilux info ../shared/data/tets/bunny_50k.node --json\n  trilux info ../shared/data/tets/bunny_50k.face"
 )]
 pub(crate) struct Args {
-    /// The file: .obj .gltf .glb .ply, .node .ele .msh .mesh, .png .jpg .hdr .exr, .meshcolors.
+    /// The file: .obj .gltf .glb .ply, .node .ele .msh .mesh, .face (with
+    /// its .node and .ele), .png .jpg .hdr .exr, .meshcolors.
     pub(crate) file: PathBuf,
 }
 
@@ -25,13 +26,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "obj" | "gltf" | "glb" => mesh_info(context, path)?,
         "ply" => ply_info(context, path)?,
         "node" | "ele" | "msh" | "mesh" => tet_info(context, path)?,
+        "face" => face_info(context, path)?,
         "png" | "jpg" | "jpeg" | "hdr" | "exr" => image_info(context, path)?,
         "meshcolors" => meshcolors_info(context, path)?,
         other => {
             return Err(file_error(
                 path,
                 format!(
-                    "unknown extension {other:?} (meshes .obj .gltf .glb .ply, tetrahedra .node .ele .msh .mesh, images .png .jpg .hdr .exr, .meshcolors)"
+                    "unknown extension {other:?} (meshes .obj .gltf .glb .ply, tetrahedra .node .ele .msh .mesh, TetGen faces .face, images .png .jpg .hdr .exr, .meshcolors)"
                 ),
             ));
         }
@@ -46,7 +48,7 @@ fn v3(v: glam::Vec3) -> Value {
 
 fn mesh_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let mesh = context.step("reading the mesh", || trilux_io::mesh::TriMesh::read(path))?;
-    Ok(describe_mesh(context, path, &mesh))
+    Ok(describe_mesh(context, path, "triangle mesh", &mesh))
 }
 
 fn ply_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
@@ -82,9 +84,12 @@ fn ply_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     ))
 }
 
+/// What `mesh` (read from `path`, a `kind` of file) is: counts, bounds,
+/// topology, attributes.
 fn describe_mesh(
     context: &mut Context,
     path: &Path,
+    kind: &str,
     mesh: &trilux_io::mesh::TriMesh,
 ) -> (String, Value) {
     let shape = context.step("checking the topology", || trilux::mesh::shape(mesh));
@@ -106,7 +111,7 @@ fn describe_mesh(
     // `+ 0.0` turns the empty sum's -0 into 0.
     let area = mesh.area() + 0.0;
     let mut text = format!(
-        "{}: triangle mesh{}\n",
+        "{}: {kind}{}\n",
         path.display(),
         if faceless { " with no faces" } else { "" }
     );
@@ -201,7 +206,7 @@ fn describe_mesh(
     let _ = writeln!(text, "  objects: {}", mesh.objects.len());
     let json = json!({
         "file": super::shown(path),
-        "kind": "triangle mesh",
+        "kind": kind,
         "vertices": mesh.positions.len(),
         "used_vertices": used,
         "welded_vertices": shape.welded_vertices,
@@ -259,6 +264,64 @@ fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
                "bounds": [lo.to_array(), hi.to_array()], "volume": volume, "inverted": inverted,
                "dihedral_degrees": dihedral.map(|(a, b)| [a, b])}),
     ))
+}
+
+/// A TetGen `.face` file: its triangles as a surface (parts, holes,
+/// closed), and whether they are the boundary of the tetrahedra of the
+/// `.node` and `.ele` files beside it (TetGen can also list interior
+/// faces, or faces of a mesh since changed).
+fn face_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
+    let files = context.step("reading the TetGen files", || {
+        trilux_io::tet::tetgen::read_all(path)
+    })?;
+    let faces = files.faces.unwrap_or_default();
+    let tets = &files.mesh;
+    let key = |f: &[u32; 3]| {
+        let mut k = *f;
+        k.sort_unstable();
+        k
+    };
+    let mut listed: Vec<[u32; 3]> = faces.iter().map(key).collect();
+    listed.sort_unstable();
+    let mut boundary: Vec<[u32; 3]> = tets.boundary().iter().map(key).collect();
+    boundary.sort_unstable();
+    let matches = listed == boundary;
+    let surface = trilux_io::mesh::TriMesh {
+        positions: tets.positions.iter().map(|p| p.as_vec3()).collect(),
+        objects: vec![trilux_io::mesh::Object {
+            name: String::new(),
+            triangles: 0..faces.len(),
+            material: None,
+        }],
+        indices: faces,
+        ..Default::default()
+    };
+    let (mut text, mut json) = describe_mesh(context, path, "TetGen faces", &surface);
+    let _ = writeln!(
+        text,
+        "  faces: {} ({} tetrahedra on {} nodes in the .node and .ele files)",
+        surface.indices.len(),
+        tets.tets.len(),
+        tets.positions.len()
+    );
+    let _ = writeln!(
+        text,
+        "  the tetrahedra's boundary ({} triangles): {}",
+        boundary.len(),
+        if matches {
+            "the same triangles"
+        } else {
+            "different triangles (interior faces, or a mesh changed since)"
+        }
+    );
+    if let Some(object) = json.as_object_mut() {
+        object.insert("faces".into(), json!(surface.indices.len()));
+        object.insert("nodes".into(), json!(tets.positions.len()));
+        object.insert("tetrahedra".into(), json!(tets.tets.len()));
+        object.insert("boundary_triangles".into(), json!(boundary.len()));
+        object.insert("matches_tetrahedra".into(), json!(matches));
+    }
+    Ok((text, json))
 }
 
 fn image_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
