@@ -387,3 +387,91 @@ fn info_reads_the_face_files_of_the_data_folder() {
         assert_eq!(report["closed"], true, "{name}: {report}");
     }
 }
+
+#[test]
+fn diffuse_paints_the_side_of_a_plane_with_one_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    trilux(d)
+        .args([
+            "tetra",
+            blob.to_str().unwrap(),
+            "--size",
+            "0.12",
+            "-o",
+            "blob.node",
+        ])
+        .assert()
+        .success();
+    let help = run(d, &["diffuse", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains("--paint plane:"), "no example in\n{help}");
+    // Ketchup (red) on the side x > 0 of a 4 cm marble blob seen from +z
+    // (+x to the right of the picture).
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "plane:1,0,0,0:ketchup",
+            "--unit-mm",
+            "20",
+            "--view=0,0,1",
+            "--size",
+            "64",
+            "-o",
+            "half.png",
+        ],
+    );
+    let mesh = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    let right = mesh
+        .tets
+        .iter()
+        .filter(|t| t.iter().map(|&v| mesh.positions[v as usize].x).sum::<f64>() > 0.0)
+        .count();
+    assert_eq!(report["paint"][0]["spec"], "plane:1,0,0,0:ketchup");
+    assert_eq!(report["paint"][0]["tetrahedra"], right, "{report}");
+    let image = trilux_io::image::read(d.join("half.png")).unwrap();
+    let red = |columns: std::ops::Range<u32>| {
+        let mut n = 0;
+        for y in 0..image.height {
+            for x in columns.clone() {
+                let p = image.pixels[(y * image.width + x) as usize];
+                n += usize::from(p[0] > 0.1 && p[0] > 2.0 * p[1]);
+            }
+        }
+        n
+    };
+    let (left, right) = (red(0..28), red(36..64));
+    assert!(
+        right > 100 && left * 10 < right,
+        "red pixels: left {left}, right {right}"
+    );
+    fails(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "plane:0,0,0,1:skin1",
+            "-o",
+            "p.png",
+        ],
+        &["--paint plane:0,0,0,1", "zero"],
+    );
+    fails(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "plane:1,0,0,0:jade",
+            "-o",
+            "p.png",
+        ],
+        &["--paint plane:1,0,0,0:jade", "marble"],
+    );
+    assert!(!d.join("p.png").exists());
+}

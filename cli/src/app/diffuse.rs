@@ -13,7 +13,7 @@ use super::{Context, Result, arg_error, file_error};
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Solve TransCut's diffusion on a tetrahedral mesh (or a surface, tetrahedralized first) and render it",
-    after_help = "Example:\n  trilux diffuse ../shared/data/tets/bunny_500k.msh --material marble \\\n      --light dir:0.3,1,0.6 --cut plane:0,0,1,0.01 -o bunny_marble.png\n\nMaterials: apple chicken1 chicken2 cream ketchup marble potato skimmilk skin1 skin2\nspectralon wholemilk, or noise:A,B (fractal noise between two of them)."
+    after_help = "Example:\n  trilux diffuse ../shared/data/tets/bunny_500k.msh --material marble \\\n      --light dir:0.3,1,0.6 --cut plane:0,0,1,0.01 -o bunny_marble.png\n\nPainting: the ears (the side y > 0.15) in skin, and a ball of ketchup:\n  trilux diffuse ../shared/data/tets/bunny_50k.node --material marble \\\n      --paint plane:0,1,0,0.15:skin1 --paint 0.03,0.08,0.03:0.01:ketchup -o bunny_painted.png\n\nMaterials: apple chicken1 chicken2 cream ketchup marble potato skimmilk skin1 skin2\nspectralon wholemilk, or noise:A,B (fractal noise between two of them)."
 )]
 pub(crate) struct Args {
     /// A tetrahedral mesh (.node, .ele, .msh, .mesh) or a closed surface
@@ -36,7 +36,10 @@ pub(crate) struct Args {
     /// plane:nx,ny,nz,d removes the side n·x > d; repeatable.
     #[arg(long, value_name = "SPEC")]
     pub(crate) cut: Vec<String>,
-    /// x,y,z:radius:material paints a material into a ball; repeatable.
+    /// x,y,z:radius:material paints a material into a soft-edged ball
+    /// (Gaussian, σ = radius); plane:nx,ny,nz,d:material paints the whole
+    /// side n·x > d (the side --cut would remove); repeatable (planes are
+    /// painted first, then balls, each in the order given).
     #[arg(long, value_name = "SPEC")]
     pub(crate) paint: Vec<String>,
     /// plane:nx,ny,nz,d breaks the object in two along the plane.
@@ -168,24 +171,71 @@ fn medium(name: &str, argument: &str) -> Result<Medium> {
     })
 }
 
-/// `x,y,z:radius:material`: a ball of paint.
-fn parse_paint(spec: &str) -> Result<Stroke> {
+/// What one `--paint` paints.
+enum Paint {
+    /// A soft-edged ball: a stroke of one point.
+    Ball(Stroke),
+    /// Every tetrahedron whose centre is on the side `(x − point) · normal
+    /// > 0`, all of it.
+    Side {
+        point: DVec3,
+        normal: DVec3,
+        medium: Medium,
+    },
+}
+
+/// `x,y,z:radius:material` (a ball) or `plane:nx,ny,nz,d:material` (a
+/// side of a plane).
+fn parse_paint(spec: &str) -> Result<Paint> {
     let argument = format!("--paint {spec}");
+    if spec.starts_with("plane:") {
+        let Some((plane, m)) = spec.rsplit_once(':').filter(|(p, _)| *p != "plane") else {
+            return Err(arg_error(argument, "expected plane:nx,ny,nz,d:material"));
+        };
+        let (point, normal) = parse_plane(plane, &argument)?;
+        return Ok(Paint::Side {
+            point,
+            normal,
+            medium: medium(m, &argument)?,
+        });
+    }
     let parts: Vec<&str> = spec.split(':').collect();
     let [xyz, r, m] = parts.as_slice() else {
-        return Err(arg_error(argument, "expected x,y,z:radius:material"));
+        return Err(arg_error(
+            argument,
+            "expected x,y,z:radius:material or plane:nx,ny,nz,d:material",
+        ));
     };
     let radius: f64 = r
         .parse()
         .ok()
         .filter(|r: &f64| r.is_finite() && *r > 0.0)
         .ok_or_else(|| arg_error(&argument, "the radius must be a positive number"))?;
-    Ok(Stroke {
+    Ok(Paint::Ball(Stroke {
         points: vec![vec3(&numbers(xyz, &argument, 3)?)],
         radius,
         medium: medium(m, &argument)?,
         strength: 1.0,
-    })
+    }))
+}
+
+/// Paints `medium` into every tetrahedron of `mesh` whose centre is on
+/// the side `(x − point) · normal > 0`; returns how many.
+fn paint_side(
+    mesh: &tet_diffusion::TetMesh,
+    media: &mut [Medium],
+    point: DVec3,
+    normal: DVec3,
+    medium: Medium,
+) -> usize {
+    let mut painted = 0;
+    for (t, &id) in mesh.original_ids().iter().enumerate() {
+        if (mesh.tet_center(t) - point).dot(normal) > 0.0 {
+            media[id as usize] = medium;
+            painted += 1;
+        }
+    }
+    painted
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
@@ -280,7 +330,20 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let unit_mm = args
         .unit_mm
         .unwrap_or(if diagonal < 5.0 { 1000.0 } else { 1.0 });
-    let media = media(&mesh, diagonal / 6.0)?;
+    let mut media = media(&mesh, diagonal / 6.0)?;
+    // Sides of planes go into the media before assembly; balls are
+    // painted into the assembled object below.
+    let mut painted = vec![0; paints.len()];
+    for ((_, paint), count) in paints.iter().zip(&mut painted) {
+        if let Paint::Side {
+            point,
+            normal,
+            medium,
+        } = paint
+        {
+            *count = paint_side(&mesh, &mut media, *point, *normal, *medium);
+        }
+    }
     let mut object = context
         .step("assembling", || Object::new(mesh, unit_mm, media, 1.3))
         .map_err(|e| file_error(&args.input, e))?;
@@ -308,10 +371,13 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             .add_light(Light::Environment(Arc::new(env)))
             .map_err(|e| file_error(path, e))?;
     }
-    for (spec, stroke) in &paints {
-        object
-            .paint(stroke)
-            .map_err(|e| arg_error(format!("--paint {spec}"), e))?;
+    for ((spec, paint), count) in paints.iter().zip(&mut painted) {
+        if let Paint::Ball(stroke) = paint {
+            *count = object
+                .paint(stroke)
+                .map_err(|e| arg_error(format!("--paint {spec}"), e))?
+                .tets;
+        }
     }
     for (spec, (point, normal)) in &cuts {
         context
@@ -395,11 +461,23 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let tets: usize = objects.iter().map(|o| o.mesh().tets().len()).sum();
     let levels = reports.first().map_or(0, |r| r.levels);
     let text = format!(
-        "{} tetrahedra ({} object{}), {} mm per unit, solved ({} levels); picture written to {}\n",
+        "{} tetrahedra ({} object{}), {} mm per unit{}, solved ({} levels); picture written to {}\n",
         tets,
         objects.len(),
         if objects.len() > 1 { "s" } else { "" },
         unit_mm,
+        if painted.is_empty() {
+            String::new()
+        } else {
+            format!(
+                ", painted {} tetrahedra",
+                painted
+                    .iter()
+                    .map(usize::to_string)
+                    .collect::<Vec<_>>()
+                    .join(" + ")
+            )
+        },
         levels,
         args.output.display()
     );
@@ -410,6 +488,11 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "objects": objects.len(),
         "unit_mm": unit_mm,
         "material": args.material,
+        "paint": paints
+            .iter()
+            .zip(&painted)
+            .map(|((spec, _), n)| serde_json::json!({"spec": spec, "tetrahedra": n}))
+            .collect::<Vec<_>>(),
         "output": super::shown(&args.output),
         "seconds": context.timings_json(),
     });
