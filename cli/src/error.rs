@@ -49,6 +49,12 @@ pub enum Error {
     /// An argument out of its range.
     #[error("{0}")]
     Invalid(String),
+    /// A command-line argument that is malformed, out of range, or given
+    /// without the argument it goes with: the command line itself is
+    /// wrong, whatever the files hold (the `trilux` command exits with 2
+    /// for it, as for its parser's own errors).
+    #[error("{0}")]
+    Usage(String),
     /// The output exists and overwriting was not asked for.
     #[error("{0}: the file exists; pass --force to overwrite it")]
     Exists(PathBuf),

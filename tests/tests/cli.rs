@@ -9,7 +9,7 @@ use trilux_io::mesh::TriMesh;
 use trilux_tests::{data, trilux_bin};
 
 mod common;
-use common::{fails, stderr, trilux};
+use common::{fails, fails_with, json, run, stderr, trilux};
 
 /// A built-in textured torus and a noise texture written as files.
 fn inputs(dir: &Path) -> (PathBuf, PathBuf) {
@@ -663,6 +663,7 @@ fn real_files_through_every_subcommand() {
         ("meshes/teapot.obj", "welded_vertices", 3_241),
         ("tets/sphere_20k.node", "tetrahedra", 19_443),
         ("tets/bunny_500k.msh", "nodes", 93_375),
+        ("tets/bunny_50k.face", "faces", 7_108),
     ] {
         let out = trilux(d)
             .args(["info", &s(&data(file)), "--json"])
@@ -699,4 +700,365 @@ fn real_files_through_every_subcommand() {
         ],
         &["stanford-bunny.obj", "texture coordinates"],
     );
+}
+
+#[test]
+fn info_on_an_obj_without_faces_says_so_and_does_not_call_it_closed() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("empty.obj"), "").unwrap();
+    std::fs::write(d.join("points.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\n").unwrap();
+    for file in ["empty.obj", "points.obj"] {
+        let out = run(d, &["info", file]);
+        assert!(out.status.success(), "{file}: {}", stderr(&out));
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("no faces"), "{file}: {text}");
+        assert!(
+            !text.contains("closed") && !text.contains("watertight"),
+            "{file}: {text}"
+        );
+        assert!(!text.contains("-0"), "{file}: negative zero in {text}");
+        let report = json(d, &["info", file]);
+        assert_eq!(report["triangles"], 0, "{file}: {report}");
+        assert_eq!(report["closed"], false, "{file}: {report}");
+    }
+}
+
+#[test]
+fn sample_channel_without_a_density_image_or_mesh_colours_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (_, noise) = inputs(d);
+    let noise = noise.to_str().unwrap();
+    fails_with(
+        d,
+        2,
+        &[
+            "sample",
+            "torus.obj",
+            "-n",
+            "10",
+            "--channel",
+            "r",
+            "-o",
+            "a.ply",
+        ],
+        &["--channel"],
+    );
+    // Per-face weights have no channels either.
+    std::fs::write(d.join("w.txt"), "1\n".repeat(48 * 24 * 2)).unwrap();
+    fails_with(
+        d,
+        2,
+        &[
+            "sample",
+            "torus.obj",
+            "-n",
+            "10",
+            "--face-weights",
+            "w.txt",
+            "--channel",
+            "g",
+            "-o",
+            "a.ply",
+        ],
+        &["--channel", "--face-weights"],
+    );
+    assert!(!d.join("a.ply").exists());
+    let report = json(
+        d,
+        &[
+            "sample",
+            "torus.obj",
+            "-n",
+            "10",
+            "--density",
+            noise,
+            "--channel",
+            "r",
+            "-o",
+            "a.ply",
+        ],
+    );
+    assert_eq!(report["points"], 10);
+}
+
+/// Every error is one line, `error: WHERE: WHAT`, where WHERE is the file
+/// or the argument as typed (named once), with no closing full stop.
+#[test]
+fn errors_are_one_line_naming_the_file_or_argument_first_in_every_subcommand() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    inputs(d);
+    std::fs::write(d.join("bad.meshcolors"), "MESHCOLR garbage").unwrap();
+    std::fs::write(d.join("fake.png"), "this is not a PNG").unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        // A missing input, whichever subcommand and argument names it.
+        (&["info", "missing.obj"], "missing.obj: no such file"),
+        (
+            &["sample", "missing.obj", "-n", "10", "-o", "a.ply"],
+            "missing.obj: no such file",
+        ),
+        (
+            &[
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--density",
+                "missing.png",
+                "-o",
+                "a.ply",
+            ],
+            "missing.png: no such file",
+        ),
+        (
+            &[
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--face-weights",
+                "missing.txt",
+                "-o",
+                "a.ply",
+            ],
+            "missing.txt: no such file",
+        ),
+        (
+            &[
+                "colors",
+                "render",
+                "torus.obj",
+                "missing.meshcolors",
+                "-o",
+                "x.png",
+            ],
+            "missing.meshcolors: no such file",
+        ),
+        (
+            &[
+                "colors",
+                "convert",
+                "torus.obj",
+                "--texture",
+                "missing.png",
+                "-o",
+                "t.meshcolors",
+            ],
+            "missing.png: no such file",
+        ),
+        (
+            &["tetra", "missing.obj", "-o", "m.node"],
+            "missing.obj: no such file",
+        ),
+        (
+            &["diffuse", "missing.node", "-o", "a.png"],
+            "missing.node: no such file",
+        ),
+        // A bad file, named once.
+        (
+            &[
+                "colors",
+                "render",
+                "torus.obj",
+                "bad.meshcolors",
+                "-o",
+                "x.png",
+            ],
+            "bad.meshcolors: ",
+        ),
+        (&["info", "fake.png"], "fake.png: "),
+        // An argument as typed, then what is wrong with it.
+        (
+            &[
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--threads",
+                "0",
+                "-o",
+                "a.ply",
+            ],
+            "--threads 0: ",
+        ),
+        (
+            &[
+                "colors",
+                "convert",
+                "torus.obj",
+                "--budget",
+                "0",
+                "-o",
+                "t.meshcolors",
+            ],
+            "--budget 0: ",
+        ),
+        (&["bench", "sampling", "--repeats", "0"], "--repeats 0: "),
+        (
+            &["diffuse", "torus.obj", "--material", "jade", "-o", "a.png"],
+            "--material jade: ",
+        ),
+        (
+            &["diffuse", "torus.obj", "--light", "dir:0,1", "-o", "a.png"],
+            "--light dir:0,1: ",
+        ),
+        (
+            &[
+                "diffuse",
+                "torus.obj",
+                "--cut",
+                "plane:0,0,0,1",
+                "-o",
+                "a.png",
+            ],
+            "--cut plane:0,0,0,1: ",
+        ),
+        (
+            &["diffuse", "torus.obj", "--size", "0", "-o", "a.png"],
+            "--size 0: ",
+        ),
+        (&["demo", "--out", "demo", "--size", "0"], "--size 0: "),
+        (
+            &[
+                "colors",
+                "render",
+                "torus.obj",
+                "bad.meshcolors",
+                "--size",
+                "0",
+                "-o",
+                "x.png",
+            ],
+            "--size 0: ",
+        ),
+    ];
+    for &(args, start) in cases {
+        fails(d, args, &[start]);
+        let err = stderr(&run(d, args));
+        let line = err.strip_suffix('\n').unwrap_or(&err);
+        assert!(
+            !line.contains('\n'),
+            "{args:?}: more than one line: {err:?}"
+        );
+        assert!(
+            line.starts_with(&format!("error: {start}")),
+            "{args:?}: {line:?} does not start with {start:?}"
+        );
+        assert!(!line.ends_with('.'), "{args:?}: {line:?}");
+        let place = start.split(": ").next().unwrap();
+        assert_eq!(line.matches(place).count(), 1, "{args:?}: {line:?}");
+    }
+    assert!(!d.join("demo").exists(), "a refused demo made its folder");
+}
+
+#[test]
+fn with_json_a_failure_is_one_json_object_on_stdout_with_the_same_exit_code() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    inputs(d);
+    let cases: &[(&[&str], i32, &str)] = &[
+        // A run error, --json after or before the subcommand.
+        (&["info", "missing.obj", "--json"], 1, "missing.obj"),
+        (&["--json", "info", "missing.obj"], 1, "missing.obj"),
+        // A usage error found by trilux, and two found by the parser.
+        (
+            &[
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--channel",
+                "r",
+                "-o",
+                "a.ply",
+                "--json",
+            ],
+            2,
+            "--channel",
+        ),
+        (&["sample", "torus.obj", "--json"], 2, "--count"),
+        (
+            &[
+                "--json",
+                "sample",
+                "torus.obj",
+                "-n",
+                "10",
+                "--method",
+                "magic",
+                "-o",
+                "a.ply",
+            ],
+            2,
+            "magic",
+        ),
+        (&["--json", "frobnicate"], 2, "frobnicate"),
+    ];
+    for &(args, code, needle) in cases {
+        let out = run(d, args);
+        assert_eq!(out.status.code(), Some(code), "{args:?}: {}", stderr(&out));
+        let stdout = String::from_utf8(out.stdout.clone()).unwrap();
+        assert_eq!(stdout.lines().count(), 1, "{args:?}: {stdout:?}");
+        let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+        assert_eq!(report.as_object().unwrap().len(), 2, "{report}");
+        assert_eq!(report["exit_code"], code, "{report}");
+        let message = report["error"].as_str().unwrap();
+        assert!(message.contains(needle), "{args:?}: {report}");
+        // The human message is on stderr too.
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+        // Without --json: the same exit code, and nothing on stdout.
+        let plain: Vec<&str> = args.iter().copied().filter(|a| *a != "--json").collect();
+        let out = run(d, &plain);
+        assert_eq!(out.status.code(), Some(code), "{plain:?}");
+        assert!(out.stdout.is_empty(), "{plain:?}");
+    }
+    // Help is still help.
+    let out = run(d, &["sample", "--help", "--json"]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("Example"));
+}
+
+#[test]
+fn global_options_are_listed_once_under_their_own_heading() {
+    let dir = tempfile::tempdir().unwrap();
+    for sub in [
+        &[][..],
+        &["info"],
+        &["sample"],
+        &["colors", "convert"],
+        &["colors", "render"],
+        &["tetra"],
+        &["diffuse"],
+        &["demo"],
+        &["bench"],
+    ] {
+        let mut args = sub.to_vec();
+        args.push("--help");
+        let out = run(dir.path(), &args);
+        assert!(out.status.success(), "{args:?}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        let lines: Vec<&str> = text.lines().collect();
+        let heading = lines
+            .iter()
+            .position(|l| *l == "Global options:")
+            .unwrap_or_else(|| panic!("{args:?}: no global options heading in\n{text}"));
+        for flag in ["--json", "--quiet", "--force"] {
+            let defined: Vec<usize> = (0..lines.len())
+                .filter(|&i| {
+                    let l = lines[i].trim_start();
+                    l.starts_with(flag) || l.starts_with(&format!("-q, {flag}"))
+                })
+                .collect();
+            assert_eq!(defined.len(), 1, "{args:?}: {flag} in\n{text}");
+            // Under the heading: after it, with no other heading between.
+            let at = defined[0];
+            assert!(at > heading, "{args:?}: {flag} above the heading\n{text}");
+            assert!(
+                lines[heading + 1..at].iter().all(|l| l.starts_with(' ')),
+                "{args:?}: {flag} not under the heading\n{text}"
+            );
+        }
+    }
 }

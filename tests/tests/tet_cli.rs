@@ -10,7 +10,7 @@ use trilux_io::mesh::TriMesh;
 use trilux_tests::data;
 
 mod common;
-use common::{fails, json, trilux};
+use common::{fails, json, run, trilux};
 
 /// The built-in bumpy blob (closed, about unit size) written as OBJ.
 fn blob(dir: &Path) -> PathBuf {
@@ -314,4 +314,164 @@ fn tetra_stuffs_the_raw_bunny_and_diffuse_accepts_it() {
         trilux_io::image::read(d.join("bunny.png")).unwrap().width,
         128
     );
+}
+
+/// Writes `faces` as a TetGen `.face` file (1-based, boundary markers).
+fn write_face_file(path: &Path, faces: &[[u32; 3]]) {
+    let mut text = format!("# boundary triangles\n{} 1\n", faces.len());
+    for (k, f) in faces.iter().enumerate() {
+        text.push_str(&format!(
+            "{} {} {} {} 1\n",
+            k + 1,
+            f[0] + 1,
+            f[1] + 1,
+            f[2] + 1
+        ));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn info_reads_a_tetgen_face_file_beside_its_node_and_ele_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    trilux(d)
+        .args([
+            "tetra",
+            blob.to_str().unwrap(),
+            "--size",
+            "0.15",
+            "-o",
+            "blob.node",
+        ])
+        .assert()
+        .success();
+    let mesh = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    let boundary = mesh.boundary();
+    write_face_file(&d.join("blob.face"), &boundary);
+    let report = json(d, &["info", "blob.face"]);
+    assert_eq!(report["kind"], "TetGen faces", "{report}");
+    assert_eq!(report["faces"], boundary.len(), "{report}");
+    assert_eq!(report["tetrahedra"], mesh.tets.len(), "{report}");
+    assert_eq!(report["matches_tetrahedra"], true, "{report}");
+    assert_eq!(report["closed"], true, "{report}");
+    assert_eq!(report["holes"], 0, "{report}");
+    let out = run(d, &["info", "blob.face"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(&format!("faces: {}", boundary.len())),
+        "{text}"
+    );
+    // A face list that is not the tetrahedra's boundary says so.
+    write_face_file(&d.join("blob.face"), &boundary[1..]);
+    let report = json(d, &["info", "blob.face"]);
+    assert_eq!(report["matches_tetrahedra"], false, "{report}");
+    assert_eq!(report["closed"], false, "{report}");
+    // The .node and .ele files it refers to are needed, and named.
+    std::fs::copy(d.join("blob.face"), d.join("lonely.face")).unwrap();
+    fails(d, &["info", "lonely.face"], &["lonely.node"]);
+}
+
+#[test]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
+fn info_reads_the_face_files_of_the_data_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["bunny_50k", "sphere_20k"] {
+        let file = data(&format!("tets/{name}.face"));
+        let report = json(dir.path(), &["info", file.to_str().unwrap()]);
+        assert_eq!(report["matches_tetrahedra"], true, "{name}: {report}");
+        assert_eq!(report["closed"], true, "{name}: {report}");
+    }
+}
+
+#[test]
+fn diffuse_paints_the_side_of_a_plane_with_one_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    trilux(d)
+        .args([
+            "tetra",
+            blob.to_str().unwrap(),
+            "--size",
+            "0.12",
+            "-o",
+            "blob.node",
+        ])
+        .assert()
+        .success();
+    let help = run(d, &["diffuse", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains("--paint plane:"), "no example in\n{help}");
+    // Ketchup (red) on the side x > 0 of a 4 cm marble blob seen from +z
+    // (+x to the right of the picture).
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "plane:1,0,0,0:ketchup",
+            "--unit-mm",
+            "20",
+            "--view=0,0,1",
+            "--size",
+            "64",
+            "-o",
+            "half.png",
+        ],
+    );
+    let mesh = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    let right = mesh
+        .tets
+        .iter()
+        .filter(|t| t.iter().map(|&v| mesh.positions[v as usize].x).sum::<f64>() > 0.0)
+        .count();
+    assert_eq!(report["paint"][0]["spec"], "plane:1,0,0,0:ketchup");
+    assert_eq!(report["paint"][0]["tetrahedra"], right, "{report}");
+    let image = trilux_io::image::read(d.join("half.png")).unwrap();
+    let red = |columns: std::ops::Range<u32>| {
+        let mut n = 0;
+        for y in 0..image.height {
+            for x in columns.clone() {
+                let p = image.pixels[(y * image.width + x) as usize];
+                n += usize::from(p[0] > 0.1 && p[0] > 2.0 * p[1]);
+            }
+        }
+        n
+    };
+    let (left, right) = (red(0..28), red(36..64));
+    assert!(
+        right > 100 && left * 10 < right,
+        "red pixels: left {left}, right {right}"
+    );
+    fails(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "plane:0,0,0,1:skin1",
+            "-o",
+            "p.png",
+        ],
+        &["--paint plane:0,0,0,1", "zero"],
+    );
+    fails(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "plane:1,0,0,0:jade",
+            "-o",
+            "p.png",
+        ],
+        &["--paint plane:1,0,0,0:jade", "marble"],
+    );
+    assert!(!d.join("p.png").exists());
 }

@@ -64,7 +64,10 @@ fn time<T>(repeats: usize, mut f: impl FnMut() -> T) -> f64 {
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     if args.repeats == 0 {
-        return Err(invalid("--repeats must be at least 1"));
+        return Err(super::arg_error(
+            "--repeats 0",
+            "at least one repetition is needed",
+        ));
     }
     if let Some(dir) = &args.plots {
         std::fs::create_dir_all(dir).map_err(|source| trilux::Error::File {
@@ -284,7 +287,10 @@ fn cli_overhead(n: usize, file: Option<&Path>) -> Result<(f64, f64)> {
             })?;
         let cli = start.elapsed().as_secs_f64();
         if !status.success() {
-            return Err(invalid("the trilux sample run of the benchmark failed"));
+            return Err(invalid(format!(
+                "bench sampling: the `trilux sample` run on {} failed",
+                file.display()
+            )));
         }
         Ok((library, cli))
     })();
@@ -352,7 +358,9 @@ fn colors(context: &mut Context, args: &Args, data: Option<&Path>) -> Result<()>
         }
     }
     let Some((_surface, colors)) = finest else {
-        return Err(invalid("no conversion at the texel budget"));
+        return Err(invalid(
+            "bench colors: no conversion was made at the texel budget",
+        ));
     };
     // Lookups: mesh colours (linear, trilinear MIP) against the texture's
     // bilinear filter at the same surface points.
@@ -361,7 +369,7 @@ fn colors(context: &mut Context, args: &Args, data: Option<&Path>) -> Result<()>
     let uvs = mesh
         .uvs
         .as_ref()
-        .ok_or_else(|| invalid("the mesh has no UVs"))?;
+        .ok_or_else(|| invalid("bench colors: the mesh has no texture coordinates"))?;
     let point_uvs: Vec<[f32; 2]> = points
         .iter()
         .map(|&(f, b)| {

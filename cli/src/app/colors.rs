@@ -9,7 +9,7 @@ use mesh_sampling::{SurfaceSampler, UniformSampler};
 use trilux::{ColorMesh, SurfaceTexture};
 use trilux_io::mesh::TriMesh;
 
-use super::{Context, Result, invalid};
+use super::{Context, Result, arg_error, file_error};
 
 #[derive(Debug, clap::Subcommand)]
 #[command(about = "Mesh colours: convert a textured mesh, bake an atlas, render")]
@@ -143,14 +143,16 @@ pub(crate) fn convert_mesh(
 
 fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
     if !args.max_res.is_power_of_two() || args.max_res > 1 << mesh_colors::MAX_LEVEL {
-        return Err(invalid(format!(
-            "--max-res {}: must be a power of two from 1 to {}",
-            args.max_res,
-            1 << mesh_colors::MAX_LEVEL
-        )));
+        return Err(arg_error(
+            format!("--max-res {}", args.max_res),
+            format!(
+                "the face resolution must be a power of two from 1 to {}",
+                1 << mesh_colors::MAX_LEVEL
+            ),
+        ));
     }
     if args.budget == Some(0) {
-        return Err(invalid("--budget must be at least 1 sample"));
+        return Err(arg_error("--budget 0", "at least one sample is needed"));
     }
     super::check_output(context, &args.output, &["meshcolors"])?;
     if let Some(p) = &args.preview {
@@ -158,10 +160,10 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
     }
     let mesh = super::read_mesh(context, &args.mesh)?;
     if mesh.uvs.is_none() {
-        return Err(invalid(format!(
-            "{}: the mesh has no texture coordinates, so there is no texture to convert",
-            args.mesh.display()
-        )));
+        return Err(file_error(
+            &args.mesh,
+            "the mesh has no texture coordinates, so there is no texture to convert",
+        ));
     }
     let texture = match &args.texture {
         Some(p) => Some(super::read_image(context, p, false)?),
@@ -174,17 +176,16 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
     };
     let (surface, colors, psnr) = convert_mesh(context, &mesh, texture.as_ref(), &options)
         .map_err(|e| match e {
-            trilux::Error::MissingTexture => invalid(format!(
-                "{}: the mesh's materials have no texture: give one with --texture IMAGE",
-                args.mesh.display()
-            )),
-            other => other,
+            trilux::Error::MissingTexture => file_error(
+                &args.mesh,
+                "the mesh's materials have no texture (give one with --texture IMAGE)",
+            ),
+            other => super::at(args.mesh.display(), other),
         })?;
     let force = context.force;
     context.step("writing the mesh colours", || {
         trilux::output::write_atomic(&args.output, force, |tmp| {
-            mesh_colors::file::save(tmp, &colors, None)
-                .map_err(|e| invalid(format!("{}: {e}", args.output.display())))
+            mesh_colors::file::save(tmp, &colors, None).map_err(|e| file_error(&args.output, e))
         })
     })?;
     if let Some(p) = &args.preview {
@@ -227,11 +228,16 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
     Ok(())
 }
 
-/// Loads mesh colours and checks they belong to the mesh.
-pub(crate) fn load_for(mesh: &TriMesh, path: &Path) -> Result<(ColorMesh, MeshColors)> {
-    let (colors, _) =
-        mesh_colors::file::load(path).map_err(|e| invalid(format!("{}: {e}", path.display())))?;
-    let surface = ColorMesh::new(mesh)?;
+/// Loads mesh colours and checks they belong to the mesh (read from
+/// `mesh_path`).
+pub(crate) fn load_for(
+    mesh: &TriMesh,
+    mesh_path: &Path,
+    path: &Path,
+) -> Result<(ColorMesh, MeshColors)> {
+    super::check_input(path)?;
+    let (colors, _) = mesh_colors::file::load(path).map_err(|e| file_error(path, e))?;
+    let surface = ColorMesh::new(mesh).map_err(|e| super::at(mesh_path.display(), e))?;
     surface.check(&colors, path)?;
     Ok((surface, colors))
 }
@@ -239,24 +245,27 @@ pub(crate) fn load_for(mesh: &TriMesh, path: &Path) -> Result<(ColorMesh, MeshCo
 fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
     let ext = super::extension(&args.output);
     if ext == "gltf" || ext == "glb" {
-        return Err(invalid(format!(
-            "{}: trilux-io writes no glTF yet; write .obj (with .mtl and .png beside it)",
-            args.output.display()
-        )));
+        return Err(file_error(
+            &args.output,
+            "trilux-io writes no glTF yet (write .obj, with .mtl and .png beside it)",
+        ));
     }
     super::check_output(context, &args.output, &["obj"])?;
     let mesh = super::read_mesh(context, &args.mesh)?;
-    let (surface, colors) =
-        context.step("reading the mesh colours", || load_for(&mesh, &args.colors))?;
-    let atlas = context.step("baking the atlas", || {
-        mesh_colors::atlas::bake(
-            &colors,
-            &mesh_colors::atlas::Options {
-                gutter: args.gutter,
-                mip_levels: args.mip,
-            },
-        )
+    let (surface, colors) = context.step("reading the mesh colours", || {
+        load_for(&mesh, &args.mesh, &args.colors)
     })?;
+    let atlas = context
+        .step("baking the atlas", || {
+            mesh_colors::atlas::bake(
+                &colors,
+                &mesh_colors::atlas::Options {
+                    gutter: args.gutter,
+                    mip_levels: args.mip,
+                },
+            )
+        })
+        .map_err(|e| super::at(args.colors.display(), e))?;
     // No texture file named: the OBJ writer writes the atlas image
     // beside the .obj and .mtl as NAME_atlas.png.
     let (baked, image) = trilux::atlas_mesh(&surface, &atlas, None);
@@ -347,33 +356,13 @@ pub(crate) fn render_colors_from(
 }
 
 fn render(context: &mut Context, args: RenderArgs) -> Result<()> {
-    if args.size == 0 || args.size > 8192 {
-        return Err(invalid(format!(
-            "--size {}: must be 1..=8192 pixels",
-            args.size
-        )));
-    }
+    super::check_size(args.size, 8192)?;
     super::check_output(context, &args.output, &["png", "exr"])?;
-    let view = match &args.view {
-        None => None,
-        Some(spec) => {
-            let v: Vec<f32> = spec
-                .split(',')
-                .map(|x| x.trim().parse::<f32>())
-                .collect::<std::result::Result<_, _>>()
-                .ok()
-                .filter(|v: &Vec<f32>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
-                .ok_or_else(|| invalid(format!("--view {spec:?}: expected three numbers x,y,z")))?;
-            let v = glam::Vec3::new(v[0], v[1], v[2]);
-            if v.length_squared() == 0.0 {
-                return Err(invalid(format!("--view {spec:?}: the direction is zero")));
-            }
-            Some(v)
-        }
-    };
+    let view = args.view.as_deref().map(super::parse_view).transpose()?;
     let mesh = super::read_mesh(context, &args.mesh)?;
-    let (surface, colors) =
-        context.step("reading the mesh colours", || load_for(&mesh, &args.colors))?;
+    let (surface, colors) = context.step("reading the mesh colours", || {
+        load_for(&mesh, &args.mesh, &args.colors)
+    })?;
     let image = context.step("rendering", || {
         render_colors_from(&surface, &colors, args.filter, args.size, view)
     });

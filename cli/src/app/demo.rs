@@ -84,7 +84,7 @@ impl Demo<'_> {
         let start = Instant::now();
         let result = f(self);
         bar.finish_and_clear();
-        let (what, files) = result.map_err(|e| invalid(format!("demo pipeline {name}: {e}")))?;
+        let (what, files) = result.map_err(|e| super::at(format!("demo pipeline {name}"), e))?;
         self.done.push(Done {
             name,
             what,
@@ -114,12 +114,13 @@ fn points_pipeline(
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    super::check_size(args.size, 4096)?;
     let out = args.out.clone();
     if out.exists() && !out.is_dir() {
-        return Err(invalid(format!(
-            "--out {}: exists and is not a folder",
-            out.display()
-        )));
+        return Err(super::file_error(
+            &out,
+            "a file, not a folder (--out names the folder to write into)",
+        ));
     }
     std::fs::create_dir_all(&out).map_err(|source| trilux::Error::File {
         path: out.clone(),
@@ -130,13 +131,10 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             .map(|mut d| d.next().is_some())
             .unwrap_or(false)
     {
-        return Err(invalid(format!(
-            "--out {}: the folder is not empty; pass --force to overwrite the demo's files in it, or choose another folder",
-            out.display()
-        )));
-    }
-    if args.size == 0 || args.size > 4096 {
-        return Err(invalid(format!("--size {}: must be 1..=4096", args.size)));
+        return Err(super::file_error(
+            &out,
+            "the folder is not empty; pass --force to overwrite the demo's files in it, or choose another folder",
+        ));
     }
     let start = Instant::now();
     let mut demo = Demo {
@@ -238,7 +236,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             super::colors::convert_mesh(&mut quiet, &torus, Some(&checker), &Default::default())?;
         let file = d.path("torus.meshcolors");
         trilux::output::write_atomic(&file, d.context.force, |tmp| {
-            mesh_colors::file::save(tmp, &colors, None).map_err(|e| invalid(format!("{}: {e}", file.display())))
+            mesh_colors::file::save(tmp, &colors, None).map_err(|e| super::file_error(&file, e))
         })?;
         let atlas = mesh_colors::atlas::bake(&colors, &Default::default())?;
         let (baked, _) = trilux::atlas_mesh(&surface, &atlas, None);
@@ -264,7 +262,12 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     demo.run("colors-density", |d| {
         let n = 200_000;
         let file = d.path("torus.meshcolors");
-        let source = super::sample::meshcolors_source(&torus, &file, Channel::Luminance)?;
+        let source = super::sample::meshcolors_source(
+            &torus,
+            &d.path("torus.obj"),
+            &file,
+            Channel::Luminance,
+        )?;
         let files = points_pipeline(
             d,
             "torus_colors_points",

@@ -8,12 +8,12 @@ use std::sync::Arc;
 use glam::{DVec3, Vec3};
 use tet_diffusion::{Cut, Light, Medium, Noise, Object, Stroke};
 
-use super::{Context, Result, invalid};
+use super::{Context, Result, arg_error, file_error};
 
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Solve TransCut's diffusion on a tetrahedral mesh (or a surface, tetrahedralized first) and render it",
-    after_help = "Example:\n  trilux diffuse ../shared/data/tets/bunny_500k.msh --material marble \\\n      --light dir:0.3,1,0.6 --cut plane:0,0,1,0.01 -o bunny_marble.png\n\nMaterials: apple chicken1 chicken2 cream ketchup marble potato skimmilk skin1 skin2\nspectralon wholemilk, or noise:A,B (fractal noise between two of them)."
+    after_help = "Example:\n  trilux diffuse ../shared/data/tets/bunny_500k.msh --material marble \\\n      --light dir:0.3,1,0.6 --cut plane:0,0,1,0.01 -o bunny_marble.png\n\nPainting: the ears (the side y > 0.15) in skin, and a ball of ketchup:\n  trilux diffuse ../shared/data/tets/bunny_50k.node --material marble \\\n      --paint plane:0,1,0,0.15:skin1 --paint 0.03,0.08,0.03:0.01:ketchup -o bunny_painted.png\n\nMaterials: apple chicken1 chicken2 cream ketchup marble potato skimmilk skin1 skin2\nspectralon wholemilk, or noise:A,B (fractal noise between two of them)."
 )]
 pub(crate) struct Args {
     /// A tetrahedral mesh (.node, .ele, .msh, .mesh) or a closed surface
@@ -36,7 +36,10 @@ pub(crate) struct Args {
     /// plane:nx,ny,nz,d removes the side n·x > d; repeatable.
     #[arg(long, value_name = "SPEC")]
     pub(crate) cut: Vec<String>,
-    /// x,y,z:radius:material paints a material into a ball; repeatable.
+    /// x,y,z:radius:material paints a material into a soft-edged ball
+    /// (Gaussian, σ = radius); plane:nx,ny,nz,d:material paints the whole
+    /// side n·x > d (the side --cut would remove); repeatable (planes are
+    /// painted first, then balls, each in the order given).
     #[arg(long, value_name = "SPEC")]
     pub(crate) paint: Vec<String>,
     /// plane:nx,ny,nz,d breaks the object in two along the plane.
@@ -71,22 +74,24 @@ type MediaFn = Box<dyn Fn(&tet_diffusion::TetMesh, f64) -> Result<Vec<Medium>>>;
 /// A boundary to draw: positions, triangles, (unused) colours, normals.
 type Shape = (Vec<Vec3>, Vec<[u32; 3]>, Vec<[f32; 3]>, Vec<Vec3>);
 
-fn numbers(spec: &str, what: &str, n: usize) -> Result<Vec<f64>> {
-    let v: Vec<f64> = spec
+/// `text` as `n` finite comma-separated numbers; `argument` is the option
+/// as typed, which names the problem.
+fn numbers(text: &str, argument: &str, n: usize) -> Result<Vec<f64>> {
+    let v: Option<Vec<f64>> = text
         .split(',')
-        .map(|s| s.trim().parse::<f64>())
-        .collect::<std::result::Result<_, _>>()
-        .map_err(|_| {
-            invalid(format!(
-                "{what} {spec:?}: expected {n} comma-separated numbers"
-            ))
-        })?;
-    if v.len() != n || v.iter().any(|x| !x.is_finite()) {
-        return Err(invalid(format!(
-            "{what} {spec:?}: expected {n} finite comma-separated numbers"
-        )));
+        .map(|s| s.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect();
+    match v {
+        Some(v) if v.len() == n => Ok(v),
+        _ => Err(arg_error(
+            argument,
+            if argument.ends_with(&format!(" {text}")) {
+                format!("expected {n} finite comma-separated numbers")
+            } else {
+                format!("expected {n} finite comma-separated numbers, found {text:?}")
+            },
+        )),
     }
-    Ok(v)
 }
 
 fn vec3(v: &[f64]) -> DVec3 {
@@ -95,26 +100,28 @@ fn vec3(v: &[f64]) -> DVec3 {
 
 /// `kind:x,y,z[:r,g,b]`.
 pub(crate) fn parse_light(spec: &str) -> Result<Light> {
+    let argument = format!("--light {spec}");
     let parts: Vec<&str> = spec.split(':').collect();
-    let what = "--light";
     let (kind, xyz, rgb) = match parts.as_slice() {
         [k, xyz] => (*k, *xyz, None),
         [k, xyz, rgb] => (*k, *xyz, Some(*rgb)),
         _ => {
-            return Err(invalid(format!(
-                "--light {spec:?}: expected dir:x,y,z[:r,g,b] or point:x,y,z[:r,g,b]"
-            )));
+            return Err(arg_error(
+                argument,
+                "expected dir:x,y,z[:r,g,b] or point:x,y,z[:r,g,b]",
+            ));
         }
     };
-    let p = vec3(&numbers(xyz, what, 3)?);
+    let p = vec3(&numbers(xyz, &argument, 3)?);
     let c = match rgb {
         Some(rgb) => {
-            let c = numbers(rgb, what, 3)?;
+            let c = numbers(rgb, &argument, 3)?;
             [c[0], c[1], c[2]]
         }
         None => [1.0; 3],
     };
     match kind {
+        "dir" if p.length_squared() == 0.0 => Err(arg_error(argument, "the direction is zero")),
         "dir" => Ok(Light::Directional {
             to_light: p,
             irradiance: c,
@@ -123,37 +130,112 @@ pub(crate) fn parse_light(spec: &str) -> Result<Light> {
             position: p,
             intensity: c,
         }),
-        other => Err(invalid(format!(
-            "--light {spec:?}: unknown kind {other:?} (dir or point)"
-        ))),
+        other => Err(arg_error(
+            argument,
+            format!("unknown kind of light {other:?} (dir or point)"),
+        )),
     }
 }
 
-/// `plane:nx,ny,nz,d` as (point, unit normal).
-fn parse_plane(spec: &str, what: &str) -> Result<(DVec3, DVec3)> {
+/// `plane:nx,ny,nz,d` as (point, unit normal); `argument` is the option
+/// as typed.
+fn parse_plane(spec: &str, argument: &str) -> Result<(DVec3, DVec3)> {
     let rest = spec
         .strip_prefix("plane:")
-        .ok_or_else(|| invalid(format!("{what} {spec:?}: expected plane:nx,ny,nz,d")))?;
-    let v = numbers(rest, what, 4)?;
+        .ok_or_else(|| arg_error(argument, "expected plane:nx,ny,nz,d"))?;
+    let v = numbers(rest, argument, 4)?;
     let n = vec3(&v);
     if n.length_squared() == 0.0 {
-        return Err(invalid(format!("{what} {spec:?}: the normal is zero")));
+        return Err(arg_error(argument, "the plane's normal is zero"));
     }
     let unit = n.normalize();
     Ok((unit * (v[3] / n.length()), unit))
 }
 
-fn medium(name: &str) -> Result<Medium> {
+/// A measured material by name; `argument` is the option as typed.
+fn medium(name: &str, argument: &str) -> Result<Medium> {
     Medium::measured(name).map_err(|_| {
-        invalid(format!(
-            "unknown material {name:?}: one of {}",
-            tet_diffusion::MEASURED
-                .iter()
-                .map(|m| m.0)
-                .collect::<Vec<_>>()
-                .join(", ")
-        ))
+        let names = tet_diffusion::MEASURED
+            .iter()
+            .map(|m| m.0)
+            .collect::<Vec<_>>()
+            .join(", ");
+        arg_error(
+            argument,
+            if argument.ends_with(&format!(" {name}")) {
+                format!("unknown material (one of {names})")
+            } else {
+                format!("unknown material {name:?} (one of {names})")
+            },
+        )
     })
+}
+
+/// What one `--paint` paints.
+enum Paint {
+    /// A soft-edged ball: a stroke of one point.
+    Ball(Stroke),
+    /// Every tetrahedron whose centre is on the side `(x − point) · normal
+    /// > 0`, all of it.
+    Side {
+        point: DVec3,
+        normal: DVec3,
+        medium: Medium,
+    },
+}
+
+/// `x,y,z:radius:material` (a ball) or `plane:nx,ny,nz,d:material` (a
+/// side of a plane).
+fn parse_paint(spec: &str) -> Result<Paint> {
+    let argument = format!("--paint {spec}");
+    if spec.starts_with("plane:") {
+        let Some((plane, m)) = spec.rsplit_once(':').filter(|(p, _)| *p != "plane") else {
+            return Err(arg_error(argument, "expected plane:nx,ny,nz,d:material"));
+        };
+        let (point, normal) = parse_plane(plane, &argument)?;
+        return Ok(Paint::Side {
+            point,
+            normal,
+            medium: medium(m, &argument)?,
+        });
+    }
+    let parts: Vec<&str> = spec.split(':').collect();
+    let [xyz, r, m] = parts.as_slice() else {
+        return Err(arg_error(
+            argument,
+            "expected x,y,z:radius:material or plane:nx,ny,nz,d:material",
+        ));
+    };
+    let radius: f64 = r
+        .parse()
+        .ok()
+        .filter(|r: &f64| r.is_finite() && *r > 0.0)
+        .ok_or_else(|| arg_error(&argument, "the radius must be a positive number"))?;
+    Ok(Paint::Ball(Stroke {
+        points: vec![vec3(&numbers(xyz, &argument, 3)?)],
+        radius,
+        medium: medium(m, &argument)?,
+        strength: 1.0,
+    }))
+}
+
+/// Paints `medium` into every tetrahedron of `mesh` whose centre is on
+/// the side `(x − point) · normal > 0`; returns how many.
+fn paint_side(
+    mesh: &tet_diffusion::TetMesh,
+    media: &mut [Medium],
+    point: DVec3,
+    normal: DVec3,
+    medium: Medium,
+) -> usize {
+    let mut painted = 0;
+    for (t, &id) in mesh.original_ids().iter().enumerate() {
+        if (mesh.tet_center(t) - point).dot(normal) > 0.0 {
+            media[id as usize] = medium;
+            painted += 1;
+        }
+    }
+    painted
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
@@ -164,13 +246,19 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     if let Some(p) = &args.vtu {
         super::check_output(context, p, &["vtu"])?;
     }
-    if args.size == 0 || args.size > 8192 {
-        return Err(invalid(format!(
-            "--size {}: must be 1..=8192 pixels",
-            args.size
-        )));
-    }
+    super::check_size(args.size, 8192)?;
     // Arguments first: a typo fails before any long step.
+    if let Some(mm) = args.unit_mm
+        && !(mm.is_finite() && mm > 0.0)
+    {
+        return Err(arg_error(
+            format!("--unit-mm {mm}"),
+            "millimetres per mesh unit must be a positive number",
+        ));
+    }
+    if let Some(path) = &args.envmap {
+        super::check_input(path)?;
+    }
     let mut lights = args
         .light
         .iter()
@@ -179,60 +267,28 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let cuts = args
         .cut
         .iter()
-        .map(|s| parse_plane(s, "--cut"))
+        .map(|s| Ok((s, parse_plane(s, &format!("--cut {s}"))?)))
         .collect::<Result<Vec<_>>>()?;
     let fracture = args
         .fracture
         .as_deref()
-        .map(|s| parse_plane(s, "--fracture"))
+        .map(|s| parse_plane(s, &format!("--fracture {s}")).map(|plane| (s, plane)))
         .transpose()?;
     let paints = args
         .paint
         .iter()
-        .map(|s| {
-            let parts: Vec<&str> = s.split(':').collect();
-            let [xyz, r, m] = parts.as_slice() else {
-                return Err(invalid(format!(
-                    "--paint {s:?}: expected x,y,z:radius:material"
-                )));
-            };
-            let radius: f64 = r
-                .parse()
-                .ok()
-                .filter(|r: &f64| r.is_finite() && *r > 0.0)
-                .ok_or_else(|| {
-                    invalid(format!(
-                        "--paint {s:?}: the radius must be a positive number"
-                    ))
-                })?;
-            Ok(Stroke {
-                points: vec![vec3(&numbers(xyz, "--paint", 3)?)],
-                radius,
-                medium: medium(m)?,
-                strength: 1.0,
-            })
-        })
+        .map(|s| Ok((s, parse_paint(s)?)))
         .collect::<Result<Vec<_>>>()?;
-    let view = match &args.view {
-        None => None,
-        Some(spec) => {
-            let v = vec3(&numbers(spec, "--view", 3)?);
-            if v.length_squared() == 0.0 {
-                return Err(invalid(format!("--view {spec:?}: the direction is zero")));
-            }
-            Some(v.as_vec3())
-        }
-    };
+    let view = args.view.as_deref().map(super::parse_view).transpose()?;
     let material = args.material.clone();
+    let material_arg = format!("--material {material}");
     let media: MediaFn = match material.strip_prefix("noise:") {
         Some(pair) => {
             let names: Vec<&str> = pair.split(',').collect();
             let [a, b] = names.as_slice() else {
-                return Err(invalid(format!(
-                    "--material {material:?}: expected noise:A,B"
-                )));
+                return Err(arg_error(material_arg, "expected noise:A,B"));
             };
-            let (a, b) = (medium(a)?, medium(b)?);
+            let (a, b) = (medium(a, &material_arg)?, medium(b, &material_arg)?);
             Box::new(move |mesh, scale| {
                 Noise {
                     a,
@@ -242,20 +298,18 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                     seed: 1,
                 }
                 .media(mesh)
-                .map_err(|e| invalid(format!("--material: {e}")))
+                .map_err(|e| arg_error(&material_arg, e))
             })
         }
         None => {
-            let m = medium(&material)?;
+            let m = medium(&material, &material_arg)?;
             Box::new(move |mesh, _| Ok(vec![m; mesh.tets().len()]))
         }
     };
 
     let ext = super::extension(&args.input);
     let (positions, tets) = if ["node", "ele", "msh", "mesh"].contains(&ext.as_str()) {
-        let tet = context.step("reading the tetrahedra", || {
-            trilux_io::tet::TetMesh::read(&args.input)
-        })?;
+        let tet = super::read_tets(context, &args.input)?;
         (tet.positions, tet.tets)
     } else {
         let surface = super::read_mesh(context, &args.input)?;
@@ -265,8 +319,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
         (out.positions, out.tets)
     };
-    let mesh = tet_diffusion::TetMesh::new(&positions, &tets)
-        .map_err(|e| invalid(format!("{}: {e}", args.input.display())))?;
+    let mesh =
+        tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_error(&args.input, e))?;
     let (lo, hi) = positions
         .iter()
         .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| {
@@ -276,37 +330,56 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let unit_mm = args
         .unit_mm
         .unwrap_or(if diagonal < 5.0 { 1000.0 } else { 1.0 });
-    let media = media(&mesh, diagonal / 6.0)?;
+    let mut media = media(&mesh, diagonal / 6.0)?;
+    // Sides of planes go into the media before assembly; balls are
+    // painted into the assembled object below.
+    let mut painted = vec![0; paints.len()];
+    for ((_, paint), count) in paints.iter().zip(&mut painted) {
+        if let Paint::Side {
+            point,
+            normal,
+            medium,
+        } = paint
+        {
+            *count = paint_side(&mesh, &mut media, *point, *normal, *medium);
+        }
+    }
     let mut object = context
         .step("assembling", || Object::new(mesh, unit_mm, media, 1.3))
-        .map_err(|e| invalid(format!("{}: {e}", args.input.display())))?;
+        .map_err(|e| file_error(&args.input, e))?;
     if lights.is_empty() && args.envmap.is_none() {
         lights.push(Light::Directional {
             to_light: DVec3::new(0.4, 1.0, 0.7),
             irradiance: [1.0; 3],
         });
     }
-    for light in &lights {
+    for (k, light) in lights.iter().enumerate() {
         object
             .add_light(light.clone())
-            .map_err(|e| invalid(format!("--light: {e}")))?;
+            .map_err(|e| match args.light.get(k) {
+                Some(spec) => arg_error(format!("--light {spec}"), e),
+                None => file_error(&args.input, e),
+            })?;
     }
     if let Some(path) = &args.envmap {
         let image = super::read_image(context, path, false)?;
         let rgb: Vec<[f32; 3]> = image.pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let env =
             tet_diffusion::Environment::new(&rgb, image.width as usize, image.height as usize, 256)
-                .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+                .map_err(|e| file_error(path, e))?;
         object
             .add_light(Light::Environment(Arc::new(env)))
-            .map_err(|e| invalid(format!("--envmap: {e}")))?;
+            .map_err(|e| file_error(path, e))?;
     }
-    for stroke in &paints {
-        object
-            .paint(stroke)
-            .map_err(|e| invalid(format!("--paint: {e}")))?;
+    for ((spec, paint), count) in paints.iter().zip(&mut painted) {
+        if let Paint::Ball(stroke) = paint {
+            *count = object
+                .paint(stroke)
+                .map_err(|e| arg_error(format!("--paint {spec}"), e))?
+                .tets;
+        }
     }
-    for (point, normal) in &cuts {
+    for (spec, (point, normal)) in &cuts {
         context
             .step("cutting", || {
                 object.cut(
@@ -317,13 +390,13 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                     CUT_RELAX_SWEEPS,
                 )
             })
-            .map_err(|e| invalid(format!("--cut: {e}")))?;
+            .map_err(|e| arg_error(format!("--cut {spec}"), e))?;
     }
     let mut objects = match fracture {
-        Some((point, normal)) => {
+        Some((spec, (point, normal))) => {
             let [a, mut b] = object
                 .fracture(point, normal)
-                .map_err(|e| invalid(format!("--fracture: {e}")))?;
+                .map_err(|e| arg_error(format!("--fracture {spec}"), e))?;
             b.set_transform(glam::DAffine3::from_translation(normal * diagonal * 0.15));
             vec![a, b]
         }
@@ -334,7 +407,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         reports.push(
             context
                 .step("solving", || o.solve())
-                .map_err(|e| invalid(format!("solving: {e}")))?,
+                .map_err(|e| file_error(&args.input, format!("the solve failed: {e}")))?,
         );
     }
     let image = context.step("rendering", || render(&objects, &lights, args.size, view));
@@ -388,11 +461,23 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let tets: usize = objects.iter().map(|o| o.mesh().tets().len()).sum();
     let levels = reports.first().map_or(0, |r| r.levels);
     let text = format!(
-        "{} tetrahedra ({} object{}), {} mm per unit, solved ({} levels); picture written to {}\n",
+        "{} tetrahedra ({} object{}), {} mm per unit{}, solved ({} levels); picture written to {}\n",
         tets,
         objects.len(),
         if objects.len() > 1 { "s" } else { "" },
         unit_mm,
+        if painted.is_empty() {
+            String::new()
+        } else {
+            format!(
+                ", painted {} tetrahedra",
+                painted
+                    .iter()
+                    .map(usize::to_string)
+                    .collect::<Vec<_>>()
+                    .join(" + ")
+            )
+        },
         levels,
         args.output.display()
     );
@@ -403,6 +488,11 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "objects": objects.len(),
         "unit_mm": unit_mm,
         "material": args.material,
+        "paint": paints
+            .iter()
+            .zip(&painted)
+            .map(|((spec, _), n)| serde_json::json!({"spec": spec, "tetrahedra": n}))
+            .collect::<Vec<_>>(),
         "output": super::shown(&args.output),
         "seconds": context.timings_json(),
     });

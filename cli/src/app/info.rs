@@ -6,34 +6,36 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 
-use super::{Context, Result, invalid};
+use super::{Context, Result, file_error};
 
 #[derive(Debug, clap::Args)]
 #[command(
-    about = "Describe a mesh, tetrahedral mesh, image or .meshcolors file (counts, bounds, UVs, holes, quality)",
-    after_help = "Example:\n  trilux info ../shared/data/meshes/stanford-bunny.obj\n  trilux info ../shared/data/tets/bunny_50k.node --json"
+    about = "Describe a mesh, tetrahedral mesh, TetGen .face file, image or .meshcolors file (counts, bounds, UVs, holes, quality)",
+    after_help = "Example:\n  trilux info ../shared/data/meshes/stanford-bunny.obj\n  trilux info ../shared/data/tets/bunny_50k.node --json\n  trilux info ../shared/data/tets/bunny_50k.face"
 )]
 pub(crate) struct Args {
-    /// The file: .obj .gltf .glb .ply, .node .ele .msh .mesh, .png .jpg .hdr .exr, .meshcolors.
+    /// The file: .obj .gltf .glb .ply, .node .ele .msh .mesh, .face (with
+    /// its .node and .ele), .png .jpg .hdr .exr, .meshcolors.
     pub(crate) file: PathBuf,
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let path = &args.file;
-    if !path.exists() {
-        return Err(invalid(format!("{}: no such file", path.display())));
-    }
+    super::check_input(path)?;
     let (text, json) = match super::extension(path).as_str() {
         "obj" | "gltf" | "glb" => mesh_info(context, path)?,
         "ply" => ply_info(context, path)?,
         "node" | "ele" | "msh" | "mesh" => tet_info(context, path)?,
+        "face" => face_info(context, path)?,
         "png" | "jpg" | "jpeg" | "hdr" | "exr" => image_info(context, path)?,
         "meshcolors" => meshcolors_info(context, path)?,
         other => {
-            return Err(invalid(format!(
-                "{}: unknown extension {other:?} (meshes .obj .gltf .glb .ply, tetrahedra .node .ele .msh .mesh, images .png .jpg .hdr .exr, .meshcolors)",
-                path.display()
-            )));
+            return Err(file_error(
+                path,
+                format!(
+                    "unknown extension {other:?} (meshes .obj .gltf .glb .ply, tetrahedra .node .ele .msh .mesh, TetGen faces .face, images .png .jpg .hdr .exr, .meshcolors)"
+                ),
+            ));
         }
     };
     context.report(&text, json);
@@ -46,7 +48,7 @@ fn v3(v: glam::Vec3) -> Value {
 
 fn mesh_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let mesh = context.step("reading the mesh", || trilux_io::mesh::TriMesh::read(path))?;
-    Ok(describe_mesh(context, path, &mesh))
+    Ok(describe_mesh(context, path, "triangle mesh", &mesh))
 }
 
 fn ply_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
@@ -82,13 +84,20 @@ fn ply_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     ))
 }
 
+/// What `mesh` (read from `path`, a `kind` of file) is: counts, bounds,
+/// topology, attributes.
 fn describe_mesh(
     context: &mut Context,
     path: &Path,
+    kind: &str,
     mesh: &trilux_io::mesh::TriMesh,
 ) -> (String, Value) {
     let shape = context.step("checking the topology", || trilux::mesh::shape(mesh));
-    let (lo, hi) = trilux::mesh::bounds(mesh).unwrap_or_default();
+    // A file without faces (empty, or points only) has no surface: no
+    // bounds of triangles, and it is neither closed nor open.
+    let faceless = mesh.indices.is_empty();
+    let bounds = trilux::mesh::bounds(mesh);
+    let (lo, hi) = bounds.unwrap_or_default();
     let diagonal = (hi - lo).length();
     let used = {
         let mut used = vec![false; mesh.positions.len()];
@@ -99,7 +108,13 @@ fn describe_mesh(
         }
         used.iter().filter(|&&u| u).count()
     };
-    let mut text = format!("{}: triangle mesh\n", path.display());
+    // `+ 0.0` turns the empty sum's -0 into 0.
+    let area = mesh.area() + 0.0;
+    let mut text = format!(
+        "{}: {kind}{}\n",
+        path.display(),
+        if faceless { " with no faces" } else { "" }
+    );
     let _ = writeln!(
         text,
         "  vertices: {} ({} used, {} after welding equal positions)",
@@ -107,24 +122,33 @@ fn describe_mesh(
         used,
         shape.welded_vertices
     );
-    let _ = writeln!(text, "  triangles: {}", mesh.indices.len());
-    let _ = writeln!(text, "  bounds: {lo} .. {hi} (size {})", hi - lo);
-    let _ = writeln!(
-        text,
-        "  diagonal: {diagonal} — units look like {}",
-        trilux::mesh::unit_guess(diagonal)
-    );
-    let _ = writeln!(text, "  area: {:.6}", mesh.area());
-    let closed = shape.boundary_edges == 0 && shape.non_manifold_edges == 0;
-    let _ = writeln!(
-        text,
-        "  parts: {}, holes: {} ({} boundary edges), non-manifold edges: {}{}",
-        shape.parts,
-        shape.holes,
-        shape.boundary_edges,
-        shape.non_manifold_edges,
-        if closed { " — closed" } else { "" }
-    );
+    if faceless {
+        let _ = writeln!(
+            text,
+            "  triangles: 0 — no faces (an empty file or points only), so no surface"
+        );
+    } else {
+        let _ = writeln!(text, "  triangles: {}", mesh.indices.len());
+        let _ = writeln!(text, "  bounds: {lo} .. {hi} (size {})", hi - lo);
+        let _ = writeln!(
+            text,
+            "  diagonal: {diagonal} — units look like {}",
+            trilux::mesh::unit_guess(diagonal)
+        );
+        let _ = writeln!(text, "  area: {area:.6}");
+    }
+    let closed = !faceless && shape.boundary_edges == 0 && shape.non_manifold_edges == 0;
+    if !faceless {
+        let _ = writeln!(
+            text,
+            "  parts: {}, holes: {} ({} boundary edges), non-manifold edges: {}{}",
+            shape.parts,
+            shape.holes,
+            shape.boundary_edges,
+            shape.non_manifold_edges,
+            if closed { " — closed" } else { "" }
+        );
+    }
     let _ = writeln!(
         text,
         "  normals: {}",
@@ -182,15 +206,15 @@ fn describe_mesh(
     let _ = writeln!(text, "  objects: {}", mesh.objects.len());
     let json = json!({
         "file": super::shown(path),
-        "kind": "triangle mesh",
+        "kind": kind,
         "vertices": mesh.positions.len(),
         "used_vertices": used,
         "welded_vertices": shape.welded_vertices,
         "triangles": mesh.indices.len(),
-        "bounds": [v3(lo), v3(hi)],
+        "bounds": bounds.map(|(lo, hi)| json!([v3(lo), v3(hi)])),
         "diagonal": diagonal,
         "unit_guess": trilux::mesh::unit_guess(diagonal),
-        "area": mesh.area(),
+        "area": area,
         "parts": shape.parts,
         "holes": shape.holes,
         "boundary_edges": shape.boundary_edges,
@@ -205,9 +229,7 @@ fn describe_mesh(
 }
 
 fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
-    let mesh = context.step("reading the tetrahedra", || {
-        trilux_io::tet::TetMesh::read(path)
-    })?;
+    let mesh = super::read_tets(context, path)?;
     let (lo, hi) = mesh.positions.iter().fold(
         (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY),
         |(a, b), &p| (a.min(p), b.max(p)),
@@ -244,6 +266,64 @@ fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     ))
 }
 
+/// A TetGen `.face` file: its triangles as a surface (parts, holes,
+/// closed), and whether they are the boundary of the tetrahedra of the
+/// `.node` and `.ele` files beside it (TetGen can also list interior
+/// faces, or faces of a mesh since changed).
+fn face_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
+    let files = context.step("reading the TetGen files", || {
+        trilux_io::tet::tetgen::read_all(path)
+    })?;
+    let faces = files.faces.unwrap_or_default();
+    let tets = &files.mesh;
+    let key = |f: &[u32; 3]| {
+        let mut k = *f;
+        k.sort_unstable();
+        k
+    };
+    let mut listed: Vec<[u32; 3]> = faces.iter().map(key).collect();
+    listed.sort_unstable();
+    let mut boundary: Vec<[u32; 3]> = tets.boundary().iter().map(key).collect();
+    boundary.sort_unstable();
+    let matches = listed == boundary;
+    let surface = trilux_io::mesh::TriMesh {
+        positions: tets.positions.iter().map(|p| p.as_vec3()).collect(),
+        objects: vec![trilux_io::mesh::Object {
+            name: String::new(),
+            triangles: 0..faces.len(),
+            material: None,
+        }],
+        indices: faces,
+        ..Default::default()
+    };
+    let (mut text, mut json) = describe_mesh(context, path, "TetGen faces", &surface);
+    let _ = writeln!(
+        text,
+        "  faces: {} ({} tetrahedra on {} nodes in the .node and .ele files)",
+        surface.indices.len(),
+        tets.tets.len(),
+        tets.positions.len()
+    );
+    let _ = writeln!(
+        text,
+        "  the tetrahedra's boundary ({} triangles): {}",
+        boundary.len(),
+        if matches {
+            "the same triangles"
+        } else {
+            "different triangles (interior faces, or a mesh changed since)"
+        }
+    );
+    if let Some(object) = json.as_object_mut() {
+        object.insert("faces".into(), json!(surface.indices.len()));
+        object.insert("nodes".into(), json!(tets.positions.len()));
+        object.insert("tetrahedra".into(), json!(tets.tets.len()));
+        object.insert("boundary_triangles".into(), json!(boundary.len()));
+        object.insert("matches_tetrahedra".into(), json!(matches));
+    }
+    Ok((text, json))
+}
+
 fn image_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let image = context.step("reading the image", || trilux_io::image::read(path))?;
     let mut lo = [f32::INFINITY; 4];
@@ -277,7 +357,7 @@ fn image_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
 fn meshcolors_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let (colors, mip) = context
         .step("reading the mesh colours", || mesh_colors::file::load(path))
-        .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+        .map_err(|e| file_error(path, e))?;
     let mut histogram = std::collections::BTreeMap::new();
     for r in (0..colors.face_count()).filter_map(|f| colors.face_resolution(f)) {
         *histogram.entry(r).or_insert(0usize) += 1;

@@ -2,6 +2,7 @@
 //! stderr, `--json` on stdout, readable errors, safe outputs), and the
 //! dispatch.
 
+use std::fmt::Display;
 use std::io::IsTerminal;
 use std::path::Path;
 use std::process::ExitCode;
@@ -27,6 +28,89 @@ pub(crate) fn invalid(message: impl Into<String>) -> Error {
     Error::Invalid(message.into())
 }
 
+/// A wrong command line (exit code 2), found by a check of ours rather
+/// than by the parser.
+pub(crate) fn usage(message: impl Into<String>) -> Error {
+    Error::Usage(message.into())
+}
+
+// Every error reads `WHERE: WHAT`: WHERE is a file, or an argument as it
+// was typed (`--light dir:0,1`), named once; WHAT says what is wrong, in
+// lower case, as one sentence without a closing full stop, a hint after
+// a semicolon or in parentheses. A file's problem exits with 1, an
+// argument's with 2.
+
+/// A problem with a file: `PATH: problem` (exit code 1).
+pub(crate) fn file_error(path: &Path, problem: impl Display) -> Error {
+    invalid(format!("{}: {problem}", path.display()))
+}
+
+/// A problem with an argument: `ARGUMENT: problem` (exit code 2), where
+/// `argument` is the option as typed, with its value (`--size 0`).
+pub(crate) fn arg_error(argument: impl Display, problem: impl Display) -> Error {
+    usage(format!("{argument}: {problem}"))
+}
+
+/// `e` with `place` (a file or an argument) in front, unless its message
+/// already starts with it; a usage error stays one.
+pub(crate) fn at(place: impl Display, e: impl Into<Error>) -> Error {
+    let e = e.into();
+    let place = place.to_string();
+    let text = message(&e);
+    if text.starts_with(&format!("{place}: ")) {
+        return e;
+    }
+    let text = format!("{place}: {text}");
+    if matches!(e, Error::Usage(_)) {
+        usage(text)
+    } else {
+        invalid(text)
+    }
+}
+
+/// Checks that an input file exists, so that every subcommand says so in
+/// the same words.
+pub(crate) fn check_input(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        Err(file_error(path, "a folder, not a file"))
+    } else if !path.exists() {
+        Err(file_error(path, "no such file"))
+    } else {
+        Ok(())
+    }
+}
+
+/// `x,y,z` as a non-zero direction, for `--view`.
+pub(crate) fn parse_view(spec: &str) -> Result<glam::Vec3> {
+    let v: Vec<f32> = spec
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<std::result::Result<_, _>>()
+        .ok()
+        .filter(|v: &Vec<f32>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
+        .ok_or_else(|| arg_error(format!("--view {spec}"), "expected three numbers x,y,z"))?;
+    let v = glam::Vec3::new(v[0], v[1], v[2]);
+    if v.length_squared() == 0.0 {
+        return Err(arg_error(format!("--view {spec}"), "the direction is zero"));
+    }
+    Ok(v)
+}
+
+/// Checks `--size` (pixels of a square picture) against `max`.
+pub(crate) fn check_size(size: u32, max: u32) -> Result<()> {
+    if size == 0 || size > max {
+        return Err(arg_error(
+            format!("--size {size}"),
+            format!("the picture must be 1 to {max} pixels wide"),
+        ));
+    }
+    Ok(())
+}
+
+/// The help heading of the options every subcommand takes, so that a
+/// subcommand's help lists them once, apart from its own.
+const GLOBAL: &str = "Global options";
+
 #[derive(Debug, Parser)]
 #[command(
     name = "trilux",
@@ -37,13 +121,13 @@ pub(crate) fn invalid(message: impl Into<String>) -> Error {
 )]
 struct Cli {
     /// No progress bars (they are also hidden when stderr is not a terminal).
-    #[arg(long, short, global = true)]
+    #[arg(long, short, global = true, help_heading = GLOBAL)]
     quiet: bool,
     /// Print one JSON object with the results on stdout instead of text.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, help_heading = GLOBAL)]
     json: bool,
     /// Overwrite existing output files.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, help_heading = GLOBAL)]
     force: bool,
     #[command(subcommand)]
     command: Command,
@@ -124,9 +208,15 @@ pub(crate) fn round(x: f64, digits: i32) -> f64 {
 }
 
 /// Parses the arguments, runs the subcommand, prints an error as one
-/// readable paragraph on stderr (exit code 1; usage errors exit with 2).
+/// readable line on stderr (exit code 1; usage errors, the parser's and
+/// [`Error::Usage`], exit with 2). With `--json` a failure is also one
+/// JSON object on stdout, `{"error": "...", "exit_code": N}`, where a
+/// success's result would have gone.
 pub(crate) fn run() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return parse_failure(&e),
+    };
     let mut context = Context {
         json: cli.json,
         force: cli.force,
@@ -145,14 +235,55 @@ pub(crate) fn run() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {}", message(&e));
-            ExitCode::FAILURE
+            let text = message(&e);
+            let code = exit_code(&e);
+            eprintln!("error: {text}");
+            if cli.json {
+                json_error(&text, code);
+            }
+            ExitCode::from(code)
         }
     }
 }
 
-/// The error and its causes as one paragraph, without repeating a cause
-/// the message already contains.
+/// A failure as the one JSON object `--json` promises on stdout.
+fn json_error(text: &str, code: u8) {
+    println!("{}", serde_json::json!({"error": text, "exit_code": code}));
+}
+
+/// Prints the parser's message (help and version are not failures), and
+/// with `--json` anywhere before a `--` also the JSON object: the
+/// arguments did not parse, so `--json` is looked for in them as given.
+fn parse_failure(e: &clap::Error) -> ExitCode {
+    let _ = e.print();
+    if !e.use_stderr() {
+        return ExitCode::SUCCESS;
+    }
+    let code = u8::try_from(e.exit_code()).unwrap_or(2);
+    let json = std::env::args_os()
+        .skip(1)
+        .take_while(|a| a != "--")
+        .any(|a| a == "--json");
+    if json {
+        // The first paragraph of the parser's text (its usage and tips
+        // follow a blank line) as one line, without its "error: ".
+        let rendered = e.render().to_string();
+        let first = rendered.split("\n\n").next().unwrap_or_default();
+        let text = first.split_whitespace().collect::<Vec<_>>().join(" ");
+        json_error(text.strip_prefix("error: ").unwrap_or(&text), code);
+    }
+    ExitCode::from(code)
+}
+
+/// 2 for a wrong command line, 1 for anything else.
+fn exit_code(e: &Error) -> u8 {
+    if matches!(e, Error::Usage(_)) { 2 } else { 1 }
+}
+
+/// The error and its causes as one line, without repeating a cause the
+/// message already contains, naming its place (the text before the first
+/// `": "`) once even when a cause names it again, and without a closing
+/// full stop.
 fn message(e: &Error) -> String {
     let mut text = e.to_string();
     let mut source = std::error::Error::source(e);
@@ -164,19 +295,34 @@ fn message(e: &Error) -> String {
         }
         source = s.source();
     }
-    text
+    let mut text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    if let Some(end) = text.find(": ") {
+        let place = text[..end + 2].to_string();
+        let rest = text[end + 2..].replace(&place, "");
+        text = format!("{place}{rest}");
+    }
+    text.trim_end_matches('.').to_string()
 }
 
 /// Reads a triangle mesh, naming the file in any error.
 pub(crate) fn read_mesh(context: &mut Context, path: &Path) -> Result<trilux_io::mesh::TriMesh> {
+    check_input(path)?;
     let mesh = context.step("reading the mesh", || trilux_io::mesh::TriMesh::read(path))?;
     if mesh.indices.is_empty() {
-        return Err(invalid(format!(
-            "{}: the file has no triangles (a point cloud or an empty mesh)",
-            path.display()
-        )));
+        return Err(file_error(
+            path,
+            "the file has no triangles (a point cloud or an empty mesh)",
+        ));
     }
     Ok(mesh)
+}
+
+/// Reads a tetrahedral mesh, naming the file in any error.
+pub(crate) fn read_tets(context: &mut Context, path: &Path) -> Result<trilux_io::tet::TetMesh> {
+    check_input(path)?;
+    Ok(context.step("reading the tetrahedra", || {
+        trilux_io::tet::TetMesh::read(path)
+    })?)
 }
 
 /// Reads an image.
@@ -185,6 +331,7 @@ pub(crate) fn read_image(
     path: &Path,
     raw: bool,
 ) -> Result<trilux_io::image::Image> {
+    check_input(path)?;
     let options = trilux_io::image::ReadOptions {
         raw,
         ..Default::default()
@@ -213,10 +360,10 @@ pub(crate) fn write_image(
             image,
             trilux_io::image::ExrPrecision::F32,
         )?),
-        _ => Err(invalid(format!(
-            "{}: unknown image extension {ext:?} (write .png or .exr)",
-            path.display()
-        ))),
+        _ => Err(file_error(
+            path,
+            format!("unknown image extension {ext:?} (write .png or .exr)"),
+        )),
     })
 }
 
@@ -233,24 +380,25 @@ pub(crate) fn extension(path: &Path) -> String {
 pub(crate) fn check_output(context: &Context, path: &Path, allowed: &[&str]) -> Result<()> {
     let ext = extension(path);
     if !allowed.contains(&ext.as_str()) {
-        return Err(invalid(format!(
-            "{}: unknown output extension {ext:?} (expected {})",
-            path.display(),
-            allowed
-                .iter()
-                .map(|e| format!(".{e}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )));
+        return Err(file_error(
+            path,
+            format!(
+                "unknown output extension {ext:?} (expected {})",
+                allowed
+                    .iter()
+                    .map(|e| format!(".{e}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        ));
     }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
         && !dir.is_dir()
     {
-        return Err(invalid(format!(
-            "{}: the folder {} does not exist",
-            path.display(),
-            dir.display()
-        )));
+        return Err(file_error(
+            path,
+            format!("the folder {} does not exist", dir.display()),
+        ));
     }
     trilux::output::check_new(path, context.force)
 }
@@ -262,7 +410,7 @@ pub(crate) fn with_threads<T: Send>(
 ) -> Result<T> {
     match threads {
         None => Ok(f()),
-        Some(0) => Err(invalid("--threads must be at least 1")),
+        Some(0) => Err(arg_error("--threads 0", "at least one thread is needed")),
         Some(n) => {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(n)

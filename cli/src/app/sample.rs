@@ -13,7 +13,7 @@ use mesh_sampling::{
 use trilux_io::mesh::TriMesh;
 use trilux_io::mesh::ply;
 
-use super::{Context, Result, invalid};
+use super::{Context, Result, arg_error, file_error};
 
 /// The most points one run may ask for (about 100 bytes each while
 /// sampling and writing).
@@ -27,8 +27,9 @@ pub(crate) const MAX_POINTS: u64 = 200_000_000;
 pub(crate) struct Args {
     /// The mesh: .obj, .gltf, .glb or .ply.
     pub(crate) mesh: PathBuf,
-    /// How many points. Signed, so that `-n -5` reaches the range check
-    /// and its message instead of being taken for an unknown option.
+    /// How many points (1 to 200,000,000).
+    // Signed, so that `-n -5` reaches the range check and its message
+    // instead of being taken for an unknown option.
     #[arg(
         short = 'n',
         long = "count",
@@ -40,9 +41,10 @@ pub(crate) struct Args {
     /// 8/16-bit values are used as stored (no sRGB decoding).
     #[arg(long, value_name = "IMAGE", group = "density_source")]
     pub(crate) density: Option<PathBuf>,
-    /// Which value of the density image (or mesh colours) is the density.
-    #[arg(long, value_enum, default_value_t = ChannelArg::Luminance)]
-    pub(crate) channel: ChannelArg,
+    /// Which value of the density image (or mesh colours) is the density
+    /// (default: luminance); only with --density or --density-meshcolors.
+    #[arg(long, value_enum)]
+    pub(crate) channel: Option<ChannelArg>,
     /// One weight per triangle, one number per line (`#` comments allowed).
     #[arg(long, value_name = "FILE", group = "density_source")]
     pub(crate) face_weights: Option<PathBuf>,
@@ -81,6 +83,13 @@ pub(crate) enum ChannelArg {
 }
 
 impl ChannelArg {
+    /// The name on the command line.
+    fn name(self) -> String {
+        self.to_possible_value()
+            .map(|v| v.get_name().to_string())
+            .unwrap_or_default()
+    }
+
     pub(crate) fn channel(self) -> Channel {
         match self {
             Self::Luminance => Channel::Luminance,
@@ -163,6 +172,7 @@ pub(crate) fn draw(
 /// Reads per-face weights: one number per line, blank lines and `#`
 /// comments skipped, exactly one per triangle.
 pub(crate) fn read_face_weights(path: &Path, triangles: usize) -> Result<Vec<f32>> {
+    super::check_input(path)?;
     let text = std::fs::read_to_string(path).map_err(|source| trilux::Error::File {
         path: path.to_path_buf(),
         source,
@@ -174,46 +184,72 @@ pub(crate) fn read_face_weights(path: &Path, triangles: usize) -> Result<Vec<f32
             continue;
         }
         let w: f32 = line.parse().map_err(|_| {
-            invalid(format!(
-                "{}: line {}: expected a weight (a number), found {line:?}",
-                path.display(),
-                i + 1
-            ))
+            file_error(
+                path,
+                format!(
+                    "line {}: expected a weight (a number), found {line:?}",
+                    i + 1
+                ),
+            )
         })?;
         if !(w.is_finite() && w >= 0.0) {
-            return Err(invalid(format!(
-                "{}: line {}: weight {w} is not finite and >= 0",
-                path.display(),
-                i + 1
-            )));
+            return Err(file_error(
+                path,
+                format!("line {}: weight {w} is not finite and >= 0", i + 1),
+            ));
         }
         weights.push(w);
     }
     if weights.len() != triangles {
-        return Err(invalid(format!(
-            "{}: {} weights for a mesh of {triangles} triangles (one per triangle, in file order)",
-            path.display(),
-            weights.len()
-        )));
+        return Err(file_error(
+            path,
+            format!(
+                "{} weights for a mesh of {triangles} triangles (one per triangle, in file order)",
+                weights.len()
+            ),
+        ));
     }
     Ok(weights)
 }
 
-/// A density from one channel of mesh colours made for `mesh`.
-pub(crate) fn meshcolors_source(mesh: &TriMesh, path: &Path, channel: Channel) -> Result<Source> {
-    let (surface, colors) = super::colors::load_for(mesh, path)?;
+/// A density from one channel of mesh colours made for `mesh` (read from
+/// `mesh_path`).
+pub(crate) fn meshcolors_source(
+    mesh: &TriMesh,
+    mesh_path: &Path,
+    path: &Path,
+    channel: Channel,
+) -> Result<Source> {
+    let (surface, colors) = super::colors::load_for(mesh, mesh_path, path)?;
     let density = trilux::colors::color_density(&surface, &colors, channel)
-        .map_err(|e| invalid(format!("{}: {e}", path.display())))?;
+        .map_err(|e| file_error(path, e))?;
     Ok(Source::Atlas(density))
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     if args.count <= 0 || args.count.unsigned_abs() > MAX_POINTS {
-        return Err(invalid(format!(
-            "-n {}: the number of points must be between 1 and {MAX_POINTS}",
-            args.count
-        )));
+        return Err(arg_error(
+            format!("-n {}", args.count),
+            format!("the number of points must be between 1 and {MAX_POINTS}"),
+        ));
     }
+    if let Some(channel) = args.channel
+        && args.density.is_none()
+        && args.density_meshcolors.is_none()
+    {
+        return Err(arg_error(
+            format!("--channel {}", channel.name()),
+            format!(
+                "a channel is read from --density IMAGE or --density-meshcolors FILE, and neither is given{}",
+                if args.face_weights.is_some() {
+                    " (--face-weights has one weight per triangle, no channels)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    let channel = args.channel.unwrap_or(ChannelArg::Luminance).channel();
     super::check_output(context, &args.output, &["ply"])?;
     if let Some(p) = &args.preview {
         super::check_output(context, p, &["png", "exr"])?;
@@ -227,22 +263,29 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         Method::Uniform
     });
     if method != Method::Uniform && !has_density {
-        return Err(invalid(format!(
-            "--method {} needs a density (--density, --face-weights or --density-meshcolors)",
-            method.name()
-        )));
+        return Err(arg_error(
+            format!("--method {}", method.name()),
+            "this method needs a density (give --density, --face-weights or --density-meshcolors)",
+        ));
     }
     if method == Method::Uniform && has_density {
-        return Err(invalid(
-            "--method uniform samples by area and would ignore the density: choose subdivision, exact or rejection",
+        return Err(arg_error(
+            "--method uniform",
+            "uniform sampling is by area and would ignore the density (choose subdivision, exact or rejection)",
+        ));
+    }
+    if method == Method::Rejection && args.face_weights.is_some() {
+        return Err(arg_error(
+            "--method rejection",
+            "rejection needs a texture density; per-face weights are sampled exactly by subdivision",
         ));
     }
     let source = if let Some(path) = &args.density {
         if mesh.uvs.is_none() {
-            return Err(invalid(format!(
-                "{}: a density texture is looked up at texture coordinates, and the mesh has none",
-                args.mesh.display()
-            )));
+            return Err(file_error(
+                &args.mesh,
+                "a density texture is looked up at texture coordinates, and the mesh has none",
+            ));
         }
         let image = super::read_image(context, path, true)?;
         let wrap = mesh
@@ -251,20 +294,15 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             .map_or(mesh_sampling::Wrap::Repeat, |m| {
                 trilux::sampling_wrap(m.wrap[0])
             });
-        let texture = trilux::density_texture(&image, args.channel.channel())
-            .map_err(|e| invalid(format!("{}: {e}", path.display())))?
+        let texture = trilux::density_texture(&image, channel)
+            .map_err(|e| file_error(path, e))?
             .with_wrap(wrap);
         Source::Texture(texture)
     } else if let Some(path) = &args.face_weights {
-        if method == Method::Rejection {
-            return Err(invalid(
-                "--method rejection needs a texture density; per-face weights are sampled exactly by subdivision",
-            ));
-        }
         Source::FaceWeights(read_face_weights(path, mesh.indices.len())?)
     } else if let Some(path) = &args.density_meshcolors {
         context.step("baking the mesh colours", || {
-            meshcolors_source(&mesh, path, args.channel.channel())
+            meshcolors_source(&mesh, &args.mesh, path, channel)
         })?
     } else {
         Source::Uniform
@@ -272,7 +310,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let n = args.count as usize;
     let points = super::with_threads(args.threads, || {
         context.step("sampling", || draw(&mesh, &source, method, args.seed, n))
-    })??;
+    })?
+    .map_err(|e| super::at(args.mesh.display(), e))?;
     let cloud = context.step("building the point cloud", || {
         trilux::point_cloud(&mesh, &points)
     });

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use tet_diffusion::stuffing;
 use trilux_io::mesh::TriMesh;
 
-use super::{Context, Result, invalid};
+use super::{Context, Result, arg_error, file_error};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -42,20 +42,23 @@ pub(crate) fn stuff(
     let (lo, hi) = trilux::mesh::bounds(mesh).unwrap_or_default();
     let h = h.unwrap_or_else(|| f64::from((hi - lo).length()) / 40.0);
     if !(h.is_finite() && h > 0.0) {
-        return Err(invalid(format!(
-            "--size {h}: the spacing must be a positive length"
-        )));
+        return Err(arg_error(
+            format!("--size {h}"),
+            "the lattice spacing must be a positive length",
+        ));
     }
     let options = stuffing::Options {
         graded,
         ..stuffing::Options::new(h)
     };
     stuffing::tetrahedralize(&mesh.positions, &mesh.indices, &options).map_err(|e| match e {
-        stuffing::Error::EmptyVolume { h } => invalid(format!(
-            "{}: the surface encloses nothing at spacing {h} (an open sheet, or thinner than the lattice: try a smaller --size)",
-            path.display()
-        )),
-        other => invalid(format!("{}: {other}", path.display())),
+        stuffing::Error::EmptyVolume { h } => file_error(
+            path,
+            format!(
+                "the surface encloses nothing at spacing {h} (an open sheet, or thinner than the lattice: try a smaller --size)"
+            ),
+        ),
+        other => file_error(path, other),
     })
 }
 

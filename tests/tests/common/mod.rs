@@ -22,8 +22,21 @@ pub(crate) fn stderr(out: &Output) -> String {
 /// Runs and expects failure with exit code 1 or 2 and a one-paragraph
 /// message containing every `needle`, no panic and no backtrace.
 pub(crate) fn fails(dir: &Path, args: &[&str], needles: &[&str]) {
-    let out = trilux(dir).args(args).output().unwrap();
-    let err = stderr(&out);
+    let out = run(dir, args);
+    failed(args, &out, needles);
+}
+
+/// Like [`fails`], and the exit code is `code` (1: the inputs or the run
+/// failed; 2: the command line is wrong). Returns the message.
+pub(crate) fn fails_with(dir: &Path, code: i32, args: &[&str], needles: &[&str]) -> String {
+    let out = run(dir, args);
+    failed(args, &out, needles);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {}", stderr(&out));
+    stderr(&out)
+}
+
+fn failed(args: &[&str], out: &Output, needles: &[&str]) {
+    let err = stderr(out);
     assert!(!out.status.success(), "{args:?} succeeded");
     assert!(
         matches!(out.status.code(), Some(1 | 2)),
@@ -44,4 +57,9 @@ pub(crate) fn json(dir: &Path, args: &[&str]) -> serde_json::Value {
     let out = trilux(dir).args(args).arg("--json").output().unwrap();
     assert!(out.status.success(), "{args:?}: {}", stderr(&out));
     serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Runs `trilux ARGS` in `dir` and returns what it did.
+pub(crate) fn run(dir: &Path, args: &[&str]) -> Output {
+    trilux(dir).args(args).output().unwrap()
 }
