@@ -146,9 +146,10 @@ pub struct Options {
     /// The warping thresholds and the angle bounds they give.
     pub params: Params,
     /// Grade the mesh: keep tetrahedra of size `h` near the surface and use
-    /// cubes of up to `2^graded_levels · h` deep inside: 36% of the uniform
-    /// count on the 510k-tetrahedron bunny, 38–47% on the other data meshes
-    /// (the `stuffing` example), with the same angle bounds.
+    /// cubes of up to `2^graded_levels · h` deep inside: 32–43% of the
+    /// uniform count on the data meshes at about 500k uniform tetrahedra
+    /// (36% on the bunny; the `stuffing` example), with the same angle
+    /// bounds.
     pub graded: bool,
     /// Coarsest level of the graded mesh (cells of `2^graded_levels · h`);
     /// 1 to 10.
@@ -264,7 +265,7 @@ impl Position for [f64; 3] {
 /// padded bounding box) times the cost of a fast winding number (about
 /// `O(log n)` for `n` triangles), plus a few winding numbers per lattice
 /// edge that crosses the surface; parallel over fixed chunks. On the
-/// 43k-triangle closed bunny, 510k tetrahedra take 0.9 s on 2 cores, 8.9×
+/// 43k-triangle closed bunny, 510k tetrahedra take 0.9 s on 2 cores, 10×
 /// less than TetGen `-pq1.2` for a similar count in the same run (the
 /// `stuffing` example).
 ///
