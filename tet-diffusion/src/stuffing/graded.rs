@@ -269,16 +269,8 @@ impl Octree {
                             mark(&mut level, n, l, a);
                             continue;
                         }
-                        let h = 1usize << (l - 1);
-                        for c in (0..8).rev() {
-                            stack.push((
-                                l - 1,
-                                [
-                                    a[0] + (c & 1) * h,
-                                    a[1] + ((c >> 1) & 1) * h,
-                                    a[2] + (c >> 2) * h,
-                                ],
-                            ));
+                        for child in children(l, a).into_iter().rev() {
+                            stack.push((l - 1, child));
                         }
                     }
                 }
@@ -308,24 +300,24 @@ impl Octree {
 
     /// Replaces each of `cells` (leaves, sorted) by its 8 children.
     fn split(&mut self, cells: &[(u32, [usize; 3])]) {
-        let mut next = Vec::with_capacity(self.leaves.len() + 7 * cells.len());
-        for &(l, a) in &self.leaves {
+        let leaves = std::mem::take(&mut self.leaves);
+        let mut next = Vec::with_capacity(leaves.len() + 7 * cells.len());
+        for (l, a) in leaves {
             if l == 0 || cells.binary_search(&(l, a)).is_err() {
                 next.push((l, a));
                 continue;
             }
-            let h = 1usize << (l - 1);
-            for c in 0..8 {
-                let child = [
-                    a[0] + (c & 1) * h,
-                    a[1] + ((c >> 1) & 1) * h,
-                    a[2] + (c >> 2) * h,
-                ];
-                mark(&mut self.level, self.n, l - 1, child);
-                next.push((l - 1, child));
-            }
+            self.split_into(l, a, &mut next);
         }
         self.leaves = next;
+    }
+
+    /// Marks the 8 children of leaf `(l, a)` (`l ≥ 1`) and appends them.
+    fn split_into(&mut self, l: u32, a: [usize; 3], next: &mut Vec<(u32, [usize; 3])>) {
+        for child in children(l, a) {
+            mark(&mut self.level, self.n, l - 1, child);
+            next.push((l - 1, child));
+        }
     }
 
     /// Splits leaves until neighbouring leaves sharing a face or an edge
@@ -338,16 +330,7 @@ impl Octree {
             for k in 0..self.leaves.len() {
                 let (l, a) = self.leaves[k];
                 if l >= 2 && self.min_level_around(l, a) + 1 < l as u8 {
-                    let h = 1usize << (l - 1);
-                    for c in 0..8 {
-                        let child = [
-                            a[0] + (c & 1) * h,
-                            a[1] + ((c >> 1) & 1) * h,
-                            a[2] + (c >> 2) * h,
-                        ];
-                        mark(&mut self.level, self.n, l - 1, child);
-                        next.push((l - 1, child));
-                    }
+                    self.split_into(l, a, &mut next);
                     changed = true;
                 } else {
                     next.push((l, a));
@@ -513,6 +496,19 @@ impl Octree {
             );
         }
     }
+}
+
+/// The 8 children (level `l - 1`) of the cell at `a` of level `l ≥ 1`,
+/// x fastest.
+fn children(l: u32, a: [usize; 3]) -> [[usize; 3]; 8] {
+    let h = 1usize << (l - 1);
+    std::array::from_fn(|c| {
+        [
+            a[0] + (c & 1) * h,
+            a[1] + ((c >> 1) & 1) * h,
+            a[2] + (c >> 2) * h,
+        ]
+    })
 }
 
 /// Marks the cubes of cell `(l, a)` as covered by a level-`l` leaf.
