@@ -475,3 +475,80 @@ fn diffuse_paints_the_side_of_a_plane_with_one_flag() {
     );
     assert!(!d.join("p.png").exists());
 }
+
+#[test]
+fn tetra_refuses_a_spacing_too_fine_before_computing_and_reports_the_one_it_used() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    // A user trial's tiny --size ran for minutes and aborted on memory:
+    // now it is a usage error naming the argument, in readable numbers.
+    for size in ["0.0004", "1e-300"] {
+        let err = common::fails_with(
+            d,
+            2,
+            &["tetra", blob, "--size", size, "-o", "t.node"],
+            &["--size", "too fine for this surface", "use a larger --size"],
+        );
+        assert!(err.len() < 300, "{err}");
+    }
+    assert!(!d.join("t.node").exists());
+    // The spacing used (here the default) and every file written, in a
+    // stable order, preview included.
+    let report = json(d, &["tetra", blob, "-o", "b.node", "--preview", "b.png"]);
+    let h = report["spacing"].as_f64().unwrap();
+    assert!(h > 0.0 && h < 0.2, "{h}");
+    let files: Vec<&str> = report["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    assert_eq!(files.len(), 3, "{files:?}");
+    assert!(files.windows(2).all(|w| w[0] <= w[1]), "{files:?}");
+    assert!(files.iter().any(|f| f.ends_with("b.png")));
+}
+
+#[test]
+fn huge_and_far_away_coordinates_are_measured_where_the_file_puts_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let tet = |scale: f32, at: Vec3| TriMesh {
+        positions: [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z]
+            .map(|p| at + p * scale)
+            .to_vec(),
+        indices: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        ..TriMesh::default()
+    };
+    // Coordinates near 1e30: the default spacing used to overflow in f32
+    // and blame a --size nobody gave.
+    tet(1e30, Vec3::ZERO).write(d.join("huge.obj")).unwrap();
+    let report = json(d, &["tetra", "huge.obj", "-o", "h.node"]);
+    assert!(report["tetrahedra"].as_u64().unwrap() > 0);
+    // A unit tetrahedron at 100000: `info` used to show the reader's
+    // shifted bounds, around 0.
+    tet(1.0, Vec3::splat(100_000.0))
+        .write(d.join("far.obj"))
+        .unwrap();
+    let info = json(d, &["info", "far.obj"]);
+    let lo = info["bounds"][0][0].as_f64().unwrap();
+    let hi = info["bounds"][1][0].as_f64().unwrap();
+    assert!(
+        (lo - 100_000.0).abs() < 1e-3 && (hi - 100_001.0).abs() < 1e-3,
+        "{info}"
+    );
+}
+
+#[test]
+fn diffuse_names_the_formats_it_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("x.vtu"), "<VTKFile/>").unwrap();
+    common::fails_with(
+        d,
+        1,
+        &["diffuse", "x.vtu", "-o", "x.png"],
+        &["x.vtu", ".node", ".obj"],
+    );
+}

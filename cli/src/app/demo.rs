@@ -286,7 +286,12 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         // The blob stuffed (isosurface stuffing), then TransCut's diffusion
         // in marble, lit from the upper front and cut open to show the
         // light bleeding through the inside.
-        let stuffed = super::tetra::stuff(&blob, Path::new("blob.obj"), Some(0.06), true)?;
+        let (stuffed, _) = super::tetra::stuff(
+            &blob,
+            Path::new("blob.obj"),
+            super::tetra::Spacing::Size(Some(0.06)),
+            true,
+        )?;
         let tets = trilux::tet::from_stuffing(&stuffed, blob.origin);
         let files = trilux::output::write_atomic_files(&d.path("blob.node"), d.context.force, |tmp| {
             Ok(trilux_io::tet::write(tmp, &tets)?)

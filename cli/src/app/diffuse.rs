@@ -308,13 +308,22 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     };
 
     let ext = super::extension(&args.input);
+    if !["node", "ele", "msh", "mesh", "obj", "gltf", "glb", "ply"].contains(&ext.as_str()) {
+        return Err(file_error(
+            &args.input,
+            format!(
+                "{ext:?} is not read here: diffuse takes tetrahedra (.node, .ele, .msh, .mesh) or \
+                 a surface to fill (.obj, .gltf, .glb, .ply)"
+            ),
+        ));
+    }
     let (positions, tets) = if ["node", "ele", "msh", "mesh"].contains(&ext.as_str()) {
         let tet = super::read_tets(context, &args.input)?;
         (tet.positions, tet.tets)
     } else {
         let surface = super::read_mesh(context, &args.input)?;
-        let stuffed = context.step("tetrahedralizing", || {
-            super::tetra::stuff(&surface, &args.input, None, false)
+        let (stuffed, _) = context.step("tetrahedralizing", || {
+            super::tetra::stuff(&surface, &args.input, super::tetra::Spacing::Default, false)
         })?;
         let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
         (out.positions, out.tets)

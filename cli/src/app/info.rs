@@ -96,7 +96,10 @@ fn describe_mesh(
     // A file without faces (empty, or points only) has no surface: no
     // bounds of triangles, and it is neither closed nor open.
     let faceless = mesh.indices.is_empty();
-    let bounds = trilux::mesh::bounds(mesh);
+    // In the file's coordinates: the reader shifts far-away meshes by
+    // `origin` to keep f32 precision.
+    let bounds = trilux::mesh::bounds(mesh)
+        .map(|(lo, hi)| (lo.as_dvec3() + mesh.origin, hi.as_dvec3() + mesh.origin));
     let (lo, hi) = bounds.unwrap_or_default();
     let diagonal = (hi - lo).length();
     let used = {
@@ -133,7 +136,7 @@ fn describe_mesh(
         let _ = writeln!(
             text,
             "  diagonal: {diagonal} — units look like {}",
-            trilux::mesh::unit_guess(diagonal)
+            trilux::mesh::unit_guess(diagonal as f32)
         );
         let _ = writeln!(text, "  area: {area:.6}");
     }
@@ -211,9 +214,9 @@ fn describe_mesh(
         "used_vertices": used,
         "welded_vertices": shape.welded_vertices,
         "triangles": mesh.indices.len(),
-        "bounds": bounds.map(|(lo, hi)| json!([v3(lo), v3(hi)])),
+        "bounds": bounds.map(|(lo, hi)| json!([lo.to_array(), hi.to_array()])),
         "diagonal": diagonal,
-        "unit_guess": trilux::mesh::unit_guess(diagonal),
+        "unit_guess": trilux::mesh::unit_guess(diagonal as f32),
         "area": area,
         "parts": shape.parts,
         "holes": shape.holes,

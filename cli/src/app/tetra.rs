@@ -32,34 +32,97 @@ pub(crate) struct Args {
     pub(crate) preview: Option<PathBuf>,
 }
 
-/// Stuffs `mesh` at spacing `h` (default diagonal / 40).
+/// How the spacing of [`stuff`] is chosen: `--size` of `trilux tetra`, or
+/// the default of a command without that option (`trilux diffuse`).
+pub(crate) enum Spacing {
+    /// `--size` as given, or its default when absent.
+    Size(Option<f64>),
+    /// Always the default; errors suggest `trilux tetra --size`.
+    Default,
+}
+
+/// Stuffs `mesh` (read from `path`) at the spacing `spacing` says, by
+/// default 1/40 of the bounding box's diagonal; returns the mesh and the
+/// spacing used.
 pub(crate) fn stuff(
     mesh: &TriMesh,
     path: &Path,
-    h: Option<f64>,
+    spacing: Spacing,
     graded: bool,
-) -> Result<stuffing::TetMesh> {
+) -> Result<(stuffing::TetMesh, f64)> {
     let (lo, hi) = trilux::mesh::bounds(mesh).unwrap_or_default();
-    let h = h.unwrap_or_else(|| f64::from((hi - lo).length()) / 40.0);
+    let (h, given) = match spacing {
+        Spacing::Size(Some(h)) => (h, true),
+        Spacing::Size(None) | Spacing::Default => {
+            // In f64: an f32 diagonal overflows for coordinates near 1e38.
+            ((hi.as_dvec3() - lo.as_dvec3()).length() / 40.0, false)
+        }
+    };
+    // What to do about a spacing too fine or too coarse for this surface.
+    let (larger, smaller) = match spacing {
+        Spacing::Default => (
+            "tetrahedralize it with `trilux tetra --size H` first",
+            "tetrahedralize it with `trilux tetra --size H` and a smaller H first",
+        ),
+        Spacing::Size(_) => ("use a larger --size", "try a smaller --size"),
+    };
     if !(h.is_finite() && h > 0.0) {
-        return Err(arg_error(
-            format!("--size {h}"),
-            "the lattice spacing must be a positive length",
-        ));
+        return Err(if given {
+            arg_error(
+                format!("--size {}", number(h)),
+                "the lattice spacing must be a positive length",
+            )
+        } else {
+            let fix = match spacing {
+                Spacing::Default => larger,
+                Spacing::Size(_) => "give --size",
+            };
+            file_error(
+                path,
+                format!("no default lattice spacing from bounds {lo} .. {hi}; {fix}"),
+            )
+        });
     }
     let options = stuffing::Options {
         graded,
         ..stuffing::Options::new(h)
     };
-    stuffing::tetrahedralize(&mesh.positions, &mesh.indices, &options).map_err(|e| match e {
-        stuffing::Error::EmptyVolume { h } => file_error(
-            path,
-            format!(
-                "the surface encloses nothing at spacing {h} (an open sheet, or thinner than the lattice: try a smaller --size)"
+    let too_fine = |problem: String| {
+        let problem = format!("too fine for this surface: {problem}; {larger}");
+        if given {
+            arg_error(format!("--size {}", number(h)), problem)
+        } else {
+            file_error(path, problem)
+        }
+    };
+    let stuffed = stuffing::tetrahedralize(&mesh.positions, &mesh.indices, &options).map_err(
+        |e| match e {
+            stuffing::Error::EmptyVolume { h } => file_error(
+                path,
+                format!(
+                    "the surface encloses nothing at spacing {h} (an open sheet, or thinner than \
+                     the lattice: {smaller})"
+                ),
             ),
-        ),
-        other => file_error(path, other),
-    })
+            stuffing::Error::LatticeTooLarge {
+                vertices, limit, ..
+            } => too_fine(format!(
+                "the lattice would need {} vertices, more than the limit of {limit}",
+                if vertices == u128::MAX {
+                    "more than 10^36".to_string()
+                } else {
+                    vertices.to_string()
+                }
+            )),
+            stuffing::Error::TooManyTetrahedra {
+                estimated, limit, ..
+            } => too_fine(format!(
+                "about {estimated} tetrahedra, more than the limit of {limit}"
+            )),
+            other => file_error(path, other),
+        },
+    )?;
+    Ok((stuffed, h))
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
@@ -68,12 +131,12 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         super::check_output(context, p, &["png", "exr"])?;
     }
     let mesh = super::read_mesh(context, &args.surface)?;
-    let tets = context.step("stuffing", || {
-        stuff(&mesh, &args.surface, args.size, args.graded)
+    let (tets, h) = context.step("stuffing", || {
+        stuff(&mesh, &args.surface, Spacing::Size(args.size), args.graded)
     })?;
     let out = trilux::tet::from_stuffing(&tets, mesh.origin);
     let force = context.force;
-    let files = context.step("writing", || {
+    let mut files = context.step("writing", || {
         trilux::output::write_atomic_files(&args.output, force, |tmp| {
             Ok(trilux_io::tet::write(tmp, &out)?)
         })
@@ -84,13 +147,18 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             trilux::preview::render_mesh(&surface.positions, &surface.indices, 768, 768)
         });
         super::write_image(context, p, &image)?;
+        files.push(p.clone());
     }
+    // The writer's list follows the folder's order; show a stable one.
+    files.sort();
     let r = &tets.report;
     let text = format!(
-        "{} tetrahedra, {} vertices, {} boundary triangles in {:.2} s; dihedral angles {:.2}° .. {:.2}°; written to {}\n",
+        "{} tetrahedra, {} vertices, {} boundary triangles at spacing {}{} in {:.2} s; dihedral angles {:.2}° .. {:.2}°; written to {}\n",
         r.tets,
         r.vertices,
         r.boundary_triangles,
+        number(h),
+        if args.graded { " (graded)" } else { "" },
         r.elapsed.as_secs_f64(),
         r.min_dihedral_deg,
         r.max_dihedral_deg,
@@ -106,6 +174,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "tetrahedra": r.tets,
         "vertices": r.vertices,
         "boundary_triangles": r.boundary_triangles,
+        "spacing": h,
+        "graded": args.graded,
         "dihedral_degrees": [r.min_dihedral_deg, r.max_dihedral_deg],
         "stuffing_seconds": r.elapsed.as_secs_f64(),
         "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
@@ -113,4 +183,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     });
     context.report(&text, json);
     Ok(())
+}
+
+/// A length as a person reads it: plain for everyday values, in
+/// scientific notation when tiny or huge (not 300 zeros).
+fn number(x: f64) -> String {
+    if x == 0.0 || (1e-4..1e7).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
 }

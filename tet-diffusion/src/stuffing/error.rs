@@ -38,19 +38,32 @@ pub enum Error {
     },
     /// The lattice at this spacing would exceed the memory bound.
     #[error(
-        "a lattice of spacing h = {h} over this surface needs {vertices} vertices, more than the \
-         limit of {limit} (about {limit_mib} MiB); choose a larger h or raise \
-         Options::max_lattice_vertices"
+        "a lattice of spacing h = {h:e} over this surface needs {} vertices, more than the \
+         limit of {limit} (about {limit_mib} MiB); choose a larger h",
+        count(*vertices)
     )]
     LatticeTooLarge {
         /// The spacing given.
         h: f64,
-        /// Lattice vertices that spacing needs.
+        /// Lattice vertices that spacing needs (`u128::MAX`: beyond 10^36).
         vertices: u128,
         /// The limit ([`super::Options::max_lattice_vertices`]).
         limit: usize,
         /// The limit's approximate memory, in MiB.
         limit_mib: usize,
+    },
+    /// The mesh at this spacing would have more tetrahedra than the bound.
+    #[error(
+        "at spacing h = {h:e} the mesh would have about {estimated} tetrahedra, more than the \
+         limit of {limit}; choose a larger h (or a graded mesh with a raised limit)"
+    )]
+    TooManyTetrahedra {
+        /// The spacing given.
+        h: f64,
+        /// Tetrahedra of the uniform mesh (6 per inside lattice vertex).
+        estimated: u128,
+        /// The limit ([`super::Options::max_tets`]).
+        limit: usize,
     },
     /// No lattice vertex lies inside the surface at this spacing: the input
     /// is an open sheet, a single triangle, or thinner than the lattice.
@@ -70,4 +83,13 @@ pub enum Error {
         /// Its value.
         value: f64,
     },
+}
+
+/// A vertex count for a message: "more than 10^36" for the saturated one.
+fn count(n: u128) -> String {
+    if n == u128::MAX {
+        "more than 10^36".to_string()
+    } else {
+        n.to_string()
+    }
 }

@@ -481,11 +481,25 @@ fn bad_input_is_refused_with_the_reason() {
         tetrahedralize(&tri, &[[0, 1, 2]], &Options::new(0.1)),
         Err(Error::EmptyVolume { .. })
     ));
-    // A lattice beyond the memory bound is refused before allocation.
+    // A lattice beyond the memory bound is refused before allocation, and
+    // an absurd spacing says so without a 39-digit count.
     assert!(matches!(
         tetrahedralize(&p, &t, &Options::new(1e-6)),
         Err(Error::LatticeTooLarge { .. })
     ));
+    let absurd = tetrahedralize(&p, &t, &Options::new(1e-300)).unwrap_err();
+    assert!(absurd.to_string().contains("more than 10^36"), "{absurd}");
+    // So is an output beyond the tetrahedron bound, once the inside is
+    // known: this shape has far more than 1000 tetrahedra at h = 0.1.
+    let mut small = Options::new(0.1);
+    small.max_tets = 1000;
+    let err = tetrahedralize(&p, &t, &small).unwrap_err();
+    assert!(
+        matches!(err, Error::TooManyTetrahedra { estimated, limit: 1000, .. } if estimated > 1000),
+        "{err:?}"
+    );
+    small.max_tets = 1 << 24;
+    assert!(tetrahedralize(&p, &t, &small).is_ok());
     let mut opts = Options::new(0.3);
     opts.winding_beta = 0.5;
     assert!(matches!(
