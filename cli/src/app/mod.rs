@@ -115,7 +115,7 @@ const GLOBAL: &str = "Global options";
 #[command(
     name = "trilux",
     version,
-    about = "Sample meshes, convert textures to mesh colours and back, inspect files, preview, benchmark",
+    about = "Sample meshes, convert textures to mesh colours and back, fill surfaces with tetrahedra, render translucent diffusion, inspect files, benchmark",
     long_about = None,
     after_help = "Start with `trilux demo`, which runs every pipeline on built-in data and writes previews."
 )]
