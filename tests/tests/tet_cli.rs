@@ -19,6 +19,22 @@ fn blob(dir: &Path) -> PathBuf {
     path
 }
 
+/// The blob tetrahedralized at spacing `size` into `blob.node` (+ `.ele`).
+fn stuffed_blob(dir: &Path, size: &str) {
+    let blob = blob(dir);
+    trilux(dir)
+        .args([
+            "tetra",
+            blob.to_str().unwrap(),
+            "--size",
+            size,
+            "-o",
+            "blob.node",
+        ])
+        .assert()
+        .success();
+}
+
 #[test]
 fn tetra_writes_tetgen_medit_and_vtu_with_the_reported_counts() {
     let dir = tempfile::tempdir().unwrap();
@@ -134,12 +150,7 @@ fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
 fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let blob = blob(d);
-    let blob = blob.to_str().unwrap();
-    trilux(d)
-        .args(["tetra", blob, "--size", "0.12", "-o", "blob.node"])
-        .assert()
-        .success();
+    stuffed_blob(d, "0.12");
     let tets = trilux_io::tet::read(d.join("blob.node")).unwrap();
     let report = json(
         d,
@@ -222,7 +233,7 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
         d,
         &[
             "diffuse",
-            blob,
+            "blob.obj",
             "--material",
             "noise:marble,skin1",
             "--size",
@@ -335,18 +346,7 @@ fn write_face_file(path: &Path, faces: &[[u32; 3]]) {
 fn info_reads_a_tetgen_face_file_beside_its_node_and_ele_files() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let blob = blob(d);
-    trilux(d)
-        .args([
-            "tetra",
-            blob.to_str().unwrap(),
-            "--size",
-            "0.15",
-            "-o",
-            "blob.node",
-        ])
-        .assert()
-        .success();
+    stuffed_blob(d, "0.15");
     let mesh = trilux_io::tet::read(d.join("blob.node")).unwrap();
     let boundary = mesh.boundary();
     write_face_file(&d.join("blob.face"), &boundary);
@@ -392,18 +392,7 @@ fn info_reads_the_face_files_of_the_data_folder() {
 fn diffuse_paints_the_side_of_a_plane_with_one_flag() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let blob = blob(d);
-    trilux(d)
-        .args([
-            "tetra",
-            blob.to_str().unwrap(),
-            "--size",
-            "0.12",
-            "-o",
-            "blob.node",
-        ])
-        .assert()
-        .success();
+    stuffed_blob(d, "0.12");
     let help = run(d, &["diffuse", "--help"]);
     let help = String::from_utf8_lossy(&help.stdout);
     assert!(help.contains("--paint plane:"), "no example in\n{help}");
