@@ -566,22 +566,7 @@ mod tests {
     fn graded_background_is_conforming_and_fills_the_same_volume() {
         for levels in [1, 2, 3] {
             let (lattice, tets) = ball_background(40, 18.0, levels);
-            let mut faces: Vec<[u32; 3]> = tets
-                .iter()
-                .flat_map(|t| {
-                    [
-                        [t[0], t[1], t[2]],
-                        [t[0], t[1], t[3]],
-                        [t[0], t[2], t[3]],
-                        [t[1], t[2], t[3]],
-                    ]
-                    .map(|mut f| {
-                        f.sort_unstable();
-                        f
-                    })
-                })
-                .collect();
-            faces.sort_unstable();
+            let faces = crate::stuffing::tests::sorted_faces(&tets);
             let mut i = 0;
             while i < faces.len() {
                 let mut j = i;

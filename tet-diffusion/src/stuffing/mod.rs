@@ -345,19 +345,15 @@ fn run<P: Position>(
         options.params.alpha_long(),
         options.params.alpha_short(),
     );
-    let background = options.graded.then(|| {
-        let position = |v: u32| match warped.binary_search_by_key(&v, |w| w.0) {
-            Ok(i) => warped[i].1,
-            Err(_) => lattice.position(v),
-        };
-        graded::background(&lattice, &signs, options.graded_levels, position)
-    });
     let ctx = Context {
         lattice: &lattice,
         signs: &signs,
         cuts: &cut_list,
         warped: &warped,
     };
+    let background = options
+        .graded
+        .then(|| graded::background(&lattice, &signs, options.graded_levels, |v| ctx.position(v)));
     let mut cells = ctx.stuff(background.as_ref().map(|b| &b.fine[..]), rule);
     if let Some(b) = &background {
         cells.extend(b.coarse.iter().map(|t| {

@@ -8,6 +8,23 @@ use super::*;
 
 /// A triangle soup: positions and counter-clockwise triangles.
 type Soup = (Vec<DVec3>, Vec<[u32; 3]>);
+/// Every face of `tets` (4 each) as sorted vertex triples, sorted: a face
+/// shared by two tetrahedra appears twice in a row.
+pub(crate) fn sorted_faces(tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
+    let mut faces: Vec<[u32; 3]> = tets
+        .iter()
+        .flat_map(|t| {
+            [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]].map(|f| {
+                let mut face = f.map(|k| t[k]);
+                face.sort_unstable();
+                face
+            })
+        })
+        .collect();
+    faces.sort_unstable();
+    faces
+}
+
 /// A surface to check boundary vertices against, with a tolerance.
 type Reference<'a> = (&'a [DVec3], &'a [[u32; 3]], f64);
 
@@ -182,23 +199,7 @@ pub(crate) fn check_mesh(
         return Err("two vertices share a position".into());
     }
     // Faces in at most two tetrahedra.
-    let mut faces: Vec<[u32; 3]> = m
-        .tets
-        .iter()
-        .flat_map(|t| {
-            [
-                [t[0], t[1], t[2]],
-                [t[0], t[1], t[3]],
-                [t[0], t[2], t[3]],
-                [t[1], t[2], t[3]],
-            ]
-            .map(|mut f| {
-                f.sort_unstable();
-                f
-            })
-        })
-        .collect();
-    faces.sort_unstable();
+    let faces = sorted_faces(&m.tets);
     let mut run = 1;
     for w in faces.windows(2) {
         if w[0] == w[1] {

@@ -321,31 +321,9 @@ fn corners(positions: &[DVec3], t: [u32; 3]) -> [DVec3; 3] {
 mod tests {
     use super::*;
 
-    /// An outward-oriented UV sphere.
-    pub(crate) fn sphere(n: u32, radius: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-        let mut p = vec![DVec3::new(0.0, 0.0, radius)];
-        for i in 1..n {
-            let th = PI * f64::from(i) / f64::from(n);
-            for j in 0..2 * n {
-                let ph = PI * f64::from(j) / f64::from(n);
-                p.push(radius * DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()));
-            }
-        }
-        p.push(DVec3::new(0.0, 0.0, -radius));
-        let ring = |i: u32, j: u32| 1 + (i - 1) * 2 * n + (j % (2 * n));
-        let south = p.len() as u32 - 1;
-        let mut t = Vec::new();
-        for j in 0..2 * n {
-            t.push([0, ring(1, j), ring(1, j + 1)]);
-            t.push([south, ring(n - 1, j + 1), ring(n - 1, j)]);
-        }
-        for i in 1..n - 1 {
-            for j in 0..2 * n {
-                t.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
-                t.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
-            }
-        }
-        (p, t)
+    /// The stuffing tests' UV sphere, centred at the origin.
+    fn sphere(n: u32, radius: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+        crate::stuffing::tests::sphere(n, radius, DVec3::ZERO)
     }
 
     #[test]
