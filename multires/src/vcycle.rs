@@ -7,6 +7,8 @@
 //! solved exactly by Cholesky — so the V-cycle is a symmetric positive
 //! definite operator and CG's theory holds.
 
+use std::borrow::Cow;
+
 use rayon::prelude::*;
 use sprs::CsMat;
 
@@ -58,10 +60,11 @@ struct Level {
     inverse_diagonal: Vec<f64>,
 }
 
-/// The V-cycle preconditioner of a matrix `m` it borrows.
+/// The V-cycle preconditioner of a matrix `m` it borrows (or owns, after
+/// [`into_owned`](VCycle::into_owned)).
 #[derive(Debug)]
 pub struct VCycle<'m> {
-    fine: &'m CsMat<f64>,
+    fine: Cow<'m, CsMat<f64>>,
     fine_inverse_diagonal: Vec<f64>,
     /// Levels 1.. (Galerkin operators).
     levels: Vec<Level>,
@@ -120,7 +123,7 @@ impl<'m> VCycle<'m> {
             None
         };
         Ok(Self {
-            fine: m,
+            fine: Cow::Borrowed(m),
             fine_inverse_diagonal,
             levels,
             restrict,
@@ -136,6 +139,31 @@ impl<'m> VCycle<'m> {
         &self.hierarchy
     }
 
+    /// The same V-cycle holding its own copy of the matrix, so that it can
+    /// be kept while the matrix it was built from changes: it then stays a
+    /// symmetric positive definite preconditioner of the old matrix, and
+    /// CG on a matrix whose values moved (painted materials, the same
+    /// pattern) still converges with it, without paying for the hierarchy
+    /// again — in more iterations the more the values moved (3× those of a
+    /// fresh V-cycle in the test where a third of the diagonal grew 1.5×).
+    pub fn into_owned(self) -> VCycle<'static> {
+        VCycle {
+            fine: Cow::Owned(self.fine.into_owned()),
+            fine_inverse_diagonal: self.fine_inverse_diagonal,
+            levels: self.levels,
+            restrict: self.restrict,
+            coarsest: self.coarsest,
+            options: self.options,
+            hierarchy: self.hierarchy,
+            work: self.work,
+        }
+    }
+
+    /// Unknowns of the matrix it was built from.
+    pub fn rows(&self) -> usize {
+        self.fine.rows()
+    }
+
     /// Stored entries of all operators divided by those of the original
     /// (the "operator complexity" of multigrid).
     pub fn operator_complexity(&self) -> f64 {
@@ -145,7 +173,7 @@ impl<'m> VCycle<'m> {
 
     fn matrix(&self, level: usize) -> (&CsMat<f64>, &[f64]) {
         match level {
-            0 => (self.fine, &self.fine_inverse_diagonal),
+            0 => (&*self.fine, &self.fine_inverse_diagonal),
             l => (
                 &self.levels[l - 1].matrix,
                 &self.levels[l - 1].inverse_diagonal,
@@ -270,7 +298,7 @@ impl<'m> VCycle<'m> {
     ) -> Result<Report, Error> {
         // The matrix was checked (square, finite, symmetric) when the
         // V-cycle was built.
-        options.settle(pcg_checked(self.fine, b, x, self, options, monitor)?)
+        options.settle(pcg_checked(&self.fine, b, x, self, options, monitor)?)
     }
 }
 

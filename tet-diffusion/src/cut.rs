@@ -34,7 +34,12 @@ pub enum Cut {
 }
 
 impl Cut {
-    fn check(&self) -> Result<(), Error> {
+    /// Checks the cut's values.
+    ///
+    /// # Errors
+    /// [`Error::BadArgument`] for a non-finite or zero plane/stroke, or a
+    /// stroke of fewer than two points.
+    pub fn check(&self) -> Result<(), Error> {
         let nonzero = |what: &str, v: DVec3| -> Result<(), Error> {
             finite_vec(what, v)?;
             if v.length_squared() == 0.0 {

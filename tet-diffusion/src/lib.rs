@@ -70,6 +70,7 @@ pub mod material;
 pub mod mesh;
 mod object;
 pub mod paint;
+pub mod session;
 pub mod stuffing;
 
 // Test meshes built in code, shared with the integration tests.
@@ -83,8 +84,9 @@ pub use fem::{Integration, P1Matrices};
 pub use light::{Environment, Light};
 pub use material::{MEASURED, Medium, Noise, ResolutionWarning};
 pub use mesh::{Quality, TetMesh};
-pub use object::{Method, Object, SolveReport, SolverSettings};
+pub use object::{Budget, Method, Object, SolveReport, SolverSettings};
 pub use paint::{PaintReport, Stroke};
+pub use session::{Applied, Edit, Log, Logged, Session, SessionOptions};
 
 pub use glam;
 pub use multires;

@@ -276,6 +276,11 @@ pub(crate) struct LitLight {
 }
 
 impl LitLight {
+    /// Bytes of its visibility bits.
+    pub(crate) fn bytes(&self) -> usize {
+        self.visible.len() * 8
+    }
+
     /// Traces the light's shadow rays from every boundary vertex.
     pub(crate) fn trace(
         light: Light,

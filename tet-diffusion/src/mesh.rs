@@ -102,6 +102,21 @@ pub(crate) fn dihedral(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> (f64, f64) {
 }
 
 impl TetMesh {
+    /// Bytes of the arrays this mesh holds (positions, tets, adjacency,
+    /// boundary), to budget copies of it.
+    pub fn memory_bytes(&self) -> usize {
+        let csr = |c: &Csr| c.offsets.len() * 8 + c.items.len() * 4;
+        self.positions.len() * 24
+            + self.tets.len() * (16 + 4 + 16 + 16)
+            + csr(&self.vertex_tets)
+            + csr(&self.neighbors)
+            + self.boundary.len() * 12
+            + self.boundary_vertices.len() * 4
+            + self.boundary_index.len() * 4
+            + self.vertex_area.len() * 8
+            + self.vertex_normal.len() * 24
+    }
+
     /// Builds and validates a mesh from positions and four vertex indices
     /// per tetrahedron (0-based): exactly the fields of a TetGen, Gmsh or
     /// MEDIT file as `trilux_io::tet::TetMesh` reads them.

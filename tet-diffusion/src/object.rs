@@ -1,16 +1,15 @@
 //! A translucent object: a tet mesh, its materials and lights, TransCut's
 //! three RGB systems, and their solution `φ`.
 
-#![expect(
-    clippy::needless_range_loop,
-    reason = "RGB loops index several per-channel arrays by one channel index"
-)]
-
+use std::ops::ControlFlow;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use glam::{DAffine3, DVec3};
 use multires::{
-    Cascade, CascadeOptions, Report, SolveOptions, VCycle, VCycleOptions, Weights, cg, pcg,
+    Cascade, CascadeOptions, Report, SolveOptions, Stop, VCycle, VCycleOptions, Weights,
+    pcg_monitored,
 };
 use rayon::prelude::*;
 use sprs::CsMat;
@@ -76,6 +75,49 @@ pub struct SolveReport {
     pub hierarchy_ms: f64,
     /// Time of the iterations, ms.
     pub solve_ms: f64,
+    /// Whether this solve built the hierarchy (the first solve after the
+    /// mesh changed, or after a change of method).
+    pub hierarchy_built: bool,
+    /// Whether the [`Budget`]'s deadline or cancel flag stopped it.
+    pub interrupted: bool,
+}
+
+/// Limits of one [`Object::solve_monitored`].
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Budget<'a> {
+    /// Relative residual to reach instead of the settings' (a loose one,
+    /// such as 10⁻², for a first look).
+    pub tolerance: Option<f64>,
+    /// Stop at this instant.
+    pub deadline: Option<Instant>,
+    /// Stop as soon as this is set (checked after every iteration).
+    pub cancel: Option<&'a AtomicBool>,
+}
+
+/// The solver state kept across solves while the mesh stays the same.
+#[derive(Debug)]
+pub(crate) struct Kept {
+    method: Method,
+    share_hierarchy: bool,
+    solver: KeptSolver,
+}
+
+#[derive(Debug)]
+enum KeptSolver {
+    Jacobi,
+    /// One shared (green channel's) V-cycle, or one per channel.
+    VCycles(Vec<VCycle<'static>>),
+    Cascade(Cascade),
+}
+
+impl KeptSolver {
+    fn levels(&self) -> usize {
+        match self {
+            Self::Jacobi => 1,
+            Self::VCycles(v) => v.first().map_or(1, |v| v.hierarchy().levels()),
+            Self::Cascade(c) => c.hierarchy().levels(),
+        }
+    }
 }
 
 /// Where a fractured piece came from, to recombine it exactly.
@@ -123,6 +165,10 @@ pub struct Object {
     pub(crate) transform: DAffine3,
     pub(crate) lineage: Option<Lineage>,
     pub(crate) assembly_ms: f64,
+    /// The solver's hierarchy, kept until the mesh changes; shared by
+    /// clones (it is only read).
+    pub(crate) kept: Option<Arc<Kept>>,
+    pub(crate) hierarchy_builds: usize,
 }
 
 impl Object {
@@ -221,6 +267,8 @@ impl Object {
             transform: DAffine3::IDENTITY,
             lineage: None,
             assembly_ms: 0.0,
+            kept: None,
+            hierarchy_builds: 0,
         };
         object.rebuild();
         Ok(object)
@@ -229,6 +277,7 @@ impl Object {
     /// Recomputes everything that depends on the mesh: geometry, matrices,
     /// shadows, visibility, `q` and `b`.
     pub(crate) fn rebuild(&mut self) {
+        self.kept = None;
         self.reassemble();
         let lights: Vec<Light> = self.lights.drain(..).map(|l| l.light).collect();
         self.shadows = None;
@@ -322,6 +371,11 @@ impl Object {
         light.set_color(rgb);
         self.update_rhs();
         Ok(())
+    }
+
+    /// The lights, in the order they were added.
+    pub fn lights(&self) -> Vec<Light> {
+        self.lights.iter().map(|l| l.light.clone()).collect()
     }
 
     /// Removes all lights (and the extra incident light).
@@ -480,6 +534,66 @@ impl Object {
         self.assembly_ms
     }
 
+    /// Bytes of the arrays this object holds (mesh, matrices, geometry,
+    /// media, lights' visibility, `φ`, `q`, `b`; not the kept hierarchy,
+    /// which clones share), to budget copies of it.
+    pub fn memory_bytes(&self) -> usize {
+        let n = self.mesh.vertex_count();
+        let t = self.mesh.tets().len();
+        let matrices: usize = self
+            .matrices
+            .iter()
+            .map(|m| m.nnz() * 12 + (m.rows() + 1) * 8)
+            .sum();
+        let lights: usize = self.lights.iter().map(LitLight::bytes).sum();
+        self.mesh.memory_bytes()
+            + matrices
+            + t * (8 + 48 + 48)
+            + self.media.len() * std::mem::size_of::<Medium>()
+            + lights
+            + 3 * 2 * 8 * n
+            + self.q.len() * 24
+    }
+
+    /// Replaces every medium by `medium`, re-assembles, and returns each
+    /// tet (mesh index) with its previous medium.
+    pub(crate) fn set_all_media(&mut self, medium: Medium) -> Vec<(u32, Medium)> {
+        let previous: Vec<(u32, Medium)> = self
+            .mesh
+            .original_ids()
+            .iter()
+            .enumerate()
+            .map(|(t, &id)| (t as u32, self.media[id as usize]))
+            .collect();
+        for &id in self.mesh.original_ids() {
+            self.media[id as usize] = medium;
+        }
+        self.reassemble_values();
+        previous
+    }
+
+    /// Puts back what [`set_all_media`](Self::set_all_media) returned.
+    pub(crate) fn restore_all_media(&mut self, previous: &[(u32, Medium)]) {
+        for &(t, m) in previous {
+            let id = self.mesh.original_ids()[t as usize] as usize;
+            self.media[id] = m;
+        }
+        self.reassemble_values();
+    }
+
+    /// Re-assembles the matrices from the media, keeping the geometry.
+    fn reassemble_values(&mut self) {
+        let start = Instant::now();
+        self.coefficients = self.coefficients_of_media();
+        self.matrices = assembly::assemble(
+            &self.mesh,
+            &self.geometry,
+            &self.coefficients,
+            self.boundary_factor(),
+        );
+        self.assembly_ms = start.elapsed().as_secs_f64() * 1e3;
+    }
+
     /// Time of the last full matrix assembly, ms.
     pub fn assembly_ms(&self) -> f64 {
         self.assembly_ms
@@ -516,92 +630,110 @@ impl Object {
     }
 
     /// Solves the three systems `M φ = b` with [`settings`](Self::settings),
-    /// starting from the current `φ` (warm start).
+    /// starting from the current `φ` (warm start). The solver's hierarchy
+    /// is built on the first solve after the mesh changed (creation, a
+    /// cut) and kept across paint, light and material edits, which change
+    /// only the values of `M` or `b` (see [`hierarchy_builds`](Self::hierarchy_builds)).
     ///
     /// # Errors
     /// [`Error::NotConverged`] with the true residual when a channel does
     /// not reach the tolerance (`φ` then holds the last iterate);
     /// [`Error::Solver`] for an error of `multires`.
     pub fn solve(&mut self) -> Result<SolveReport, Error> {
+        self.solve_monitored(&Budget::default())
+    }
+
+    /// [`solve`](Self::solve) within a [`Budget`]: its own tolerance (a
+    /// loose one gives a quick preview, which a later call refines from the
+    /// same warm start), a deadline, and a cancel flag another thread sets
+    /// when new input makes this solve moot. A solve stopped by the
+    /// deadline or the flag is `Ok` with [`SolveReport::interrupted`] set,
+    /// and `φ` holds the last iterate of each channel (channels after the
+    /// one interrupted keep their previous `φ`).
+    ///
+    /// # Errors
+    /// As [`solve`](Self::solve) (an interruption is not an error);
+    /// [`Error::BadArgument`] for a tolerance that is not finite and ≥ 0.
+    pub fn solve_monitored(&mut self, budget: &Budget<'_>) -> Result<SolveReport, Error> {
         let s = self.settings;
+        let tolerance = budget.tolerance.unwrap_or(s.tolerance);
+        if !(tolerance.is_finite() && tolerance >= 0.0) {
+            return Err(Error::BadArgument {
+                what: "the solve's tolerance".into(),
+                value: tolerance,
+                need: "it must be finite and at least 0",
+            });
+        }
         // Convergence is checked below, per channel, so that the error can
         // name the channel.
-        let options = SolveOptions::new(s.tolerance, s.max_iterations).allow_unconverged();
-        let positions = self.mesh.positions();
-        let weights = Weights::Points(&positions);
+        let options = SolveOptions::new(tolerance, s.max_iterations).allow_unconverged();
         let mut hierarchy_ms = 0.0;
-        let mut solve_ms = 0.0;
-        let mut levels = 1;
-        let mut reports = Vec::with_capacity(3);
-        let matrices = &self.matrices;
-        let clock = Instant::now;
-        match s.method {
-            Method::JacobiPcg => {
-                let t = clock();
-                for c in 0..3 {
-                    reports.push(cg(&matrices[c], &self.rhs[c], &mut self.phi[c], &options)?);
-                }
-                solve_ms += ms(t);
+        let built = self.ensure_kept()?;
+        if let Some(t) = built {
+            hierarchy_ms = t;
+        }
+        let kept = self
+            .kept
+            .clone()
+            .ok_or(Error::Solver(multires::Error::InvalidOption(
+                "the solver state was not built",
+            )))?;
+        let levels = kept.solver.levels();
+        let stop_now = || {
+            budget.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+                || budget.deadline.is_some_and(|d| Instant::now() >= d)
+        };
+        let mut monitor = |_: usize, _: &[f64]| {
+            if stop_now() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
             }
-            Method::VCyclePcg => {
-                let vopts = VCycleOptions::default();
-                if s.share_hierarchy {
-                    let t = clock();
-                    let v = VCycle::new(&matrices[1], weights, &vopts)?;
-                    hierarchy_ms += ms(t);
-                    levels = v.hierarchy().levels();
-                    let t = clock();
-                    for c in 0..3 {
-                        reports.push(pcg(
-                            &matrices[c],
-                            &self.rhs[c],
-                            &mut self.phi[c],
-                            &v,
-                            &options,
-                        )?);
-                    }
-                    solve_ms += ms(t);
-                } else {
-                    for c in 0..3 {
-                        let t = clock();
-                        let v = VCycle::new(&matrices[c], weights, &vopts)?;
-                        hierarchy_ms += ms(t);
-                        levels = v.hierarchy().levels();
-                        let t = clock();
-                        reports.push(v.solve(&self.rhs[c], &mut self.phi[c], &options)?);
-                        solve_ms += ms(t);
-                    }
+        };
+        let t = Instant::now();
+        let mut reports: Vec<Report> = Vec::with_capacity(3);
+        let mut interrupted = false;
+        for c in 0..3 {
+            let (m, b, x) = (&self.matrices[c], &self.rhs[c], &mut self.phi[c]);
+            let r = match &kept.solver {
+                KeptSolver::Jacobi => multires::cg_monitored(m, b, x, &options, &mut monitor)?,
+                KeptSolver::VCycles(v) => {
+                    let v = &v[if v.len() == 3 { c } else { 0 }];
+                    pcg_monitored(m, b, x, v, &options, &mut monitor)?
                 }
-            }
-            Method::Cascade | Method::CascadeGalerkin => {
-                let copts = if s.method == Method::Cascade {
-                    CascadeOptions::default()
-                } else {
-                    CascadeOptions::galerkin()
-                };
-                let t = clock();
-                let cascade = Cascade::new(&matrices[1], weights, &copts)?;
-                hierarchy_ms += ms(t);
-                levels = cascade.hierarchy().levels();
-                let t = clock();
-                for c in 0..3 {
-                    let r =
-                        cascade.solve(&matrices[c], &self.rhs[c], &mut self.phi[c], &options)?;
-                    reports.push(r.finest);
+                KeptSolver::Cascade(cascade) => {
+                    cascade
+                        .solve_monitored(m, b, x, &options, &mut monitor)?
+                        .finest
                 }
-                solve_ms += ms(t);
+            };
+            reports.push(r);
+            if r.stop == Stop::Interrupted {
+                interrupted = true;
+                break;
             }
         }
+        let solve_ms = ms(t);
+        let skipped = Report {
+            stop: Stop::Interrupted,
+            iterations: 0,
+            residual: f64::NAN,
+        };
+        while reports.len() < 3 {
+            reports.push(skipped);
+        }
         let channels: [Report; 3] = [reports[0], reports[1], reports[2]];
-        for (c, r) in channels.iter().enumerate() {
-            if !r.converged() {
-                return Err(Error::NotConverged {
-                    channel: ["red", "green", "blue"][c],
-                    residual: r.residual,
-                    iterations: r.iterations,
-                    stop: format!("{:?}", r.stop),
-                    tolerance: s.tolerance,
-                });
+        if !interrupted {
+            for (c, r) in channels.iter().enumerate() {
+                if !r.converged() {
+                    return Err(Error::NotConverged {
+                        channel: ["red", "green", "blue"][c],
+                        residual: r.residual,
+                        iterations: r.iterations,
+                        stop: format!("{:?}", r.stop),
+                        tolerance,
+                    });
+                }
             }
         }
         Ok(SolveReport {
@@ -609,7 +741,70 @@ impl Object {
             levels,
             hierarchy_ms,
             solve_ms,
+            hierarchy_built: built.is_some(),
+            interrupted,
         })
+    }
+
+    /// Builds the solver's hierarchy unless one of the current method is
+    /// kept; returns the build time (ms) when it built one.
+    fn ensure_kept(&mut self) -> Result<Option<f64>, Error> {
+        let s = self.settings;
+        if self
+            .kept
+            .as_ref()
+            .is_some_and(|k| k.method == s.method && k.share_hierarchy == s.share_hierarchy)
+        {
+            return Ok(None);
+        }
+        // Free the old hierarchy before building the new one.
+        self.kept = None;
+        let t = Instant::now();
+        let positions = self.mesh.positions();
+        let weights = Weights::Points(&positions);
+        let matrices = &self.matrices;
+        let solver = match s.method {
+            Method::JacobiPcg => KeptSolver::Jacobi,
+            Method::VCyclePcg => {
+                let vopts = VCycleOptions::default();
+                let channels: &[usize] = if s.share_hierarchy { &[1] } else { &[0, 1, 2] };
+                let mut v = Vec::with_capacity(channels.len());
+                for &c in channels {
+                    v.push(VCycle::new(&matrices[c], weights, &vopts)?.into_owned());
+                }
+                KeptSolver::VCycles(v)
+            }
+            Method::Cascade | Method::CascadeGalerkin => {
+                let copts = if s.method == Method::Cascade {
+                    CascadeOptions::default()
+                } else {
+                    CascadeOptions::galerkin()
+                };
+                KeptSolver::Cascade(Cascade::new(&matrices[1], weights, &copts)?)
+            }
+        };
+        self.kept = Some(Arc::new(Kept {
+            method: s.method,
+            share_hierarchy: s.share_hierarchy,
+            solver,
+        }));
+        self.hierarchy_builds += 1;
+        Ok(Some(ms(t)))
+    }
+
+    /// How many times this object (and the objects it was cloned from)
+    /// built a solver hierarchy: once after creation and after each cut;
+    /// paint, light and material edits keep it.
+    pub fn hierarchy_builds(&self) -> usize {
+        self.hierarchy_builds
+    }
+
+    /// Drops the kept hierarchy, so that the next solve builds a new one
+    /// from the current matrices (worth it after painting most of the
+    /// object with a very different medium: the kept one still converges,
+    /// in more iterations).
+    pub fn forget_hierarchy(&mut self) {
+        self.kept = None;
     }
 
     /// Outgoing radiance (Eq. 3) at each boundary vertex, in the order of

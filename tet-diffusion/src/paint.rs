@@ -44,6 +44,101 @@ impl Object {
     /// that is not positive and finite, a strength outside `[0, 1]`, or a
     /// bad medium.
     pub fn paint(&mut self, stroke: &Stroke) -> Result<PaintReport, Error> {
+        self.paint_recorded(stroke).map(|(report, _)| report)
+    }
+
+    /// [`paint`](Self::paint), also returning each changed tet (mesh index)
+    /// with the medium it had, which [`restore_media`](Self::restore_media)
+    /// puts back.
+    pub(crate) fn paint_recorded(
+        &mut self,
+        stroke: &Stroke,
+    ) -> Result<(PaintReport, Vec<(u32, Medium)>), Error> {
+        stroke.check()?;
+        let mesh = &self.mesh;
+        let reach2 = (3.0 * stroke.radius).powi(2);
+        let weights: Vec<(usize, f64)> = (0..mesh.tets().len())
+            .into_par_iter()
+            .with_min_len(1024)
+            .filter_map(|t| {
+                let c = mesh.tet_center(t);
+                let d2 = stroke
+                    .points
+                    .iter()
+                    .map(|p| p.distance_squared(c))
+                    .fold(f64::INFINITY, f64::min);
+                (d2 <= reach2).then(|| {
+                    (
+                        t,
+                        stroke.strength * (-d2 / (2.0 * stroke.radius * stroke.radius)).exp(),
+                    )
+                })
+            })
+            .collect();
+        let mut previous = Vec::with_capacity(weights.len());
+        for &(t, w) in &weights {
+            let id = mesh.original_ids()[t] as usize;
+            previous.push((t as u32, self.media[id]));
+            self.media[id] = self.media[id].lerp(&stroke.medium, w);
+        }
+        let tets: Vec<u32> = weights.iter().map(|&(t, _)| t as u32).collect();
+        let rows = self.update_rows_of(&tets);
+        Ok((
+            PaintReport {
+                tets: weights.len(),
+                rows,
+            },
+            previous,
+        ))
+    }
+
+    /// Puts back the media [`paint_recorded`](Self::paint_recorded)
+    /// returned (mesh tet index, medium), in reverse order so that a tet
+    /// listed twice gets its first value, and re-assembles their rows.
+    pub(crate) fn restore_media(&mut self, previous: &[(u32, Medium)]) -> usize {
+        for &(t, m) in previous.iter().rev() {
+            let id = self.mesh.original_ids()[t as usize] as usize;
+            self.media[id] = m;
+        }
+        let tets: Vec<u32> = previous.iter().map(|&(t, _)| t).collect();
+        self.update_rows_of(&tets)
+    }
+
+    /// Recomputes the coefficients of mesh tets `tets` from their media
+    /// and re-assembles the rows of their vertices; returns the rows.
+    fn update_rows_of(&mut self, tets: &[u32]) -> usize {
+        let mut rows: Vec<u32> = Vec::new();
+        for &t in tets {
+            let t = t as usize;
+            let (kappa, mu) = self.tet_coefficients(self.mesh.original_ids()[t]);
+            self.coefficients.kappa[t] = kappa;
+            self.coefficients.mu[t] = mu;
+            rows.extend_from_slice(&self.mesh.tets()[t]);
+        }
+        rows.sort_unstable();
+        rows.dedup();
+        let a = self.boundary_factor();
+        reassemble_rows(
+            &self.mesh,
+            &self.geometry,
+            &self.coefficients,
+            a,
+            &rows,
+            &mut self.matrices,
+        );
+        rows.len()
+    }
+}
+
+impl Stroke {
+    /// Checks the stroke's values.
+    ///
+    /// # Errors
+    /// [`Error::BadArgument`] for no points, a non-finite point, a radius
+    /// that is not positive and finite, a strength outside `[0, 1]`, or a
+    /// bad medium.
+    pub fn check(&self) -> Result<(), Error> {
+        let stroke = self;
         if stroke.points.is_empty() {
             return Err(Error::BadArgument {
                 what: "the number of paint stroke points".into(),
@@ -69,51 +164,6 @@ impl Object {
             });
         }
         stroke.medium.check("the painted medium")?;
-        let mesh = &self.mesh;
-        let reach2 = (3.0 * stroke.radius).powi(2);
-        let weights: Vec<(usize, f64)> = (0..mesh.tets().len())
-            .into_par_iter()
-            .with_min_len(1024)
-            .filter_map(|t| {
-                let c = mesh.tet_center(t);
-                let d2 = stroke
-                    .points
-                    .iter()
-                    .map(|p| p.distance_squared(c))
-                    .fold(f64::INFINITY, f64::min);
-                (d2 <= reach2).then(|| {
-                    (
-                        t,
-                        stroke.strength * (-d2 / (2.0 * stroke.radius * stroke.radius)).exp(),
-                    )
-                })
-            })
-            .collect();
-        for &(t, w) in &weights {
-            let id = mesh.original_ids()[t] as usize;
-            self.media[id] = self.media[id].lerp(&stroke.medium, w);
-        }
-        let mut rows: Vec<u32> = Vec::new();
-        for &(t, _) in &weights {
-            let (kappa, mu) = self.tet_coefficients(self.mesh.original_ids()[t]);
-            self.coefficients.kappa[t] = kappa;
-            self.coefficients.mu[t] = mu;
-            rows.extend_from_slice(&self.mesh.tets()[t]);
-        }
-        rows.sort_unstable();
-        rows.dedup();
-        let a = self.boundary_factor();
-        reassemble_rows(
-            &self.mesh,
-            &self.geometry,
-            &self.coefficients,
-            a,
-            &rows,
-            &mut self.matrices,
-        );
-        Ok(PaintReport {
-            tets: weights.len(),
-            rows: rows.len(),
-        })
+        Ok(())
     }
 }
