@@ -96,8 +96,8 @@ pub fn diffusion_mesh(mesh: &TetMesh) -> Result<tet_diffusion::TetMesh, tet_diff
     tet_diffusion::TetMesh::new(&mesh.positions, &mesh.tets)
 }
 
-/// A stuffed mesh (`tet_diffusion::stuffing`) as trilux-io's, to write.
-pub fn from_stuffing(mesh: &tet_diffusion::stuffing::TetMesh, origin: DVec3) -> TetMesh {
+/// A stuffed mesh (`tet_stuffing`) as trilux-io's, to write.
+pub fn from_stuffing(mesh: &tet_stuffing::TetMesh, origin: DVec3) -> TetMesh {
     TetMesh {
         positions: mesh.positions.iter().map(|&p| p + origin).collect(),
         tets: mesh.tets.clone(),

@@ -32,7 +32,10 @@
 //! - [`fem`]: the P1 finite-element reference of Arbree et al., assembled
 //!   independently in closed form and by quadrature, with the exact
 //!   relation `M = 4 (K + lumped mass + lumped boundary mass / 2A)`.
-//! - [`stuffing`]: isosurface stuffing, from a closed surface to a tet mesh.
+//!
+//! Tetrahedra from a surface come from the `tet-stuffing` crate (isosurface
+//! stuffing, once this crate's `stuffing` module), whose plain-array output
+//! [`TetMesh::new`] takes as is.
 //!
 //! Positions are glam `DVec3` in the mesh's unit; materials are per mm, so
 //! a mesh in metres needs `length_unit_mm = 1000` (a marble bunny must look
@@ -71,7 +74,6 @@ pub mod mesh;
 mod object;
 pub mod paint;
 pub mod session;
-pub mod stuffing;
 
 // Test meshes built in code, shared with the integration tests.
 #[cfg(test)]

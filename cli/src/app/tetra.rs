@@ -1,9 +1,9 @@
 //! `trilux tetra`: a closed surface to tetrahedra by isosurface stuffing
-//! (the algorithm is `tet_diffusion::stuffing`).
+//! (the algorithm is `tet_stuffing`).
 
 use std::path::{Path, PathBuf};
 
-use tet_diffusion::stuffing;
+use tet_stuffing as stuffing;
 use trilux_io::mesh::TriMesh;
 
 use super::{Context, Result, arg_error, file_error};

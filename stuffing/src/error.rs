@@ -1,5 +1,4 @@
-//! The stuffing module's own error type (it depends on nothing else of the
-//! crate, so that it could become a crate of its own).
+//! The crate's one error type.
 
 /// Why a surface could not be turned into tetrahedra.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

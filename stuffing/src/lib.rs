@@ -21,12 +21,16 @@
 //! 5. optionally ([`Options::graded`]) coarser, octree-graded tetrahedra
 //!    deep inside, with the fine BCC lattice kept near the surface.
 //!
-//! The module depends on `glam`, `rayon`, `thiserror` and `std` only.
+//! The crate depends on `glam`, `rayon`, `thiserror` and `std` only: a
+//! user who wants tetrahedra from a surface gets no solver, sparse-matrix
+//! or BVH crate (the winding-number tree of [`winding`] is its own, a few
+//! hundred lines). Its output is plain data (`Vec<DVec3>`, `Vec<[u32; 4]>`)
+//! that `tet-diffusion`, `trilux-io`'s writers or any FEM code take as is.
 //!
 //! # Example
 //! ```
-//! use tet_diffusion::stuffing::{self, Options};
-//! use tet_diffusion::glam::DVec3;
+//! use tet_stuffing::{self as stuffing, Options};
+//! use tet_stuffing::glam::DVec3;
 //! // A cube of side 1 with outward (counter-clockwise) faces.
 //! let p: Vec<DVec3> = (0..8)
 //!     .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
@@ -62,6 +66,8 @@ use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
 pub use error::Error;
+
+pub use glam;
 pub use quality::{EDGES, Quality, dihedral_angles, quality, signed_volume};
 
 use cuts::{Cut, Sign};
@@ -536,3 +542,8 @@ impl Context<'_> {
 
 #[cfg(test)]
 mod tests;
+
+/// The README's example, compiled as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctest;

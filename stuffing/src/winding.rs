@@ -58,7 +58,7 @@ struct Expansion {
 ///
 /// # Example
 /// ```
-/// use tet_diffusion::stuffing::winding::WindingNumber;
+/// use tet_stuffing::winding::WindingNumber;
 /// use glam::DVec3;
 /// // A tetrahedron with outward (counter-clockwise) faces.
 /// let p = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
@@ -323,7 +323,7 @@ mod tests {
 
     /// The stuffing tests' UV sphere, centred at the origin.
     fn sphere(n: u32, radius: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-        crate::stuffing::tests::sphere(n, radius, DVec3::ZERO)
+        crate::tests::sphere(n, radius, DVec3::ZERO)
     }
 
     #[test]

@@ -526,7 +526,7 @@ fn mark(level: &mut [u8], n: [usize; 3], l: u32, a: [usize; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stuffing::quality::{dihedral_angles, signed_volume};
+    use crate::quality::{dihedral_angles, signed_volume};
     use glam::DVec3;
 
     /// The graded background over a ball: fine BCC tetrahedra where both
@@ -566,7 +566,7 @@ mod tests {
     fn graded_background_is_conforming_and_fills_the_same_volume() {
         for levels in [1, 2, 3] {
             let (lattice, tets) = ball_background(40, 18.0, levels);
-            let faces = crate::stuffing::tests::sorted_faces(&tets);
+            let faces = crate::tests::sorted_faces(&tets);
             let mut i = 0;
             while i < faces.len() {
                 let mut j = i;
@@ -619,8 +619,8 @@ mod tests {
     /// with the second pair), inside the stencils' bounds, never inverted.
     #[test]
     fn half_pyramids_towards_a_larger_leaf_stay_within_the_bounds_when_warped() {
-        use crate::stuffing::Params;
-        use crate::stuffing::lattice::{LONG_DIRS, SHORT_DIRS};
+        use crate::Params;
+        use crate::lattice::{LONG_DIRS, SHORT_DIRS};
         // Doubled coordinates / 2: the cube's face is z = 0, its centre
         // above it; f is the larger leaf's face centre, one face corner.
         let (f, a, b, d) = (DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y);

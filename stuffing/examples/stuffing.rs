@@ -1,7 +1,7 @@
 //! Isosurface stuffing on real meshes, side by side with TetGen.
 //!
 //! ```text
-//! TRILUX_DATA=../shared/data cargo run --release -p tet-diffusion --example stuffing -- [--json]
+//! TRILUX_DATA=../shared/data cargo run --release -p tet-stuffing --example stuffing -- [--json]
 //! ```
 //!
 //! For every mesh in `$TRILUX_DATA/meshes` and the closed boundary of
@@ -23,8 +23,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-use tet_diffusion::glam::DVec3;
-use tet_diffusion::stuffing::{self, Options, winding::WindingNumber};
+use tet_stuffing::glam::DVec3;
+use tet_stuffing::{self as stuffing, Options, winding::WindingNumber};
 
 /// One row of the table.
 struct Row {

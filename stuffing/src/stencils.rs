@@ -291,9 +291,9 @@ fn split_prism(a: [Point; 3], b: [Point; 3], d: [bool; 3], apex: usize) -> Optio
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::stuffing::Params;
-    use crate::stuffing::lattice::{LONG_DIRS, SHORT_DIRS};
-    use crate::stuffing::quality::{dihedral_angles, signed_volume};
+    use crate::Params;
+    use crate::lattice::{LONG_DIRS, SHORT_DIRS};
+    use crate::quality::{dihedral_angles, signed_volume};
 
     /// A small deterministic generator (SplitMix64) for the sampling test.
     pub(crate) struct Rng(pub(crate) u64);
