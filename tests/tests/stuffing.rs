@@ -17,7 +17,12 @@ fn accepted(name: &str, positions: &[DVec3], triangles: &[[u32; 3]], h: f64) -> 
         .unwrap_or_else(|e| panic!("{name}: tet-diffusion refused the mesh: {e}"));
     let q = td.quality();
     let w = q.edge_weight_range.map(|x| x / q.mean_edge_length);
-    eprintln!("{name}: {} tets, cotangent edge weights / mean edge length {:.3} .. {:.3}", m.tets.len(), w[0], w[1]);
+    eprintln!(
+        "{name}: {} tets, cotangent edge weights / mean edge length {:.3} .. {:.3}",
+        m.tets.len(),
+        w[0],
+        w[1]
+    );
     assert_eq!(q.poor_tets, 0, "{name}: poorly shaped tetrahedra");
     assert!(w[0] > -5.0 && w[1] < 5.0, "{name}: weights {w:?}");
     w
@@ -38,7 +43,14 @@ fn a_stuffed_cube_is_a_valid_diffusion_mesh() {
     let p: Vec<DVec3> = (0..8)
         .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
         .collect();
-    let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
     let tris: Vec<[u32; 3]> = quads
         .iter()
         .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
@@ -59,7 +71,10 @@ fn every_stuffed_data_mesh_is_a_valid_diffusion_mesh() {
         .filter(|p| p.extension().is_some_and(|e| e == "obj"))
         .collect();
     files.sort();
-    assert!(files.len() >= 6, "expected the six meshes of the data README");
+    assert!(
+        files.len() >= 6,
+        "expected the six meshes of the data README"
+    );
     for f in &files {
         let m = trilux_io::mesh::TriMesh::read(f).expect("a readable mesh");
         let p: Vec<DVec3> = m.positions.iter().map(|p| p.as_dvec3()).collect();
