@@ -38,24 +38,11 @@ fn diagonal(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
 }
 
 #[test]
-fn a_stuffed_cube_is_a_valid_diffusion_mesh() {
-    // A unit cube with outward faces, split into triangles.
-    let p: Vec<DVec3> = (0..8)
-        .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-        .collect();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let tris: Vec<[u32; 3]> = quads
-        .iter()
-        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-        .collect();
-    accepted("cube", &p, &tris, 0.15);
+fn the_stuffed_blob_is_a_valid_diffusion_mesh() {
+    // The demo's closed, bumpy blob (about 2 units across).
+    let blob = trilux::shapes::blob(2);
+    let p: Vec<DVec3> = blob.positions.iter().map(|p| p.as_dvec3()).collect();
+    accepted("blob", &p, &blob.indices, 0.1);
 }
 
 #[test]
@@ -64,21 +51,20 @@ fn a_stuffed_cube_is_a_valid_diffusion_mesh() {
     ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
 )]
 fn every_stuffed_data_mesh_is_a_valid_diffusion_mesh() {
-    let dir = trilux_tests::data("meshes");
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .expect("the meshes folder")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "obj"))
-        .collect();
-    files.sort();
-    assert!(
-        files.len() >= 6,
-        "expected the six meshes of the data README"
-    );
+    // The six meshes of the data README, open and closed.
+    let names = [
+        "fandisk",
+        "nefertiti",
+        "spot",
+        "stanford-bunny",
+        "suzanne",
+        "teapot",
+    ];
+    let files = names.map(|n| trilux_tests::data(&format!("meshes/{n}.obj")));
     for f in &files {
         let m = trilux_io::mesh::TriMesh::read(f).expect("a readable mesh");
         let p: Vec<DVec3> = m.positions.iter().map(|p| p.as_dvec3()).collect();
-        let name = f.file_stem().unwrap().to_string_lossy().into_owned();
+        let name = f.display().to_string();
         accepted(&name, &p, &m.indices, diagonal(&p, &m.indices) / 30.0);
     }
     let tets = trilux_io::tet::TetMesh::read(trilux_tests::data("tets/bunny_500k.node")).unwrap();
