@@ -11,11 +11,13 @@ pub enum Error {
     /// line or byte, and the problem).
     #[error(transparent)]
     Io(#[from] trilux_io::Error),
-    /// mesh-sampling refused the mesh or the density.
-    #[error("sampling: {0}")]
+    /// mesh-sampling refused the mesh or the density (the source says
+    /// why).
+    #[error("sampling")]
     Sampling(#[from] mesh_sampling::Error),
-    /// mesh-colors refused the mesh, the texture or the file.
-    #[error("mesh colours: {0}")]
+    /// mesh-colors refused the mesh, the texture or the file (the source
+    /// says why).
+    #[error("mesh colours")]
     Colors(#[from] mesh_colors::Error),
     /// The mesh has no texture coordinates but the operation needs them.
     #[error("{what} needs texture coordinates, and the mesh has none")]
@@ -58,8 +60,23 @@ pub enum Error {
     /// The output exists and overwriting was not asked for.
     #[error("{0}: the file exists; pass --force to overwrite it")]
     Exists(PathBuf),
-    /// An I/O failure outside trilux-io (temporary files, renames).
-    #[error("{path}: {source}")]
+    /// What went wrong at a place: a file, an argument as typed, or a
+    /// step ("the solve failed"); the source says what. The place is
+    /// shown, the source is not (print the chain, joined by `": "`).
+    #[error("{place}")]
+    At {
+        /// The file, the argument as typed, or the step.
+        place: String,
+        /// Whether the command line itself is wrong (the `trilux` command
+        /// exits with 2 for it).
+        usage: bool,
+        /// What is wrong there.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync + 'static>,
+    },
+    /// An I/O failure outside trilux-io (temporary files, renames); the
+    /// `std::io::Error` is the source.
+    #[error("{}", path.display())]
     File {
         /// The file.
         path: PathBuf,
@@ -67,6 +84,31 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+}
+
+impl Error {
+    /// Whether the command line is what is wrong ([`Error::Usage`], or an
+    /// [`Error::At`] that says so): the `trilux` command exits with 2.
+    pub fn is_usage(&self) -> bool {
+        match self {
+            Error::Usage(_) => true,
+            Error::At { usage, .. } => *usage,
+            _ => false,
+        }
+    }
+
+    /// The file or argument this error's own message starts with, when it
+    /// names one.
+    pub fn place(&self) -> Option<String> {
+        match self {
+            Error::At { place, .. } => Some(place.clone()),
+            Error::Io(e) => Some(e.path.display().to_string()),
+            Error::WrongMesh { path, .. } | Error::Exists(path) | Error::File { path, .. } => {
+                Some(path.display().to_string())
+            }
+            _ => None,
+        }
+    }
 }
 
 /// Short for `Result<T, Error>`.

@@ -25,8 +25,9 @@ impl fmt::Display for Location {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ErrorKind {
-    /// The file could not be opened, read or written.
-    #[error("could not read or write the file: {0}")]
+    /// The file could not be opened, read or written; the
+    /// `std::io::Error` is the source.
+    #[error("could not read or write the file")]
     Io(#[source] std::io::Error),
     /// The extension names no format this crate reads or writes.
     #[error("the extension {0:?} names no format known here (expected one of {1})")]
@@ -86,7 +87,7 @@ pub enum ErrorKind {
     Unsupported(String),
     /// A codec (PNG, JPEG, HDR, EXR) could not decode or encode the data;
     /// its own error is the source.
-    #[error("the {format} codec failed: {source}")]
+    #[error("the {format} codec failed")]
     Codec {
         /// The format.
         format: &'static str,
@@ -156,6 +157,26 @@ impl Error {
         Self::new(path, ErrorKind::Io(error))
     }
 }
+
+/// A foreign error whose `Display` already prints its own cause and whose
+/// `source()` returns that cause too (image-rs's `ImageError` does both):
+/// shown as its text, with the chain stopped here, so that a printer that
+/// joins the chain with `": "` says the cause once.
+pub(crate) struct Whole(pub(crate) Box<dyn std::error::Error + Send + Sync>);
+
+impl fmt::Debug for Whole {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Debug::fmt(&self.0, f)
+    }
+}
+
+impl fmt::Display for Whole {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        fmt::Display::fmt(&self.0, f)
+    }
+}
+
+impl std::error::Error for Whole {}
 
 /// The lowercased extension of `path` ("" when it has none), which picks
 /// the format in every `read`.

@@ -186,7 +186,8 @@ fn check_exr_blocks(bytes: &[u8], name: &Path, options: ReadOptions) -> Result<(
             name,
             ErrorKind::Codec {
                 format: "OpenEXR",
-                source: Box::new(e),
+                // exr's I/O variant prints its cause and returns it.
+                source: Box::new(crate::error::Whole(Box::new(e))),
             },
         )
     })?;
@@ -252,7 +253,7 @@ fn codec_error(path: &Path, format: ImageFormat, e: ImageError) -> Error {
         ImageError::IoError(io) => ErrorKind::Io(io),
         other => ErrorKind::Codec {
             format: format_name(format),
-            source: Box::new(other),
+            source: Box::new(crate::error::Whole(Box::new(other))),
         },
     };
     Error::new(path, kind)

@@ -105,14 +105,26 @@ pub enum Error {
     /// A `.meshcolors` file that cannot be read.
     #[error("invalid .meshcolors data at byte {offset}: {reason}")]
     File {
+        /// The file, for [`crate::file::load`] (`None` for bytes or a
+        /// stream). Not part of the message: the caller names the file.
+        path: Option<std::path::PathBuf>,
         /// Byte offset where the problem was found.
         offset: u64,
         /// What was wrong.
         reason: String,
     },
-    /// An I/O failure while writing or reading a `.meshcolors` stream.
-    #[error("cannot read or write mesh colours: {0}")]
-    Io(String),
+    /// An I/O failure while writing or reading a `.meshcolors` stream; the
+    /// `std::io::Error` is the source.
+    #[error("cannot read or write mesh colours")]
+    Io {
+        /// The file, for [`crate::file::save`] and [`crate::file::load`]
+        /// (`None` for a stream). Not part of the message, as with
+        /// `std::io::Error`: the caller names the file it passed.
+        path: Option<std::path::PathBuf>,
+        /// What the operating system said.
+        #[source]
+        source: IoError,
+    },
     /// An allocation sized by arguments (or a file) would exceed its budget.
     #[error("{what} would need {requested} {unit}, more than the budget of {budget}")]
     TooLarge {
@@ -133,4 +145,27 @@ pub enum Error {
         /// The fingerprint of the mesh they were loaded for.
         expected: crate::Fingerprint,
     },
+}
+
+/// The `std::io::Error` behind [`Error::Io`], shared so that [`Error`]
+/// stays `Clone`; two compare equal when their [`std::io::ErrorKind`]s do.
+#[derive(Debug, Clone)]
+pub struct IoError(pub std::sync::Arc<std::io::Error>);
+
+impl PartialEq for IoError {
+    fn eq(&self, other: &Self) -> bool {
+        self.0.kind() == other.0.kind()
+    }
+}
+
+impl std::fmt::Display for IoError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for IoError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        self.0.source()
+    }
 }

@@ -94,27 +94,34 @@ pub fn to_bytes(colors: &MeshColors, mip: Option<&MipMap>) -> Result<Vec<u8>, Er
     Ok(out)
 }
 
+/// `e` as [`Error::Io`], naming `path` when there is one.
+fn io_error(path: Option<&Path>, e: std::io::Error) -> Error {
+    Error::Io {
+        path: path.map(Path::to_path_buf),
+        source: crate::IoError(std::sync::Arc::new(e)),
+    }
+}
+
 /// Writes mesh colours (and optionally their MIP pyramid) to a stream.
 ///
 /// # Errors
 /// [`Error::Io`], or as for [`to_bytes`].
 pub fn write(mut to: impl Write, colors: &MeshColors, mip: Option<&MipMap>) -> Result<(), Error> {
     to.write_all(&to_bytes(colors, mip)?)
-        .map_err(|e| Error::Io(e.to_string()))
+        .map_err(|e| io_error(None, e))
 }
 
 /// Saves to a `.meshcolors` file.
 ///
 /// # Errors
-/// [`Error::Io`] naming the path, or as for [`to_bytes`].
+/// [`Error::Io`] with `path` set, or as for [`to_bytes`].
 pub fn save(
     path: impl AsRef<Path>,
     colors: &MeshColors,
     mip: Option<&MipMap>,
 ) -> Result<(), Error> {
     let path = path.as_ref();
-    std::fs::write(path, to_bytes(colors, mip)?)
-        .map_err(|e| Error::Io(format!("{}: {e}", path.display())))
+    std::fs::write(path, to_bytes(colors, mip)?).map_err(|e| io_error(Some(path), e))
 }
 
 /// Reads a `.meshcolors` stream (see [`from_bytes`]).
@@ -124,18 +131,18 @@ pub fn save(
 pub fn read(mut from: impl Read) -> Result<(MeshColors, Option<MipMap>), Error> {
     let mut bytes = Vec::new();
     from.read_to_end(&mut bytes)
-        .map_err(|e| Error::Io(e.to_string()))?;
+        .map_err(|e| io_error(None, e))?;
     from_bytes(&bytes)
 }
 
 /// Loads a `.meshcolors` file.
 ///
 /// # Errors
-/// [`Error::Io`] naming the path, or as for [`from_bytes`] (with the path
-/// in the message).
+/// [`Error::Io`] or [`Error::File`] with `path` set, else as for
+/// [`from_bytes`].
 pub fn load(path: impl AsRef<Path>) -> Result<(MeshColors, Option<MipMap>), Error> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+    let bytes = std::fs::read(path).map_err(|e| io_error(Some(path), e))?;
     from_bytes(&bytes).map_err(|e| with_path(e, path))
 }
 
@@ -190,12 +197,13 @@ fn check_mesh(
     }
 }
 
-/// A file error with the file's name in front of its reason.
+/// A file error with the file it was found in.
 fn with_path(e: Error, path: &Path) -> Error {
     match e {
-        Error::File { offset, reason } => Error::File {
+        Error::File { offset, reason, .. } => Error::File {
+            path: Some(path.to_path_buf()),
             offset,
-            reason: format!("{}: {reason}", path.display()),
+            reason,
         },
         other => other,
     }
@@ -203,6 +211,7 @@ fn with_path(e: Error, path: &Path) -> Error {
 
 fn bad(offset: usize, reason: impl Into<String>) -> Error {
     Error::File {
+        path: None,
         offset: offset as u64,
         reason: reason.into(),
     }

@@ -68,7 +68,7 @@ mod structure;
 mod texture;
 mod topology;
 
-pub use error::Error;
+pub use error::{Error, IoError};
 pub use luminance::luminance;
 pub use mip::{FINEST_LEVEL, MAX_PROBES, MipMap};
 pub use paint::{Blend, Brush, Painter, Stroke};

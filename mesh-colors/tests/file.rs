@@ -100,7 +100,7 @@ fn truncated_and_inconsistent_files_are_rejected_with_the_offset() {
     );
     // A face naming a missing vertex: the error gives the face's offset.
     match rejected(&set(HEADER + 12 * 5, 10_000)) {
-        Error::File { offset, reason } => {
+        Error::File { offset, reason, .. } => {
             assert_eq!(offset, (HEADER + 12 * 5) as u64);
             assert!(reason.contains("face 5"), "{reason}");
         }

@@ -2,6 +2,7 @@
 
 /// What is wrong with a mesh, a material, a light, an edit or a solve.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// The mesh has no tetrahedra (or no vertices).
     #[error("the mesh is empty: it has {vertices} vertices and {tets} tetrahedra")]
@@ -109,7 +110,7 @@ pub enum Error {
     NotMatchingPieces,
     /// The solver stopped before reaching the tolerance.
     #[error(
-        "the {channel} channel did not converge: relative residual {residual:e} after {iterations} iterations ({stop}), tolerance {tolerance:e}"
+        "the {channel} channel did not converge: relative residual {residual:e} after {iterations} iterations ({stop:?}), tolerance {tolerance:e}"
     )]
     NotConverged {
         /// "red", "green" or "blue".
@@ -119,16 +120,17 @@ pub enum Error {
         /// Iterations done.
         iterations: usize,
         /// Why it stopped.
-        stop: String,
+        stop: multires::Stop,
         /// The tolerance asked for.
         tolerance: f64,
     },
-    /// An error of the linear solver.
-    #[error("the linear solver failed: {0}")]
+    /// An error of the linear solver (the source says which).
+    #[error("the linear solver failed")]
     Solver(#[from] multires::Error),
-    /// An error of the environment map's distribution.
-    #[error("the environment map cannot be sampled: {0}")]
-    Environment(String),
+    /// The environment map's distribution could not be built (the source,
+    /// `discrete-sampling`'s error, says why).
+    #[error("the environment map cannot be sampled")]
+    Environment(#[from] discrete_sampling::Error),
 }
 
 /// Checks that `value` is finite.

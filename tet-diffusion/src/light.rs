@@ -171,7 +171,7 @@ impl Environment {
         }
         let lum: Vec<f32> = rgb.iter().map(|p| luminance(*p)).collect();
         let dist = discrete_sampling::Distribution2D::from_equirect(&lum, width, height)
-            .map_err(|e| Error::Environment(e.to_string()))?;
+            .map_err(Error::Environment)?;
         let mut out = Vec::with_capacity(samples);
         for k in 0..samples {
             let u = [(k as f64 + 0.5) / samples as f64, radical_inverse(k as u32)];

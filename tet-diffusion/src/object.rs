@@ -730,7 +730,7 @@ impl Object {
                         channel: ["red", "green", "blue"][c],
                         residual: r.residual,
                         iterations: r.iterations,
-                        stop: format!("{:?}", r.stop),
+                        stop: r.stop,
                         tolerance,
                     });
                 }

@@ -9,7 +9,7 @@ use mesh_sampling::{SurfaceSampler, UniformSampler};
 use trilux::{ColorMesh, SurfaceTexture};
 use trilux_io::mesh::TriMesh;
 
-use super::{Context, Result, arg_error, file_error};
+use super::{Context, Result, arg_error, file_cause, file_error};
 
 #[derive(Debug, clap::Subcommand)]
 #[command(about = "Mesh colours: convert a textured mesh, bake an atlas, render")]
@@ -185,7 +185,7 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
     let force = context.force;
     context.step("writing the mesh colours", || {
         trilux::output::write_atomic(&args.output, force, |tmp| {
-            mesh_colors::file::save(tmp, &colors, None).map_err(|e| file_error(&args.output, e))
+            mesh_colors::file::save(tmp, &colors, None).map_err(|e| file_cause(&args.output, e))
         })
     })?;
     if let Some(p) = &args.preview {
@@ -236,7 +236,7 @@ pub(crate) fn load_for(
     path: &Path,
 ) -> Result<(ColorMesh, MeshColors)> {
     super::check_input(path)?;
-    let (colors, _) = mesh_colors::file::load(path).map_err(|e| file_error(path, e))?;
+    let (colors, _) = mesh_colors::file::load(path).map_err(|e| file_cause(path, e))?;
     let surface = ColorMesh::new(mesh).map_err(|e| super::at(mesh_path.display(), e))?;
     surface.check(&colors, path)?;
     Ok((surface, colors))

@@ -8,7 +8,7 @@ use trilux::shapes;
 use trilux_io::mesh::TriMesh;
 
 use super::sample::{Method, Source, draw};
-use super::{Context, Result, invalid};
+use super::{Context, Result};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -236,7 +236,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             super::colors::convert_mesh(&mut quiet, &torus, Some(&checker), &Default::default())?;
         let file = d.path("torus.meshcolors");
         trilux::output::write_atomic(&file, d.context.force, |tmp| {
-            mesh_colors::file::save(tmp, &colors, None).map_err(|e| super::file_error(&file, e))
+            mesh_colors::file::save(tmp, &colors, None).map_err(|e| super::file_cause(&file, e))
         })?;
         let atlas = mesh_colors::atlas::bake(&colors, &Default::default())?;
         let (baked, _) = trilux::atlas_mesh(&surface, &atlas, None);
@@ -296,7 +296,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         let files = trilux::output::write_atomic_files(&d.path("blob.node"), d.context.force, |tmp| {
             Ok(trilux_io::tet::write(tmp, &tets)?)
         })?;
-        let solver = |e: tet_diffusion::Error| invalid(format!("diffusion on the stuffed blob: {e}"));
+        let solver = |e: tet_diffusion::Error| super::placed("diffusion on the stuffed blob", false, e);
         let mesh = tet_diffusion::TetMesh::new(&tets.positions, &tets.tets).map_err(solver)?;
         let marble = tet_diffusion::Medium::measured("marble").map_err(solver)?;
         let media = vec![marble; mesh.tets().len()];

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use glam::{DVec3, Vec3};
 use tet_diffusion::{Cut, Light, Medium, Noise, Object, Stroke};
 
-use super::{Context, Result, arg_error, file_error};
+use super::{Context, Result, arg_cause, arg_error, file_cause, file_error};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -298,7 +298,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                     seed: 1,
                 }
                 .media(mesh)
-                .map_err(|e| arg_error(&material_arg, e))
+                .map_err(|e| arg_cause(&material_arg, e))
             })
         }
         None => {
@@ -329,7 +329,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         (out.positions, out.tets)
     };
     let mesh =
-        tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_error(&args.input, e))?;
+        tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_cause(&args.input, e))?;
     let (lo, hi) = positions
         .iter()
         .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| {
@@ -355,7 +355,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     }
     let mut object = context
         .step("assembling", || Object::new(mesh, unit_mm, media, 1.3))
-        .map_err(|e| file_error(&args.input, e))?;
+        .map_err(|e| file_cause(&args.input, e))?;
     if lights.is_empty() && args.envmap.is_none() {
         lights.push(Light::Directional {
             to_light: DVec3::new(0.4, 1.0, 0.7),
@@ -366,8 +366,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         object
             .add_light(light.clone())
             .map_err(|e| match args.light.get(k) {
-                Some(spec) => arg_error(format!("--light {spec}"), e),
-                None => file_error(&args.input, e),
+                Some(spec) => arg_cause(format!("--light {spec}"), e),
+                None => file_cause(&args.input, e),
             })?;
     }
     if let Some(path) = &args.envmap {
@@ -375,16 +375,16 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         let rgb: Vec<[f32; 3]> = image.pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let env =
             tet_diffusion::Environment::new(&rgb, image.width as usize, image.height as usize, 256)
-                .map_err(|e| file_error(path, e))?;
+                .map_err(|e| file_cause(path, e))?;
         object
             .add_light(Light::Environment(Arc::new(env)))
-            .map_err(|e| file_error(path, e))?;
+            .map_err(|e| file_cause(path, e))?;
     }
     for ((spec, paint), count) in paints.iter().zip(&mut painted) {
         if let Paint::Ball(stroke) = paint {
             *count = object
                 .paint(stroke)
-                .map_err(|e| arg_error(format!("--paint {spec}"), e))?
+                .map_err(|e| arg_cause(format!("--paint {spec}"), e))?
                 .tets;
         }
     }
@@ -399,13 +399,13 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                     CUT_RELAX_SWEEPS,
                 )
             })
-            .map_err(|e| arg_error(format!("--cut {spec}"), e))?;
+            .map_err(|e| arg_cause(format!("--cut {spec}"), e))?;
     }
     let mut objects = match fracture {
         Some((spec, (point, normal))) => {
             let [a, mut b] = object
                 .fracture(point, normal)
-                .map_err(|e| arg_error(format!("--fracture {spec}"), e))?;
+                .map_err(|e| arg_cause(format!("--fracture {spec}"), e))?;
             b.set_transform(glam::DAffine3::from_translation(normal * diagonal * 0.15));
             vec![a, b]
         }
@@ -414,9 +414,9 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let mut reports = Vec::new();
     for o in &mut objects {
         reports.push(
-            context
-                .step("solving", || o.solve())
-                .map_err(|e| file_error(&args.input, format!("the solve failed: {e}")))?,
+            context.step("solving", || o.solve()).map_err(|e| {
+                file_cause(&args.input, super::placed("the solve failed", false, e))
+            })?,
         );
     }
     let image = context.step("rendering", || render(&objects, &lights, args.size, view));

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::{Value, json};
 
-use super::{Context, Result, file_error};
+use super::{Context, Result, file_cause, file_error};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -360,7 +360,7 @@ fn image_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
 fn meshcolors_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let (colors, mip) = context
         .step("reading the mesh colours", || mesh_colors::file::load(path))
-        .map_err(|e| file_error(path, e))?;
+        .map_err(|e| file_cause(path, e))?;
     let mut histogram = std::collections::BTreeMap::new();
     for r in (0..colors.face_count()).filter_map(|f| colors.face_resolution(f)) {
         *histogram.entry(r).or_insert(0usize) += 1;

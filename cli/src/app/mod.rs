@@ -42,30 +42,52 @@ pub(crate) fn usage(message: impl Into<String>) -> Error {
 
 /// A problem with a file: `PATH: problem` (exit code 1).
 pub(crate) fn file_error(path: &Path, problem: impl Display) -> Error {
-    invalid(format!("{}: {problem}", path.display()))
+    placed(path.display(), false, invalid(problem.to_string()))
 }
 
 /// A problem with an argument: `ARGUMENT: problem` (exit code 2), where
 /// `argument` is the option as typed, with its value (`--size 0`).
 pub(crate) fn arg_error(argument: impl Display, problem: impl Display) -> Error {
-    usage(format!("{argument}: {problem}"))
+    placed(argument, true, usage(problem.to_string()))
 }
 
-/// `e` with `place` (a file or an argument) in front, unless its message
-/// already starts with it; a usage error stays one.
+/// A library's error `e` about a file: `PATH: e` with `e` kept as the
+/// source (its own causes follow it in the printed chain).
+pub(crate) fn file_cause(path: &Path, e: impl std::error::Error + Send + Sync + 'static) -> Error {
+    placed(path.display(), false, e)
+}
+
+/// A library's error `e` about an argument as typed (exit code 2).
+pub(crate) fn arg_cause(
+    argument: impl Display,
+    e: impl std::error::Error + Send + Sync + 'static,
+) -> Error {
+    placed(argument, true, e)
+}
+
+/// `source` at `place` (a file, an argument as typed, or a step).
+pub(crate) fn placed(
+    place: impl Display,
+    usage: bool,
+    source: impl std::error::Error + Send + Sync + 'static,
+) -> Error {
+    Error::At {
+        place: place.to_string(),
+        usage,
+        source: Box::new(source),
+    }
+}
+
+/// `e` with `place` (a file or an argument) in front, unless `e` already
+/// starts with it; a usage error stays one.
 pub(crate) fn at(place: impl Display, e: impl Into<Error>) -> Error {
     let e = e.into();
     let place = place.to_string();
-    let text = message(&e);
-    if text.starts_with(&format!("{place}: ")) {
+    if e.place().as_deref() == Some(place.as_str()) {
         return e;
     }
-    let text = format!("{place}: {text}");
-    if matches!(e, Error::Usage(_)) {
-        usage(text)
-    } else {
-        invalid(text)
-    }
+    let usage = e.is_usage();
+    placed(place, usage, e)
 }
 
 /// Checks that an input file exists, so that every subcommand says so in
@@ -277,30 +299,21 @@ fn parse_failure(e: &clap::Error) -> ExitCode {
 
 /// 2 for a wrong command line, 1 for anything else.
 fn exit_code(e: &Error) -> u8 {
-    if matches!(e, Error::Usage(_)) { 2 } else { 1 }
+    if e.is_usage() { 2 } else { 1 }
 }
 
-/// The error and its causes as one line, without repeating a cause the
-/// message already contains, naming its place (the text before the first
-/// `": "`) once even when a cause names it again, and without a closing
-/// full stop.
+/// The error and its causes as one line, joined by `": "` (every error
+/// type of the workspace shows its cause or returns it from `source()`,
+/// never both), without a closing full stop.
 fn message(e: &Error) -> String {
-    let mut text = e.to_string();
+    let mut parts = vec![e.to_string()];
     let mut source = std::error::Error::source(e);
     while let Some(s) = source {
-        let part = s.to_string();
-        if !text.contains(&part) {
-            text.push_str(": ");
-            text.push_str(&part);
-        }
+        parts.push(s.to_string());
         source = s.source();
     }
-    let mut text = text.split_whitespace().collect::<Vec<_>>().join(" ");
-    if let Some(end) = text.find(": ") {
-        let place = text[..end + 2].to_string();
-        let rest = text[end + 2..].replace(&place, "");
-        text = format!("{place}{rest}");
-    }
+    let text = parts.join(": ");
+    let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
     text.trim_end_matches('.').to_string()
 }
 
@@ -415,7 +428,7 @@ pub(crate) fn with_threads<T: Send>(
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(n)
                 .build()
-                .map_err(|e| invalid(format!("--threads {n}: {e}")))?;
+                .map_err(|e| placed(format!("--threads {n}"), false, e))?;
             Ok(pool.install(f))
         }
     }

@@ -13,7 +13,7 @@ use mesh_sampling::{
 use trilux_io::mesh::TriMesh;
 use trilux_io::mesh::ply;
 
-use super::{Context, Result, arg_error, file_error};
+use super::{Context, Result, arg_error, file_cause, file_error};
 
 /// The most points one run may ask for (about 100 bytes each while
 /// sampling and writing).
@@ -222,7 +222,7 @@ pub(crate) fn meshcolors_source(
 ) -> Result<Source> {
     let (surface, colors) = super::colors::load_for(mesh, mesh_path, path)?;
     let density = trilux::colors::color_density(&surface, &colors, channel)
-        .map_err(|e| file_error(path, e))?;
+        .map_err(|e| file_cause(path, e))?;
     Ok(Source::Atlas(density))
 }
 
@@ -295,7 +295,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                 trilux::sampling_wrap(m.wrap[0])
             });
         let texture = trilux::density_texture(&image, channel)
-            .map_err(|e| file_error(path, e))?
+            .map_err(|e| file_cause(path, e))?
             .with_wrap(wrap);
         Source::Texture(texture)
     } else if let Some(path) = &args.face_weights {

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use tet_stuffing as stuffing;
 use trilux_io::mesh::TriMesh;
 
-use super::{Context, Result, arg_error, file_error};
+use super::{Context, Result, arg_error, file_cause, file_error};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -119,7 +119,7 @@ pub(crate) fn stuff(
             } => too_fine(format!(
                 "about {estimated} tetrahedra, more than the limit of {limit}"
             )),
-            other => file_error(path, other),
+            other => file_cause(path, other),
         },
     )?;
     Ok((stuffed, h))
