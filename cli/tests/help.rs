@@ -1,6 +1,4 @@
-//! The binary starts and lists its subcommands (this also makes
-//! `cargo test --workspace` build it for the end-to-end tests of
-//! `trilux-tests`).
+//! The binary starts and lists its subcommands.
 
 #[test]
 fn help_lists_every_subcommand() {

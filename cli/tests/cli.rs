@@ -6,10 +6,8 @@
 use std::path::{Path, PathBuf};
 
 use trilux_io::mesh::TriMesh;
-use trilux_tests::{data, trilux_bin};
-
 mod common;
-use common::{fails, fails_with, json, run, stderr, trilux};
+use common::{data, fails, fails_with, have_data, json, run, stderr, trilux, trilux_bin};
 
 /// A built-in textured torus and a noise texture written as files.
 fn inputs(dir: &Path) -> (PathBuf, PathBuf) {
@@ -569,11 +567,10 @@ fn an_interrupted_run_leaves_no_output_file_or_a_complete_one() {
 }
 
 #[test]
-#[cfg_attr(
-    not(trilux_data),
-    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
-)]
 fn real_files_through_every_subcommand() {
+    if !have_data("real_files_through_every_subcommand") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let bunny = data("meshes/stanford-bunny.obj");

@@ -7,10 +7,8 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use trilux_io::mesh::TriMesh;
-use trilux_tests::data;
-
 mod common;
-use common::{fails, json, run, trilux};
+use common::{data, fails, have_data, json, run, trilux};
 
 /// The built-in bumpy blob (closed, about unit size) written as OBJ.
 fn blob(dir: &Path) -> PathBuf {
@@ -291,11 +289,10 @@ fn diffuse_names_a_bad_material_light_cut_or_mesh() {
 }
 
 #[test]
-#[cfg_attr(
-    not(trilux_data),
-    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
-)]
 fn tetra_stuffs_the_raw_bunny_and_diffuse_accepts_it() {
+    if !have_data("tetra_stuffs_the_raw_bunny_and_diffuse_accepts_it") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let bunny = data("meshes/stanford-bunny.obj");
@@ -374,11 +371,10 @@ fn info_reads_a_tetgen_face_file_beside_its_node_and_ele_files() {
 }
 
 #[test]
-#[cfg_attr(
-    not(trilux_data),
-    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
-)]
 fn info_reads_the_face_files_of_the_data_folder() {
+    if !have_data("info_reads_the_face_files_of_the_data_folder") {
+        return;
+    }
     let dir = tempfile::tempdir().unwrap();
     for name in ["bunny_50k", "sphere_20k"] {
         let file = data(&format!("tets/{name}.face"));
