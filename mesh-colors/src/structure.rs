@@ -96,6 +96,19 @@ impl MeshColors {
     /// # Errors
     /// [`Error::BadResolution`] naming the face, [`Error::ResolutionCount`],
     /// [`Error::BadChannels`].
+    ///
+    /// # Example
+    /// ```
+    /// use mesh_colors::{MeshColors, Topology};
+    /// let topology = Topology::new(4, &[[0, 1, 2], [2, 1, 3]])?;
+    /// // Face 0 at resolution 4, face 1 at 2, RGB.
+    /// let colors = MeshColors::new(topology, &[4, 2], 3)?;
+    /// assert_eq!(colors.face_resolution(0), Some(4));
+    /// // 3 is not a power of two.
+    /// let topology = Topology::new(4, &[[0, 1, 2], [2, 1, 3]])?;
+    /// assert!(MeshColors::new(topology, &[3, 2], 3).is_err());
+    /// # Ok::<(), mesh_colors::Error>(())
+    /// ```
     pub fn new(topology: Topology, resolutions: &[u32], channels: usize) -> Result<Self, Error> {
         if resolutions.len() != topology.faces.len() {
             return Err(Error::ResolutionCount {

@@ -54,6 +54,18 @@ impl Texture {
     /// # Errors
     /// [`Error::BadTexture`] when a size is zero or `data.len()` is not
     /// `width · height · channels`; [`Error::BadChannels`].
+    ///
+    /// # Example
+    /// ```
+    /// use mesh_colors::Texture;
+    /// // 2×1 grey texels, row 0 first (`v = 0` is row 0).
+    /// let t = Texture::new(2, 1, 1, vec![0.0, 1.0])?;
+    /// let mut out = [0.0];
+    /// t.bilinear([0.5, 0.5], &mut out); // between the two texel centres
+    /// assert!((out[0] - 0.5).abs() < 1e-6);
+    /// assert!(Texture::new(2, 1, 1, vec![0.0]).is_err()); // too few texels
+    /// # Ok::<(), mesh_colors::Error>(())
+    /// ```
     pub fn new(
         width: usize,
         height: usize,

@@ -33,6 +33,17 @@ impl Topology {
     /// mesh colours give an edge one sample row seen from both sides, which
     /// has no meaning for a fan of faces, so such meshes are rejected rather
     /// than coloured inconsistently).
+    ///
+    /// # Example
+    /// ```
+    /// use mesh_colors::Topology;
+    /// // Two triangles sharing the edge (1, 2): five edges, one shared.
+    /// let t = Topology::new(4, &[[0, 1, 2], [2, 1, 3]])?;
+    /// assert_eq!(t.edges().len(), 5);
+    /// // A vertex index beyond the count is an error naming the face.
+    /// assert!(Topology::new(3, &[[0, 1, 3]]).is_err());
+    /// # Ok::<(), mesh_colors::Error>(())
+    /// ```
     pub fn new(vertex_count: usize, faces: &[[u32; 3]]) -> Result<Self, Error> {
         let mut lookup: HashMap<(u32, u32), u32> = HashMap::with_capacity(faces.len() * 3 / 2);
         let mut edges = Vec::with_capacity(faces.len() * 3 / 2);

@@ -178,6 +178,20 @@ impl TriMesh {
     ///
     /// # Errors
     /// [`Error`] naming the file, the line, and what was wrong.
+    ///
+    /// # Example
+    /// ```
+    /// use trilux_io::mesh::TriMesh;
+    /// let path = std::env::temp_dir().join(format!("trilux-io-doc-{}.obj", std::process::id()));
+    /// std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    /// let mesh = TriMesh::read(&path)?;
+    /// assert_eq!((mesh.positions.len(), mesh.indices), (3, vec![[0, 1, 2]]));
+    /// # std::fs::remove_file(&path).unwrap();
+    /// // An unknown extension is refused, naming the file.
+    /// let e = TriMesh::read("model.stl").unwrap_err();
+    /// assert!(e.to_string().starts_with("model.stl: "));
+    /// # Ok::<(), trilux_io::Error>(())
+    /// ```
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         match crate::error::extension(path).as_str() {

@@ -149,6 +149,19 @@ fn library_files(folder: &Path, names: &str) -> Vec<String> {
 ///
 /// # Errors
 /// As for [`read`], without the files.
+///
+/// # Example
+/// ```
+/// // A quad is split into two triangles; `v` is flipped to glTF's convention.
+/// let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nf 1/1 2/2 3/3 4/4\n";
+/// let mesh = trilux_io::mesh::obj::from_bytes(obj, "quad.obj")?;
+/// assert_eq!(mesh.indices.len(), 2);
+/// assert_eq!(mesh.uvs.as_ref().map(|uv| uv[0].y), Some(1.0));
+/// // A face that names a missing vertex is an error at its line.
+/// let e = trilux_io::mesh::obj::from_bytes(b"v 0 0 0\nf 1 2 3\n", "bad.obj").unwrap_err();
+/// assert!(e.to_string().starts_with("bad.obj: line 2: "), "{e}");
+/// # Ok::<(), trilux_io::Error>(())
+/// ```
 pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<TriMesh> {
     parse(data, path.as_ref()).map(|(mesh, _)| mesh)
 }

@@ -70,6 +70,20 @@ impl TetMesh {
     ///
     /// # Errors
     /// [`Error`] naming the file, the line or byte, and what was wrong.
+    ///
+    /// # Example
+    /// ```
+    /// use trilux_io::tet::TetMesh;
+    /// let dir = std::env::temp_dir().join(format!("trilux-io-doc-tet-{}", std::process::id()));
+    /// std::fs::create_dir_all(&dir).unwrap();
+    /// // One tetrahedron as a TetGen pair (1-based indices).
+    /// std::fs::write(dir.join("one.node"), "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n").unwrap();
+    /// std::fs::write(dir.join("one.ele"), "1 4 0\n1 1 2 3 4\n").unwrap();
+    /// let mesh = TetMesh::read(dir.join("one.node"))?; // finds one.ele beside it
+    /// assert_eq!(mesh.tets, vec![[0, 1, 2, 3]]);
+    /// # std::fs::remove_dir_all(&dir).unwrap();
+    /// # Ok::<(), trilux_io::Error>(())
+    /// ```
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         match crate::error::extension(path).as_str() {
