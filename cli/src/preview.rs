@@ -121,11 +121,7 @@ impl Renderer {
         let (w, h) = (width * ss, height * ss);
         let aspect = width as f32 / height as f32;
         let color = (0..h)
-            .flat_map(|y| {
-                let t = y as f32 / h as f32;
-                let g = 0.32 - 0.17 * t;
-                std::iter::repeat_n([g, g, g * 1.05, 1.0], w as usize)
-            })
+            .flat_map(|y| std::iter::repeat_n(background(y, h), w as usize))
             .collect();
         Self {
             width,
@@ -267,6 +263,54 @@ impl Renderer {
         }
     }
 
+    /// Per output pixel, the fraction of its samples a triangle or point
+    /// covers (0 = background only, 1 = fully covered), row-major like
+    /// [`image`](Self::image).
+    pub fn coverage(&self) -> Vec<f32> {
+        let w = self.width * self.ss;
+        let n = (self.ss * self.ss) as f32;
+        let mut out = Vec::with_capacity((self.width * self.height) as usize);
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let mut covered = 0u32;
+                for dy in 0..self.ss {
+                    for dx in 0..self.ss {
+                        let i = ((y * self.ss + dy) * w + x * self.ss + dx) as usize;
+                        covered += u32::from(self.depth[i].is_finite());
+                    }
+                }
+                out.push(covered as f32 / n);
+            }
+        }
+        out
+    }
+
+    /// The background alone (the soft grey gradient every picture starts
+    /// from), averaged per output pixel as [`image`](Self::image) averages.
+    pub fn background(&self) -> Image {
+        let h = self.height * self.ss;
+        let n = (self.ss * self.ss) as f32;
+        let mut pixels = Vec::with_capacity((self.width * self.height) as usize);
+        for y in 0..self.height {
+            // Summed in the order `image` sums, so that an uncovered
+            // pixel of the picture equals this bit for bit.
+            let mut sum = [0.0f32; 4];
+            for dy in 0..self.ss {
+                for _ in 0..self.ss {
+                    for (s, c) in sum.iter_mut().zip(background(y * self.ss + dy, h)) {
+                        *s += c;
+                    }
+                }
+            }
+            pixels.extend(std::iter::repeat_n(sum.map(|s| s / n), self.width as usize));
+        }
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels,
+        }
+    }
+
     /// The picture: each output pixel the mean of its samples.
     pub fn image(&self) -> Image {
         let w = self.width * self.ss;
@@ -292,6 +336,14 @@ impl Renderer {
             pixels,
         }
     }
+}
+
+/// The background colour of sample row `y` of `h` (linear RGBA): a soft
+/// grey gradient, lighter at the top.
+fn background(y: u32, h: u32) -> [f32; 4] {
+    let t = y as f32 / h as f32;
+    let g = 0.32 - 0.17 * t;
+    [g, g, g * 1.05, 1.0]
 }
 
 /// Diffuse shading of `albedo` under a key light from the upper left of

@@ -213,7 +213,10 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
         ],
     );
     assert_eq!(report["objects"], 2);
-    assert_eq!(report["tetrahedra"], tets.tets.len());
+    // The fracture splits the tetrahedra the plane crosses (both crack
+    // faces flat), so the pieces hold more than were stuffed.
+    let pieces = report["tetrahedra"].as_u64().unwrap();
+    assert!(pieces > tets.tets.len() as u64, "{pieces}");
     fails(
         d,
         &[

@@ -43,7 +43,7 @@ use tet_diffusion::multires::{
     self, Cascade, CascadeOptions, SolveOptions, VCycle, VCycleOptions, Weights,
 };
 use tet_diffusion::sprs::CsMat;
-use tet_diffusion::{Cut, Integration, Light, Medium, Method, Object, Stroke, TetMesh};
+use tet_diffusion::{Cut, CutMethod, Integration, Light, Medium, Method, Object, Stroke, TetMesh};
 
 /// A solve of channel `c` into `x` with an iteration cap and an optional
 /// monitor.
@@ -468,7 +468,8 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
         let mut o = object.clone();
         o.settings.method = method;
         let t = Instant::now();
-        o.cut(&plane, 5).map_err(|e| e.to_string())?;
+        o.cut(&plane, CutMethod::Relax { sweeps: 5 })
+            .map_err(|e| e.to_string())?;
         o.solve().map_err(|e| e.to_string())?;
         tcut[k] = ms(t);
         cut_objects.push(o);

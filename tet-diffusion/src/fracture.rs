@@ -1,8 +1,9 @@
 //! Fracture and recombination (the paper's Fig. 1d–e): split an object
-//! along a plane into two objects that solve independently (the vertices
-//! of the faces between the sides are duplicated, one copy per piece), move
-//! them apart for display with rigid transforms, and merge two pieces back
-//! into exactly the object they came from.
+//! along a plane into two objects that solve independently (the tets the
+//! plane crosses split along it exactly, by the machinery of the exact
+//! cut, and the vertices of the faces between the sides duplicated, one
+//! copy per piece), move them apart for display with rigid transforms, and
+//! merge two pieces back into exactly the split object they came from.
 
 #![expect(
     clippy::needless_range_loop,
@@ -13,6 +14,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::DVec3;
 
+use crate::cut::split::{self, Keep};
 use crate::error::finite_vec;
 use crate::object::Lineage;
 use crate::{Error, Light, Object, TetMesh};
@@ -21,11 +23,16 @@ use crate::{Error, Light, Object, TetMesh};
 static FRACTURES: AtomicU64 = AtomicU64::new(1);
 
 impl Object {
-    /// Splits the object by the plane through `point` with `normal`: tets
-    /// whose centre has `(c − point) · normal ≥ 0` go to the second piece,
-    /// the others to the first. Each piece keeps the material, the lights
-    /// (re-traced against its own surface), `φ` as its warm start, and what
-    /// it needs to be [`recombine`](Object::recombine)d.
+    /// Splits the object by the plane through `point` with `normal`: the
+    /// tets the plane crosses are first split along it exactly (as
+    /// [`CutMethod::Exact`](crate::CutMethod::Exact) splits them, vertices
+    /// within [`SNAP`](crate::cut::SNAP) of it snapped onto it, `φ`
+    /// interpolated at the new vertices); then the tets on the side
+    /// `(x − point) · normal ≥ 0` go to the second piece, the others to the
+    /// first, so both crack faces lie on the plane. Each piece keeps the
+    /// material, the lights (re-traced against its own surface), `φ` as
+    /// its warm start, and what it needs to be
+    /// [`recombine`](Object::recombine)d.
     ///
     /// # Errors
     /// [`Error::BadArgument`] for a non-finite point or a zero normal,
@@ -40,10 +47,10 @@ impl Object {
                 need: "it must be non-zero",
             });
         }
-        let mesh = &self.mesh;
-        let upper: Vec<bool> = (0..mesh.tets().len())
-            .map(|t| (mesh.tet_center(t) - point).dot(normal) >= 0.0)
-            .collect();
+        let unit = normal.normalize();
+        let level = move |x: DVec3| (x - point).dot(unit);
+        let split = split::split(&self.mesh, &level, Keep::Both);
+        let upper: Vec<bool> = split.side.iter().map(|&s| s > 0).collect();
         let count = upper.iter().filter(|&&u| u).count();
         if count == 0 {
             return Err(Error::EmptyPiece {
@@ -55,6 +62,11 @@ impl Object {
                 side: "the negative",
             });
         }
+        // A split changed the mesh: the pieces recombine into the split
+        // object, which is no longer a piece of an earlier fracture.
+        let changed = split.split_tets > 0 || split.snapped > 0;
+        let parts = self.split_parts(&split, false)?;
+        let mesh = &parts.mesh;
         let token = FRACTURES.fetch_add(1, Ordering::Relaxed);
         let piece = |want: bool| -> Result<Object, Error> {
             let tet_ids: Vec<u32> = (0..upper.len() as u32)
@@ -92,27 +104,33 @@ impl Object {
                 parent_tets: mesh.tets().len(),
                 vertex,
                 tet: tet_ids,
-                parent: self.lineage.clone().map(Box::new),
+                parent: if changed {
+                    None
+                } else {
+                    self.lineage.clone().map(Box::new)
+                },
                 parent_original: mesh.original_ids().to_vec(),
             };
-            self.derive(sub, lineage)
+            self.derive(sub, lineage, &parts.media, &parts.phi)
         };
         Ok([piece(false)?, piece(true)?])
     }
 
-    /// A new object on `mesh` with this one's material, settings and
-    /// lights, `φ` carried through `lineage.vertex`.
-    fn derive(&self, mesh: TetMesh, lineage: Lineage) -> Result<Object, Error> {
-        let mut object = Object::new(mesh, self.length_unit_mm, self.media.clone(), self.eta)?;
+    /// A new object on `mesh` with `media`, this one's settings and
+    /// lights, and `phi` (of the parent mesh) carried through
+    /// `lineage.vertex`.
+    fn derive(
+        &self,
+        mesh: TetMesh,
+        lineage: Lineage,
+        media: &[crate::Medium],
+        phi: &[Vec<f64>; 3],
+    ) -> Result<Object, Error> {
+        let mut object = Object::new(mesh, self.length_unit_mm, media.to_vec(), self.eta)?;
         object.settings = self.settings;
         object.shadows_enabled = self.shadows_enabled;
-        object.phi = std::array::from_fn(|c| {
-            lineage
-                .vertex
-                .iter()
-                .map(|&v| self.phi[c][v as usize])
-                .collect()
-        });
+        object.phi =
+            std::array::from_fn(|c| lineage.vertex.iter().map(|&v| phi[c][v as usize]).collect());
         for l in &self.lights {
             object.add_light(l.light.clone())?;
         }
@@ -121,7 +139,8 @@ impl Object {
     }
 
     /// Merges the two pieces of one [`fracture`](Object::fracture) back
-    /// into the object they came from: the same vertices, tets, material
+    /// into the object they came from, split along the fracture plane: the
+    /// same vertices, tets, material
     /// (with what was painted on either piece) and therefore exactly the
     /// same matrices. Display transforms are dropped; lights and settings
     /// come from `a`.

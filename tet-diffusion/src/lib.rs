@@ -22,7 +22,9 @@
 //!   results independent of the number of threads. [`Object::solve`] uses
 //!   `multires` (V-cycle-PCG by default; the paper's cascade and
 //!   Jacobi-PCG selectable), warm-started from the last `φ`;
-//!   [`Object::radiance`] is Eq. 3.
+//!   [`Object::radiance`] is Eq. 3 divided by `η²`, the radiance in air
+//!   (Eq. 3 as printed, the radiance just inside, is
+//!   [`Object::radiance_inside`]).
 //! - [`Light`]: directional, point and importance-sampled environment
 //!   maps, with shadow rays against the boundary cached per vertex; `q` of
 //!   Eq. 2 with the Fresnel transmittance on entry.
@@ -53,7 +55,7 @@
 //! let mut cube = Object::homogeneous(mesh, 1.0, Medium::measured("skin1")?, 1.3)?;
 //! cube.add_light(Light::Directional { to_light: DVec3::Z, irradiance: [1.0; 3] })?;
 //! cube.solve()?;
-//! let radiance = cube.radiance(None); // RGB per boundary vertex (Eq. 3)
+//! let radiance = cube.radiance(None); // RGB per boundary vertex (Eq. 3 / η²)
 //! assert_eq!(radiance.len(), cube.mesh().boundary_vertices().len());
 //! // Paint ketchup into one corner: only the touched rows are re-assembled.
 //! let ketchup = Medium::measured("ketchup")?;
@@ -80,7 +82,7 @@ pub mod session;
 #[path = "../tests/common/kuhn.rs"]
 mod kuhn;
 
-pub use cut::{Cut, CutReport};
+pub use cut::{Cut, CutMethod, CutReport};
 pub use error::Error;
 pub use fem::{Integration, P1Matrices};
 pub use light::{Environment, Light};

@@ -807,29 +807,70 @@ impl Object {
         self.kept = None;
     }
 
-    /// Outgoing radiance (Eq. 3) at each boundary vertex, in the order of
+    /// The hemispherical flux `J⁺` (W/mm², RGB) that meets the boundary
+    /// from inside at each boundary vertex, in the order of
     /// [`TetMesh::boundary_vertices`]:
-    /// `L_o = F_t(ω_o) / (4π) · [(1 + 1/A) φ − 4 q / (1 + F_dr)]`,
-    /// with `F_t` at the angle between the vertex normal and `toward` (the
-    /// unit direction to the viewer, in mesh coordinates), or at normal
-    /// exitance when `None`. Clamped at 0.
-    pub fn radiance(&self, toward: Option<DVec3>) -> Vec<[f64; 3]> {
+    /// `J⁺ = [(1 + 1/A) φ − 4 q / (1 + F_dr)] / 4 = (φ − 2q) / (2 (1 + F_dr))`
+    /// (Arbree et al.; the bracket of TransCut's Eq. 3), clamped at 0.
+    /// `(1 − F_dr) J⁺` of it leaves the object. Radiance is this times
+    /// [`fresnel::exit_radiance_factor`] (in air) or
+    /// [`fresnel::inside_radiance_factor`] (Eq. 3 as printed), which a
+    /// renderer evaluates per fragment from the direction to its eye.
+    pub fn boundary_flux(&self) -> Vec<[f64; 3]> {
         let a = self.boundary_factor();
         let fdr = self.fdr();
+        self.mesh
+            .boundary_vertices()
+            .iter()
+            .enumerate()
+            .map(|(k, &v)| {
+                [0, 1, 2].map(|c| {
+                    let j = ((1.0 + 1.0 / a) * self.phi[c][v as usize]
+                        - 4.0 * self.q[k][c] / (1.0 + fdr))
+                        / 4.0;
+                    j.max(0.0)
+                })
+            })
+            .collect()
+    }
+
+    /// Outgoing radiance in air (W/(mm² sr), RGB) at each boundary vertex,
+    /// in the order of [`TetMesh::boundary_vertices`]:
+    /// `L_o = F_t(ω_o) J⁺ / (π η²)` — TransCut's Eq. 3 divided by `η²`,
+    /// because Eq. 3 as printed is the radiance just inside the boundary
+    /// and `L/η²` is invariant across it (see
+    /// [`fresnel::exit_radiance_factor`]; [`radiance_inside`](Self::radiance_inside)
+    /// is the printed form). Integrated over the boundary and the outgoing
+    /// hemisphere it equals the power that entered minus the power
+    /// absorbed. `F_t` is at the angle between the vertex normal and
+    /// `toward` (the unit direction to the viewer, in mesh coordinates), or
+    /// at normal exitance when `None`. Never negative.
+    pub fn radiance(&self, toward: Option<DVec3>) -> Vec<[f64; 3]> {
+        self.radiance_with(toward, fresnel::exit_radiance_factor)
+    }
+
+    /// TransCut's Eq. 3 exactly as printed,
+    /// `L = F_t(ω_o) / (4π) · [(1 + 1/A) φ − 4 q / (1 + F_dr)]`: the
+    /// radiance just *inside* the boundary, `η²` times the radiance in air
+    /// that [`radiance`](Self::radiance) gives (1.69× at η = 1.3). For
+    /// comparison with the paper and with renders made before the
+    /// correction; arguments and order as for [`radiance`](Self::radiance).
+    pub fn radiance_inside(&self, toward: Option<DVec3>) -> Vec<[f64; 3]> {
+        self.radiance_with(toward, fresnel::inside_radiance_factor)
+    }
+
+    /// [`boundary_flux`](Self::boundary_flux) times `factor(cos, η)` per
+    /// boundary vertex.
+    fn radiance_with(&self, toward: Option<DVec3>, factor: fn(f64, f64) -> f64) -> Vec<[f64; 3]> {
         let mesh = &self.mesh;
         let toward = toward.map(|d| d.normalize_or_zero());
         mesh.boundary_vertices()
             .iter()
-            .enumerate()
-            .map(|(k, &v)| {
+            .zip(self.boundary_flux())
+            .map(|(&v, j)| {
                 let cos = toward.map_or(1.0, |d| mesh.vertex_normals()[v as usize].dot(d));
-                let ft = fresnel::transmittance(cos, self.eta);
-                [0, 1, 2].map(|c| {
-                    let l = ft / (4.0 * std::f64::consts::PI)
-                        * ((1.0 + 1.0 / a) * self.phi[c][v as usize]
-                            - 4.0 * self.q[k][c] / (1.0 + fdr));
-                    l.max(0.0)
-                })
+                let f = factor(cos, self.eta);
+                j.map(|x| f * x)
             })
             .collect()
     }

@@ -169,18 +169,19 @@ pub struct SessionOptions {
     /// Relative residual of the first result after an edit (10⁻²: with
     /// the V-cycle, a few iterations).
     pub coarse_tolerance: f64,
-    /// Sweeps of the cut's relaxation (see [`Object::cut`]).
-    pub relax_sweeps: usize,
+    /// How cuts cut (see [`Object::cut`]): exact by default, or the
+    /// paper's relaxation.
+    pub cut_method: crate::CutMethod,
     /// Bytes the undo deltas may hold together.
     pub undo_budget_bytes: usize,
 }
 
 impl Default for SessionOptions {
-    /// 10⁻², 20 sweeps, 512 MiB of undo.
+    /// 10⁻², exact cuts, 512 MiB of undo.
     fn default() -> Self {
         Self {
             coarse_tolerance: 1e-2,
-            relax_sweeps: 20,
+            cut_method: crate::CutMethod::Exact,
             undo_budget_bytes: 512 << 20,
         }
     }
@@ -492,7 +493,7 @@ impl Session {
                         continue;
                     }
                     let mut piece = piece.clone();
-                    match piece.cut(&local, self.options.relax_sweeps) {
+                    match piece.cut(&local, self.options.cut_method) {
                         Ok(_) => {
                             touched.push(pieces.len());
                             pieces.push(piece);

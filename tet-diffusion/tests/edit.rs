@@ -4,7 +4,7 @@ mod common;
 
 use common::*;
 use tet_diffusion::glam::{DAffine3, DVec3};
-use tet_diffusion::{Cut, Error, Light, Medium, Object, Stroke, TetMesh};
+use tet_diffusion::{Cut, CutMethod, Error, Light, Medium, Object, Stroke, TetMesh};
 
 fn lit_ball(n: usize) -> Object {
     let mut o =
@@ -72,7 +72,7 @@ fn plane_cut() {
         point: DVec3::new(0.0, 0.0, 1.0),
         normal: DVec3::new(0.2, 0.1, 1.0),
     };
-    let report = o.cut(&cut, 10).unwrap();
+    let report = o.cut(&cut, CutMethod::Relax { sweeps: 10 }).unwrap();
     assert!(report.removed_tets > 0 && report.removed_vertices > 0 && report.moved_vertices > 0);
     assert_eq!(
         o.mesh().tets().len() + report.removed_tets,
@@ -111,7 +111,7 @@ fn stroke_cut() {
     };
     assert!(cut.side(DVec3::new(0.0, 4.0, 0.0)) > 0.0);
     assert!(cut.side(DVec3::new(0.0, -4.0, 0.0)) < 0.0);
-    let report = o.cut(&cut, 5).unwrap();
+    let report = o.cut(&cut, CutMethod::Relax { sweeps: 5 }).unwrap();
     assert!(report.removed_tets > 0);
     check_cut(&before, &o, &cut);
     o.solve().unwrap();
@@ -125,19 +125,19 @@ fn bad_cuts_are_errors() {
         normal: DVec3::X,
     };
     assert!(matches!(
-        o.cut(&everything, 1),
+        o.cut(&everything, CutMethod::Exact),
         Err(Error::CutRemovesEverything { .. })
     ));
     let zero = Cut::Plane {
         point: DVec3::ZERO,
         normal: DVec3::ZERO,
     };
-    assert!(o.cut(&zero, 1).is_err());
+    assert!(o.cut(&zero, CutMethod::Exact).is_err());
     let nan = Cut::Stroke {
         points: vec![DVec3::ZERO, DVec3::NAN],
         view: DVec3::Z,
     };
-    assert!(o.cut(&nan, 1).is_err());
+    assert!(o.cut(&nan, CutMethod::Relax { sweeps: 1 }).is_err());
     // Nothing was lost.
     assert_eq!(o.mesh().tets().len(), 3 * 3 * 3 * 6);
 }
@@ -186,10 +186,8 @@ fn fracture_and_recombine() {
     let mut o = lit_ball(6);
     o.solve().unwrap();
     let [mut a, mut b] = o.fracture(DVec3::ZERO, DVec3::new(1.0, 0.2, 0.1)).unwrap();
-    assert_eq!(
-        a.mesh().tets().len() + b.mesh().tets().len(),
-        o.mesh().tets().len()
-    );
+    // The tets the plane crosses are split: more tets than before.
+    assert!(a.mesh().tets().len() + b.mesh().tets().len() > o.mesh().tets().len());
     // The faces between the pieces are duplicated.
     assert!(a.mesh().vertex_count() + b.mesh().vertex_count() > o.mesh().vertex_count());
     // Each piece solves on its own (its light now also enters the crack).
@@ -201,13 +199,37 @@ fn fracture_and_recombine() {
             < 1e-12
     );
     let back = Object::recombine(&a, &b).unwrap();
-    assert_eq!(back.mesh().positions(), o.mesh().positions());
-    assert_eq!(back.mesh().tets(), o.mesh().tets());
+    // The recombined object is the original split along the plane: every
+    // tet on one side, the same volume up to the vertices snapped onto the
+    // plane, and its system is a fresh assembly's.
+    assert_eq!(
+        back.mesh().tets().len(),
+        a.mesh().tets().len() + b.mesh().tets().len()
+    );
+    assert!(back.mesh().tets().len() > o.mesh().tets().len());
+    let volume = (back.mesh().volume() / o.mesh().volume() - 1.0).abs();
+    assert!(volume < 1e-2, "{volume}");
+    let mut fresh = Object::new(back.mesh().clone(), 1.0, back.media().to_vec(), 1.3).unwrap();
+    fresh
+        .add_light(Light::Directional {
+            to_light: DVec3::new(0.3, 1.0, 0.2),
+            irradiance: [1.0; 3],
+        })
+        .unwrap();
     for c in 0..3 {
-        assert_eq!(back.matrix(c).data(), o.matrix(c).data());
-        assert_eq!(back.matrix(c).indices(), o.matrix(c).indices());
-        assert_eq!(back.rhs(c), o.rhs(c));
+        assert_eq!(back.matrix(c).data(), fresh.matrix(c).data());
+        assert_eq!(back.matrix(c).indices(), fresh.matrix(c).indices());
+        assert_eq!(back.rhs(c), fresh.rhs(c));
     }
+    // Both crack faces lie on the plane: fracturing the recombined object
+    // again splits nothing and gives the same pieces.
+    let [a2, b2] = back
+        .fracture(DVec3::ZERO, DVec3::new(1.0, 0.2, 0.1))
+        .unwrap();
+    assert_eq!(a2.mesh().tets(), a.mesh().tets());
+    assert_eq!(a2.mesh().positions(), a.mesh().positions());
+    assert_eq!(b2.mesh().tets(), b.mesh().tets());
+    assert_eq!(b2.mesh().positions(), b.mesh().positions());
     // Pieces of different fractures do not recombine.
     let [c, _] = o.fracture(DVec3::ZERO, DVec3::Y).unwrap();
     assert!(matches!(
@@ -232,9 +254,112 @@ fn paint_on_a_piece_survives_recombination() {
     })
     .unwrap();
     let back = Object::recombine(&a, &b).unwrap();
-    let fresh = Object::new(o.mesh().clone(), 1.0, back.media().to_vec(), 1.3).unwrap();
+    let fresh = Object::new(back.mesh().clone(), 1.0, back.media().to_vec(), 1.3).unwrap();
     for c in 0..3 {
         assert_eq!(back.matrix(c).data(), fresh.matrix(c).data());
     }
     assert_ne!(back.media(), o.media());
+}
+
+#[test]
+fn exact_plane_cut_lies_on_the_plane() {
+    let mut o = lit_ball(8);
+    o.solve().unwrap();
+    let before = o.clone();
+    let (point, normal) = (DVec3::new(0.0, 0.0, 1.0), DVec3::new(0.2, 0.1, 1.0));
+    let cut = Cut::Plane { point, normal };
+    let report = o.cut(&cut, CutMethod::Exact).unwrap();
+    assert!(report.split_tets > 0 && report.created_vertices > 0 && report.created_tets > 0);
+    assert!(report.min_created_dihedral >= tet_diffusion::cut::MIN_CREATED_DIHEDRAL_DEGREES);
+    let (off, deviation, vertices) = check_exact_plane_cut(
+        before.mesh(),
+        o.mesh(),
+        point,
+        normal,
+        tet_diffusion::cut::MIN_CREATED_DIHEDRAL_DEGREES,
+    );
+    eprintln!(
+        "{vertices} cut vertices, at most {off:e} of the box off the plane, normals within {deviation:.2e}°; {report:?}"
+    );
+    // The volume left is the analytic clipped volume, up to the vertices
+    // snapped onto the plane (each moved less than SNAP of an edge).
+    let analytic = clipped_volume(before.mesh(), point, normal);
+    let left = o.mesh().volume();
+    let error = (left / analytic - 1.0).abs();
+    eprintln!("volume {left} vs analytic {analytic}: {error:.2e}");
+    assert!(error < 2e-3, "{error}");
+    // The system is a fresh assembly's on the cut mesh, φ carried over is a
+    // good warm start, and the new vertices got interpolated φ.
+    let fresh = Object::new(o.mesh().clone(), 1.0, o.media().to_vec(), 1.3).unwrap();
+    for c in 0..3 {
+        assert_eq!(o.matrix(c).data(), fresh.matrix(c).data());
+        assert!(o.phi(c).iter().all(|&p| p > 0.0));
+    }
+    let warm = o.solve().unwrap();
+    let mut cold = fresh;
+    cold.add_light(Light::Directional {
+        to_light: DVec3::new(0.3, 1.0, 0.2),
+        irradiance: [1.0; 3],
+    })
+    .unwrap();
+    let c = cold.solve().unwrap();
+    assert!(warm.channels[1].iterations < c.channels[1].iterations);
+}
+
+#[test]
+fn exact_cuts_split_pieces_paint_alone_and_undo_by_a_clone() {
+    let mut o = lit_ball(6);
+    o.solve().unwrap();
+    let kept = o.clone();
+    let cut = Cut::Stroke {
+        points: vec![DVec3::new(-9.0, 1.0, 9.0), DVec3::new(9.0, 1.3, 9.0)],
+        view: DVec3::NEG_Z,
+    };
+    let report = o.cut(&cut, CutMethod::Exact).unwrap();
+    assert!(report.split_tets > 0);
+    // Every vertex lies on the kept side, those of the cut face on the
+    // stroke's surface.
+    for &x in o.mesh().positions() {
+        assert!(cut.side(x) <= 1e-9, "{x}");
+    }
+    // Each piece of a split tet has its own id: painting one piece leaves
+    // its siblings alone, and the painted rows equal a full assembly.
+    let ids = o.mesh().original_ids().to_vec();
+    let mut sorted = ids.clone();
+    sorted.sort_unstable();
+    sorted.dedup();
+    assert_eq!(sorted.len(), ids.len());
+    let stroke = Stroke {
+        points: vec![DVec3::new(0.0, 1.1, 0.0)],
+        radius: 0.5,
+        medium: Medium::measured("ketchup").unwrap(),
+        strength: 1.0,
+    };
+    let painted = o.paint(&stroke).unwrap();
+    assert!(painted.tets > 0);
+    let full = Object::new(o.mesh().clone(), 1.0, o.media().to_vec(), 1.3).unwrap();
+    for c in 0..3 {
+        assert_eq!(o.matrix(c).data(), full.matrix(c).data());
+    }
+    o.solve().unwrap();
+    // Undo is the clone taken before: untouched by the cut and the paint.
+    assert!(kept.mesh().tets().len() < o.mesh().tets().len() + report.removed_tets + 1);
+    let again = Object::new(kept.mesh().clone(), 1.0, kept.media().to_vec(), 1.3).unwrap();
+    for c in 0..3 {
+        assert_eq!(kept.matrix(c).data(), again.matrix(c).data());
+    }
+}
+
+#[test]
+fn fracture_pieces_meet_on_the_plane_with_the_analytic_volumes() {
+    let o = lit_ball(6);
+    let (point, normal) = (DVec3::new(0.3, 0.0, 0.0), DVec3::new(1.0, 0.2, 0.1));
+    let [a, b] = o.fracture(point, normal).unwrap();
+    let below = clipped_volume(o.mesh(), point, normal);
+    let above = clipped_volume(o.mesh(), point, -normal);
+    for (piece, analytic, n) in [(&a, below, normal), (&b, above, -normal)] {
+        let error = (piece.mesh().volume() / analytic - 1.0).abs();
+        assert!(error < 5e-3, "{error}");
+        check_exact_plane_cut(o.mesh(), piece.mesh(), point, n, 0.0);
+    }
 }

@@ -356,18 +356,54 @@ fn warns_when_the_mesh_cannot_resolve_the_material() {
 
 #[test]
 fn manufactured_solution_after_a_cut() {
-    // The cut surface (flat, relaxed) is a boundary like any other.
+    // The cut surface (exact or relaxed) is a boundary like any other.
     let whole = manufactured_error(ball(12, 3.0), 0.2, 1.0);
-    let mut o = Object::homogeneous(ball(12, 3.0), 1.0, grey(0.2, 1.0), 1.3).unwrap();
-    o.cut(
-        &tet_diffusion::Cut::Plane {
-            point: DVec3::new(0.0, 0.0, 0.7),
-            normal: DVec3::new(0.3, 0.0, 1.0),
-        },
-        5,
-    )
-    .unwrap();
-    let cut = manufactured_error(o.mesh().clone(), 0.2, 1.0);
-    eprintln!("manufactured: whole {whole:.2e}, cut {cut:.2e}");
-    assert!(cut < 3.0 * whole, "{cut} vs {whole}");
+    for method in [
+        tet_diffusion::CutMethod::Exact,
+        tet_diffusion::CutMethod::Relax { sweeps: 5 },
+    ] {
+        let mut o = Object::homogeneous(ball(12, 3.0), 1.0, grey(0.2, 1.0), 1.3).unwrap();
+        o.cut(
+            &tet_diffusion::Cut::Plane {
+                point: DVec3::new(0.0, 0.0, 0.7),
+                normal: DVec3::new(0.3, 0.0, 1.0),
+            },
+            method,
+        )
+        .unwrap();
+        let cut = manufactured_error(o.mesh().clone(), 0.2, 1.0);
+        eprintln!("manufactured, {method:?}: whole {whole:.2e}, cut {cut:.2e}");
+        assert!(cut < 3.0 * whole, "{cut} vs {whole}");
+    }
+}
+
+#[test]
+fn radiance_lets_out_the_power_that_entered_and_was_not_absorbed() {
+    // ∫∫ L cos θ dω dA = ∫ q dA − ∫ μa φ dV, independent of any camera;
+    // Eq. 3 as printed (the radiance inside) breaks it by η².
+    for (material, eta) in [("marble", 1.3), ("skimmilk", 1.5), ("marble", 1.0)] {
+        let mut o =
+            Object::homogeneous(ball(6, 10.0), 1.0, Medium::measured(material).unwrap(), eta)
+                .unwrap();
+        o.add_light(Light::Directional {
+            to_light: DVec3::new(0.3, 1.0, 0.2),
+            irradiance: [1.0, 0.8, 0.6],
+        })
+        .unwrap();
+        o.settings.tolerance = 1e-10;
+        o.solve().unwrap();
+        let outside = radiance_balance(&o, |o, d| o.radiance(Some(d)), 4096);
+        let inside = radiance_balance(&o, |o, d| o.radiance_inside(Some(d)), 4096);
+        for c in 0..3 {
+            let (radiated, balance) = outside[c];
+            let ratio = radiated / balance;
+            eprintln!("{material} η = {eta} channel {c}: radiated / (in − absorbed) = {ratio:.5}");
+            assert!(
+                (ratio - 1.0).abs() < 0.01,
+                "{material} η = {eta} channel {c}: {ratio}"
+            );
+            let published = inside[c].0 / inside[c].1;
+            assert!((published / ratio - eta * eta).abs() < 1e-9 * eta * eta);
+        }
+    }
 }

@@ -314,7 +314,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                     point: glam::DVec3::new(0.0, 0.0, 0.35),
                     normal: glam::DVec3::Z,
                 },
-                super::diffuse::CUT_RELAX_SWEEPS,
+                tet_diffusion::CutMethod::Exact,
             )
             .map_err(solver)?;
         let report = object.solve().map_err(solver)?;

@@ -107,3 +107,187 @@ pub(crate) fn sphere_error(mesh: TetMesh, mu_a: f64, sigma_s: f64, radius: f64) 
     o.solve().unwrap();
     rel_l2(o.mesh(), o.phi(0), &exact)
 }
+
+/// `n` unit directions spread evenly over the sphere (a Fibonacci
+/// lattice), each standing for `4π/n` steradians.
+pub(crate) fn sphere_directions(n: usize) -> Vec<DVec3> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - (2.0 * i as f64 + 1.0) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let a = golden * i as f64;
+            DVec3::new(r * a.cos(), r * a.sin(), z)
+        })
+        .collect()
+}
+
+/// The energy balance of the radiance, per channel, in W: the radiance
+/// of [`Object::radiance`] integrated over the boundary (each vertex's
+/// share `S_i/3`) and every direction it is seen from
+/// (`∫∫ L cos θ dω dA`, by `directions` points over the sphere, the
+/// outgoing hemisphere of each vertex being where `cos θ > 0`), and the
+/// power that entered (`∫ q dA`) minus the power absorbed (`∫ μa φ dV`,
+/// lumped as the solver lumps it). Lengths in mm.
+pub(crate) fn radiance_balance(
+    o: &Object,
+    radiance: impl Fn(&Object, DVec3) -> Vec<[f64; 3]>,
+    directions: usize,
+) -> [(f64, f64); 3] {
+    let mesh = o.mesh();
+    let unit = o.length_unit_mm();
+    let share: Vec<f64> = mesh
+        .boundary_vertices()
+        .iter()
+        .map(|&v| mesh.vertex_areas()[v as usize] / 3.0 * unit * unit)
+        .collect();
+    let mut radiated = [0.0; 3];
+    let dirs = sphere_directions(directions);
+    let solid_angle = 4.0 * std::f64::consts::PI / directions as f64;
+    for &d in &dirs {
+        let l = radiance(o, d);
+        for (k, &v) in mesh.boundary_vertices().iter().enumerate() {
+            let cos = mesh.vertex_normals()[v as usize].dot(d);
+            if cos > 0.0 {
+                for c in 0..3 {
+                    radiated[c] += l[k][c] * cos * share[k] * solid_angle;
+                }
+            }
+        }
+    }
+    std::array::from_fn(|c| {
+        let entered: f64 = o.incident().iter().zip(&share).map(|(q, s)| q[c] * s).sum();
+        let absorbed: f64 = mesh
+            .tets()
+            .iter()
+            .enumerate()
+            .map(|(t, tet)| {
+                let mean = tet.iter().map(|&v| o.phi(c)[v as usize]).sum::<f64>() / 4.0;
+                mesh.tet_volume(t) * unit.powi(3) * o.medium(t).unwrap().sigma_a[c] * mean
+            })
+            .sum();
+        (radiated[c], entered - absorbed)
+    })
+}
+
+/// The volume of `mesh` on the side `(x − point) · normal ≤ 0`, computed
+/// independently of any cut: each tet's faces are clipped by the plane
+/// (Sutherland–Hodgman) and the clipped polygons coned from a point of the
+/// plane, whose cone over the cap face is flat (divergence theorem).
+pub(crate) fn clipped_volume(mesh: &TetMesh, point: DVec3, normal: DVec3) -> f64 {
+    let n = normal.normalize();
+    let d = |x: DVec3| (x - point).dot(n);
+    let faces = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+    let mut total = 0.0;
+    for t in 0..mesh.tets().len() {
+        let c = mesh.corners(t);
+        for f in faces {
+            let poly: Vec<DVec3> = f.iter().map(|&k| c[k]).collect();
+            let mut clipped = Vec::new();
+            for i in 0..poly.len() {
+                let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+                let (da, db) = (d(a), d(b));
+                if da <= 0.0 {
+                    clipped.push(a);
+                }
+                if (da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0) {
+                    clipped.push(a + (b - a) * (da / (da - db)));
+                }
+            }
+            for k in 1..clipped.len().saturating_sub(1) {
+                let (a, b, e) = (
+                    clipped[0] - point,
+                    clipped[k] - point,
+                    clipped[k + 1] - point,
+                );
+                total += a.dot(b.cross(e)) / 6.0;
+            }
+        }
+    }
+    total
+}
+
+/// Checks an exact cut by the plane (`point`, `normal`, removing the side
+/// the normal points to) of `before` into `after`: every boundary vertex
+/// the cut made (not an old boundary vertex where it was) lies on the plane
+/// to `1e-9` of the bounding box; every tet has a dihedral angle of at
+/// least `min(bound, before's smallest)`; the cut face's normal is within
+/// 1° of the plane's at every vertex of it. Returns (the largest distance
+/// of a cut vertex from the plane relative to the box, the largest normal
+/// deviation in degrees, the number of cut vertices).
+pub(crate) fn check_exact_plane_cut(
+    before: &TetMesh,
+    after: &TetMesh,
+    point: DVec3,
+    normal: DVec3,
+    bound: f64,
+) -> (f64, f64, usize) {
+    let n = normal.normalize();
+    let (lo, hi) = before
+        .positions()
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| {
+            (a.min(p), b.max(p))
+        });
+    let size = (hi - lo).length();
+    let old_surface: std::collections::HashSet<[u64; 3]> = before
+        .boundary_vertices()
+        .iter()
+        .map(|&v| before.positions()[v as usize].to_array().map(f64::to_bits))
+        .collect();
+    let on_plane = |x: DVec3| (x - point).dot(n).abs() <= 1e-9 * size;
+    let mut farthest = 0.0f64;
+    let mut cut_vertices = vec![false; after.vertex_count()];
+    for &v in after.boundary_vertices() {
+        let x = after.positions()[v as usize];
+        if !old_surface.contains(&x.to_array().map(f64::to_bits)) {
+            let dist = (x - point).dot(n).abs() / size;
+            farthest = farthest.max(dist);
+            assert!(
+                dist <= 1e-9,
+                "boundary vertex {v} at {x} is {dist:e} of the box off the plane"
+            );
+            cut_vertices[v as usize] = true;
+        }
+    }
+    // Angles.
+    let min_of = |m: &TetMesh| {
+        (0..m.tets().len())
+            .map(|t| {
+                m.dihedral_angles(t)
+                    .into_iter()
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(f64::INFINITY, f64::min)
+            .to_degrees()
+    };
+    let (was, now) = (min_of(before), min_of(after));
+    assert!(
+        now >= bound.min(was) - 1e-9,
+        "smallest dihedral {now}° (before {was}°, bound {bound}°)"
+    );
+    // The cut face: boundary faces with every vertex on the plane.
+    let mut face_normal = vec![DVec3::ZERO; after.vertex_count()];
+    for f in after.boundary() {
+        let p = f.map(|v| after.positions()[v as usize]);
+        if p.iter().all(|&x| on_plane(x)) {
+            let cross = (p[1] - p[0]).cross(p[2] - p[0]);
+            for &v in f {
+                face_normal[v as usize] += cross;
+            }
+        }
+    }
+    let mut worst = 0.0f64;
+    let mut count = 0;
+    for (v, &is_cut) in cut_vertices.iter().enumerate() {
+        if is_cut {
+            let m = face_normal[v];
+            assert!(m.length() > 0.0, "cut vertex {v} has no face on the plane");
+            let angle = m.normalize().dot(n).clamp(-1.0, 1.0).acos().to_degrees();
+            worst = worst.max(angle);
+            count += 1;
+        }
+    }
+    assert!(worst < 1.0, "the cut face's normal deviates by {worst}°");
+    (farthest, worst, count)
+}

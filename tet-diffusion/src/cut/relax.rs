@@ -1,125 +1,19 @@
-//! Cutting (TransCut Sec. 5): remove the tets lying entirely on the cut
-//! side of a plane or of a stroke swept along the view direction, drop
-//! orphaned vertices, relax the remaining cut-side vertices toward the
-//! cross-section, rebuild the system, and carry `φ` over as the warm
-//! start.
+//! TransCut's cut (Sec. 5): remove the tets lying entirely on the cut
+//! side, drop orphaned vertices, and relax the remaining cut-side vertices
+//! toward the cross-section.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::error::finite_vec;
+use super::{Cut, CutReport};
 use crate::mesh::{POOR_DIHEDRAL_DEGREES, dihedral_angles, volume6};
 use crate::{Error, Object, TetMesh};
-
-/// What to cut away.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Cut {
-    /// Removes the half-space `(x − point) · normal > 0`.
-    Plane {
-        /// A point of the plane, mesh units.
-        point: DVec3,
-        /// The normal, pointing into the removed side.
-        normal: DVec3,
-    },
-    /// A polyline drawn on the screen, swept along the viewing direction
-    /// `view` (from the eye into the scene): removes what lies to its left
-    /// as the viewer sees it. Each point is classified by the segment
-    /// closest to it in the screen plane.
-    Stroke {
-        /// At least two points, mesh units.
-        points: Vec<DVec3>,
-        /// The viewing direction.
-        view: DVec3,
-    },
-}
-
-impl Cut {
-    /// Checks the cut's values.
-    ///
-    /// # Errors
-    /// [`Error::BadArgument`] for a non-finite or zero plane/stroke, or a
-    /// stroke of fewer than two points.
-    pub fn check(&self) -> Result<(), Error> {
-        let nonzero = |what: &str, v: DVec3| -> Result<(), Error> {
-            finite_vec(what, v)?;
-            if v.length_squared() == 0.0 {
-                return Err(Error::BadArgument {
-                    what: format!("the length of {what}"),
-                    value: 0.0,
-                    need: "it must be non-zero",
-                });
-            }
-            Ok(())
-        };
-        match self {
-            Self::Plane { point, normal } => {
-                finite_vec("the cut plane's point", *point)?;
-                nonzero("the cut plane's normal", *normal)
-            }
-            Self::Stroke { points, view } => {
-                nonzero("the stroke's view direction", *view)?;
-                if points.len() < 2 {
-                    return Err(Error::BadArgument {
-                        what: "the number of stroke points".into(),
-                        value: points.len() as f64,
-                        need: "a cutting stroke needs at least two points",
-                    });
-                }
-                for (k, p) in points.iter().enumerate() {
-                    finite_vec(&format!("stroke point {k}"), *p)?;
-                }
-                Ok(())
-            }
-        }
-    }
-
-    /// Signed distance-like side of `x`: positive on the removed side.
-    pub fn side(&self, x: DVec3) -> f64 {
-        match self {
-            Self::Plane { point, normal } => (x - *point).dot(normal.normalize()),
-            Self::Stroke { points, view } => {
-                let d = view.normalize();
-                let flat = |p: DVec3| p - d * p.dot(d);
-                let xf = flat(x);
-                let mut best = (f64::INFINITY, 0.0);
-                for w in points.windows(2) {
-                    let (a, b) = (flat(w[0]), flat(w[1]));
-                    let s = b - a;
-                    let len2 = s.length_squared();
-                    if len2 == 0.0 {
-                        continue;
-                    }
-                    let t = ((xf - a).dot(s) / len2).clamp(0.0, 1.0);
-                    let dist = xf.distance(a + s * t);
-                    if dist < best.0 {
-                        let left = s.cross(d).normalize();
-                        best = (dist, (xf - a).dot(left));
-                    }
-                }
-                best.1
-            }
-        }
-    }
-}
-
-/// What a cut did.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CutReport {
-    /// Tetrahedra removed.
-    pub removed_tets: usize,
-    /// Vertices removed (no tet left around them).
-    pub removed_vertices: usize,
-    /// Cut-side vertices moved at least once by the relaxation.
-    pub moved_vertices: usize,
-    /// Relaxation sweeps done (fewer than asked when nothing could move).
-    pub sweeps: usize,
-}
 
 /// The relaxation step of the paper, `x ← x + ρ (x′ − x)`.
 pub const RHO: f64 = 0.1;
 
 impl Object {
-    /// Cuts the object: removes every tet whose four vertices lie on the
+    /// [`CutMethod::Relax`](super::CutMethod::Relax): removes every tet whose four vertices lie on the
     /// cut side, removes orphaned vertices, keeps each remaining tet's
     /// original id, then relaxes the remaining cut-side vertices that were
     /// inside the object toward the cross-section for `relax_sweeps` sweeps, `x ← x + ρ (x′ − x)`
@@ -132,8 +26,7 @@ impl Object {
     /// # Errors
     /// [`Error::BadArgument`] for a non-finite or zero plane/stroke,
     /// [`Error::CutRemovesEverything`].
-    pub fn cut(&mut self, cut: &Cut, relax_sweeps: usize) -> Result<CutReport, Error> {
-        cut.check()?;
+    pub(super) fn cut_relax(&mut self, cut: &Cut, relax_sweeps: usize) -> Result<CutReport, Error> {
         let mesh = &self.mesh;
         let n = mesh.vertex_count();
         let side: Vec<f64> = mesh.positions().par_iter().map(|&x| cut.side(x)).collect();
@@ -184,6 +77,10 @@ impl Object {
             removed_vertices,
             moved_vertices: moved,
             sweeps,
+            split_tets: 0,
+            created_tets: 0,
+            created_vertices: 0,
+            min_created_dihedral: f64::INFINITY,
         })
     }
 }
