@@ -80,7 +80,10 @@ fn photon(rng: &mut Random, sigma_s: f64, mu_a: f64) -> f64 {
     let albedo = sigma_s / sigma_t;
     let cone = CONE_DEGREES.to_radians().cos();
     // Enter through the disc the light (from +y) sees.
-    let (r, a) = (RADIUS * rng.next().sqrt(), 2.0 * std::f64::consts::PI * rng.next());
+    let (r, a) = (
+        RADIUS * rng.next().sqrt(),
+        2.0 * std::f64::consts::PI * rng.next(),
+    );
     let (x, z) = (r * a.cos(), r * a.sin());
     let mut p = DVec3::new(x, (RADIUS * RADIUS - r * r).max(0.0).sqrt(), z);
     let n = p / RADIUS;
@@ -154,8 +157,11 @@ fn traced(photons: usize, sigma_s: f64, mu_a: f64, seed: u64) -> (f64, f64) {
 /// (in air) and with the printed Eq. 3 (`radiance_inside`).
 fn diffusion(material: Medium) -> Result<([f64; 3], [f64; 3]), String> {
     let data = std::env::var_os("TRILUX_DATA").unwrap_or_else(|| "../shared/data".into());
-    let path = std::path::Path::new(&data).join("tets").join("sphere_200k.node");
-    let file = trilux_io::tet::TetMesh::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let path = std::path::Path::new(&data)
+        .join("tets")
+        .join("sphere_200k.node");
+    let file =
+        trilux_io::tet::TetMesh::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mesh = TetMesh::new(&file.positions, &file.tets).map_err(|e| e.to_string())?;
     let mut o = Object::homogeneous(mesh, RADIUS, material, ETA).map_err(|e| e.to_string())?;
     o.add_light(Light::Directional {
@@ -182,7 +188,11 @@ fn diffusion(material: Medium) -> Result<([f64; 3], [f64; 3]), String> {
     let mut out = [[0.0; 3]; 2];
     for (slot, inside) in [(0, false), (1, true)] {
         for &w in &directions {
-            let l = if inside { o.radiance_inside(Some(w)) } else { o.radiance(Some(w)) };
+            let l = if inside {
+                o.radiance_inside(Some(w))
+            } else {
+                o.radiance(Some(w))
+            };
             for (j, &v) in mesh.boundary_vertices().iter().enumerate() {
                 let v = v as usize;
                 if mesh.positions()[v].y <= 0.0 {
@@ -221,7 +231,9 @@ fn run() -> Result<(), String> {
     println!(
         "{name}, R = {RADIUS} mm, η = {ETA}, light from +y, intensity toward +z (within {CONE_DEGREES}°) from y > 0, W/sr; {photons} photons per channel\n"
     );
-    println!("| channel | path traced | ± (1σ) | diffusion, radiance in air | ratio | Eq. 3 as printed | ratio |");
+    println!(
+        "| channel | path traced | ± (1σ) | diffusion, radiance in air | ratio | Eq. 3 as printed | ratio |"
+    );
     println!("|---|---|---|---|---|---|---|");
     for c in 0..3 {
         let (t, sd) = traced(photons, m.sigma_s_prime[c], m.sigma_a[c], 0x7A11 + c as u64);
