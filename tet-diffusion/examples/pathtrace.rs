@@ -155,6 +155,10 @@ fn traced(photons: usize, sigma_s: f64, mu_a: f64, seed: u64) -> (f64, f64) {
 
 /// The diffusion model's intensity (W/sr) per channel, with `radiance`
 /// (in air) and with the printed Eq. 3 (`radiance_inside`).
+#[allow(
+    clippy::needless_range_loop,
+    reason = "RGB loops index several per-channel arrays by one channel index"
+)]
 fn diffusion(material: Medium) -> Result<([f64; 3], [f64; 3]), String> {
     let data = std::env::var_os("TRILUX_DATA").unwrap_or_else(|| "../shared/data".into());
     let path = std::path::Path::new(&data)
@@ -209,6 +213,10 @@ fn diffusion(material: Medium) -> Result<([f64; 3], [f64; 3]), String> {
     Ok((out[0], out[1]))
 }
 
+#[allow(
+    clippy::needless_range_loop,
+    reason = "RGB loops index several per-channel arrays by one channel index"
+)]
 fn run() -> Result<(), String> {
     let mut photons = 200_000usize;
     let mut name = "marble".to_string();

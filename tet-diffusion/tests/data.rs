@@ -148,6 +148,10 @@ fn manufactured(mesh: TetMesh, mu_a: f64, sigma_s: f64) -> f64 {
     not(trilux_data),
     ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
 )]
+#[allow(
+    clippy::needless_range_loop,
+    reason = "RGB loops index several per-channel arrays by one channel index"
+)]
 fn radiance_balances_the_power_on_every_tetgen_mesh() {
     // ∫∫ L cos θ dω dA over the boundary and the outgoing hemisphere =
     // power in − ∫ μa φ dV, to 1 %, for two materials and three indices

@@ -60,12 +60,16 @@ fn directional_light_and_shadows() {
     o.solve().unwrap();
     let vertex = |k: usize| m.boundary_vertices()[k] as usize;
     assert!(o.phi(0)[vertex(lit)] > 10.0 * o.phi(0)[vertex(shadowed)]);
-    // Eq. 3 where q = 0: L_o = F_t / 4π · (1 + 1/A) φ.
-    let l = o.radiance(None);
+    // Eq. 3 where q = 0: L = F_t / 4π · (1 + 1/A) φ just inside, and that
+    // over η² in air.
+    let inside = o.radiance_inside(None);
     let expected = ft / (4.0 * std::f64::consts::PI)
         * (1.0 + 1.0 / o.boundary_factor())
         * o.phi(1)[vertex(back)];
-    assert!((l[back][1] - expected).abs() < 1e-12 * expected);
+    assert!((inside[back][1] - expected).abs() < 1e-12 * expected);
+    let l = o.radiance(None);
+    let in_air = expected / (o.eta() * o.eta());
+    assert!((l[back][1] - in_air).abs() < 1e-12 * in_air);
     assert!(l.iter().flatten().all(|x| x.is_finite() && *x >= 0.0));
     // Seen at grazing angles, less light leaves.
     let grazing = o.radiance(Some(DVec3::new(1.0, 0.0, 0.1)));

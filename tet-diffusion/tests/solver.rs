@@ -378,6 +378,10 @@ fn manufactured_solution_after_a_cut() {
 }
 
 #[test]
+#[allow(
+    clippy::needless_range_loop,
+    reason = "RGB loops index several per-channel arrays by one channel index"
+)]
 fn radiance_lets_out_the_power_that_entered_and_was_not_absorbed() {
     // ∫∫ L cos θ dω dA = ∫ q dA − ∫ μa φ dV, independent of any camera;
     // Eq. 3 as printed (the radiance inside) breaks it by η².

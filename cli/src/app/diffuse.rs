@@ -681,6 +681,10 @@ pub(crate) fn exposure_white(picture: &Picture) -> f32 {
 /// ([`exposure_white`]), the background gradient left as it is (a pixel
 /// the objects do not cover is copied unchanged; an edge pixel scales only
 /// its covered part), then the PNG writer's sRGB encoding.
+#[allow(
+    clippy::needless_range_loop,
+    reason = "each of R, G, B reads three per-channel arrays"
+)]
 pub(crate) fn tone_map(picture: &Picture) -> trilux_io::image::Image {
     let white = exposure_white(picture);
     let pixels = picture

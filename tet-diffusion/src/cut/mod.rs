@@ -7,7 +7,7 @@
 //!   of the tets it creates ([`split`]);
 //! - **relax** (the paper's): the tets entirely on the cut side are
 //!   removed and the remaining cut-side vertices relaxed toward the
-//!   cross-section ([`relax`]), which leaves the face as jagged as the
+//!   cross-section, which leaves the face as jagged as the
 //!   mesh where the relaxation cannot reach.
 //!
 //! Either way the system is rebuilt and `φ` carried over as the warm

@@ -129,6 +129,10 @@ pub(crate) fn sphere_directions(n: usize) -> Vec<DVec3> {
 /// outgoing hemisphere of each vertex being where `cos θ > 0`), and the
 /// power that entered (`∫ q dA`) minus the power absorbed (`∫ μa φ dV`,
 /// lumped as the solver lumps it). Lengths in mm.
+#[allow(
+    clippy::needless_range_loop,
+    reason = "RGB loops index several per-channel arrays by one channel index"
+)]
 pub(crate) fn radiance_balance(
     o: &Object,
     radiance: impl Fn(&Object, DVec3) -> Vec<[f64; 3]>,
