@@ -24,7 +24,7 @@ fn stuffed_blob(dir: &Path, size: &str) {
         .args([
             "tetra",
             blob.to_str().unwrap(),
-            "--size",
+            "--spacing",
             size,
             "-o",
             "blob.node",
@@ -40,7 +40,7 @@ fn tetra_writes_tetgen_medit_and_vtu_with_the_reported_counts() {
     let blob = blob(d);
     let blob = blob.to_str().unwrap();
     for out in ["blob.node", "blob.mesh"] {
-        let report = json(d, &["tetra", blob, "--size", "0.15", "-o", out]);
+        let report = json(d, &["tetra", blob, "--spacing", "0.15", "-o", out]);
         let mesh = trilux_io::tet::read(d.join(out)).unwrap();
         assert!(!mesh.tets.is_empty());
         assert_eq!(report["tetrahedra"], mesh.tets.len());
@@ -53,16 +53,24 @@ fn tetra_writes_tetgen_medit_and_vtu_with_the_reported_counts() {
         assert!(0.0 < lo && lo <= hi && hi < 180.0, "{lo} {hi}");
     }
     // The same lattice gives the same mesh in every format.
-    let report = json(d, &["tetra", blob, "--size", "0.15", "-o", "blob.vtu"]);
+    let report = json(d, &["tetra", blob, "--spacing", "0.15", "-o", "blob.vtu"]);
     let vtu = std::fs::read_to_string(d.join("blob.vtu")).unwrap();
     let cells = format!("NumberOfCells=\"{}\"", report["tetrahedra"]);
     assert!(vtu.contains(&cells), "{cells} not in the VTU header");
     // Grading keeps the surface's resolution with fewer tetrahedra inside.
     let graded = json(
         d,
-        &["tetra", blob, "--size", "0.05", "--graded", "-o", "g.node"],
+        &[
+            "tetra",
+            blob,
+            "--spacing",
+            "0.05",
+            "--graded",
+            "-o",
+            "g.node",
+        ],
     );
-    let uniform = json(d, &["tetra", blob, "--size", "0.05", "-o", "u.node"]);
+    let uniform = json(d, &["tetra", blob, "--spacing", "0.05", "-o", "u.node"]);
     assert!(
         graded["tetrahedra"].as_u64() < uniform["tetrahedra"].as_u64(),
         "graded {} vs uniform {}",
@@ -83,7 +91,7 @@ fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
     triangle.write(d.join("triangle.obj")).unwrap();
     fails(
         d,
-        &["tetra", "triangle.obj", "--size", "0.1", "-o", "t.node"],
+        &["tetra", "triangle.obj", "--spacing", "0.1", "-o", "t.node"],
         &["triangle.obj", "encloses nothing"],
     );
     assert!(!d.join("t.node").exists() && !d.join("t.ele").exists());
@@ -106,7 +114,7 @@ fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
     sheet.write(d.join("sheet.obj")).unwrap();
     fails(
         d,
-        &["tetra", "sheet.obj", "--size", "0.1", "-o", "s.node"],
+        &["tetra", "sheet.obj", "--spacing", "0.1", "-o", "s.node"],
         &["sheet.obj", "encloses nothing"],
     );
     fails(
@@ -118,14 +126,14 @@ fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
     let blob = blob.to_str().unwrap();
     fails(
         d,
-        &["tetra", blob, "--size=-1", "-o", "neg.node"],
-        &["--size"],
+        &["tetra", blob, "--spacing=-1", "-o", "neg.node"],
+        &["--spacing"],
     );
     // An existing output is kept without --force, replaced with it.
     std::fs::write(d.join("kept.mesh"), "precious").unwrap();
     fails(
         d,
-        &["tetra", blob, "--size", "0.2", "-o", "kept.mesh"],
+        &["tetra", blob, "--spacing", "0.2", "-o", "kept.mesh"],
         &["kept.mesh", "--force"],
     );
     assert_eq!(
@@ -133,7 +141,15 @@ fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
         "precious"
     );
     trilux(d)
-        .args(["tetra", blob, "--size", "0.2", "-o", "kept.mesh", "--force"])
+        .args([
+            "tetra",
+            blob,
+            "--spacing",
+            "0.2",
+            "-o",
+            "kept.mesh",
+            "--force",
+        ])
         .assert()
         .success();
     assert!(
@@ -470,18 +486,51 @@ fn tetra_refuses_a_spacing_too_fine_before_computing_and_reports_the_one_it_used
     let d = dir.path();
     let blob = blob(d);
     let blob = blob.to_str().unwrap();
-    // A user trial's tiny --size ran for minutes and aborted on memory:
+    // A user trial's tiny spacing ran for minutes and aborted on memory:
     // now it is a usage error naming the argument, in readable numbers.
     for size in ["0.0004", "1e-300"] {
         let err = common::fails_with(
             d,
             2,
-            &["tetra", blob, "--size", size, "-o", "t.node"],
-            &["--size", "too fine for this surface", "use a larger --size"],
+            &["tetra", blob, "--spacing", size, "-o", "t.node"],
+            &[
+                "--spacing",
+                "too fine for this surface",
+                "use a larger --spacing",
+            ],
         );
         assert!(err.len() < 300, "{err}");
     }
     assert!(!d.join("t.node").exists());
+    // The old name still works, says it is deprecated, and errors name it
+    // as typed.
+    let out = run(d, &["tetra", blob, "--size", "0.3", "-o", "old.node"]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    assert!(
+        common::stderr(&out)
+            .contains("warning: `trilux tetra --size` is deprecated, use --spacing")
+    );
+    common::fails_with(
+        d,
+        2,
+        &["tetra", blob, "--size", "1e-300", "-o", "t.node"],
+        &["--size 1e-300: ", "use a larger --size"],
+    );
+    common::fails_with(
+        d,
+        2,
+        &[
+            "tetra",
+            blob,
+            "--size",
+            "0.3",
+            "--spacing",
+            "0.3",
+            "-o",
+            "t.node",
+        ],
+        &["--spacing"],
+    );
     // The spacing used (here the default) and every file written, in a
     // stable order, preview included.
     let report = json(d, &["tetra", blob, "-o", "b.node", "--preview", "b.png"]);

@@ -289,7 +289,10 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         let (stuffed, _) = super::tetra::stuff(
             &blob,
             Path::new("blob.obj"),
-            super::tetra::Spacing::Size(Some(0.06)),
+            super::tetra::Spacing::Given {
+                h: Some(0.06),
+                option: "--spacing",
+            },
             true,
         )?;
         let tets = trilux::tet::from_stuffing(&stuffed, blob.origin);

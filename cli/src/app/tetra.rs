@@ -11,7 +11,7 @@ use super::{Context, Result, arg_error, file_cause, file_error};
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Tetrahedralize a surface by isosurface stuffing (bounded dihedral angles); writes TetGen, MEDIT or VTU",
-    after_help = "Example:\n  trilux tetra ../shared/data/meshes/stanford-bunny.obj --size 0.003 -o bunny.node --preview bunny_tets.png"
+    after_help = "Example:\n  trilux tetra ../shared/data/meshes/stanford-bunny.obj --spacing 0.003 -o bunny.node --preview bunny_tets.png"
 )]
 pub(crate) struct Args {
     /// The surface: .obj, .gltf, .glb or .ply (holes and overlaps are fine:
@@ -20,6 +20,10 @@ pub(crate) struct Args {
     /// Lattice spacing in the mesh's unit (default: 1/40 of the bounding
     /// box's diagonal).
     #[arg(long, value_name = "H")]
+    pub(crate) spacing: Option<f64>,
+    /// The old name of --spacing (`--size` is a picture's pixels in the
+    /// other subcommands); accepted with a deprecation note on stderr.
+    #[arg(long, value_name = "H", hide = true, conflicts_with = "spacing")]
     pub(crate) size: Option<f64>,
     /// Coarser tetrahedra deep inside (octree grading).
     #[arg(long)]
@@ -32,12 +36,16 @@ pub(crate) struct Args {
     pub(crate) preview: Option<PathBuf>,
 }
 
-/// How the spacing of [`stuff`] is chosen: `--size` of `trilux tetra`, or
-/// the default of a command without that option (`trilux diffuse`).
+/// How the spacing of [`stuff`] is chosen: `--spacing` of `trilux tetra`,
+/// or the default of a command without that option (`trilux diffuse`).
 pub(crate) enum Spacing {
-    /// `--size` as given, or its default when absent.
-    Size(Option<f64>),
-    /// Always the default; errors suggest `trilux tetra --size`.
+    /// The option as given (`h`, and `option`, its name as typed, for
+    /// errors), or its default when absent.
+    Given {
+        h: Option<f64>,
+        option: &'static str,
+    },
+    /// Always the default; errors suggest `trilux tetra --spacing`.
     Default,
 }
 
@@ -52,30 +60,37 @@ pub(crate) fn stuff(
 ) -> Result<(stuffing::TetMesh, f64)> {
     let (lo, hi) = trilux::mesh::bounds(mesh).unwrap_or_default();
     let (h, given) = match spacing {
-        Spacing::Size(Some(h)) => (h, true),
-        Spacing::Size(None) | Spacing::Default => {
+        Spacing::Given { h: Some(h), .. } => (h, true),
+        Spacing::Given { h: None, .. } | Spacing::Default => {
             // In f64: an f32 diagonal overflows for coordinates near 1e38.
             ((hi.as_dvec3() - lo.as_dvec3()).length() / 40.0, false)
         }
     };
     // What to do about a spacing too fine or too coarse for this surface.
+    let option = match spacing {
+        Spacing::Given { option, .. } => option,
+        Spacing::Default => "--spacing",
+    };
     let (larger, smaller) = match spacing {
         Spacing::Default => (
-            "tetrahedralize it with `trilux tetra --size H` first",
-            "tetrahedralize it with `trilux tetra --size H` and a smaller H first",
+            "tetrahedralize it with `trilux tetra --spacing H` first".to_string(),
+            "tetrahedralize it with `trilux tetra --spacing H` and a smaller H first".to_string(),
         ),
-        Spacing::Size(_) => ("use a larger --size", "try a smaller --size"),
+        Spacing::Given { .. } => (
+            format!("use a larger {option}"),
+            format!("try a smaller {option}"),
+        ),
     };
     if !(h.is_finite() && h > 0.0) {
         return Err(if given {
             arg_error(
-                format!("--size {}", number(h)),
+                format!("{option} {}", number(h)),
                 "the lattice spacing must be a positive length",
             )
         } else {
             let fix = match spacing {
-                Spacing::Default => larger,
-                Spacing::Size(_) => "give --size",
+                Spacing::Default => larger.clone(),
+                Spacing::Given { .. } => format!("give {option}"),
             };
             file_error(
                 path,
@@ -90,7 +105,7 @@ pub(crate) fn stuff(
     let too_fine = |problem: String| {
         let problem = format!("too fine for this surface: {problem}; {larger}");
         if given {
-            arg_error(format!("--size {}", number(h)), problem)
+            arg_error(format!("{option} {}", number(h)), problem)
         } else {
             file_error(path, problem)
         }
@@ -130,9 +145,24 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     if let Some(p) = &args.preview {
         super::check_output(context, p, &["png", "exr"])?;
     }
+    let spacing = match (args.spacing, args.size) {
+        (None, Some(h)) => {
+            eprintln!(
+                "warning: `trilux tetra --size` is deprecated, use --spacing (--size is a picture's pixels in the other subcommands)"
+            );
+            Spacing::Given {
+                h: Some(h),
+                option: "--size",
+            }
+        }
+        (h, _) => Spacing::Given {
+            h,
+            option: "--spacing",
+        },
+    };
     let mesh = super::read_mesh(context, &args.surface)?;
     let (tets, h) = context.step("stuffing", || {
-        stuff(&mesh, &args.surface, Spacing::Size(args.size), args.graded)
+        stuff(&mesh, &args.surface, spacing, args.graded)
     })?;
     let out = trilux::tet::from_stuffing(&tets, mesh.origin);
     let force = context.force;
