@@ -64,6 +64,11 @@ impl SubTriangle {
         self.0 & DOWN != 0
     }
 
+    /// The grid position and orientation `(i, j, down)`.
+    pub(crate) fn grid(self) -> (u32, u32, bool) {
+        (self.i(), self.j(), self.down())
+    }
+
     /// The fraction of the parent triangle's area: `4^-level`.
     pub(crate) fn area_fraction(self) -> f64 {
         0.25f64.powi(i32::from(self.level()))
@@ -102,18 +107,6 @@ impl SubTriangle {
         let d = f64::from((self.0 >> 26) & 1);
         let s = 1.0 - 2.0 * d;
         (h * (i + d + s * a), h * (j + d + s * b))
-    }
-
-    /// The code as bits (for branch-free selection).
-    #[inline]
-    pub(crate) fn bits(self) -> u32 {
-        self.0
-    }
-
-    /// The code from [`bits`](Self::bits).
-    #[inline]
-    pub(crate) fn from_bits(bits: u32) -> Self {
-        Self(bits)
     }
 
     /// The barycenter, as parent `(u, v)`.

@@ -1,0 +1,606 @@
+//! Sampling with a density: a texture by adaptive subdivision (Šik &
+//! Křivánek 2013, Sec. 3.3–3.5), optionally exact, or per-face and
+//! per-vertex weights.
+
+mod build;
+mod options;
+mod stable;
+mod weights;
+
+use discrete_sampling::{DiscreteSampler, GuideTable};
+use glam::DVec2;
+use rand::Rng;
+use rand::distr::Distribution;
+
+use crate::layout::{Piece, PieceAlias};
+use crate::parallel::{BLOCK, unit};
+use crate::point::Frame;
+use crate::subdivision::{MAX_LEVEL, SubTriangle};
+use crate::{DensityTexture, Error, Layout, MeshRef, SurfacePoint, SurfaceSampler};
+
+use build::{
+    PARALLEL_FACES, PARALLEL_LEAVES, capped_levels, collect_pieces, face_level, face_uvs,
+    texture_pieces, uv_constant,
+};
+pub(crate) use build::{check_integration, exact_mass, map_faces, texture_uvs};
+pub use options::{DEFAULT_MAX_PIECES, Density, Depth, Mode, Options};
+use weights::{check_weights, linear_corner_barycentric, piece_fraction};
+
+/// The structure a piece is drawn from, which also holds the pieces in
+/// face order (the alias table's columns are the records).
+#[derive(Debug, Clone)]
+enum Table<S> {
+    Alias(PieceAlias),
+    Inversion { sampler: S, pieces: Vec<Piece> },
+}
+
+impl<S> Table<S> {
+    fn len(&self) -> usize {
+        match self {
+            Self::Alias(a) => a.len(),
+            Self::Inversion { pieces, .. } => pieces.len(),
+        }
+    }
+
+    /// Piece `k` in face order.
+    #[inline]
+    fn get(&self, k: usize) -> Piece {
+        match self {
+            Self::Alias(a) => a.get(k),
+            Self::Inversion { pieces, .. } => pieces[k],
+        }
+    }
+}
+
+/// Draws points on a mesh with probability density proportional to a
+/// texture, per-face or per-vertex weights.
+///
+/// A texture density is resampled on an adaptive subdivision of each
+/// triangle (Šik & Křivánek 2013): the depth makes sub-triangles about a
+/// texel and their edges no longer than two texels (so slivers are
+/// subdivided along their length too), the density is looked up at each
+/// sub-triangle's
+/// barycenter, and four siblings of equal value merge into their parent.
+/// A sub-triangle costs its triangle, a code of its level and position
+/// (Fig. 4, decoded in O(1)) and its value, plus its share of the table it
+/// is drawn from ([`Layout`]): by default an alias table whose 16-byte
+/// columns are the records themselves (one column per draw, two when the
+/// alias side is taken). With
+/// [`Layout::Inversion`], `S` is the 1D sampler over the CDF that picks a
+/// sub-triangle: the guide table by default,
+/// [`CdfBisection`](discrete_sampling::CdfBisection) for the paper's
+/// "without table" variant.
+///
+/// Per-face weights are sampled exactly (triangle by weight × area, then
+/// uniformly in it), and so are per-vertex weights: a linear density is a
+/// mixture of three components, each "proportional to one barycentric
+/// weight", drawn in closed form.
+///
+/// # Example
+/// ```
+/// use glam::{Vec2, Vec3};
+/// use mesh_sampling::{Density, DensitySampler, DensityTexture, MeshRef, SurfaceSampler};
+///
+/// let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(1.0, 1.0, 0.0)];
+/// let uvs = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
+/// let indices = [[0, 1, 2], [1, 3, 2]];
+/// let mesh = MeshRef { uvs: Some(&uvs), ..MeshRef::new(&positions, &indices) };
+/// // Left half black, right half white.
+/// let texture = DensityTexture::new(2, 1, vec![0.0, 1.0])?
+///     .with_filter(mesh_sampling::Filter::Nearest);
+/// let sampler = DensitySampler::new(mesh, Density::Texture(&texture))?;
+/// for p in sampler.sample_n(1, 1000).unwrap() {
+///     assert!(p.position.x >= 0.5);
+///     assert!((p.pdf - 2.0).abs() < 1e-4); // density 1 over half the area
+/// }
+/// # Ok::<(), mesh_sampling::Error>(())
+/// ```
+#[derive(Debug, Clone)]
+pub struct DensitySampler<'a, S = GuideTable> {
+    mesh: MeshRef<'a>,
+    density: Density<'a>,
+    mode: Mode,
+    table: Table<S>,
+    /// Pieces of face `f`: `face_start[f]..face_start[f + 1]`.
+    face_start: Vec<u32>,
+    /// Subdivision depth of each face (texture densities).
+    face_level: Vec<u8>,
+    /// Per face, its corner, edges and normal: one memory access.
+    frames: Vec<Frame>,
+    /// `1 / ∫ density dA` of the density sampled.
+    norm: f64,
+    /// Expected fraction of proposals accepted (1 without rejection).
+    acceptance: f64,
+}
+
+impl<'a> DensitySampler<'a, GuideTable> {
+    /// A sampler with default [`Options`] and the guide table.
+    ///
+    /// # Errors
+    /// As for [`with_options`](Self::with_options).
+    pub fn new(mesh: MeshRef<'a>, density: Density<'a>) -> Result<Self, Error> {
+        Self::with_options(mesh, density, &Options::default())
+    }
+
+    /// A sampler with the guide table and `options`.
+    ///
+    /// # Errors
+    /// As for [`with_table`](Self::with_table).
+    pub fn with_options(
+        mesh: MeshRef<'a>,
+        density: Density<'a>,
+        options: &Options,
+    ) -> Result<Self, Error> {
+        Self::with_table(mesh, density, options)
+    }
+}
+
+impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
+    /// Validates the mesh and the density, subdivides (in parallel with
+    /// the `rayon` feature; the result does not depend on the thread
+    /// count) and builds the table `options.layout` names; with
+    /// [`Layout::Inversion`] it is of type `S`:
+    /// `DensitySampler::<CdfBisection>::with_table(…)` is the paper's
+    /// variant without the lookup table (`S` is not used by the alias
+    /// layout).
+    ///
+    /// # Errors
+    /// The mesh's errors ([`MeshRef::validate`]); [`Error::MissingUvs`] or
+    /// [`Error::NonFiniteUv`] for a texture density;
+    /// [`Error::WeightLength`], [`Error::InvalidWeight`] for weights;
+    /// [`Error::InvalidOption`]; [`Error::TooManyPieces`] when one piece
+    /// per triangle already exceeds [`Options::max_pieces`];
+    /// [`Error::IntegrationTooLarge`] in exact mode for UVs that tile a
+    /// varying texture too many times to integrate it exactly, and
+    /// [`Error::AcceptanceTooLow`] below [`MIN_ACCEPTANCE`];
+    /// [`Error::ZeroDensity`] when the density is zero on every triangle
+    /// of non-zero area.
+    pub fn with_table(
+        mesh: MeshRef<'a>,
+        density: Density<'a>,
+        options: &Options,
+    ) -> Result<Self, Error> {
+        mesh.validate()?;
+        if options.max_level > MAX_LEVEL {
+            return Err(Error::InvalidOption(format!(
+                "max_level {} exceeds {MAX_LEVEL}",
+                options.max_level
+            )));
+        }
+        if !(options.merge_tolerance >= 0.0 && options.merge_tolerance <= 1.0) {
+            return Err(Error::InvalidOption(format!(
+                "merge_tolerance {} is not in [0, 1]",
+                options.merge_tolerance
+            )));
+        }
+        let faces = mesh.indices.len();
+        // Threads pay off for large meshes or deep subdivisions; below
+        // that, waking them costs more than the work (a constant density
+        // builds as fast as the uniform sampler's table).
+        let many = faces >= PARALLEL_FACES;
+        let (pieces, face_start, face_level, exact_mass) = match density {
+            Density::Texture(texture) => {
+                let uvs = texture_uvs(&mesh)?;
+                // Per face: its level, and its value if the density is
+                // constant over its footprint (then it is one piece).
+                let wanted: Vec<(u8, Option<f32>)> = map_faces(many, faces, |f| {
+                    let uv = face_uvs(uvs, mesh.indices[f]);
+                    (face_level(texture, uv, options), uv_constant(texture, uv))
+                });
+                let (levels, leaves) = capped_levels(&wanted, options.max_pieces)?;
+                let heavy = many || leaves >= PARALLEL_LEAVES;
+                let (pieces, starts) = collect_pieces(heavy, faces, |f, out| match wanted[f].1 {
+                    Some(c) if c > 0.0 && mesh.area(f) > 0.0 => out.push((SubTriangle::ROOT, c)),
+                    Some(_) => {}
+                    None => texture_pieces(&mesh, uvs, texture, levels[f], options, f, out),
+                });
+                if options.mode == Mode::Exact {
+                    check_integration(&mesh, uvs, texture)?;
+                }
+                let exact = (options.mode == Mode::Exact).then(|| {
+                    map_faces(heavy, faces, |f| exact_mass(&mesh, uvs, texture, f))
+                        .iter()
+                        .sum()
+                });
+                (pieces, starts, levels, exact)
+            }
+            Density::PerFace(w) => {
+                check_weights("face", w, faces)?;
+                let (pieces, starts) = collect_pieces(many, faces, |f, out| {
+                    if w[f] > 0.0 && mesh.area(f) > 0.0 {
+                        out.push((SubTriangle::ROOT, w[f]));
+                    }
+                });
+                (pieces, starts, vec![0; faces], None)
+            }
+            Density::PerVertex(w) => {
+                check_weights("vertex", w, mesh.positions.len())?;
+                let (pieces, starts) = collect_pieces(many, faces, |f, out| {
+                    if mesh.area(f) > 0.0 {
+                        let tri = mesh.indices[f];
+                        for c in (0..3).filter(|&c| w[tri[c] as usize] > 0.0) {
+                            out.push((SubTriangle::vertex(c), w[tri[c] as usize]));
+                        }
+                    }
+                });
+                (pieces, starts, vec![0; faces], None)
+            }
+        };
+        if pieces.len() > u32::MAX as usize {
+            return Err(Error::TooLarge(pieces.len()));
+        }
+        let areas: Vec<f64> = map_faces(many, faces, |f| mesh.area(f));
+        let masses: Vec<f64> = pieces
+            .iter()
+            .map(|p| f64::from(p.value) * areas[p.face as usize] * piece_fraction(p.part))
+            .collect();
+        let proposal_mass: f64 = masses.iter().sum();
+        let zero = Error::ZeroDensity { triangles: faces };
+        // The alias layout when its columns can be packed (see
+        // `Layout::Alias`), otherwise the inversion method.
+        let alias = match options.layout {
+            Layout::Alias => PieceAlias::new(&pieces, &masses, faces),
+            Layout::Inversion => None,
+        };
+        let table = match alias {
+            Some(alias) => Table::Alias(alias),
+            None => Table::Inversion {
+                sampler: S::from_weights(&masses).map_err(|_| zero)?,
+                pieces,
+            },
+        };
+        drop(masses);
+        let mass = exact_mass.unwrap_or(proposal_mass);
+        if mass.is_nan() || mass <= 0.0 {
+            return Err(Error::ZeroDensity { triangles: faces });
+        }
+        check_acceptance((mass / proposal_mass).min(1.0))?;
+        Ok(Self {
+            mesh,
+            density,
+            mode: if exact_mass.is_some() {
+                Mode::Exact
+            } else {
+                Mode::Approximate
+            },
+            table,
+            face_start,
+            face_level,
+            frames: Frame::all(&mesh),
+            norm: 1.0 / mass,
+            acceptance: (mass / proposal_mass).min(1.0),
+        })
+    }
+
+    /// The mesh sampled.
+    pub fn mesh(&self) -> &MeshRef<'a> {
+        &self.mesh
+    }
+
+    /// The mode actually used: [`Mode::Exact`] only for a texture density
+    /// built with it (per-face and per-vertex densities are always exact).
+    pub fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// Number of sub-triangles (or linear components) in the table.
+    pub fn pieces(&self) -> usize {
+        self.table.len()
+    }
+
+    /// The subdivision depth of triangle `face` (0 for weights).
+    pub fn level(&self, face: usize) -> u8 {
+        self.face_level.get(face).copied().unwrap_or(0)
+    }
+
+    /// The integral of the sampled density's unnormalised form over the
+    /// mesh: `Σ f_i |D_i|` (Eq. 2's denominator) in approximate mode, the
+    /// exact integral of the filtered texture in exact mode.
+    pub fn total_mass(&self) -> f64 {
+        1.0 / self.norm
+    }
+
+    /// The expected fraction of proposals accepted: 1 in approximate mode
+    /// and for weights, `∫ f / Σ bound_i |D_i|` in exact mode.
+    pub fn acceptance(&self) -> f64 {
+        self.acceptance
+    }
+
+    /// The layout pieces are drawn from.
+    pub fn layout(&self) -> Layout {
+        match self.table {
+            Table::Alias(_) => Layout::Alias,
+            Table::Inversion { .. } => Layout::Inversion,
+        }
+    }
+
+    /// Heap memory of the table the pieces are drawn from (with the
+    /// alias layout: the pieces themselves, 16 bytes each; with the
+    /// inversion layout: the pieces' 12-byte records and the sampler over
+    /// their CDF).
+    pub fn table_bytes(&self) -> usize {
+        match &self.table {
+            Table::Alias(a) => a.memory_bytes(),
+            Table::Inversion { sampler, pieces } => {
+                sampler.memory_bytes() + pieces.len() * size_of::<Piece>()
+            }
+        }
+    }
+
+    /// Heap memory of the sampler (table, face index and frames), not
+    /// counting the mesh and texture it borrows.
+    pub fn memory_bytes(&self) -> usize {
+        self.table_bytes()
+            + self.face_start.len() * size_of::<u32>()
+            + self.face_level.len()
+            + self.frames.len() * size_of::<Frame>()
+    }
+
+    /// The density (w.r.t. area, normalised over the mesh) this sampler
+    /// draws from, at barycentrics `barycentric` of triangle `face`: what a
+    /// path tracer needs for multiple importance sampling when a ray hits
+    /// the mesh. 0 for a triangle that does not exist, a zero-area
+    /// triangle, or barycentrics that are NaN or infinite.
+    pub fn pdf(&self, face: usize, barycentric: [f32; 3]) -> f32 {
+        let Some(range) = self.face_range(face) else {
+            return 0.0;
+        };
+        if !barycentric.iter().all(|b| b.is_finite()) {
+            return 0.0;
+        }
+        let [b0, b1, b2] = barycentric.map(f64::from);
+        let value = match self.density {
+            Density::PerFace(w) => {
+                if range.is_empty() {
+                    0.0
+                } else {
+                    f64::from(w[face])
+                }
+            }
+            Density::PerVertex(w) => {
+                if range.is_empty() {
+                    return 0.0;
+                }
+                let t = self.mesh.indices[face].map(|i| f64::from(w[i as usize]));
+                t[0] * b0 + t[1] * b1 + t[2] * b2
+            }
+            Density::Texture(texture) => match self.mode {
+                Mode::Exact if range.is_empty() => 0.0,
+                Mode::Exact => texture.eval(self.uv_at(face, b1, b2)),
+                Mode::Approximate => self.approximate_value(range, face, b1, b2),
+            },
+        };
+        (value * self.norm) as f32
+    }
+
+    fn face_range(&self, face: usize) -> Option<std::ops::Range<usize>> {
+        let start = *self.face_start.get(face)? as usize;
+        let end = *self.face_start.get(face + 1)? as usize;
+        Some(start..end)
+    }
+
+    /// `p′` before normalisation at `(u, v)` of `face`: the value of the
+    /// stored sub-triangle containing it, found by bisection on the
+    /// depth-first keys of the face's sub-triangles.
+    fn approximate_value(&self, range: std::ops::Range<usize>, face: usize, u: f64, v: f64) -> f64 {
+        let depth = self.face_level[face];
+        let key = SubTriangle::locate(depth, u, v).key(depth);
+        // Bisection for the last piece whose key is at most `key`.
+        let (mut lo, mut hi) = (range.start, range.end);
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if self.table.get(mid).part.key(depth) <= key {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        if lo == range.start {
+            return 0.0;
+        }
+        let p = self.table.get(lo - 1);
+        let span = 1u64 << (2 * (depth - p.part.level()));
+        if key < p.part.key(depth) + span {
+            f64::from(p.value)
+        } else {
+            0.0
+        }
+    }
+
+    /// The texture coordinate at `(u, v)` of `face`.
+    #[inline]
+    fn uv_at(&self, face: usize, u: f64, v: f64) -> DVec2 {
+        let uvs = self.mesh.uvs.unwrap_or_default();
+        let [a, b, c] = face_uvs(uvs, self.mesh.indices[face]);
+        a + (b - a) * u + (c - a) * v
+    }
+
+    /// Where piece `k` puts the point for variates `xi1`, `xi2`: parent
+    /// barycentrics.
+    #[inline]
+    fn place(&self, piece: Piece, xi1: f64, xi2: f64) -> [f32; 3] {
+        match piece.part.corner() {
+            Some(corner) => linear_corner_barycentric(corner, xi1, xi2),
+            None => {
+                // The square-root map (Sec. 3.5) in the sub-triangle's own
+                // legs, kept in f64 up to the parent's barycentrics.
+                let s = xi1.sqrt();
+                let a = xi2 * s;
+                let (u, v) = piece.part.to_parent(a, s - a);
+                [(1.0 - u - v).max(0.0) as f32, u as f32, v as f32]
+            }
+        }
+    }
+
+    /// The point at `bary` of the piece's face, with its density (which
+    /// for the approximate mode and per-face weights is the piece's value,
+    /// and for per-vertex weights is interpolated).
+    #[inline]
+    fn point(&self, piece: Piece, bary: [f32; 3], value: f64) -> SurfacePoint {
+        let face = piece.face;
+        let frame = &self.frames[face as usize];
+        SurfacePoint::in_frame(&self.mesh, frame, face, bary, (value * self.norm) as f32)
+    }
+
+    /// The unnormalised density of a non-rejected point.
+    #[inline]
+    fn value(&self, piece: Piece, bary: [f32; 3]) -> f64 {
+        match self.density {
+            Density::PerVertex(w) => {
+                let t = self.mesh.indices[piece.face as usize].map(|i| w[i as usize]);
+                f64::from(t[0] * bary[0] + t[1] * bary[1] + t[2] * bary[2])
+            }
+            _ => f64::from(piece.value),
+        }
+    }
+
+    /// One piece drawn from the table (one `u64` of `rng`).
+    #[inline]
+    fn piece<R: Rng + ?Sized>(&self, rng: &mut R) -> Piece {
+        match &self.table {
+            Table::Alias(alias) => alias.piece(rng.next_u64()),
+            Table::Inversion { sampler, pieces } => pieces[sampler.sample_rng(rng)],
+        }
+    }
+
+    /// Fills `out` with pieces (one `u64` of `rng` each): the variates
+    /// first, then the searches, then the records, each in a pass of its
+    /// own so that the loads of independent draws overlap.
+    #[inline]
+    fn pieces_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [Piece]) {
+        match &self.table {
+            Table::Alias(alias) => alias.fill(rng, out),
+            Table::Inversion { sampler, pieces } => {
+                let mut picks = [0usize; BLOCK];
+                for block in out.chunks_mut(BLOCK) {
+                    let picks = &mut picks[..block.len()];
+                    sampler.sample_into(rng, picks);
+                    for (piece, &k) in block.iter_mut().zip(picks.iter()) {
+                        *piece = pieces[k];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Loads what the points of `pieces` will read of their faces: the
+    /// frame and corner indices, then the corners' UVs and normals, each a
+    /// pass of independent loads, so that a block's cache misses overlap
+    /// instead of coming one point at a time (the point computations
+    /// between them are too long for the core to look ahead past). The
+    /// values are kept (and passed to `black_box`) only so that the loads
+    /// are not optimised away; the points read the lines again from L1.
+    #[inline]
+    fn touch_faces(&self, pieces: &[Piece]) {
+        let mut corners = [[0u32; 3]; BLOCK];
+        let mut seen = [0u32; BLOCK];
+        for ((c, s), p) in corners.iter_mut().zip(&mut seen).zip(pieces) {
+            let f = p.face as usize;
+            *s = self.frames[f].touch();
+            *c = self.mesh.indices[f];
+        }
+        let n = pieces.len();
+        if let Some(uvs) = self.mesh.uvs {
+            for (s, c) in seen.iter_mut().zip(&corners[..n]) {
+                *s ^= c
+                    .map(|i| uvs[i as usize].x.to_bits())
+                    .iter()
+                    .fold(0, |a, b| a ^ b);
+            }
+        }
+        if let Some(normals) = self.mesh.normals {
+            for (s, c) in seen.iter_mut().zip(&corners[..n]) {
+                *s ^= c
+                    .map(|i| normals[i as usize].x.to_bits())
+                    .iter()
+                    .fold(0, |a, b| a ^ b);
+            }
+        }
+        std::hint::black_box(&seen);
+    }
+
+    fn exact_texture(&self) -> Option<&DensityTexture> {
+        match (self.density, self.mode) {
+            (Density::Texture(t), Mode::Exact) => Some(t),
+            _ => None,
+        }
+    }
+}
+
+/// Three `u64` of the random stream per point (one for the piece, two for
+/// the point in it); four per proposal in exact mode.
+impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {
+    /// Computed in blocks, like
+    /// [`UniformSampler`](crate::UniformSampler)'s: the block's pieces by
+    /// the table's batch search (with the alias layout: the columns, then
+    /// the aliases' columns), then their faces' records, then the points;
+    /// in exact mode, blocks of proposals of which the accepted are kept.
+    fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
+        let mut pieces = [Piece::default(); BLOCK];
+        if let Some(texture) = self.exact_texture() {
+            // Proposals in blocks, the accepted ones kept in order.
+            let mut filled = 0;
+            while filled < out.len() {
+                self.pieces_into(rng, &mut pieces);
+                self.touch_faces(&pieces);
+                for &piece in &pieces {
+                    let xi1 = unit(rng.next_u64());
+                    let bary = self.place(piece, xi1, unit(rng.next_u64()));
+                    let [_, u, v] = bary.map(f64::from);
+                    let f = texture.eval(self.uv_at(piece.face as usize, u, v));
+                    if unit(rng.next_u64()) * f64::from(piece.value) < f && filled < out.len() {
+                        out[filled] = self.point(piece, bary, f);
+                        filled += 1;
+                    }
+                }
+            }
+            return;
+        }
+        for block in out.chunks_mut(BLOCK) {
+            let n = block.len();
+            self.pieces_into(rng, &mut pieces[..n]);
+            self.touch_faces(&pieces[..n]);
+            for (slot, &piece) in block.iter_mut().zip(&pieces) {
+                let xi1 = unit(rng.next_u64());
+                let bary = self.place(piece, xi1, unit(rng.next_u64()));
+                *slot = self.point(piece, bary, self.value(piece, bary));
+            }
+        }
+    }
+}
+
+impl<S: DiscreteSampler + Sync> Distribution<SurfacePoint> for DensitySampler<'_, S> {
+    fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> SurfacePoint {
+        loop {
+            let piece = self.piece(rng);
+            let xi1 = unit(rng.next_u64());
+            let bary = self.place(piece, xi1, unit(rng.next_u64()));
+            let Some(texture) = self.exact_texture() else {
+                return self.point(piece, bary, self.value(piece, bary));
+            };
+            let [_, u, v] = bary.map(f64::from);
+            let f = texture.eval(self.uv_at(piece.face as usize, u, v));
+            // Accept with probability f / bound (bound ≥ f).
+            if unit(rng.next_u64()) * f64::from(piece.value) < f {
+                return self.point(piece, bary, f);
+            }
+        }
+    }
+}
+
+/// The lowest expected acceptance a rejection step may have: 10⁻⁹ (a
+/// billion proposals a point, about a minute of work), so that no draw
+/// runs unbounded.
+pub const MIN_ACCEPTANCE: f64 = 1e-9;
+
+/// `Ok` if a rejection step accepts at least [`MIN_ACCEPTANCE`].
+pub(crate) fn check_acceptance(acceptance: f64) -> Result<(), Error> {
+    if acceptance >= MIN_ACCEPTANCE {
+        Ok(())
+    } else {
+        Err(Error::AcceptanceTooLow {
+            acceptance,
+            minimum: MIN_ACCEPTANCE,
+        })
+    }
+}

@@ -1,0 +1,127 @@
+//! Value stability: the first points of the uniform, density and blue-noise
+//! samplers for a fixed seed, pinned, so that a change of layout, of the
+//! random stream or of the build that moves points is a conscious one (the
+//! statistical tests would pass for any correct sampler).
+
+use glam::{Vec2, Vec3};
+use mesh_sampling::{
+    Density, DensitySampler, DensityTexture, Filter, MeshRef, SurfacePoint, SurfaceSampler,
+    UniformSampler,
+};
+
+/// A 4 × 4 grid of quads over the unit square (UVs equal to (x, y)), with
+/// its corner lifted so that triangles differ in area.
+fn grid() -> (Vec<Vec3>, Vec<Vec2>, Vec<[u32; 3]>) {
+    let n = 4u32;
+    let (mut positions, mut uvs, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f32 / n as f32, j as f32 / n as f32);
+            positions.push(Vec3::new(x, y, x * y));
+            uvs.push(Vec2::new(x, y));
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            indices.push([a, a + 1, a + n + 1]);
+            indices.push([a + 1, a + n + 2, a + n + 1]);
+        }
+    }
+    (positions, uvs, indices)
+}
+
+/// An 8 × 8 texture with distinct smooth values.
+fn texture() -> DensityTexture {
+    let texels = (0..64)
+        .map(|k| 1.0 + ((k % 8) as f32 * 0.7).sin() + 0.1 * (k / 8) as f32)
+        .collect();
+    DensityTexture::new(8, 8, texels).unwrap()
+}
+
+/// (face, barycentrics) of each point, as pinned below.
+fn summary(points: &[SurfacePoint]) -> Vec<(u32, [f32; 3])> {
+    points.iter().map(|p| (p.face, p.barycentric)).collect()
+}
+
+fn assert_pinned(what: &str, got: &[(u32, [f32; 3])], want: &[(u32, [f32; 3])]) {
+    assert_eq!(got.len(), want.len(), "{what}: {got:?}");
+    for (k, (g, w)) in got.iter().zip(want).enumerate() {
+        let close = g.1.iter().zip(&w.1).all(|(a, b)| (a - b).abs() <= 1e-6);
+        assert!(
+            g.0 == w.0 && close,
+            "{what}, point {k}: {g:?}, pinned {w:?}\nall: {got:?}"
+        );
+    }
+}
+
+#[test]
+fn uniform_points_are_pinned() {
+    let (positions, _, indices) = grid();
+    let sampler = UniformSampler::new(MeshRef::new(&positions, &indices)).unwrap();
+    let got = summary(&sampler.sample_n(2026, 4).unwrap());
+    assert_pinned("uniform", &got, &UNIFORM);
+}
+
+#[test]
+fn density_points_are_pinned_for_both_filters() {
+    let (positions, uvs, indices) = grid();
+    let mesh = MeshRef {
+        uvs: Some(&uvs),
+        ..MeshRef::new(&positions, &indices)
+    };
+    for filter in [Filter::Bilinear, Filter::Nearest] {
+        let t = texture().with_filter(filter);
+        let sampler = DensitySampler::new(mesh, Density::Texture(&t)).unwrap();
+        assert_eq!(sampler.layout(), mesh_sampling::Layout::Alias);
+        let got = summary(&sampler.sample_n(2026, 4).unwrap());
+        let want = if filter == Filter::Bilinear {
+            &DENSITY_BILINEAR[..]
+        } else {
+            &DENSITY_NEAREST[..]
+        };
+        assert_pinned(&format!("density {filter:?}"), &got, want);
+    }
+}
+
+#[cfg(feature = "blue-noise")]
+#[test]
+fn blue_noise_points_are_pinned() {
+    use mesh_sampling::{BlueNoiseOptions, BlueNoiseTarget, blue_noise};
+    let (positions, _, indices) = grid();
+    let sampler = UniformSampler::new(MeshRef::new(&positions, &indices)).unwrap();
+    let points = blue_noise(
+        &sampler,
+        BlueNoiseTarget::Count(200),
+        2026,
+        &BlueNoiseOptions::default(),
+    )
+    .unwrap();
+    assert_pinned("blue noise", &summary(&points[..4]), &BLUE_NOISE);
+}
+
+const UNIFORM: [(u32, [f32; 3]); 4] = [
+    (24, [0.8187891, 0.048960943, 0.13224994]),
+    (26, [0.11395139, 0.4261354, 0.4599132]),
+    (17, [0.3382452, 0.26578057, 0.39597422]),
+    (15, [0.13347909, 0.7937605, 0.0727604]),
+];
+const DENSITY_BILINEAR: [(u32, [f32; 3]); 4] = [
+    (27, [0.40939456, 0.024480471, 0.566125]),
+    (25, [0.056975696, 0.2130677, 0.7299566]),
+    (26, [0.1691226, 0.13289028, 0.69798714]),
+    (12, [0.066739544, 0.39688024, 0.53638023]),
+];
+const DENSITY_NEAREST: [(u32, [f32; 3]); 4] = [
+    (27, [0.40939456, 0.024480471, 0.566125]),
+    (25, [0.056975696, 0.2130677, 0.7299566]),
+    (26, [0.1691226, 0.13289028, 0.69798714]),
+    (13, [0.066739544, 0.39688024, 0.53638023]),
+];
+#[cfg(feature = "blue-noise")]
+const BLUE_NOISE: [(u32, [f32; 3]); 4] = [
+    (0, [0.57337856, 0.3101681, 0.116453335]),
+    (0, [0.23901673, 0.29438075, 0.46660253]),
+    (0, [0.34885493, 0.63759553, 0.013549532]),
+    (0, [0.043647766, 0.9136988, 0.042653415]),
+];
