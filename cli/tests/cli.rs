@@ -1059,3 +1059,78 @@ fn global_options_are_listed_once_under_their_own_heading() {
         }
     }
 }
+
+#[test]
+fn sample_blue_noise_writes_the_library_points_for_the_seed() {
+    use mesh_sampling::{BlueNoiseOptions, BlueNoiseTarget, blue_noise};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, noise) = inputs(d);
+    let mesh = TriMesh::read(&torus).unwrap();
+    let options = BlueNoiseOptions {
+        progressive: true,
+        ..BlueNoiseOptions::default()
+    };
+    let written = |args: &[&str], name: &str| -> Vec<glam::Vec3> {
+        let out = trilux(d)
+            .args(["-q", "sample", torus.to_str().unwrap(), "--blue-noise"])
+            .args(args)
+            .args(["--seed", "11", "-o", name])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", stderr(&out));
+        trilux_io::mesh::ply::read(d.join(name)).unwrap().positions
+    };
+    let positions = |points: Vec<mesh_sampling::SurfacePoint>| -> Vec<glam::Vec3> {
+        points.iter().map(|p| p.position).collect()
+    };
+    // Uniform, by count and by radius, on 1 and 2 threads.
+    let uniform = mesh_sampling::UniformSampler::new(trilux::mesh_ref(&mesh)).unwrap();
+    let library = blue_noise(&uniform, BlueNoiseTarget::Count(1500), 11, &options).unwrap();
+    assert_eq!(written(&["-n", "1500"], "b1.ply"), positions(library));
+    assert_eq!(
+        written(&["-n", "1500", "--threads", "2"], "b2.ply"),
+        written(&["-n", "1500", "--threads", "1"], "b3.ply")
+    );
+    let library = blue_noise(&uniform, BlueNoiseTarget::Radius(0.05), 11, &options).unwrap();
+    assert!(library.len() > 100);
+    assert_eq!(written(&["--radius", "0.05"], "r.ply"), positions(library));
+    // A density texture, as the command reads it: values as stored.
+    let raw = trilux_io::image::ReadOptions {
+        raw: true,
+        ..Default::default()
+    };
+    let image = trilux_io::image::read_with(&noise, raw).unwrap();
+    let texture = trilux::density_texture(&image, mesh_sampling::Channel::Luminance).unwrap();
+    let sampler = mesh_sampling::DensitySampler::new(
+        trilux::mesh_ref(&mesh),
+        mesh_sampling::Density::Texture(&texture),
+    )
+    .unwrap();
+    let library = blue_noise(&sampler, BlueNoiseTarget::Count(1000), 11, &options).unwrap();
+    let cli = written(
+        &["-n", "1000", "--density", noise.to_str().unwrap()],
+        "d.ply",
+    );
+    assert_eq!(cli, positions(library));
+    // Rejection cannot give candidates; a radius must be positive and
+    // needs --blue-noise.
+    let t = torus.to_str().unwrap();
+    let n = noise.to_str().unwrap();
+    let rejection = ["sample", t, "--blue-noise", "-n", "10", "--density", n];
+    let rejection = [&rejection[..], &["--method", "rejection", "-o", "x.ply"]].concat();
+    fails_with(d, 2, &rejection, &["--method rejection", "blue noise"]);
+    fails_with(
+        d,
+        2,
+        &["sample", t, "--blue-noise", "--radius=-1", "-o", "x.ply"],
+        &["--radius", "positive"],
+    );
+    fails_with(
+        d,
+        2,
+        &["sample", t, "--radius", "0.1", "-o", "x.ply"],
+        &["--blue-noise"],
+    );
+    no_partial_files(d);
+}

@@ -19,7 +19,12 @@
 //! medians of five timed runs of about 0.1 s each; points are streamed
 //! through [`SurfaceSampler::sample_stream`] and summed, so memory
 //! bandwidth for storing them is not what is measured (the peer comparison
-//! stores their positions, as the peers do).
+//! stores their positions, as the peers do). Beside each alias-layout
+//! density the machine's limit for its table is probed (`support/probe.rs`:
+//! random reads of 16-byte records from a table of as many records, one at
+//! a time and in the sampler's blocks), and the summary gives each density
+//! rate as a fraction of that probe, beside its ratio to the uniform
+//! texture's rate (Sec. 5.2) and to the uniform sampler's.
 
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -34,6 +39,9 @@ use mesh_sampling::{
 };
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
+
+#[path = "support/probe.rs"]
+mod probe;
 
 const SIZE: usize = 1024;
 const RUNS: usize = 5;
@@ -585,7 +593,20 @@ fn measure_pair(
         1.0,
         alias.pieces(),
     ));
+    let table_mb = alias.table_bytes() as f64 / 1e6;
+    let pieces = alias.pieces();
     drop(alias);
+    // The limit for a table of this size, on this pool.
+    let limit = probe::probe(pieces, 1 << 22, RUNS);
+    rows.push(row(
+        "probe-latency",
+        limit.latency,
+        0.0,
+        table_mb,
+        1.0,
+        pieces,
+    ));
+    rows.push(row("probe-batch", limit.batch, 0.0, table_mb, 1.0, pieces));
     let exact_options = Options {
         mode: Mode::Exact,
         ..Options::default()
@@ -646,10 +667,14 @@ fn print_summary(rows: &[Row]) {
     };
     println!("\n## Density rate / uniform sampler rate (same mesh, same threads)\n");
     println!(
-        "| mesh | density | threads | alias layout | inversion layout | speed-up over rejection |"
+        "Beside it, the alias layout's rate against the uniform texture's (the density sampler with a constant texture, Sec. 5.2) and as a fraction of the probe: random 16-byte reads from a table of as many records, in the sampler's blocks (and the probe's one-at-a-time rate).\n"
     );
-    println!("|---|---|---:|---:|---:|---:|");
+    println!(
+        "| mesh | density | threads | alias layout | inversion layout | speed-up over rejection | alias / uniform texture | alias / probe batch | probe M reads/s: latency / batch |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|");
     let mut worst: [Option<(f64, &Row)>; 2] = [None, None];
+    let mut worst_flat: Option<(f64, &Row)> = None;
     for r in rows.iter().filter(|r| r.method == "subdivision") {
         let Some(u) = find(&r.mesh, "-", "uniform-sampler", r.threads) else {
             continue;
@@ -659,15 +684,31 @@ fn print_summary(rows: &[Row]) {
             .map(|i| i.msamples_per_s / u.msamples_per_s);
         let rejection = find(&r.mesh, &r.density, "rejection", r.threads)
             .map(|j| r.msamples_per_s / j.msamples_per_s);
+        let flat = find(&r.mesh, "uniform", "subdivision", r.threads)
+            .map(|f| r.msamples_per_s / f.msamples_per_s);
+        let batch = find(&r.mesh, &r.density, "probe-batch", r.threads);
+        let latency = find(&r.mesh, &r.density, "probe-latency", r.threads);
+        let percent = |x: Option<f64>| x.map_or("-".into(), |x| format!("{:.0}%", 100.0 * x));
         println!(
-            "| {} | {} | {} | {:.0}% | {} | {} |",
+            "| {} | {} | {} | {:.0}% | {} | {} | {} | {} | {} |",
             r.mesh,
             r.density,
             r.threads,
             100.0 * alias,
-            inversion.map_or("-".into(), |x| format!("{:.0}%", 100.0 * x)),
+            percent(inversion),
             rejection.map_or("-".into(), |x| format!("{x:.1}×")),
+            percent(flat),
+            percent(batch.map(|b| r.msamples_per_s / b.msamples_per_s)),
+            match (latency, batch) {
+                (Some(l), Some(b)) => format!("{:.1} / {:.1}", l.msamples_per_s, b.msamples_per_s),
+                _ => "-".into(),
+            },
         );
+        if let Some(flat) = flat
+            && worst_flat.is_none_or(|(w, _)| flat < w)
+        {
+            worst_flat = Some((flat, r));
+        }
         for (slot, ratio) in worst.iter_mut().zip([Some(alias), inversion]) {
             if let Some(ratio) = ratio
                 && slot.is_none_or(|(w, _)| ratio < w)
@@ -677,6 +718,15 @@ fn print_summary(rows: &[Row]) {
         }
     }
     println!();
+    if let Some((ratio, r)) = worst_flat {
+        println!(
+            "- Lowest density rate against the uniform texture's (alias layout; Šik & Křivánek: at most 35% lower): {:.0}% ({}, {}, {} thread(s))",
+            100.0 * ratio,
+            r.mesh,
+            r.density,
+            r.threads
+        );
+    }
     for (name, w) in ["alias", "inversion"].iter().zip(worst) {
         if let Some((ratio, r)) = w {
             println!(

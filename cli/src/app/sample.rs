@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use clap::ValueEnum;
 use glam::Vec3;
 use mesh_sampling::{
-    Channel, Density, DensitySampler, Mode, RejectionSampler, SurfacePoint, SurfaceSampler,
-    UniformSampler,
+    BlueNoiseOptions, BlueNoiseTarget, Channel, Density, DensitySampler, Mode, RejectionSampler,
+    SurfaceArea, SurfacePoint, SurfaceSampler, UniformSampler, blue_noise,
 };
 use trilux_io::mesh::TriMesh;
 use trilux_io::mesh::ply;
@@ -22,7 +22,7 @@ pub(crate) const MAX_POINTS: u64 = 200_000_000;
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Scatter random points on a mesh (uniform or with a density) and write a PLY point cloud",
-    after_help = "Example:\n  trilux sample ../shared/data/meshes/spot.obj -n 1000000 \\\n      --density ../shared/data/textures/spot_texture.png -o spot.ply --preview spot.png"
+    after_help = "Examples:\n  trilux sample ../shared/data/meshes/spot.obj -n 1000000 \\\n      --density ../shared/data/textures/spot_texture.png -o spot.ply --preview spot.png\n  trilux sample ../shared/data/meshes/spot.obj --blue-noise --radius 0.01 -o spot_blue.ply"
 )]
 pub(crate) struct Args {
     /// The mesh: .obj, .gltf, .glb or .ply.
@@ -34,9 +34,25 @@ pub(crate) struct Args {
         short = 'n',
         long = "count",
         value_name = "N",
-        allow_negative_numbers = true
+        allow_negative_numbers = true,
+        required_unless_present = "radius"
     )]
-    pub(crate) count: i64,
+    pub(crate) count: Option<i64>,
+    /// Blue noise: points that keep their distance (Poisson-disk), following
+    /// the density, by weighted sample elimination (Yuksel 2015), in
+    /// progressive order (every prefix of N/2^k points is itself spread).
+    #[arg(long)]
+    pub(crate) blue_noise: bool,
+    /// With --blue-noise, instead of -n: the disk radius in the mesh's unit
+    /// (Blender's distance_min / 2); with a density, the radius where the
+    /// density is its mean.
+    #[arg(
+        long,
+        value_name = "R",
+        requires = "blue_noise",
+        conflicts_with = "count"
+    )]
+    pub(crate) radius: Option<f64>,
     /// A density texture (PNG, JPEG, HDR, EXR), looked up at the mesh's UVs;
     /// 8/16-bit values are used as stored (no sRGB decoding).
     #[arg(long, value_name = "IMAGE", group = "density_source")]
@@ -129,6 +145,36 @@ pub(crate) enum Source {
     Atlas(trilux::colors::ColorDensity),
 }
 
+/// How many points a run draws, and how.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Points {
+    /// This many independent points.
+    Random(usize),
+    /// Blue noise, progressive, by count or radius.
+    BlueNoise(BlueNoiseTarget),
+}
+
+/// The blue-noise options of `trilux sample --blue-noise`: the library's
+/// defaults, in progressive order.
+pub(crate) fn blue_noise_options() -> BlueNoiseOptions {
+    BlueNoiseOptions {
+        progressive: true,
+        ..BlueNoiseOptions::default()
+    }
+}
+
+/// The points of `sampler` that `points` asks for.
+fn points_of<S: SurfaceSampler + SurfaceArea>(
+    sampler: &S,
+    points: Points,
+    seed: u64,
+) -> std::result::Result<Vec<SurfacePoint>, mesh_sampling::Error> {
+    match points {
+        Points::Random(n) => sampler.sample_n(seed, n),
+        Points::BlueNoise(target) => blue_noise(sampler, target, seed, &blue_noise_options()),
+    }
+}
+
 /// Draws `n` points of `source` on `mesh` with `method`.
 pub(crate) fn draw(
     mesh: &TriMesh,
@@ -137,23 +183,43 @@ pub(crate) fn draw(
     seed: u64,
     n: usize,
 ) -> Result<Vec<SurfacePoint>> {
+    draw_points(mesh, source, method, seed, Points::Random(n))
+}
+
+/// Draws the points `points` asks for, of `source` on `mesh` with `method`
+/// (blue noise with any method but rejection).
+pub(crate) fn draw_points(
+    mesh: &TriMesh,
+    source: &Source,
+    method: Method,
+    seed: u64,
+    points: Points,
+) -> Result<Vec<SurfacePoint>> {
     let base = trilux::mesh_ref(mesh);
     let (mesh_ref, texture) = match source {
         Source::Uniform => (base, None),
         Source::Texture(t) => (base, Some(t)),
         Source::FaceWeights(w) => {
             let sampler = DensitySampler::new(base, Density::PerFace(w))?;
-            return Ok(sampler.sample_n(seed, n)?);
+            return Ok(points_of(&sampler, points, seed)?);
         }
         Source::Atlas(density) => (density.mesh_ref(), Some(&density.texture)),
     };
     let Some(texture) = texture else {
-        return Ok(UniformSampler::new(mesh_ref)?.sample_n(seed, n)?);
+        return Ok(points_of(&UniformSampler::new(mesh_ref)?, points, seed)?);
     };
-    let points = match method {
-        Method::Uniform => UniformSampler::new(mesh_ref)?.sample_n(seed, n),
-        Method::Rejection => RejectionSampler::new(mesh_ref, texture)?.sample_n(seed, n),
-        Method::Subdivision | Method::Exact => {
+    let points = match (method, points) {
+        (Method::Uniform, _) => points_of(&UniformSampler::new(mesh_ref)?, points, seed),
+        (Method::Rejection, Points::Random(n)) => {
+            RejectionSampler::new(mesh_ref, texture)?.sample_n(seed, n)
+        }
+        (Method::Rejection, Points::BlueNoise(_)) => {
+            return Err(arg_error(
+                "--method rejection",
+                "blue noise draws its candidates by subdivision or exactly, not by rejection",
+            ));
+        }
+        (Method::Subdivision | Method::Exact, _) => {
             let options = mesh_sampling::Options {
                 mode: if method == Method::Exact {
                     Mode::Exact
@@ -162,8 +228,9 @@ pub(crate) fn draw(
                 },
                 ..Default::default()
             };
-            DensitySampler::with_options(mesh_ref, Density::Texture(texture), &options)?
-                .sample_n(seed, n)
+            let sampler =
+                DensitySampler::with_options(mesh_ref, Density::Texture(texture), &options)?;
+            points_of(&sampler, points, seed)
         }
     };
     Ok(points?)
@@ -227,12 +294,27 @@ pub(crate) fn meshcolors_source(
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
-    if args.count <= 0 || args.count.unsigned_abs() > MAX_POINTS {
-        return Err(arg_error(
-            format!("-n {}", args.count),
-            format!("the number of points must be between 1 and {MAX_POINTS}"),
-        ));
-    }
+    let wanted = match (args.count, args.radius) {
+        (Some(count), _) if count <= 0 || count.unsigned_abs() > MAX_POINTS => {
+            return Err(arg_error(
+                format!("-n {count}"),
+                format!("the number of points must be between 1 and {MAX_POINTS}"),
+            ));
+        }
+        (Some(count), _) if args.blue_noise => {
+            Points::BlueNoise(BlueNoiseTarget::Count(count as usize))
+        }
+        (Some(count), _) => Points::Random(count as usize),
+        (None, Some(r)) if r.is_finite() && r > 0.0 => {
+            Points::BlueNoise(BlueNoiseTarget::Radius(r))
+        }
+        (None, r) => {
+            return Err(arg_error(
+                format!("--radius {}", r.unwrap_or(f64::NAN)),
+                "the radius must be a positive number (in the mesh's unit)",
+            ));
+        }
+    };
     if let Some(channel) = args.channel
         && args.density.is_none()
         && args.density_meshcolors.is_none()
@@ -274,6 +356,12 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             "uniform sampling is by area and would ignore the density (choose subdivision, exact or rejection)",
         ));
     }
+    if method == Method::Rejection && args.blue_noise {
+        return Err(arg_error(
+            "--method rejection",
+            "blue noise draws its candidates by subdivision or exactly, not by rejection",
+        ));
+    }
     if method == Method::Rejection && args.face_weights.is_some() {
         return Err(arg_error(
             "--method rejection",
@@ -307,9 +395,10 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     } else {
         Source::Uniform
     };
-    let n = args.count as usize;
     let points = super::with_threads(args.threads, || {
-        context.step("sampling", || draw(&mesh, &source, method, args.seed, n))
+        context.step("sampling", || {
+            draw_points(&mesh, &source, method, args.seed, wanted)
+        })
     })?
     .map_err(|e| super::at(args.mesh.display(), e))?;
     let cloud = context.step("building the point cloud", || {
@@ -332,10 +421,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         });
         super::write_image(context, path, &image)?;
     }
+    let kind = if args.blue_noise {
+        format!("{}, blue noise", method.name())
+    } else {
+        method.name().to_string()
+    };
     let text = format!(
-        "{} points ({}) on {} ({} triangles) written to {}{}\n",
+        "{} points ({kind}) on {} ({} triangles) written to {}{}\n",
         points.len(),
-        method.name(),
         args.mesh.display(),
         mesh.indices.len(),
         args.output.display(),
@@ -350,6 +443,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "triangles": mesh.indices.len(),
         "points": points.len(),
         "method": method.name(),
+        "blue_noise": args.blue_noise,
         "seed": args.seed,
         "output": super::shown(&args.output),
         "preview": args.preview.as_deref().map(super::shown),
