@@ -25,7 +25,7 @@ pub enum Mode {
     /// The filtered texture exactly: `p′`'s subdivision as the proposal,
     /// weighted by a bound of the density on each sub-triangle (its exact
     /// maximum over the sub-triangle's UV bounding box), and a rejection
-    /// step. [`DensitySampler::acceptance`] says how often it accepts.
+    /// step. [`DensitySampler::acceptance`](crate::DensitySampler::acceptance) says how often it accepts.
     Exact,
 }
 
@@ -69,7 +69,7 @@ pub struct Options {
     /// exact mode stays exact, with a lower acceptance). Default
     /// `1 << 22` (4,194,304: about 200 MB of tables), four sub-triangles
     /// per texel of a 1024² texture; the error
-    /// [`Error::TooManyPieces`] only when even one piece per triangle
+    /// [`Error::TooManyPieces`](crate::Error::TooManyPieces) only when even one piece per triangle
     /// exceeds it.
     pub max_pieces: usize,
     /// The deepest subdivision level, at most 13 (`4^13` sub-triangles for
