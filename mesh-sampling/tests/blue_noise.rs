@@ -327,11 +327,21 @@ fn bad_targets_and_options_are_errors_that_say_why() {
 )]
 fn data_meshes_are_spread() {
     let dir = data_dir::data_dir().expect("TRILUX_DATA");
-    for name in ["stanford-bunny", "spot", "fandisk"] {
+    // Every data mesh, at a count whose 10⁵ candidates take the tiled
+    // parallel elimination; ρ at least 0.65 (Yuksel's elimination reaches
+    // about 0.69; independent points about 0.01).
+    for name in [
+        "fandisk",
+        "nefertiti",
+        "spot",
+        "stanford-bunny",
+        "suzanne",
+        "teapot",
+    ] {
         let mesh = trilux_io::mesh::TriMesh::read(dir.join(format!("meshes/{name}.obj"))).unwrap();
         let s = UniformSampler::new(MeshRef::new(&mesh.positions, &mesh.indices)).unwrap();
         let (blue, random) = rho_pair(&s, 20_000, 4);
         eprintln!("{name}: ρ blue {blue:.3}, random {random:.4}");
-        assert!(blue > RHO_BLUE && random < RHO_BLUE, "{name}");
+        assert!(blue >= 0.65 && random < RHO_BLUE, "{name}: ρ {blue}");
     }
 }

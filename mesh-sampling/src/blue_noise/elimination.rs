@@ -9,6 +9,18 @@
 //! `r_k ∝ 1/√p(x_k)` (the candidates' own density) the expected weight of a
 //! candidate is the same everywhere, so elimination thins every region by
 //! the same factor and the output keeps the candidates' density.
+//!
+//! In parallel: the candidates (in Morton order) are cut into tiles of
+//! [`TILE`] consecutive candidates, a number fixed by the candidate count
+//! alone. A candidate is *interior* when no disk links it to another tile
+//! (neither its own disk's members nor the disks it lies in). First each
+//! tile, on its own thread, eliminates its interior candidates down to
+//! their share of the target (`⌈interior · N / M⌉`): a removal there only
+//! changes weights inside the tile, so the tiles are independent. Then one
+//! queue over everything left (the tiles' borders and survivors)
+//! eliminates down to the target: the border pass, sequential, over about
+//! a tenth of the candidates. The result depends on the candidate count
+//! and the weights only, never on the number of threads.
 
 use kiddo::SquaredEuclidean;
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
@@ -18,6 +30,11 @@ use super::heap::BucketQueue;
 /// Candidates per neighbour-list chunk (fixed, so that the lists do not
 /// depend on the number of threads).
 const CHUNK: usize = 4096;
+
+/// Candidates per tile of the parallel first pass (fixed, so that the
+/// result does not depend on the number of threads); runs of fewer than
+/// two tiles' worth of candidates are eliminated in one pass.
+const TILE: usize = 1 << 15;
 
 /// The k-d tree over candidate positions (32 points per leaf).
 pub(crate) type Tree = ImmutableKdTree<f32, u32, 3, 32>;
@@ -134,8 +151,11 @@ pub(crate) fn eliminate(
             total[i as usize] += f64::from(w);
         }
     }
-    let mut heap = BucketQueue::new(total);
     let mut removed = Vec::with_capacity(points.len().saturating_sub(target));
+    if points.len() >= 2 * TILE {
+        removed = thin_tiles(&lists, &mut total, target);
+    }
+    let mut heap = BucketQueue::new(total);
     while heap.len() > target {
         let Some(k) = heap.pop() else { break };
         removed.push(k);
@@ -148,6 +168,80 @@ pub(crate) fn eliminate(
         .filter(|&i| heap.contains(i))
         .collect();
     Eliminated { survivors, removed }
+}
+
+/// Whether each candidate shares a disk with a candidate of another tile
+/// (tiles of [`TILE`] consecutive candidates).
+fn border(lists: &Neighbours, m: usize) -> Vec<bool> {
+    let mut border = vec![false; m];
+    for k in 0..m {
+        for &(i, _) in lists.of(k) {
+            if i as usize / TILE != k / TILE {
+                border[k] = true;
+                border[i as usize] = true;
+            }
+        }
+    }
+    border
+}
+
+/// The first pass: every tile eliminates its interior candidates down to
+/// `⌈interior · target / M⌉`, the tiles on all threads. Removed candidates'
+/// totals become −∞, the others' are lowered by their removed neighbours.
+/// Returns the removed candidates, tile after tile, each tile's in the
+/// order it removed them.
+fn thin_tiles(lists: &Neighbours, total: &mut [f64], target: usize) -> Vec<u32> {
+    let m = total.len();
+    let border = border(lists, m);
+    let keep = target as f64 / m as f64;
+    let tile = |(t, tot): (usize, &mut [f64])| thin_tile(lists, tot, t * TILE, &border, keep);
+    #[cfg(feature = "rayon")]
+    let removed: Vec<Vec<u32>> = {
+        use rayon::prelude::*;
+        total.par_chunks_mut(TILE).enumerate().map(tile).collect()
+    };
+    #[cfg(not(feature = "rayon"))]
+    let removed: Vec<Vec<u32>> = total.chunks_mut(TILE).enumerate().map(tile).collect();
+    removed.concat()
+}
+
+/// One tile of [`thin_tiles`]: `tot` holds the totals of candidates
+/// `start..start + tot.len()`. An interior candidate's disk lies in the
+/// tile, so its removal touches `tot` only.
+fn thin_tile(
+    lists: &Neighbours,
+    tot: &mut [f64],
+    start: usize,
+    border: &[bool],
+    keep: f64,
+) -> Vec<u32> {
+    let inside = |j: usize| !border[start + j];
+    let keys: Vec<f64> = (0..tot.len())
+        .map(|j| if inside(j) { tot[j] } else { f64::NEG_INFINITY })
+        .collect();
+    let interior = (0..tot.len()).filter(|&j| inside(j)).count();
+    let kept = (interior as f64 * keep).ceil() as usize;
+    let mut queue = BucketQueue::new(keys);
+    let mut removed = Vec::with_capacity(interior.saturating_sub(kept));
+    while queue.len() > kept {
+        let Some(j) = queue.pop() else { break };
+        let k = start + j as usize;
+        removed.push(k as u32);
+        for &(i, w) in lists.of(k) {
+            let local = i as usize - start;
+            if inside(local) {
+                queue.decrease(local as u32, f64::from(w));
+            } else {
+                tot[local] -= f64::from(w);
+            }
+        }
+    }
+    for (j, t) in tot.iter_mut().enumerate() {
+        if inside(j) {
+            *t = queue.key(j as u32);
+        }
+    }
+    removed
 }
 
 #[cfg(test)]

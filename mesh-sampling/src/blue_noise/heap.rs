@@ -40,7 +40,7 @@ pub(crate) struct BucketQueue {
 
 impl BucketQueue {
     /// A queue of items `0..keys.len()` (at most `u32::MAX` of them), with
-    /// keys ≥ 0.
+    /// keys ≥ 0; an item whose key is −∞ is not in it (already removed).
     pub(crate) fn new(keys: Vec<f64>) -> Self {
         let max = keys.iter().copied().fold(0.0f64, f64::max);
         let scale = if max > 0.0 {
@@ -50,14 +50,16 @@ impl BucketQueue {
         };
         let mut queue = Self {
             buckets: vec![Vec::new(); BUCKETS],
-            len: keys.len(),
+            len: keys.iter().filter(|&&k| k != REMOVED).count(),
             top: BUCKETS - 1,
             keys,
             scale,
         };
         for i in 0..queue.keys.len() {
-            let b = queue.level(queue.keys[i]);
-            queue.buckets[b].push(i as u32);
+            if queue.keys[i] != REMOVED {
+                let b = queue.level(queue.keys[i]);
+                queue.buckets[b].push(i as u32);
+            }
         }
         queue
     }
@@ -77,6 +79,12 @@ impl BucketQueue {
     #[inline]
     pub(crate) fn contains(&self, item: u32) -> bool {
         self.keys[item as usize] != REMOVED
+    }
+
+    /// The current key of `item` (−∞ once removed).
+    #[inline]
+    pub(crate) fn key(&self, item: u32) -> f64 {
+        self.keys[item as usize]
     }
 
     /// Lowers the key of `item` by `amount` ≥ 0 (an item no longer in the
@@ -161,6 +169,17 @@ mod tests {
             assert!(keys[got] >= max - width, "{} < {max}", keys[got]);
             alive[got] = false;
         }
+        assert_eq!(q.pop(), None);
+    }
+
+    #[test]
+    fn items_with_key_minus_infinity_start_removed() {
+        let mut q = BucketQueue::new(vec![2.0, REMOVED, 1.0]);
+        assert_eq!(q.len(), 2);
+        assert!(!q.contains(1));
+        assert_eq!(q.key(1), REMOVED);
+        assert_eq!(q.pop(), Some(0));
+        assert_eq!(q.pop(), Some(2));
         assert_eq!(q.pop(), None);
     }
 

@@ -144,8 +144,10 @@ fn bytes_per_candidate(factor: f64) -> f64 {
 ///
 /// # Performance
 /// `O(M log M)` for `M` candidates: one k-d tree ([`kiddo`]), one radius
-/// query per candidate (in parallel), then one heap removal per eliminated
-/// candidate, which visits that candidate's stored neighbours.
+/// query per candidate (in parallel), then one queue removal per
+/// eliminated candidate, which visits that candidate's stored neighbours:
+/// first within tiles of consecutive (Morton-ordered) candidates in
+/// parallel, then over the tiles' borders.
 pub fn blue_noise<S: SurfaceSampler + SurfaceArea>(
     sampler: &S,
     target: BlueNoiseTarget,
