@@ -56,6 +56,8 @@ mod points;
 pub mod preview;
 pub mod shapes;
 pub mod tet;
+#[cfg(feature = "view")]
+pub mod view;
 
 pub use colors::{ColorMesh, ConvertOptions, SurfaceTexture, atlas_mesh, to_mesh_colors};
 pub use density::{density_texture, sampling_wrap};

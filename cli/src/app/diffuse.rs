@@ -159,7 +159,7 @@ fn parse_plane(spec: &str, argument: &str) -> Result<(DVec3, DVec3)> {
 }
 
 /// A measured material by name; `argument` is the option as typed.
-fn medium(name: &str, argument: &str) -> Result<Medium> {
+pub(crate) fn medium(name: &str, argument: &str) -> Result<Medium> {
     Medium::measured(name).map_err(|_| {
         let names = tet_diffusion::MEASURED
             .iter()

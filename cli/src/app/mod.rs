@@ -20,6 +20,8 @@ mod info;
 mod plot;
 mod sample;
 mod tetra;
+#[cfg(feature = "view")]
+mod view;
 
 pub(crate) type Result<T> = std::result::Result<T, Error>;
 
@@ -165,6 +167,8 @@ enum Command {
     Diffuse(diffuse::Args),
     Demo(demo::Args),
     Bench(bench::Args),
+    #[cfg(feature = "view")]
+    View(view::Args),
 }
 
 /// What every subcommand gets: the shared flags, progress, timings.
@@ -253,6 +257,8 @@ pub(crate) fn run() -> ExitCode {
         Command::Diffuse(args) => diffuse::run(&mut context, args),
         Command::Demo(args) => demo::run(&mut context, args),
         Command::Bench(args) => bench::run(&mut context, args),
+        #[cfg(feature = "view")]
+        Command::View(args) => view::run(&mut context, args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

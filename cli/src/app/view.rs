@@ -1,0 +1,359 @@
+//! `trilux view`: the command that loads the object and starts the
+//! server of `trilux::view` (the server, the session and the page live
+//! in the library; this file only reads arguments and files and supplies
+//! the renderer for exports).
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use serde_json::{Value, json};
+use tet_diffusion::{Light, Noise, Object, Session};
+use trilux::view::protocol::ExportKind;
+
+use super::{Context, Result, arg_error, file_error};
+
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Cut, paint, fracture and relight a translucent object interactively in the browser (TransCut)",
+    after_help = "Example:\n  trilux view                     # a built-in marble ball with a ketchup core\n  trilux view ../shared/data/tets/bunny_50k.node --material marble --open\n  trilux view --replay session.json\n\nIt prints a URL with a secret token; open it in a browser on this machine.\nPress ? on the page for the keys. Ctrl+C stops the server."
+)]
+pub(crate) struct Args {
+    /// A tetrahedral mesh (.node, .ele, .msh, .mesh, .vtu) or a closed
+    /// surface (.obj, .gltf, .glb, .ply), tetrahedralized first; none: a
+    /// built-in object.
+    pub(crate) input: Option<PathBuf>,
+    /// A measured material (Jensen et al. 2001) or noise:A,B.
+    #[arg(long)]
+    pub(crate) material: Option<String>,
+    /// Millimetres per mesh unit (default as for `trilux diffuse`).
+    #[arg(long, value_name = "X")]
+    pub(crate) unit_mm: Option<f64>,
+    /// Port (default: a free one).
+    #[arg(long, default_value_t = 0)]
+    pub(crate) port: u16,
+    /// Address to listen on; anything but 127.0.0.1 exposes the object to
+    /// the network (the token still guards it).
+    #[arg(long, default_value = "127.0.0.1")]
+    pub(crate) host: std::net::IpAddr,
+    /// Open the page in the system's browser.
+    #[arg(long)]
+    pub(crate) open: bool,
+    /// Start from a session file the page exported (its source and edits).
+    #[arg(long, value_name = "SESSION.json")]
+    pub(crate) replay: Option<PathBuf>,
+    /// Folder the page's exports are written to.
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    pub(crate) export_dir: PathBuf,
+}
+
+/// Loads the object a session file's `source` or the arguments describe.
+pub(crate) fn load(
+    context: &mut Context,
+    input: Option<&Path>,
+    material: Option<&str>,
+    unit_mm: Option<f64>,
+) -> Result<(Object, Value)> {
+    if let Some(mm) = unit_mm
+        && !(mm.is_finite() && mm > 0.0)
+    {
+        return Err(arg_error(
+            format!("--unit-mm {mm}"),
+            "millimetres per mesh unit must be a positive number",
+        ));
+    }
+    let source = json!({
+        "mesh": input.map(|p| p.display().to_string()),
+        "material": material,
+        "unit_mm": unit_mm,
+    });
+    let Some(input) = input else {
+        let mut object =
+            trilux::view::builtin::object(16).map_err(|e| super::invalid(e.to_string()))?;
+        if let Some(m) = material {
+            let m = super::diffuse::medium(m, &format!("--material {m}"))?;
+            let media = vec![m; object.media().len()];
+            object = Object::new(object.mesh().clone(), 1.0, media, 1.3)
+                .map_err(|e| super::invalid(e.to_string()))?;
+        }
+        add_default_light(&mut object)?;
+        return Ok((object, source));
+    };
+    let ext = super::extension(input);
+    let (positions, tets) = if ["node", "ele", "msh", "mesh", "vtu"].contains(&ext.as_str()) {
+        let t = super::read_tets(context, input)?;
+        (t.positions, t.tets)
+    } else if ["obj", "gltf", "glb", "ply"].contains(&ext.as_str()) {
+        let surface = super::read_mesh(context, input)?;
+        let (stuffed, _) = context.step("tetrahedralizing", || {
+            super::tetra::stuff(&surface, input, super::tetra::Spacing::Default, false)
+        })?;
+        let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
+        (out.positions, out.tets)
+    } else {
+        return Err(file_error(
+            input,
+            format!(
+                "{ext:?} is not read here: view takes tetrahedra (.node, .ele, .msh, .mesh, .vtu) or a surface (.obj, .gltf, .glb, .ply)"
+            ),
+        ));
+    };
+    let mesh = tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_error(input, e))?;
+    let (lo, hi) = positions
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| {
+            (a.min(p), b.max(p))
+        });
+    let diagonal = (hi - lo).length();
+    let unit = unit_mm.unwrap_or(if diagonal < 5.0 { 1000.0 } else { 1.0 });
+    let material = material.unwrap_or("marble");
+    let argument = format!("--material {material}");
+    let media = match material.strip_prefix("noise:") {
+        Some(pair) => {
+            let names: Vec<&str> = pair.split(',').collect();
+            let [a, b] = names.as_slice() else {
+                return Err(arg_error(argument, "expected noise:A,B"));
+            };
+            Noise {
+                a: super::diffuse::medium(a, &argument)?,
+                b: super::diffuse::medium(b, &argument)?,
+                scale: diagonal / 6.0,
+                octaves: 4,
+                seed: 1,
+            }
+            .media(&mesh)
+            .map_err(|e| arg_error(&argument, e))?
+        }
+        None => vec![super::diffuse::medium(material, &argument)?; mesh.tets().len()],
+    };
+    let mut object = context
+        .step("assembling", || Object::new(mesh, unit, media, 1.3))
+        .map_err(|e| file_error(input, e))?;
+    add_default_light(&mut object)?;
+    Ok((object, source))
+}
+
+fn add_default_light(object: &mut Object) -> Result<()> {
+    object
+        .add_light(Light::Directional {
+            to_light: DVec3::new(0.4, 1.0, 0.7),
+            irradiance: [1.0; 3],
+        })
+        .map_err(|e| super::invalid(e.to_string()))?;
+    Ok(())
+}
+
+/// Exports through the CLI's renderer and writers.
+struct Cli;
+
+/// The pieces as one tet mesh in the display frame.
+fn merged(session: &Session) -> trilux_io::tet::TetMesh {
+    let mut out = trilux_io::tet::TetMesh::default();
+    for o in session.pieces() {
+        let base = out.positions.len() as u32;
+        out.positions.extend(o.display_positions());
+        out.tets
+            .extend(o.mesh().tets().iter().map(|t| t.map(|v| v + base)));
+    }
+    out
+}
+
+impl trilux::view::Exporter for Cli {
+    fn export(
+        &self,
+        session: &Session,
+        kind: ExportKind,
+        path: &Path,
+        size: u32,
+        view: Option<DVec3>,
+        overwrite: bool,
+    ) -> std::result::Result<(), String> {
+        let fail = |e: trilux::Error| e.to_string();
+        match kind {
+            ExportKind::Png | ExportKind::Exr => {
+                let lights = session.pieces()[0].lights();
+                let image = super::diffuse::render(
+                    session.pieces(),
+                    &lights,
+                    size,
+                    view.map(|v| v.as_vec3()),
+                );
+                let image = if kind == ExportKind::Png {
+                    super::diffuse::tone_map(&image)
+                } else {
+                    image
+                };
+                trilux::output::write_atomic(path, overwrite, |tmp| {
+                    if kind == ExportKind::Png {
+                        Ok(trilux_io::image::write_png(
+                            tmp,
+                            &image,
+                            trilux_io::image::PngDepth::Eight,
+                        )?)
+                    } else {
+                        Ok(trilux_io::image::write_exr(
+                            tmp,
+                            &image,
+                            trilux_io::image::ExrPrecision::F32,
+                        )?)
+                    }
+                })
+                .map_err(fail)
+            }
+            ExportKind::Vtu => {
+                let mesh = merged(session);
+                let mut phi: [Vec<f64>; 3] = Default::default();
+                let mut lum = Vec::new();
+                for o in session.pieces() {
+                    for (c, p) in phi.iter_mut().enumerate() {
+                        p.extend_from_slice(o.phi(c));
+                    }
+                    let mut l = vec![0.0; o.mesh().vertex_count()];
+                    for (k, &v) in o.mesh().boundary_vertices().iter().enumerate() {
+                        let r = o.radiance(None)[k];
+                        l[v as usize] = 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2];
+                    }
+                    lum.extend(l);
+                }
+                use trilux_io::tet::vtu::{Encoding, Field};
+                let fields = [
+                    Field {
+                        name: "phi_r",
+                        values: &phi[0],
+                    },
+                    Field {
+                        name: "phi_g",
+                        values: &phi[1],
+                    },
+                    Field {
+                        name: "phi_b",
+                        values: &phi[2],
+                    },
+                    Field {
+                        name: "radiance",
+                        values: &lum,
+                    },
+                ];
+                trilux::output::write_atomic(path, overwrite, |tmp| {
+                    Ok(trilux_io::tet::vtu::write(
+                        tmp,
+                        &mesh,
+                        &fields,
+                        &[],
+                        Encoding::Base64,
+                    )?)
+                })
+                .map_err(fail)
+            }
+            ExportKind::Tet => {
+                let ele = path.with_extension("ele");
+                for p in [path, ele.as_path()] {
+                    trilux::output::check_new(p, overwrite).map_err(fail)?;
+                }
+                let mesh = merged(session);
+                let tmp = trilux::output::temporary_name(path);
+                let tmp_ele = tmp.with_extension("ele");
+                let written = trilux_io::tet::tetgen::write(&tmp, &mesh)
+                    .map_err(|e| e.to_string())
+                    .and_then(|()| std::fs::rename(&tmp_ele, &ele).map_err(|e| e.to_string()))
+                    .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+                if written.is_err() {
+                    let _ = std::fs::remove_file(&tmp);
+                    let _ = std::fs::remove_file(&tmp_ele);
+                }
+                written
+            }
+            ExportKind::Session => Err("session files are written by the server".into()),
+        }
+    }
+}
+
+pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    let (object, source, log) = match &args.replay {
+        Some(path) => {
+            super::check_input(path)?;
+            let text = std::fs::read_to_string(path).map_err(|e| file_error(path, e))?;
+            let (source, log) =
+                trilux::view::session_file::from_json(&text).map_err(|e| file_error(path, e))?;
+            let mesh = source
+                .get("mesh")
+                .and_then(Value::as_str)
+                .map(PathBuf::from);
+            let material = source
+                .get("material")
+                .and_then(Value::as_str)
+                .map(str::to_string);
+            let unit = source.get("unit_mm").and_then(Value::as_f64);
+            let (object, source) = load(context, mesh.as_deref(), material.as_deref(), unit)?;
+            (object, source, Some(log))
+        }
+        None => {
+            let (o, s) = load(
+                context,
+                args.input.as_deref(),
+                args.material.as_deref(),
+                args.unit_mm,
+            )?;
+            (o, s, None)
+        }
+    };
+    if !args.export_dir.is_dir() {
+        return Err(file_error(
+            &args.export_dir,
+            "no such folder (for --export-dir)",
+        ));
+    }
+    if !args.host.is_loopback() {
+        eprintln!(
+            "warning: listening on {}: other machines that can reach it may open the page (with its token)",
+            args.host
+        );
+    }
+    let options = trilux::view::Options {
+        host: args.host,
+        port: args.port,
+        export_dir: args.export_dir.clone(),
+        ..Default::default()
+    };
+    let runtime = tokio::runtime::Runtime::new()
+        .map_err(|e| super::invalid(format!("the server's runtime: {e}")))?;
+    let tets = object.mesh().tets().len();
+    runtime.block_on(async move {
+        let running = trilux::view::start(object, source, log, options, Box::new(Cli))
+            .await
+            .map_err(super::invalid)?;
+        let url = running.url();
+        if context.json {
+            println!(
+                "{}",
+                json!({"command": "view", "url": url, "tetrahedra": tets})
+            );
+        } else {
+            println!("trilux view: {tets} tetrahedra; open {url}  (Ctrl+C stops)");
+        }
+        if args.open {
+            open_browser(&url);
+        }
+        running
+            .wait(true)
+            .await
+            .map_err(|e| super::invalid(format!("the server: {e}")))
+    })
+}
+
+/// Asks the desktop to open `url` (xdg-open, open, or start).
+fn open_browser(url: &str) {
+    let command = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(windows) {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    if std::process::Command::new(command)
+        .arg(url)
+        .spawn()
+        .is_err()
+    {
+        eprintln!("could not start {command}; open the URL yourself");
+    }
+}

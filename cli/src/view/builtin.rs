@@ -1,0 +1,103 @@
+//! The object `trilux view` opens without a mesh: a marble ball, 40 mm
+//! across, with a ketchup core off its centre and a ring of skin inside —
+//! invisible from outside, lit through, and revealed by the first cut.
+
+use tet_diffusion::glam::DVec3;
+use tet_diffusion::{Error, Medium, Object, TetMesh};
+
+/// Radius of the ball, mm (the mesh's unit).
+pub const RADIUS: f64 = 20.0;
+
+/// The ball's tets: an `n³` lattice of `[-1, 1]³`, each cube split into six
+/// tets around its main diagonal (Kuhn), mapped radially
+/// (`x ← R x ‖x‖∞ / ‖x‖₂`) so that the boundary vertices lie on the sphere
+/// and every tet stays positively oriented.
+pub fn ball(n: usize) -> Result<TetMesh, Error> {
+    let m = n + 1;
+    let id = |x: usize, y: usize, z: usize| (x + m * (y + m * z)) as u32;
+    let mut positions = Vec::with_capacity(m * m * m);
+    for z in 0..m {
+        for y in 0..m {
+            for x in 0..m {
+                let c = DVec3::new(x as f64, y as f64, z as f64) * (2.0 / n as f64) - DVec3::ONE;
+                let l = c.length();
+                positions.push(if l == 0.0 {
+                    c
+                } else {
+                    c * (RADIUS * c.abs().max_element() / l)
+                });
+            }
+        }
+    }
+    const PATHS: [[usize; 3]; 6] = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let mut tets = Vec::with_capacity(n * n * n * 6);
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                for path in PATHS {
+                    let mut c = [x, y, z];
+                    let mut tet = [id(x, y, z); 4];
+                    for (k, &axis) in path.iter().enumerate() {
+                        c[axis] += 1;
+                        tet[k + 1] = id(c[0], c[1], c[2]);
+                    }
+                    tets.push(tet);
+                }
+            }
+        }
+    }
+    TetMesh::new(&positions, &tets)
+}
+
+/// The built-in object (`n = 16`: 24 576 tets), unlit.
+///
+/// # Errors
+/// None in practice (the mesh is made here); those of [`Object::new`].
+pub fn object(n: usize) -> Result<Object, Error> {
+    let mesh = ball(n)?;
+    let marble = Medium::measured("marble")?;
+    let ketchup = Medium::measured("ketchup")?;
+    let skin = Medium::measured("skin1")?;
+    let core = DVec3::new(0.25, 0.15, 0.1) * RADIUS;
+    let media = (0..mesh.tets().len())
+        .map(|t| {
+            let c = mesh.tet_center(t);
+            let ring =
+                (c.y.abs() < 0.12 * RADIUS) && (0.55 * RADIUS..0.75 * RADIUS).contains(&c.length());
+            if c.distance(core) < 0.38 * RADIUS {
+                ketchup
+            } else if ring {
+                skin
+            } else {
+                marble
+            }
+        })
+        .collect();
+    Object::new(mesh, 1.0, media, 1.3)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ball_is_closed_round_and_heterogeneous() {
+        let o = object(8).unwrap();
+        let m = o.mesh();
+        assert_eq!(m.tets().len(), 8 * 8 * 8 * 6);
+        for &v in m.boundary_vertices() {
+            let r = m.positions()[v as usize].length();
+            assert!((r - RADIUS).abs() < 1e-9, "{r}");
+        }
+        let distinct: std::collections::HashSet<String> =
+            o.media().iter().map(|m| format!("{m:?}")).collect();
+        assert_eq!(distinct.len(), 3);
+    }
+}

@@ -1,0 +1,316 @@
+// trilux view: the page. Modes, pointer handling, the HUD; drawing is in
+// gl.js, the camera in camera.js, the socket in net.js.
+import { Renderer } from './gl.js';
+import { Camera, normalize, cross, dot } from './camera.js';
+import { Connection, SURFACE, FINAL } from './net.js';
+
+const $ = (id) => document.getElementById(id);
+const canvas = $('view'), overlay = $('overlay'), brush = $('brush');
+const state = {
+  mode: 'orbit', hello: null, status: null, camera: null, eta: 1.3, white: 1,
+  lightDir: [0.4, 1, 0.7], pending: new Map(), errors: [], probes: [], exports: [],
+  radianceFrames: 0, surfaceFrames: 0, answered: [], lastRadianceFinal: false, firstFrameAt: null,
+};
+window.trilux = state;
+
+let renderer;
+try { renderer = new Renderer(canvas); } catch (e) { $('status').textContent = String(e); throw e; }
+state.renderer = renderer;
+
+const conn = new Connection(onText, onFrame, (s) => { $('status').textContent = s; if (s === 'connected') conn.send('hello'); });
+state.conn = conn;
+function send(op, fields) {
+  const seq = conn.send(op, fields);
+  state.pending.set(seq, performance.now());
+  return seq;
+}
+
+function onText(m) {
+  if (m.type === 'hello') {
+    state.hello = m; state.eta = m.eta; state.white = m.white;
+    if (!state.camera) state.camera = new Camera(m.bounds[0], m.bounds[1]);
+    state.camera.bounds = m.bounds;
+    const sel = $('material');
+    if (!sel.options.length) for (const name of m.materials) sel.add(new Option(name, name, name === 'ketchup', name === 'ketchup'));
+    const d = m.lights.find((l) => l.kind === 'dir');
+    if (d) state.lightDir = d.dir;
+  } else if (m.type === 'status') {
+    state.status = m;
+    // The edits answered, in order (a refinement's status follows its edit's).
+    if (m.edit !== 'refine' && m.edit !== 'hello') state.answered.push(m.edit);
+    for (const s of m.seqs) state.pending.delete(s);
+    if (m.offsets) m.offsets.forEach((o, k) => { if (renderer.pieces[k]) renderer.pieces[k].offset = o; });
+    renderer.dropPiecesFrom(m.pieces);
+    showStatus(m);
+    showHistory(m.history);
+  } else if (m.type === 'error') {
+    state.errors.push(m);
+    if (m.seq != null) state.pending.delete(m.seq);
+    if (m.exists && confirm(`${m.message}\nReplace it?`)) exportFile(state.lastExport, true);
+    else $('status').textContent = `error in ${m.field}: ${m.message}`;
+  } else if (m.type === 'probe') {
+    state.probes.push(m);
+    state.pending.delete(m.seq);
+    const r = m.radiance.map((x) => x.toExponential(2)).join(', ');
+    $('probe').textContent = `Probe: ${m.material}, radiance ${r}`;
+  } else if (m.type === 'export') {
+    state.exports.push(m);
+    state.pending.delete(m.seq);
+    $('status').textContent = `written ${m.path}`;
+  }
+}
+
+function onFrame(f) {
+  if (f.kind === SURFACE) {
+    renderer.setSurface(f.piece, f.positions, f.normals, f.indices);
+    state.surfaceFrames++;
+  } else {
+    if (renderer.setRadiance(f.piece, f.radiance)) {
+      state.radianceFrames++;
+      state.lastRadianceFinal = (f.flags & FINAL) !== 0;
+      if (state.firstFrameAt === null) state.firstFrameAt = performance.now();
+    }
+  }
+  if (state.status && state.status.offsets) state.status.offsets.forEach((o, k) => { if (renderer.pieces[k]) renderer.pieces[k].offset = o; });
+}
+
+function showStatus(m) {
+  const solves = m.solves.map((s) => `${s.levels} levels, ${s.iterations.join('/')} it`).join('; ');
+  const tets = m.tets.reduce((a, b) => a + b, 0);
+  $('status').textContent = `${m.edit}${m.coarse ? ' (coarse)' : ''}: ${m.wall_ms.toFixed(0)} ms wall, ${m.cpu_ms.toFixed(0)} ms CPU` +
+    (solves ? `, ${solves}` : '') + ` | ${tets} tets, ${m.pieces} piece${m.pieces > 1 ? 's' : ''}`;
+}
+
+function showHistory(h) {
+  const ol = $('history');
+  ol.innerHTML = '';
+  for (const n of h.done) { const li = document.createElement('li'); li.textContent = n; ol.append(li); }
+  for (const n of h.redo.slice().reverse()) { const li = document.createElement('li'); li.textContent = n; li.className = 'redo'; ol.append(li); }
+}
+
+// The busy indicator: an edit unanswered for more than 1 s.
+setInterval(() => {
+  let oldest = Infinity;
+  for (const t of state.pending.values()) oldest = Math.min(oldest, t);
+  const s = (performance.now() - oldest) / 1000;
+  $('busy').textContent = s > 10 ? `working… ${s.toFixed(0)} s` : s > 1 ? 'working…' : '';
+}, 250);
+
+function frame() {
+  if (state.camera) {
+    const ld = normalize(state.lightDir);
+    renderer.draw(state.camera, {
+      eta: state.eta, exposure: Math.pow(2, +$('ev').value) / state.white,
+      lightDir: ld, lightRgb: [+$('intensity').value, +$('intensity').value, +$('intensity').value],
+      specular: $('specular').checked,
+    });
+  }
+  requestAnimationFrame(frame);
+}
+requestAnimationFrame(frame);
+
+// Modes.
+function setMode(mode) {
+  state.mode = mode;
+  for (const b of document.querySelectorAll('#modes button')) b.classList.toggle('on', b.dataset.mode === mode);
+  for (const s of document.querySelectorAll('#panel section[data-for]')) s.classList.toggle('shown', s.dataset.for === mode);
+  brush.style.display = 'none';
+  overlay.innerHTML = '';
+  if (mode === 'plane') drawPlane();
+}
+for (const b of document.querySelectorAll('#modes button')) b.onclick = () => setMode(b.dataset.mode);
+setMode('orbit');
+
+const size = () => [canvas.clientWidth, canvas.clientHeight];
+function hit(x, y) {
+  if (!state.camera) return null;
+  const [w, h] = size();
+  const { o, d } = state.camera.ray(x, y, w, h);
+  return renderer.pick(o, d);
+}
+const objectSize = () => state.camera ? state.camera.radius * 2 : 1;
+const sigma = () => +$('radius').value * objectSize();
+
+function lights() {
+  const I = +$('intensity').value;
+  const out = [{ kind: 'dir', dir: normalize(state.lightDir), rgb: [I, I, I] }];
+  if ($('point').checked && state.camera) {
+    const d = 2 * state.camera.radius;
+    const unit = state.hello ? state.hello.unit_mm : 1;
+    const p = state.camera.target.map((t, i) => t + normalize(state.lightDir)[i] * d);
+    const q = I * Math.pow(d * unit, 2);
+    out.push({ kind: 'point', pos: p, rgb: [q, q, q] });
+  }
+  return out;
+}
+
+// Pointer handling: one pointer orbits/edits, two pan and pinch-zoom.
+const pointers = new Map();
+let drag = null, lastSend = 0, pinch = null;
+function svgLine(points, color) {
+  overlay.innerHTML = `<polyline points="${points.map((p) => p.join(',')).join(' ')}" fill="none" stroke="${color}" stroke-width="2"/>`;
+}
+
+canvas.addEventListener('pointerdown', (e) => {
+  canvas.setPointerCapture(e.pointerId);
+  pointers.set(e.pointerId, [e.clientX, e.clientY]);
+  if (pointers.size === 2) { const [a, b] = [...pointers.values()]; pinch = { d: Math.hypot(a[0] - b[0], a[1] - b[1]), c: [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2] }; drag = null; return; }
+  const orbit = state.mode === 'orbit' || e.button === 1 || e.altKey || e.button === 2 || e.shiftKey && state.mode === 'orbit';
+  drag = { x: e.clientX, y: e.clientY, kind: orbit ? (e.button === 2 || e.shiftKey ? 'pan' : 'orbit') : state.mode, points: [[e.clientX, e.clientY]] };
+  if (drag.kind === 'paint') paintAt(e.clientX, e.clientY, true);
+  if (drag.kind === 'move') { const h = hit(e.clientX, e.clientY); drag.piece = h ? h.piece : null; drag.start = h ? [...renderer.pieces[h.piece].offset] : null; }
+});
+canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+canvas.addEventListener('pointermove', (e) => {
+  if (pointers.has(e.pointerId)) pointers.set(e.pointerId, [e.clientX, e.clientY]);
+  if (pinch && pointers.size === 2) {
+    const [a, b] = [...pointers.values()];
+    const d = Math.hypot(a[0] - b[0], a[1] - b[1]), c = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
+    state.camera.zoom(pinch.d / d);
+    state.camera.pan(c[0] - pinch.c[0], c[1] - pinch.c[1], canvas.clientHeight);
+    pinch = { d, c };
+    return;
+  }
+  if (state.mode === 'paint') showBrush(e.clientX, e.clientY);
+  if (!drag) return;
+  const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+  drag.x = e.clientX; drag.y = e.clientY;
+  const now = performance.now();
+  switch (drag.kind) {
+    case 'orbit': state.camera.orbit(dx, dy); break;
+    case 'pan': state.camera.pan(dx, dy, canvas.clientHeight); break;
+    case 'cut': case 'fracture': drag.points.push([e.clientX, e.clientY]); svgLine(drag.points, drag.kind === 'cut' ? '#f66' : '#fc6'); break;
+    case 'paint': paintAt(e.clientX, e.clientY, false); break;
+    case 'light': {
+      const [w, h] = size();
+      let x = 2 * e.clientX / w - 1, y = 1 - 2 * e.clientY / h;
+      const l = Math.hypot(x, y); if (l > 0.98) { x *= 0.98 / l; y *= 0.98 / l; }
+      const { f, r, u } = state.camera.basis();
+      const z = Math.sqrt(Math.max(0, 1 - x * x - y * y));
+      state.lightDir = [0, 1, 2].map((i) => r[i] * x + u[i] * y - f[i] * z);
+      if (now - lastSend > 30) { send('lights', { lights: lights() }); lastSend = now; }
+      break;
+    }
+    case 'plane': {
+      const n = parseVec($('pn').value) || [0, 0, 1];
+      const { r, u } = state.camera.basis();
+      const rot = (v, axis, a) => { const c = Math.cos(a), s = Math.sin(a), k = dot(axis, v), x = cross(axis, v); return [0, 1, 2].map((i) => v[i] * c + x[i] * s + axis[i] * k * (1 - c)); };
+      const m = normalize(rot(rot(n, u, dx * 0.01), r, dy * 0.01));
+      $('pn').value = m.map((x) => x.toFixed(3)).join(',');
+      drawPlane();
+      break;
+    }
+    case 'move': if (drag.piece != null && drag.start) {
+      const { r, u } = state.camera.basis();
+      const s = 2 * state.camera.distance * Math.tan(state.camera.fov / 2) / canvas.clientHeight;
+      drag.start = [0, 1, 2].map((i) => drag.start[i] + (r[i] * dx - u[i] * dy) * s);
+      renderer.pieces[drag.piece].offset = drag.start;
+      if (now - lastSend > 30) { send('move', { piece: drag.piece, offset: drag.start }); lastSend = now; }
+    } break;
+  }
+});
+canvas.addEventListener('pointerup', (e) => {
+  pointers.delete(e.pointerId);
+  if (pointers.size < 2) pinch = null;
+  if (!drag) return;
+  const d = drag; drag = null;
+  if ((d.kind === 'cut' || d.kind === 'fracture') && d.points.length >= 2 && state.camera) {
+    const [w, h] = size();
+    const pts = d.points.map(([x, y]) => state.camera.onPlane(x, y, w, h));
+    const view = state.camera.forward();
+    if (d.kind === 'cut') send('cut', { stroke: { points: pts, view } });
+    else {
+      const a = pts[0], b = pts[pts.length - 1];
+      const normal = normalize(cross([b[0] - a[0], b[1] - a[1], b[2] - a[2]], view));
+      const h0 = hit(d.points[0][0], d.points[0][1]);
+      send('fracture', { piece: h0 ? h0.piece : 0, point: a, normal });
+    }
+    setTimeout(() => { overlay.innerHTML = ''; }, 400);
+  }
+  if (d.kind === 'light') send('lights', { lights: lights() });
+  if (d.kind === 'move' && d.piece != null && d.start) send('move', { piece: d.piece, offset: d.start });
+  if (d.kind === 'paint') flushPaint();
+});
+canvas.addEventListener('wheel', (e) => { e.preventDefault(); state.camera && state.camera.zoom(Math.exp(e.deltaY * 0.001)); }, { passive: false });
+
+// Paint: dabs spaced by σ/2 along the stroke, sent every 30 ms.
+let dabs = [], lastDab = null;
+function paintAt(x, y, first) {
+  const h = hit(x, y);
+  if (!h) return;
+  if (!first && lastDab && Math.hypot(...h.point.map((v, i) => v - lastDab[i])) < sigma() / 2) return;
+  dabs.push(h.point); lastDab = h.point;
+  if (performance.now() - lastSend > 30) flushPaint();
+}
+function flushPaint() {
+  if (!dabs.length) return;
+  send('paint', { material: $('material').value, radius: sigma(), strength: +$('strength').value, points: dabs });
+  dabs = []; lastSend = performance.now();
+}
+let lastProbe = 0;
+function showBrush(x, y) {
+  const h = hit(x, y);
+  if (!h) { brush.style.display = 'none'; return; }
+  const dist = Math.hypot(...h.point.map((v, i) => v - state.camera.eye()[i]));
+  const px = sigma() / (dist * Math.tan(state.camera.fov / 2)) * canvas.clientHeight / 2;
+  Object.assign(brush.style, { display: 'block', left: `${x - px}px`, top: `${y - px}px`, width: `${2 * px}px`, height: `${2 * px}px` });
+  if (performance.now() - lastProbe > 150) { send('probe', { piece: h.piece, point: h.point }); lastProbe = performance.now(); }
+}
+
+// The plane: numeric fields, a square outline as the gizmo.
+function parseVec(s) { const v = s.split(',').map(Number); return v.length === 3 && v.every(Number.isFinite) && Math.hypot(...v) > 0 ? v : null; }
+function planeSpec() {
+  const n = normalize(parseVec($('pn').value) || [0, 0, 1]);
+  const d = +$('pd').value || 0;
+  const t = state.camera ? state.camera.target : [0, 0, 0];
+  return { point: [0, 1, 2].map((i) => t[i] + n[i] * d), normal: n };
+}
+function drawPlane() {
+  if (!state.camera || state.mode !== 'plane') return;
+  const { point, normal } = planeSpec();
+  let a = normalize(cross(normal, Math.abs(normal[1]) < 0.9 ? [0, 1, 0] : [1, 0, 0]));
+  const b = cross(normal, a), R = state.camera.radius * 1.2;
+  const [w, h] = size();
+  const m = state.camera.viewProj(w / h);
+  const project = (p) => { const x = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12], y = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13], ww = m[3] * p[0] + m[7] * p[1] + m[11] * p[2] + m[15]; return [(x / ww + 1) * w / 2, (1 - y / ww) * h / 2]; };
+  const corners = [[1, 1], [-1, 1], [-1, -1], [1, -1], [1, 1]].map(([s, t]) => project([0, 1, 2].map((i) => point[i] + R * (s * a[i] + t * b[i]))));
+  const tip = project([0, 1, 2].map((i) => point[i] + normal[i] * R * 0.6)), base = project(point);
+  overlay.innerHTML = `<polyline points="${corners.map((p) => p.join(',')).join(' ')}" fill="#6af2" stroke="#6af" stroke-width="1.5"/>` +
+    `<line x1="${base[0]}" y1="${base[1]}" x2="${tip[0]}" y2="${tip[1]}" stroke="#f66" stroke-width="2"/>`;
+}
+$('pn').oninput = drawPlane; $('pd').oninput = drawPlane;
+$('plane-cut').onclick = () => send('cut', { plane: planeSpec() });
+$('plane-fracture').onclick = () => { const p = planeSpec(); send('fracture', { piece: 0, point: p.point, normal: p.normal }); };
+const recombine = () => { if (renderer.pieces.length >= 2) send('recombine', { a: 0, b: 1 }); };
+$('recombine').onclick = recombine; $('recombine2').onclick = recombine;
+$('fill').onclick = () => send('material', { material: $('material').value });
+$('undo').onclick = () => send('undo');
+$('redo').onclick = () => send('redo');
+$('point').onchange = () => send('lights', { lights: lights() });
+$('intensity').onchange = () => send('lights', { lights: lights() });
+$('help').onclick = () => { $('helpbox').hidden = !$('helpbox').hidden; };
+
+function exportFile(kind, overwrite = false) {
+  const ext = { png: 'png', exr: 'exr', vtu: 'vtu', tet: 'node', session: 'json' }[kind];
+  const name = $('ename').value.replace(/[^A-Za-z0-9_.-]/g, '_').replace(/^\.+/, '') + '.' + ext;
+  state.lastExport = kind;
+  const view = state.camera ? normalize(state.camera.eye().map((v, i) => v - state.camera.target[i])) : undefined;
+  send('export', { kind, name, size: +$('size').value, overwrite, view });
+}
+for (const b of document.querySelectorAll('[data-export]')) b.onclick = () => exportFile(b.dataset.export);
+
+window.addEventListener('keydown', (e) => {
+  if (e.target.tagName === 'INPUT' || e.target.tagName === 'SELECT') return;
+  const k = e.key.toLowerCase();
+  if ((e.ctrlKey || e.metaKey) && k === 'z') { e.preventDefault(); send(e.shiftKey ? 'redo' : 'undo'); return; }
+  if ((e.ctrlKey || e.metaKey) && k === 'y') { e.preventDefault(); send('redo'); return; }
+  const modes = { o: 'orbit', c: 'cut', x: 'plane', p: 'paint', l: 'light', f: 'fracture', m: 'move' };
+  if (modes[k]) setMode(modes[k]);
+  else if (e.key === '?') $('helpbox').hidden = !$('helpbox').hidden;
+  else if (e.key === 'Escape') $('helpbox').hidden = true;
+  else if (k === 's') $('specular').checked = !$('specular').checked;
+  else if (k === 'r') recombine();
+  else if (k === 'e') exportFile('png');
+  else if (e.key === '[') $('radius').value = +$('radius').value * 0.8;
+  else if (e.key === ']') $('radius').value = +$('radius').value * 1.25;
+});

@@ -1,0 +1,44 @@
+// The WebSocket to the server: JSON edits with a sequence number up,
+// JSON status and binary frames (16-byte header, little-endian arrays)
+// down. It reconnects after a drop; the server kept the session.
+
+export const SURFACE = 1, RADIANCE = 2, FINAL = 1, LAST = 2;
+
+export function parseFrame(buffer) {
+  const h = new DataView(buffer, 0, 16);
+  const magic = String.fromCharCode(h.getUint8(0), h.getUint8(1), h.getUint8(2), h.getUint8(3));
+  if (magic !== 'TLXF' || h.getUint8(4) !== 1) throw new Error('unknown frame (magic ' + magic + ', version ' + h.getUint8(4) + ')');
+  const kind = h.getUint8(5), flags = h.getUint8(6), piece = h.getUint8(7);
+  const a = h.getUint32(8, true), b = h.getUint32(12, true);
+  if (kind === SURFACE) {
+    return { kind, flags, piece, positions: new Float32Array(buffer, 16, a * 3),
+      normals: new Float32Array(buffer, 16 + a * 12, a * 3),
+      indices: new Uint32Array(buffer, 16 + a * 24, b * 3) };
+  }
+  return { kind, flags, piece, seq: b, radiance: new Float32Array(buffer, 16, a * 3) };
+}
+
+export class Connection {
+  constructor(onText, onFrame, onState) {
+    this.seq = 0;
+    this.onText = onText; this.onFrame = onFrame; this.onState = onState;
+    this.open();
+  }
+  open() {
+    const url = location.href.replace(/^http/, 'ws').replace(/[^/]*$/, '') + 'ws';
+    const ws = new WebSocket(url);
+    ws.binaryType = 'arraybuffer';
+    ws.onopen = () => this.onState('connected');
+    ws.onclose = () => { this.onState('disconnected; reconnecting…'); setTimeout(() => this.open(), 1000); };
+    ws.onmessage = (e) => {
+      if (typeof e.data === 'string') this.onText(JSON.parse(e.data));
+      else this.onFrame(parseFrame(e.data));
+    };
+    this.ws = ws;
+  }
+  send(op, fields = {}) {
+    const seq = ++this.seq;
+    if (this.ws.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify({ seq, op, ...fields }));
+    return seq;
+  }
+}

@@ -1,0 +1,465 @@
+//! The thread that owns the [`Session`]: it takes requests in order,
+//! coalesces the edits waiting, solves coarse first, refines when idle
+//! (cancelled by the next request), and sends frames and status to every
+//! connected page. A dropped connection does not touch it: a reload
+//! continues the same session.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, TryRecvError};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use serde_json::{Value, json};
+use tet_diffusion::glam::DVec3;
+use tet_diffusion::{Applied, Session, SolveReport};
+use tokio::sync::broadcast;
+
+use super::protocol::{self, ExportKind, FINAL, LAST, RADIANCE, Request, SURFACE};
+use super::{Exporter, Out, session_file};
+
+/// What a page needs on (re)connection: the last frames sent.
+#[derive(Debug, Default)]
+pub(crate) struct Latest {
+    pub(crate) hello: Option<String>,
+    pub(crate) surfaces: Vec<Arc<Vec<u8>>>,
+    pub(crate) radiance: Vec<Arc<Vec<u8>>>,
+    pub(crate) status: Option<String>,
+}
+
+pub(crate) struct Worker {
+    pub(crate) session: Session,
+    pub(crate) requests: Receiver<(u64, Request)>,
+    pub(crate) cancel: Arc<AtomicBool>,
+    pub(crate) out: broadcast::Sender<Out>,
+    pub(crate) latest: Arc<Mutex<Latest>>,
+    pub(crate) exporter: Box<dyn Exporter>,
+    pub(crate) export_dir: PathBuf,
+    pub(crate) source: Value,
+    /// The exposure's white point, fixed at the start (a camera's
+    /// exposure does not follow each edit).
+    pub(crate) white: f64,
+}
+
+/// Process CPU time, ms (Linux; 0 elsewhere).
+fn cpu_ms() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the command name in parentheses; utime and stime are
+    // the 14th and 15th fields, in clock ticks (100 per second on Linux).
+    let Some(rest) = stat.rsplit_once(')').map(|(_, r)| r) else {
+        return 0.0;
+    };
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| f.get(i).and_then(|x| x.parse::<f64>().ok()).unwrap_or(0.0);
+    (ticks(11) + ticks(12)) * 10.0
+}
+
+impl Worker {
+    pub(crate) fn run(mut self) {
+        self.send_all();
+        loop {
+            let next = if self.session.needs_refinement() {
+                self.cancel.store(false, Ordering::SeqCst);
+                match self.requests.try_recv() {
+                    Ok(r) => Some(r),
+                    Err(TryRecvError::Empty) => None,
+                    Err(TryRecvError::Disconnected) => return,
+                }
+            } else {
+                match self.requests.recv() {
+                    Ok(r) => Some(r),
+                    Err(_) => return,
+                }
+            };
+            match next {
+                None => self.refine(),
+                Some(first) => self.handle(first),
+            }
+        }
+    }
+
+    fn send(&self, out: Out) {
+        // No page connected is not an error: the state is kept in
+        // `latest` for the next one.
+        let _ = self.out.send(out);
+    }
+
+    fn error(&self, seq: u64, field: &str, message: &str) {
+        self.send(Out::Text(
+            json!({"type": "error", "seq": seq, "field": field, "message": message}).to_string(),
+        ));
+    }
+
+    fn refine(&mut self) {
+        let t = Instant::now();
+        let c = cpu_ms();
+        match self.session.refine(&self.cancel) {
+            Ok((reports, true)) => {
+                self.send_radiance(true, 0);
+                self.send_status(&[], "refine", &reports, t, c, false);
+            }
+            Ok((_, false)) => {}
+            Err(e) => {
+                self.error(0, "(solve)", &e.to_string());
+                // Keep the coarse result; nothing more to refine until the
+                // next edit.
+                self.session.skip_refinement();
+            }
+        }
+    }
+
+    /// Handles `first` and, if it is an edit, every edit already waiting
+    /// behind it (coalesced by the session); a non-edit request stops
+    /// the gathering and is handled after them.
+    fn handle(&mut self, first: (u64, Request)) {
+        let mut seqs = Vec::new();
+        let mut after = None;
+        let mut request = Some(first);
+        while let Some((seq, r)) = request.take() {
+            match r {
+                Request::Edit(edit) => {
+                    match self.session.push(edit) {
+                        Ok(()) => seqs.push(seq),
+                        Err(e) => self.error(seq, &field_of(&e), &e.to_string()),
+                    }
+                    request = self.requests.try_recv().ok();
+                }
+                other => after = Some((seq, other)),
+            }
+        }
+        if !seqs.is_empty() || self.session.pending() > 0 {
+            self.apply(&seqs);
+        }
+        if let Some((seq, r)) = after {
+            self.other(seq, r);
+        }
+    }
+
+    fn apply(&mut self, seqs: &[u64]) {
+        let t = Instant::now();
+        let c = cpu_ms();
+        let mut reports: Vec<SolveReport> = Vec::new();
+        let mut topology = false;
+        let mut name = "edit";
+        while let Some(result) = self.session.apply_pending() {
+            match result {
+                Ok(Applied {
+                    edit,
+                    solves,
+                    topology_changed,
+                    ..
+                }) => {
+                    name = edit.name();
+                    topology |= topology_changed;
+                    reports.extend(solves);
+                }
+                Err(e) => {
+                    self.error(
+                        seqs.last().copied().unwrap_or(0),
+                        &field_of(&e),
+                        &e.to_string(),
+                    );
+                }
+            }
+        }
+        if topology {
+            self.send_surfaces();
+        }
+        let last = seqs.last().copied().unwrap_or(0);
+        self.send_radiance(!self.session.needs_refinement(), last);
+        self.send_status(seqs, name, &reports, t, c, self.session.needs_refinement());
+    }
+
+    fn other(&mut self, seq: u64, r: Request) {
+        let t = Instant::now();
+        let c = cpu_ms();
+        match r {
+            Request::Edit(_) => {}
+            Request::Hello => self.send_all(),
+            Request::Undo | Request::Redo => {
+                let undo = matches!(r, Request::Undo);
+                let result = if undo {
+                    self.session.undo()
+                } else {
+                    self.session.redo()
+                };
+                match result {
+                    Ok(Some(edit)) => {
+                        if edit.changes_topology() {
+                            self.send_surfaces();
+                        }
+                        self.send_radiance(true, seq);
+                        let name = if undo { "undo" } else { "redo" };
+                        self.send_status(&[seq], name, &[], t, c, false);
+                    }
+                    Ok(None) => self.error(
+                        seq,
+                        "op",
+                        if undo {
+                            "nothing to undo"
+                        } else {
+                            "nothing to redo"
+                        },
+                    ),
+                    Err(e) => self.error(seq, "op", &e.to_string()),
+                }
+            }
+            Request::Probe { piece, point } => self.probe(seq, piece, point),
+            Request::Export {
+                kind,
+                name,
+                size,
+                overwrite,
+                view,
+            } => {
+                let path = self.export_dir.join(&name);
+                let result = if kind == ExportKind::Session {
+                    session_file::write(&path, &self.source, &self.session.log(), overwrite)
+                } else {
+                    self.exporter
+                        .export(&self.session, kind, &path, size, view, overwrite)
+                };
+                match result {
+                    Ok(()) => self.send(Out::Text(
+                        json!({"type": "export", "seq": seq, "path": path.display().to_string()})
+                            .to_string(),
+                    )),
+                    Err(e) => {
+                        let exists = path.exists() && !overwrite;
+                        self.send(Out::Text(
+                            json!({"type": "error", "seq": seq, "field": "name",
+                                   "message": e, "exists": exists})
+                            .to_string(),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+
+    fn probe(&self, seq: u64, piece: usize, point: DVec3) {
+        let Some(o) = self.session.pieces().get(piece) else {
+            return self.error(seq, "piece", "no such piece");
+        };
+        let local = point - self.session.offsets()[piece];
+        let m = o.mesh();
+        let Some((k, &v)) = m.boundary_vertices().iter().enumerate().min_by(|a, b| {
+            let da = m.positions()[*a.1 as usize].distance_squared(local);
+            let db = m.positions()[*b.1 as usize].distance_squared(local);
+            da.total_cmp(&db)
+        }) else {
+            return self.error(seq, "piece", "the piece has no surface");
+        };
+        let radiance = o.radiance(None)[k];
+        // The medium of a tet around the vertex, by name when measured.
+        let t = m.vertex_tets(v as usize).first().copied().unwrap_or(0) as usize;
+        let medium = o.medium(t).copied();
+        let name = medium.and_then(|md| {
+            tet_diffusion::MEASURED
+                .iter()
+                .find(|(n, _, _)| tet_diffusion::Medium::measured(n).ok() == Some(md))
+                .map(|(n, _, _)| n.to_string())
+        });
+        self.send(Out::Text(
+            json!({
+                "type": "probe", "seq": seq, "piece": piece, "vertex": v,
+                "material": name.unwrap_or_else(|| "mixed".into()),
+                "sigma_a": medium.map(|m| m.sigma_a),
+                "sigma_s_prime": medium.map(|m| m.sigma_s_prime),
+                "radiance": radiance,
+            })
+            .to_string(),
+        ));
+    }
+
+    fn hello(&self) -> String {
+        let (lo, hi) = self.bounds();
+        json!({
+            "type": "hello",
+            "protocol": protocol::VERSION,
+            "eta": self.session.pieces()[0].eta(),
+            "unit_mm": self.session.pieces()[0].length_unit_mm(),
+            "white": self.white,
+            "materials": tet_diffusion::MEASURED.iter().map(|m| m.0).collect::<Vec<_>>(),
+            "bounds": [lo.to_array(), hi.to_array()],
+            "lights": lights_json(&self.session),
+            "source": self.source,
+        })
+        .to_string()
+    }
+
+    fn bounds(&self) -> (DVec3, DVec3) {
+        let mut lo = DVec3::INFINITY;
+        let mut hi = DVec3::NEG_INFINITY;
+        for (o, off) in self.session.pieces().iter().zip(self.session.offsets()) {
+            for &p in o.mesh().positions() {
+                lo = lo.min(p + *off);
+                hi = hi.max(p + *off);
+            }
+        }
+        (lo, hi)
+    }
+
+    fn send_all(&mut self) {
+        let hello = self.hello();
+        self.latest_mut().hello = Some(hello.clone());
+        self.send(Out::Text(hello));
+        self.send_surfaces();
+        self.send_radiance(!self.session.needs_refinement(), 0);
+        self.send_status(&[], "hello", &[], Instant::now(), cpu_ms(), false);
+    }
+
+    fn latest_mut(&self) -> std::sync::MutexGuard<'_, Latest> {
+        self.latest
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    fn send_surfaces(&mut self) {
+        let n = self.session.pieces().len();
+        let frames: Vec<Arc<Vec<u8>>> = self
+            .session
+            .pieces()
+            .iter()
+            .enumerate()
+            .map(|(p, o)| {
+                let m = o.mesh();
+                let bv = m.boundary_vertices();
+                let mut payload = Vec::with_capacity(bv.len() * 24 + m.boundary().len() * 12);
+                protocol::put_f32(
+                    &mut payload,
+                    bv.iter()
+                        .flat_map(|&v| m.positions()[v as usize].as_vec3().to_array()),
+                );
+                protocol::put_f32(
+                    &mut payload,
+                    bv.iter()
+                        .flat_map(|&v| m.vertex_normals()[v as usize].as_vec3().to_array()),
+                );
+                protocol::put_u32(
+                    &mut payload,
+                    m.boundary()
+                        .iter()
+                        .flat_map(|t| t.map(|v| m.boundary_index(v as usize).unwrap_or(0) as u32)),
+                );
+                let flags = if p + 1 == n { LAST } else { 0 };
+                Arc::new(protocol::frame(
+                    SURFACE,
+                    flags,
+                    p as u8,
+                    bv.len() as u32,
+                    m.boundary().len() as u32,
+                    &payload,
+                ))
+            })
+            .collect();
+        for f in &frames {
+            self.send(Out::Binary(f.clone()));
+        }
+        self.latest_mut().surfaces = frames;
+    }
+
+    fn send_radiance(&mut self, refined: bool, seq: u64) {
+        let n = self.session.pieces().len();
+        let frames: Vec<Arc<Vec<u8>>> = self
+            .session
+            .pieces()
+            .iter()
+            .enumerate()
+            .map(|(p, o)| {
+                let l = o.radiance(None);
+                let mut payload = Vec::with_capacity(l.len() * 12);
+                protocol::put_f32(&mut payload, l.iter().flat_map(|c| c.map(|x| x as f32)));
+                let flags = if refined { FINAL } else { 0 } | if p + 1 == n { LAST } else { 0 };
+                Arc::new(protocol::frame(
+                    RADIANCE,
+                    flags,
+                    p as u8,
+                    l.len() as u32,
+                    seq as u32,
+                    &payload,
+                ))
+            })
+            .collect();
+        for f in &frames {
+            self.send(Out::Binary(f.clone()));
+        }
+        self.latest_mut().radiance = frames;
+    }
+
+    fn send_status(
+        &mut self,
+        seqs: &[u64],
+        edit: &str,
+        reports: &[SolveReport],
+        start: Instant,
+        cpu_start: f64,
+        coarse: bool,
+    ) {
+        let s = &self.session;
+        let (done, redo) = s.history();
+        let status = json!({
+            "type": "status",
+            "seqs": seqs,
+            "edit": edit,
+            "coarse": coarse,
+            "wall_ms": start.elapsed().as_secs_f64() * 1e3,
+            "cpu_ms": cpu_ms() - cpu_start,
+            "solves": reports.iter().map(|r| json!({
+                "levels": r.levels,
+                "iterations": r.channels.map(|c| c.iterations),
+                "residual": r.channels.map(|c| if c.residual.is_finite() { c.residual } else { -1.0 }),
+                "hierarchy_built": r.hierarchy_built,
+                "hierarchy_ms": r.hierarchy_ms,
+                "solve_ms": r.solve_ms,
+            })).collect::<Vec<_>>(),
+            "pieces": s.pieces().len(),
+            "offsets": s.offsets().iter().map(|o| o.to_array()).collect::<Vec<_>>(),
+            "tets": s.pieces().iter().map(|o| o.mesh().tets().len()).collect::<Vec<_>>(),
+            "surface_vertices": s.pieces().iter().map(|o| o.mesh().boundary_vertices().len()).collect::<Vec<_>>(),
+            "history": {"done": done, "redo": redo},
+            "undo_bytes": s.undo_bytes(),
+            "object_bytes": s.pieces().iter().map(|o| o.memory_bytes()).sum::<usize>(),
+            "hierarchy_builds": s.pieces().iter().map(|o| o.hierarchy_builds()).collect::<Vec<_>>(),
+            "lights": lights_json(s),
+        })
+        .to_string();
+        self.latest_mut().status = Some(status.clone());
+        self.send(Out::Text(status));
+    }
+}
+
+/// The field an edit's error names: the argument for a bad one, else the
+/// edit itself (`op`).
+fn field_of(e: &tet_diffusion::Error) -> String {
+    match e {
+        tet_diffusion::Error::BadArgument { what, .. } => what.clone(),
+        _ => "op".into(),
+    }
+}
+
+/// The lights of the first piece, display frame, as the page sends them.
+fn lights_json(s: &Session) -> Value {
+    let off = s.offsets()[0];
+    Value::Array(
+        s.pieces()[0]
+            .lights()
+            .iter()
+            .filter_map(|l| match l {
+                tet_diffusion::Light::Directional {
+                    to_light,
+                    irradiance,
+                } => Some(json!({"kind": "dir", "dir": to_light.to_array(), "rgb": irradiance})),
+                tet_diffusion::Light::Point {
+                    position,
+                    intensity,
+                } => Some(
+                    json!({"kind": "point", "pos": (*position + off).to_array(), "rgb": intensity}),
+                ),
+                tet_diffusion::Light::Environment(_) => None,
+            })
+            .collect(),
+    )
+}
