@@ -171,16 +171,16 @@ impl trilux::view::Exporter for Cli {
         match kind {
             ExportKind::Png | ExportKind::Exr => {
                 let lights = session.pieces()[0].lights();
-                let image = super::diffuse::render(
+                let picture = super::diffuse::render(
                     session.pieces(),
                     &lights,
                     size,
                     view.map(|v| v.as_vec3()),
                 );
                 let image = if kind == ExportKind::Png {
-                    super::diffuse::tone_map(&image)
+                    super::diffuse::tone_map(&picture)
                 } else {
-                    image
+                    picture.image
                 };
                 trilux::output::write_atomic(path, overwrite, |tmp| {
                     if kind == ExportKind::Png {
