@@ -565,6 +565,7 @@ pub fn atlas_mesh(
             material: Some(0),
         }],
         materials: vec![material],
+        warnings: Vec::new(),
     };
     (mesh, image)
 }

@@ -70,6 +70,25 @@ pub enum ErrorKind {
         /// The number of nodes.
         count: usize,
     },
+    /// A face corner of a surface file references a vertex, texture
+    /// coordinate or normal the file does not have; names what is indexed
+    /// in the format's own words ("texture coordinate 3 of face 0, but the
+    /// file has 0 `vt` lines").
+    #[error("{what} {reference} of {element} {index}, but the file has {count} {records}")]
+    ReferenceOutOfRange {
+        /// What is indexed ("vertex", "texture coordinate", "normal").
+        what: &'static str,
+        /// The reference as written in the file.
+        reference: i64,
+        /// The kind of element holding the reference ("face", "strip").
+        element: &'static str,
+        /// The element's position in the file (0-based).
+        index: usize,
+        /// How many of what is indexed the file has.
+        count: usize,
+        /// What they are in the file ("`vt` lines", "vertices").
+        records: &'static str,
+    },
     /// A coordinate is NaN or infinite.
     #[error("point {index} (0-based) has a non-finite coordinate ({value})")]
     NonFinite {

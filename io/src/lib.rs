@@ -51,8 +51,10 @@ pub mod image;
 pub mod mesh;
 pub mod tet;
 mod text;
+mod warning;
 
 pub use error::{Error, ErrorKind, Location, Result};
+pub use warning::Warning;
 
 /// The README's examples, compiled as doctests.
 #[cfg(doctest)]

@@ -90,6 +90,7 @@ fn tetgen_round_trip_is_exact() {
         tets: vec![[0, 1, 2, 3], [3, 2, 1, 0]],
         regions: vec![7, -2],
         attributes: vec![vec![7.0, -2.0]],
+        warnings: Vec::new(),
     };
     let path = dir.join("m.node");
     tetgen::write(&path, &mesh).unwrap();
@@ -579,6 +580,7 @@ fn tet_write_by_extension_keeps_real_attributes() {
         tets: vec![[0, 1, 2, 3], [4, 1, 3, 2]],
         regions: Vec::new(),
         attributes: vec![vec![1.0, 1.5], vec![-2.0, 1e-3]],
+        warnings: Vec::new(),
     };
     trilux_io::tet::write(dir.join("m.node"), &mesh).unwrap();
     assert_eq!(trilux_io::tet::read(dir.join("m.ele")).unwrap(), mesh);

@@ -344,6 +344,7 @@ fn the_mesh_round_trips_through_the_tetgen_medit_and_vtu_writers() {
         tets: m.tets.clone(),
         regions: Vec::new(),
         attributes: Vec::new(),
+        warnings: Vec::new(),
     };
     let dir = std::env::temp_dir().join(format!("trilux-stuffing-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

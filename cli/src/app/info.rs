@@ -42,6 +42,22 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     Ok(())
 }
 
+/// Lists what the reader skipped or replaced (`warnings` in the JSON),
+/// each naming the file, the element and what was skipped, so that a user
+/// sees what the mesh lacks before a long run.
+fn add_warnings(text: &mut String, json: &mut Value, warnings: &[trilux_io::Warning]) {
+    if !warnings.is_empty() {
+        let _ = writeln!(text, "  warnings: {}", warnings.len());
+        for w in warnings {
+            let _ = writeln!(text, "    {w}");
+        }
+    }
+    if let Some(object) = json.as_object_mut() {
+        let list = warnings.iter().map(ToString::to_string).collect::<Vec<_>>();
+        object.insert("warnings".into(), json!(list));
+    }
+}
+
 fn v3(v: glam::Vec3) -> Value {
     json!([v.x, v.y, v.z])
 }
@@ -77,11 +93,10 @@ fn ply_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     }
     attributes.extend(ply.scalars.iter().map(|(n, _)| n.clone()));
     let _ = writeln!(text, "  attributes: {}", attributes.join(", "));
-    Ok((
-        text,
-        json!({"file": super::shown(path), "kind": "point cloud", "points": ply.positions.len(),
-               "bounds": [v3(lo), v3(hi)], "attributes": attributes}),
-    ))
+    let mut json = json!({"file": super::shown(path), "kind": "point cloud", "points": ply.positions.len(),
+               "bounds": [v3(lo), v3(hi)], "attributes": attributes});
+    add_warnings(&mut text, &mut json, &ply.warnings);
+    Ok((text, json))
 }
 
 /// What `mesh` (read from `path`, a `kind` of file) is: counts, bounds,
@@ -207,7 +222,7 @@ fn describe_mesh(
         })
         .collect();
     let _ = writeln!(text, "  objects: {}", mesh.objects.len());
-    let json = json!({
+    let mut json = json!({
         "file": super::shown(path),
         "kind": kind,
         "vertices": mesh.positions.len(),
@@ -228,6 +243,7 @@ fn describe_mesh(
         "objects": mesh.objects.len(),
         "materials": materials,
     });
+    add_warnings(&mut text, &mut json, &mesh.warnings);
     (text, json)
 }
 

@@ -29,6 +29,7 @@ use gltf::texture::WrappingMode;
 use super::{Material, Object, TriMesh, Wrap};
 use crate::error::{Error, ErrorKind, Result};
 use crate::image::{self, ReadOptions};
+use crate::warning::Warning;
 
 /// How to read a glTF file.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -390,7 +391,19 @@ impl Reader<'_> {
             primitive.mode(),
             Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
         ) {
-            return Ok(()); // points and lines have no surface
+            // Points and lines have no surface; said, not skipped in
+            // silence.
+            parts.mesh.warnings.push(Warning::new(
+                self.path,
+                None,
+                format!(
+                    "primitive {} of mesh {:?} is drawn as {:?}, not triangles; it is not read",
+                    primitive.index(),
+                    name,
+                    primitive.mode()
+                ),
+            ));
+            return Ok(());
         }
         use DataType::{F32, I8, I16, U8, U16, U32};
         let positions = primitive
@@ -543,11 +556,13 @@ impl Reader<'_> {
         let start = mesh.indices.len();
         for (t, tri) in triangles.into_iter().enumerate() {
             if let Some(&bad) = tri.iter().find(|&&i| i as usize >= count) {
-                return Err(self.error(ErrorKind::IndexOutOfRange {
+                return Err(self.error(ErrorKind::ReferenceOutOfRange {
+                    what: "vertex",
+                    reference: i64::from(bad),
                     element: "triangle",
                     index: start + t,
-                    node: i64::from(bad),
                     count,
+                    records: "vertices in its primitive",
                 }));
             }
             let [a, b, c] = tri.map(|i| i + base as u32);
@@ -558,7 +573,7 @@ impl Reader<'_> {
             Some(i) => Some(match material_map[i] {
                 Some(m) => m,
                 None => {
-                    let m = self.material(&primitive.material(), buffers)?;
+                    let m = self.material(&primitive.material(), buffers, &mut mesh.warnings)?;
                     mesh.materials.push(m);
                     material_map[i] = Some(mesh.materials.len() - 1);
                     mesh.materials.len() - 1
@@ -574,7 +589,12 @@ impl Reader<'_> {
         Ok(())
     }
 
-    fn material(&self, material: &gltf::Material<'_>, buffers: &[Vec<u8>]) -> Result<Material> {
+    fn material(
+        &self,
+        material: &gltf::Material<'_>,
+        buffers: &[Vec<u8>],
+        warnings: &mut Vec<Warning>,
+    ) -> Result<Material> {
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor();
         let mut out = Material {
@@ -595,7 +615,32 @@ impl Reader<'_> {
             WrappingMode::ClampToEdge => Wrap::ClampToEdge,
         };
         out.wrap = [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())];
-        let (bytes, file, mime) = match texture.source().source() {
+        let Some(image) = texture.source() else {
+            let extensions: Vec<&str> = texture
+                .extensions()
+                .map(|e| e.keys().map(String::as_str).collect())
+                .unwrap_or_default();
+            let texture_name = match texture.name() {
+                Some(name) => format!("texture {} ({name:?})", texture.index()),
+                None => format!("texture {}", texture.index()),
+            };
+            let place = if extensions.is_empty() {
+                "no image at all".to_string()
+            } else {
+                format!("its image only in {}", extensions.join(", "))
+            };
+            warnings.push(Warning::new(
+                self.path,
+                None,
+                format!(
+                    "{texture_name} has no `source` ({place}, not decoded here); material {:?} \
+                     is read without its base colour texture",
+                    out.name
+                ),
+            ));
+            return Ok(out);
+        };
+        let (bytes, file, mime) = match image.source() {
             gltf::image::Source::View { view, mime_type } => {
                 let buffer = &buffers[view.buffer().index()];
                 let end = view
@@ -804,7 +849,11 @@ fn first_dangling_reference(root: &gltf::json::Root) -> Option<String> {
             .for_each(|t| check("texture", t.index.value(), textures));
     }
     for texture in &root.textures {
-        check("image", texture.source.value(), images);
+        // No `source` (the image is only in an extension) is not a
+        // dangling reference: the material is read without it.
+        if texture.source.value() != u32::MAX as usize {
+            check("image", texture.source.value(), images);
+        }
         texture
             .sampler
             .iter()

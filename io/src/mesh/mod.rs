@@ -7,6 +7,7 @@ use glam::{DVec3, Vec2, Vec3};
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::image::Image;
+use crate::warning::Warning;
 
 pub mod gltf;
 pub mod obj;
@@ -62,6 +63,13 @@ pub struct TriMesh {
     pub objects: Vec<Object>,
     /// Materials, indexed by [`Object::material`].
     pub materials: Vec<Material>,
+    /// What the reader skipped or replaced by a default without refusing
+    /// the file, each naming the file, the element and what was skipped:
+    /// a PLY element or property it does not read, a missing `.mtl` or
+    /// texture, a `usemtl` no library defines, `f v/vt/vn` corners in a
+    /// file without `vt` lines (the UV indices dropped), a glTF texture
+    /// whose image is only in an extension. Empty for a file read whole.
+    pub warnings: Vec<Warning>,
 }
 
 /// A named run of triangles with one material.
@@ -82,8 +90,9 @@ pub struct Material {
     pub name: String,
     /// Diffuse (base) colour, linear RGB.
     pub diffuse: [f32; 3],
-    /// The diffuse (base colour) texture file, resolved against the mesh
-    /// file's folder, when it is a file.
+    /// The diffuse (base colour) texture file the mesh file names,
+    /// resolved against its folder. It may not exist: the readers then
+    /// say so in [`TriMesh::warnings`] and read the mesh anyway.
     pub diffuse_texture: Option<PathBuf>,
     /// The decoded base colour texture, when the reader decodes it (glTF:
     /// embedded or external). OBJ leaves it to the caller
@@ -164,6 +173,56 @@ pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
     mesh.write(path)
 }
 
+/// The triangle mesh of a PLY file: one object, and a material when the
+/// header names a texture (`comment TextureFile`), which is resolved
+/// against the file's folder (a warning when it does not exist).
+fn from_ply(path: &Path, ply: ply::PlyData) -> TriMesh {
+    let mut warnings = ply.warnings;
+    let mut materials = Vec::new();
+    if let Some(name) = &ply.texture_file {
+        let folder = path.parent().unwrap_or(Path::new("."));
+        let file = folder.join(name);
+        if !file.is_file() {
+
+
+            warnings.push(Warning::new(
+                &file,
+                None,
+                format!(
+                    "the texture named by `comment TextureFile` in {} does not exist; the mesh \
+                     is read without it",
+                    path.display()
+                ),
+            ));
+        }
+        materials.push(Material {
+            name: Path::new(name)
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            diffuse: [1.0; 3],
+            diffuse_texture: Some(file),
+            diffuse_image: None,
+            wrap: [Wrap::Repeat; 2],
+        });
+    }
+    TriMesh {
+        origin: ply.origin,
+        uvs1: None,
+        objects: vec![Object {
+            name: String::new(),
+            triangles: 0..ply.triangles.len(),
+            material: (!materials.is_empty()).then_some(0),
+        }],
+        positions: ply.positions,
+        indices: ply.triangles,
+        normals: ply.normals,
+        uvs: ply.uvs,
+        materials,
+        warnings,
+    }
+}
+
 impl TriMesh {
     /// The positions as the file has them, in `f64`: `origin + p`.
     pub fn absolute_positions(&self) -> Vec<DVec3> {
@@ -197,23 +256,7 @@ impl TriMesh {
         match crate::error::extension(path).as_str() {
             "obj" => obj::read(path),
             "gltf" | "glb" => gltf::read(path),
-            "ply" => {
-                let ply = ply::read(path)?;
-                Ok(TriMesh {
-                    origin: ply.origin,
-                    uvs1: None,
-                    objects: vec![Object {
-                        name: String::new(),
-                        triangles: 0..ply.triangles.len(),
-                        material: None,
-                    }],
-                    positions: ply.positions,
-                    indices: ply.triangles,
-                    normals: ply.normals,
-                    uvs: ply.uvs,
-                    materials: Vec::new(),
-                })
-            }
+            "ply" => Ok(from_ply(path, ply::read(path)?)),
             other => Err(Error::new(
                 path,
                 ErrorKind::UnknownExtension(other.to_string(), ".obj, .gltf, .glb, .ply"),
@@ -234,7 +277,18 @@ impl TriMesh {
         match crate::error::extension(path).as_str() {
             "obj" => obj::write(path, self),
             "ply" => {
+                // A texture file is named as MeshLab does, when the first
+                // material has one inside the file's folder.
+                let folder = path.parent().unwrap_or(Path::new(""));
+                let texture_file = self
+                    .materials
+                    .first()
+                    .and_then(|m| m.diffuse_texture.as_ref())
+                    .and_then(|t| t.strip_prefix(folder).ok())
+                    .and_then(|t| t.to_str())
+                    .map(str::to_string);
                 let data = ply::PlyData {
+                    texture_file,
                     positions: self.positions.clone(),
                     origin: self.origin,
                     triangles: self.indices.clone(),

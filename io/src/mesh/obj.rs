@@ -22,6 +22,7 @@ use glam::{DVec3, Vec2, Vec3};
 
 use super::{Material, Object, TriMesh, Wrap};
 use crate::error::{Error, ErrorKind, Location, Result};
+use crate::warning::Warning;
 
 /// "No UV / no normal" in a vertex key.
 const NONE: u32 = u32::MAX;
@@ -39,24 +40,82 @@ const DEFAULT_DIFFUSE: [f32; 3] = [0.8, 0.8, 0.8];
 pub fn read(path: impl AsRef<Path>) -> Result<TriMesh> {
     let path = path.as_ref();
     let data = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let (mut mesh, libraries) = parse(&data, path)?;
+    let parsed = parse(&data, path)?;
+    let mut mesh = parsed.mesh;
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut transforms: Vec<Option<UvTransform>> = vec![None; mesh.materials.len()];
-    for names in libraries {
+    let mut defined = vec![false; mesh.materials.len()];
+    for (line, names) in parsed.libraries {
         for library in library_files(folder, &names) {
             let lib_path = folder.join(&library);
-            let text = std::fs::read(&lib_path).map_err(|e| Error::io(&lib_path, e))?;
-            for (found, transform) in parse_mtl(&text, &lib_path, folder)? {
+            // A missing or unreadable library leaves the geometry intact:
+            // the materials keep the MTL defaults, and the user is told.
+            let text = match std::fs::read(&lib_path) {
+                Ok(text) => text,
+                Err(e) => {
+                    mesh.warnings.push(Warning::new(
+                        path,
+                        Some(Location::Line(line)),
+                        format!(
+                            "material library {} could not be read ({e}); its materials keep \
+                             the MTL defaults (Kd 0.8, no texture)",
+                            lib_path.display()
+                        ),
+                    ));
+                    continue;
+                }
+            };
+            let library = parse_mtl(&text, &lib_path, folder)?;
+            mesh.warnings.extend(library.warnings);
+            for (found, transform) in library.materials {
                 if let Some(i) = mesh.materials.iter().position(|m| m.name == found.name) {
                     mesh.materials[i] = found;
                     transforms.resize(mesh.materials.len(), None);
                     transforms[i] = transform;
+                    defined[i] = true;
                 }
             }
         }
     }
+    for ((material, defined), line) in mesh.materials.iter().zip(&defined).zip(&parsed.usemtl_lines)
+    {
+        if !defined {
+            mesh.warnings.push(Warning::new(
+                path,
+                Some(Location::Line(*line)),
+                format!(
+                    "usemtl {:?} names a material no material library defines; its triangles \
+                     keep the MTL defaults (Kd 0.8, no texture)",
+                    material.name
+                ),
+            ));
+        }
+    }
+    check_textures(&mut mesh);
     apply_uv_transforms(&mut mesh, &transforms);
     Ok(mesh)
+}
+
+/// Warns about each `map_Kd` texture file that does not exist: the mesh
+/// and its colours are intact without it. The path is kept (it is what
+/// the library names), so that a caller decoding it names the file too.
+fn check_textures(mesh: &mut TriMesh) {
+    for material in &mesh.materials {
+        let Some(file) = &material.diffuse_texture else {
+            continue;
+        };
+        if !file.is_file() {
+            mesh.warnings.push(Warning::new(
+                file,
+                None,
+                format!(
+                    "the texture of material {:?} does not exist; the mesh is read, the \
+                     material has its Kd colour only",
+                    material.name
+                ),
+            ));
+        }
+    }
 }
 
 /// A `map_Kd` `-s` and `-o` (u and v; w only matters to 3D textures): the
@@ -163,7 +222,17 @@ fn library_files(folder: &Path, names: &str) -> Vec<String> {
 /// # Ok::<(), trilux_io::Error>(())
 /// ```
 pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<TriMesh> {
-    parse(data, path.as_ref()).map(|(mesh, _)| mesh)
+    parse(data, path.as_ref()).map(|parsed| parsed.mesh)
+}
+
+/// What [`parse`] finds in an OBJ file besides the mesh.
+struct Parsed {
+    mesh: TriMesh,
+    /// Each `mtllib` line: its number and the rest of the line.
+    libraries: Vec<(usize, String)>,
+    /// The line of the first `usemtl` of each material, in the order of
+    /// [`TriMesh::materials`].
+    usemtl_lines: Vec<usize>,
 }
 
 /// One line's location for errors.
@@ -257,32 +326,72 @@ fn vec3(at: &At<'_>, tokens: &mut std::str::SplitWhitespace<'_>, what: &str) -> 
     Ok(v)
 }
 
+/// What a face corner's index refers to, for errors in the file's words.
+#[derive(Clone, Copy)]
+struct Indexed {
+    what: &'static str,
+    records: &'static str,
+}
+
+const VERTEX: Indexed = Indexed {
+    what: "vertex",
+    records: "`v` lines",
+};
+const TEXCOORD: Indexed = Indexed {
+    what: "texture coordinate",
+    records: "`vt` lines",
+};
+const NORMAL: Indexed = Indexed {
+    what: "normal",
+    records: "`vn` lines",
+};
+
 /// A 1-based or negative (relative) OBJ index into a list of `len`.
-fn resolve(
-    at: &At<'_>,
-    token: &str,
-    len: usize,
-    element: &'static str,
-    face: usize,
-) -> Result<u32> {
+fn resolve(at: &At<'_>, token: &str, len: usize, indexed: Indexed, face: usize) -> Result<u32> {
     let raw: i64 = token
         .parse()
-        .map_err(|_| at.syntax(&format!("a {element} index"), token))?;
+        .map_err(|_| at.syntax(&format!("a {} index", indexed.what), token))?;
     let index = if raw > 0 { raw - 1 } else { len as i64 + raw };
     if raw == 0 || index < 0 || index >= len as i64 {
-        return Err(at.error(ErrorKind::IndexOutOfRange {
-            element,
+        return Err(at.error(ErrorKind::ReferenceOutOfRange {
+            what: indexed.what,
+            reference: raw,
+            element: "face",
             index: face,
-            node: raw,
             count: len,
+            records: indexed.records,
         }));
     }
     Ok(index as u32)
 }
 
-/// The mesh and the material libraries named by `mtllib`.
-/// The mesh and the rest of each `mtllib` line.
-fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
+/// A corner's optional texture-coordinate or normal index: `NONE` when
+/// absent, or when the file has no lines of that kind at all (the index
+/// dangles; `dropped` counts it, and the caller warns once).
+fn optional_index(
+    at: &At<'_>,
+    token: Option<&str>,
+    len: usize,
+    indexed: Indexed,
+    face: usize,
+    dropped: &mut (usize, usize),
+) -> Result<u32> {
+    match token {
+        None | Some("") => Ok(NONE),
+        Some(_) if len == 0 => {
+            if dropped.0 == 0 {
+                dropped.1 = at.line;
+            }
+            dropped.0 += 1;
+            Ok(NONE)
+        }
+        Some(t) => resolve(at, t, len, indexed, face),
+    }
+}
+
+/// The mesh, the rest of each `mtllib` line and where each material is
+/// first used.
+fn parse(data: &[u8], path: &Path) -> Result<Parsed> {
     let mut v: Vec<DVec3> = Vec::new();
     let mut vt: Vec<Vec2> = Vec::new();
     let mut vn: Vec<Vec3> = Vec::new();
@@ -292,8 +401,14 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
     let mut objects: Vec<Object> = Vec::new();
     let mut materials: Vec<Material> = Vec::new();
     let mut libraries = Vec::new();
+    let mut usemtl_lines = Vec::new();
+    // Corner UV and normal indices dropped because the file has no `vt`
+    // (`vn`) lines at all, and the first line with one.
+    let mut dropped_uv = (0usize, 0usize);
+    let mut dropped_normal = (0usize, 0usize);
     let mut faces = 0usize;
     let mut name = String::new();
+    let mut object_name = String::new();
     let mut material: Option<usize> = None;
     let mut polygon: Vec<u32> = Vec::new();
 
@@ -356,15 +471,10 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
                 polygon.clear();
                 for corner in tokens {
                     let mut parts = corner.split('/');
-                    let pv = resolve(&at, parts.next().unwrap_or(""), v.len(), "face", faces)?;
-                    let pt = match parts.next() {
-                        None | Some("") => NONE,
-                        Some(t) => resolve(&at, t, vt.len(), "face", faces)?,
-                    };
-                    let pn = match parts.next() {
-                        None | Some("") => NONE,
-                        Some(t) => resolve(&at, t, vn.len(), "face", faces)?,
-                    };
+                    let pv = resolve(&at, parts.next().unwrap_or(""), v.len(), VERTEX, faces)?;
+                    let (t, n) = (parts.next(), parts.next());
+                    let pt = optional_index(&at, t, vt.len(), TEXCOORD, faces, &mut dropped_uv)?;
+                    let pn = optional_index(&at, n, vn.len(), NORMAL, faces, &mut dropped_normal)?;
                     let key = (pv, pt, pn);
                     let next = vertices.len() as u32;
                     let id = *keys.entry(key).or_insert_with(|| {
@@ -383,7 +493,16 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
             }
             "o" | "g" => {
                 close(&mut objects, &name, material, indices.len());
-                name = tokens.collect::<Vec<_>>().join(" ");
+                let given = tokens.collect::<Vec<_>>().join(" ");
+                // A bare `g` returns to the default group: its triangles
+                // stay in the current `o` object, under its name.
+                name = match keyword {
+                    "g" if given.is_empty() => object_name.clone(),
+                    _ => given,
+                };
+                if keyword == "o" {
+                    object_name = name.clone();
+                }
             }
             "usemtl" => {
                 close(&mut objects, &name, material, indices.len());
@@ -398,6 +517,7 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
                             diffuse_image: None,
                             wrap: [Wrap::Repeat; 2],
                         });
+                        usemtl_lines.push(line);
                         materials.len() - 1
                     }
                 });
@@ -409,7 +529,7 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
                         "a material library file name after mtllib".into(),
                     )));
                 }
-                libraries.push(names.to_string());
+                libraries.push((line, names.to_string()));
             }
             // Smoothing groups, lines, points, free-form geometry: skipped.
             "s" | "l" | "p" | "vp" | "cstype" | "deg" | "curv" | "curv2" | "surf" | "parm"
@@ -434,9 +554,26 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
             )),
         ));
     }
+    let mut warnings = Vec::new();
+    for ((count, line), what, records) in [
+        (dropped_uv, "texture-coordinate", "`vt`"),
+        (dropped_normal, "normal", "`vn`"),
+    ] {
+        if count > 0 {
+            warnings.push(Warning::new(
+                path,
+                Some(Location::Line(line)),
+                format!(
+                    "{count} face corners name a {what} index, but the file has no {records} \
+                     lines; those indices were dropped (the geometry is read)"
+                ),
+            ));
+        }
+    }
     let mesh = TriMesh {
         positions,
         origin,
+        warnings,
         uvs1: None,
         uvs: has_uv.then(|| {
             vertices
@@ -454,27 +591,51 @@ fn parse(data: &[u8], path: &Path) -> Result<(TriMesh, Vec<String>)> {
         objects,
         materials,
     };
-    Ok((mesh, libraries))
+    Ok(Parsed {
+        mesh,
+        libraries,
+        usemtl_lines,
+    })
 }
 
+/// The materials of one MTL library and what it skipped.
+struct MtlLibrary {
+    materials: Vec<(Material, Option<UvTransform>)>,
+    warnings: Vec<Warning>,
+}
+
+/// MTL statements that do not change what a diffuse lookup reads (the
+/// other colours, exponents, transparency, illumination model, the other
+/// maps): known, so not counted as unknown.
+const MTL_IGNORED: &[&str] = &[
+    "ka", "ks", "ke", "kt", "ns", "ni", "d", "tr", "tf", "illum", "sharpness", "map_ka", "map_ks",
+    "map_ke", "map_ns", "map_d", "map_tr", "map_bump", "bump", "map_disp", "disp", "decal", "refl",
+    "norm", "map_norm", "pr", "pm", "ps", "pc", "pcr", "aniso", "anisor", "map_pr", "map_pm",
+    "map_ps", "map_refl", "map_aat",
+];
+
 /// Parses an MTL library: `newmtl`, `Kd`, `map_Kd` (options parsed, the
-/// rest of the line is the file, spaces included). `-clamp on` makes the
+/// rest of the line is the file, spaces included). Keywords are compared
+/// ignoring ASCII case, as exporters write `map_kd`, `Map_Kd` or `KD` and
+/// every common reader accepts them. `-clamp on` makes the
 /// texture [`Wrap::ClampToEdge`]; `-s` and `-o` come back as the
 /// material's UV transform (applied to the UVs by [`read`]); the other
 /// options (`-bm`, `-blendu`, `-blendv`, `-boost`, `-cc`, `-imfchan`,
 /// `-mm`, `-t`, `-texres`, `-type`) do not change which texel a diffuse
-/// lookup reads and are skipped.
-fn parse_mtl(
-    data: &[u8],
-    path: &Path,
-    folder: &Path,
-) -> Result<Vec<(Material, Option<UvTransform>)>> {
+/// lookup reads and are skipped. Statements that are neither read nor in
+/// the MTL specification's list are counted in one warning.
+fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<MtlLibrary> {
     let mut materials: Vec<(Material, Option<UvTransform>)> = Vec::new();
+    // Unknown statements: how many, the first line and its keyword.
+    let mut unknown: Option<(usize, usize, String)> = None;
     for (line, text) in lines(data) {
         let at = At { path, line };
         let mut tokens = text.split_whitespace();
-        match tokens.next() {
-            Some("newmtl") => materials.push((
+        let Some(keyword) = tokens.next() else {
+            continue;
+        };
+        match keyword.to_ascii_lowercase().as_str() {
+            "newmtl" => materials.push((
                 Material {
                     name: rest_of(&text).to_string(),
                     diffuse: DEFAULT_DIFFUSE,
@@ -484,14 +645,14 @@ fn parse_mtl(
                 },
                 None,
             )),
-            Some("Kd") => {
+            "kd" => {
                 let kd = vec3(&at, &mut tokens, "a diffuse colour")?;
                 let (current, _) = materials
                     .last_mut()
                     .ok_or_else(|| at.syntax("newmtl before Kd", &text))?;
                 current.diffuse = kd.to_array();
             }
-            Some("map_Kd") => {
+            "map_kd" => {
                 let map = texture_map(&at, rest_of(&text))?;
                 let (current, transform) = materials
                     .last_mut()
@@ -502,10 +663,30 @@ fn parse_mtl(
                 }
                 *transform = map.transform;
             }
-            _ => {}
+            known if MTL_IGNORED.contains(&known) => {}
+            _ => match &mut unknown {
+                Some((count, _, _)) => *count += 1,
+                None => unknown = Some((1, line, keyword.chars().take(40).collect())),
+            },
         }
     }
-    Ok(materials)
+    let warnings = unknown
+        .map(|(count, line, first)| {
+            Warning::new(
+                path,
+                Some(Location::Line(line)),
+                format!(
+                    "{count} statement(s) of unknown kind skipped, the first `{first}` (MTL \
+                     keywords are compared ignoring case)"
+                ),
+            )
+        })
+        .into_iter()
+        .collect();
+    Ok(MtlLibrary {
+        materials,
+        warnings,
+    })
 }
 
 /// A `map_*` statement: the file and the options that matter.

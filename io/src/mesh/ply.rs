@@ -3,7 +3,14 @@
 //! in, ASCII and binary little-endian out. Points or triangles with
 //! optional normals (`nx ny nz`), colours (`red green blue [alpha]`,
 //! uchar), texture coordinates (`s t`; `u v` and `texture_u texture_v`
-//! are read too) and any extra per-vertex scalar properties.
+//! are read too) and any extra per-vertex scalar properties. Faces are
+//! `face` polygons (fan-triangulated) with optional per-corner texture
+//! coordinates (MeshLab/VCGLIB's `property list uchar float texcoord`:
+//! a vertex with several UVs is split per corner, as the OBJ reader
+//! does), and `tristrips` (OpenGL strip order, `-1` restarts a strip);
+//! `comment TextureFile NAME` names the texture. Elements and properties
+//! not read are listed in [`PlyData::warnings`], never skipped in
+//! silence.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -12,6 +19,7 @@ use glam::{DVec3, Vec2, Vec3};
 
 use crate::error::{Error, ErrorKind, Result};
 use crate::text::Cursor;
+use crate::warning::Warning;
 
 /// A point cloud or triangle mesh with per-vertex attributes: what
 /// [`read()`] returns and [`write()`] takes. For sampled points, fill
@@ -57,6 +65,14 @@ pub struct PlyData {
     pub face_ids: Option<Vec<u32>>,
     /// Other per-vertex scalar properties, by name, written as `float`.
     pub scalars: Vec<(String, Vec<f32>)>,
+    /// The texture a `comment TextureFile NAME` header line names
+    /// (MeshLab/VCGLIB), as written (relative to the file's folder);
+    /// written back the same way.
+    pub texture_file: Option<String>,
+    /// What the reader skipped (elements and properties it does not read),
+    /// each naming the file, the element and what was skipped. Not
+    /// written.
+    pub warnings: Vec<Warning>,
 }
 
 /// How to write the data section.
@@ -187,11 +203,27 @@ pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<PlyData> {
         return Err(c.syntax(at, "version 1.0", version));
     }
     let mut elements: Vec<Element> = Vec::new();
+    let mut texture_file = None;
     loop {
         let (at, word) = c.expect_token("end_header")?;
         match word {
             b"end_header" => break,
-            b"comment" | b"obj_info" => c.skip_line(),
+            b"comment" => {
+                // MeshLab/VCGLIB name the texture in a comment.
+                let start = c.offset();
+                c.skip_line();
+                let line = String::from_utf8_lossy(&data[start..c.offset()]);
+                let line = line.trim();
+                if let Some(name) = line
+                    .strip_prefix("TextureFile")
+                    .filter(|rest| rest.starts_with(char::is_whitespace))
+                    .map(str::trim)
+                    .filter(|name| !name.is_empty())
+                {
+                    texture_file = Some(name.to_string());
+                }
+            }
+            b"obj_info" => c.skip_line(),
             b"element" => {
                 let (_, name) = c.expect_token("an element name")?;
                 let count = c.u64("an element count")?;
@@ -247,7 +279,11 @@ pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<PlyData> {
         big_endian,
     };
 
-    let mut out = PlyData::default();
+    let mut out = PlyData {
+        texture_file,
+        ..PlyData::default()
+    };
+    let mut corners = CornerUvs::default();
     let mut vertex_seen = false;
     for element in &elements {
         // Smallest encoded element: one byte (binary) or two (ASCII) per
@@ -261,8 +297,25 @@ pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<PlyData> {
                 vertex_seen = true;
                 read_vertices(&mut reader, element, &mut out)?;
             }
-            "face" => read_faces(&mut reader, element, &mut out)?,
+            "face" => read_faces(&mut reader, element, &mut out, &mut corners)?,
+            "tristrips" => read_strips(&mut reader, element, &mut out)?,
             _ => {
+                if element.count > 0 {
+                    out.warnings.push(Warning::new(
+                        path,
+                        None,
+                        format!(
+                            "element `{}` ({} records{}) is not read",
+                            element.name,
+                            element.count,
+                            if element.name == "vertex" {
+                                ", a second vertex element"
+                            } else {
+                                ""
+                            }
+                        ),
+                    ));
+                }
                 for _ in 0..element.count {
                     for p in &element.properties {
                         reader.property(p)?;
@@ -282,15 +335,18 @@ pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<PlyData> {
         if let Some(&bad) = tri.iter().find(|&&i| i as usize >= n) {
             return Err(Error::new(
                 path,
-                ErrorKind::IndexOutOfRange {
-                    element: "face",
+                ErrorKind::ReferenceOutOfRange {
+                    what: "vertex",
+                    reference: i64::from(bad),
+                    element: "triangle",
                     index,
-                    node: i64::from(bad),
                     count: n,
+                    records: "vertices",
                 },
             ));
         }
     }
+    corners.split_vertices(&mut out);
     Ok(out)
 }
 
@@ -409,6 +465,15 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
     let extra: Vec<usize> = (0..element.properties.len())
         .filter(|i| !known.contains(i) && element.properties[*i].list.is_none())
         .collect();
+    let lists: Vec<usize> = (0..element.properties.len())
+        .filter(|&i| element.properties[i].list.is_some())
+        .collect();
+    if !lists.is_empty() {
+        let read: Vec<usize> = (0..element.properties.len())
+            .filter(|i| !lists.contains(i))
+            .collect();
+        warn_unread(r, element, &read, out);
+    }
 
     let n = element.count;
     let has_normal = normal.iter().all(Option::is_some);
@@ -497,35 +562,185 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
     Ok(())
 }
 
-fn read_faces(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -> Result<()> {
-    let indices = element
-        .properties
-        .iter()
-        .position(|p| p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index"));
-    let mut polygon: Vec<u32> = Vec::new();
-    for _ in 0..element.count {
+/// Per-corner texture coordinates of the triangles read from `face`
+/// elements (`texcoord` lists), in TriMesh's v-down convention, until the
+/// vertices are split.
+#[derive(Default)]
+struct CornerUvs {
+    /// `(triangle, its three corner UVs)`.
+    triangles: Vec<(usize, [Vec2; 3])>,
+}
+
+impl CornerUvs {
+    /// Gives each corner its own UV (MeshLab's per-wedge texture
+    /// coordinates): a vertex keeps the first UV a corner gives it, and
+    /// every other distinct UV makes a copy of the vertex with all its
+    /// attributes, as the OBJ reader splits `v/vt` pairs. Vertices no
+    /// corner gives a UV keep the per-vertex one, or (0, 0).
+    fn split_vertices(self, out: &mut PlyData) {
+        if self.triangles.is_empty() {
+            return;
+        }
+        let n = out.positions.len();
+        let mut uvs: Vec<Option<Vec2>> = match out.uvs.take() {
+            Some(uvs) => uvs.into_iter().map(Some).collect(),
+            None => vec![None; n],
+        };
+        let mut given = vec![false; n];
+        let mut copies: std::collections::HashMap<(u32, [u32; 2]), u32> = Default::default();
+        for (t, corner_uvs) in self.triangles {
+            for (corner, uv) in corner_uvs.into_iter().enumerate() {
+                let v = out.triangles[t][corner] as usize;
+                let key = (v as u32, [uv.x.to_bits(), uv.y.to_bits()]);
+                if !given[v] {
+                    given[v] = true;
+                    uvs[v] = Some(uv);
+                    copies.insert(key, v as u32);
+                    continue;
+                }
+                let copy = *copies.entry(key).or_insert_with(|| {
+                    copy_vertex(out, v);
+                    uvs.push(Some(uv));
+                    given.push(true);
+                    (out.positions.len() - 1) as u32
+                });
+                out.triangles[t][corner] = copy;
+            }
+        }
+        out.uvs = Some(uvs.into_iter().map(Option::unwrap_or_default).collect());
+    }
+}
+
+/// Appends a copy of vertex `v` with every per-vertex attribute but UVs.
+fn copy_vertex(out: &mut PlyData, v: usize) {
+    out.positions.push(out.positions[v]);
+    if let Some(normals) = out.normals.as_mut() {
+        normals.push(normals[v]);
+    }
+    if let Some(colors) = out.colors.as_mut() {
+        colors.push(colors[v]);
+    }
+    if let Some(ids) = out.face_ids.as_mut() {
+        ids.push(ids[v]);
+    }
+    for (_, column) in &mut out.scalars {
+        column.push(column[v]);
+    }
+}
+
+/// Reads one list of vertex indices (a polygon or a strip) into `into`;
+/// `-1` is kept as `None` only when `restart` allows it (strips).
+fn index_list(
+    r: &mut DataReader<'_>,
+    p: &Property,
+    count_kind: Scalar,
+    at: usize,
+    restart: bool,
+    into: &mut Vec<Option<u32>>,
+) -> Result<usize> {
+    let n = r.list_len(count_kind)?;
+    into.clear();
+    for _ in 0..n {
+        let v = r.scalar(p.kind)?;
+        if restart && v == -1.0 {
+            into.push(None);
+            continue;
+        }
+        if !(v >= 0.0 && v <= f64::from(u32::MAX - 1) && v.fract() == 0.0) {
+            return Err(r.located(
+                at,
+                ErrorKind::Syntax {
+                    expected: if restart {
+                        "a vertex index or -1 (a strip restart)".into()
+                    } else {
+                        "a vertex index".into()
+                    },
+                    found: v.to_string(),
+                },
+            ));
+        }
+        into.push(Some(v as u32));
+    }
+    Ok(n)
+}
+
+/// Warns about the properties of `element` other than those at `read`.
+fn warn_unread(r: &DataReader<'_>, element: &Element, read: &[usize], out: &mut PlyData) {
+    let skipped: Vec<&str> = (0..element.properties.len())
+        .filter(|i| !read.contains(i))
+        .map(|i| element.properties[i].name.as_str())
+        .collect();
+    if !skipped.is_empty() && element.count > 0 {
+        out.warnings.push(Warning::new(
+            r.c.path(),
+            None,
+            format!(
+                "property `{}` of element `{}` is not read",
+                skipped.join("`, `"),
+                element.name
+            ),
+        ));
+    }
+}
+
+fn read_faces(
+    r: &mut DataReader<'_>,
+    element: &Element,
+    out: &mut PlyData,
+    corners: &mut CornerUvs,
+) -> Result<()> {
+    let list_named = |names: &[&str]| {
+        element
+            .properties
+            .iter()
+            .position(|p| p.list.is_some() && names.contains(&p.name.as_str()))
+    };
+    let indices = list_named(&["vertex_indices", "vertex_index"]);
+    let texcoord = list_named(&["texcoord"]).filter(|&i| element.properties[i].kind.is_float());
+    let Some(indices) = indices else {
+        if element.count > 0 {
+            return Err(Error::new(
+                r.c.path(),
+                ErrorKind::Syntax {
+                    expected: "a face element with a vertex_indices list".into(),
+                    found: format!("{} faces without one", element.count),
+                },
+            ));
+        }
+        return Ok(());
+    };
+    warn_unread(r, element, &[Some(indices), texcoord].map(|i| i.unwrap_or(usize::MAX)), out);
+    let mut polygon: Vec<Option<u32>> = Vec::new();
+    let mut uvs: Vec<Vec2> = Vec::new();
+    for face in 0..element.count {
         let at = r.record_start();
+        let first = out.triangles.len();
+        uvs.clear();
         for (i, p) in element.properties.iter().enumerate() {
-            if Some(i) != indices {
+            let Some(count_kind) = p.list.filter(|_| i == indices || Some(i) == texcoord) else {
                 r.property(p)?;
                 continue;
-            }
-            let Some(count_kind) = p.list else { continue };
-            let n = r.list_len(count_kind)?;
-            polygon.clear();
-            for _ in 0..n {
-                let v = r.scalar(p.kind)?;
-                if !(v >= 0.0 && v <= f64::from(u32::MAX - 1) && v.fract() == 0.0) {
+            };
+            if Some(i) == texcoord {
+                let n = r.list_len(count_kind)?;
+                let mut values = Vec::with_capacity(n);
+                for _ in 0..n {
+                    values.push(r.scalar(p.kind)? as f32);
+                }
+                if n % 2 != 0 || values.iter().any(|v| !v.is_finite()) {
                     return Err(r.located(
                         at,
                         ErrorKind::Syntax {
-                            expected: "a vertex index".into(),
-                            found: v.to_string(),
+                            expected: format!("finite u v pairs in the texcoord of face {face}"),
+                            found: format!("{n} values"),
                         },
                     ));
                 }
-                polygon.push(v as u32);
+                // PLY's v grows upwards; TriMesh's grows downwards.
+                uvs.extend(values.chunks_exact(2).map(|uv| Vec2::new(uv[0], 1.0 - uv[1])));
+                continue;
             }
+            let n = index_list(r, p, count_kind, at, false, &mut polygon)?;
             if n < 3 {
                 return Err(r.located(
                     at,
@@ -535,8 +750,74 @@ fn read_faces(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -> R
                     },
                 ));
             }
+            let polygon: Vec<u32> = polygon.iter().flatten().copied().collect();
             for k in 1..n - 1 {
                 out.triangles.push([polygon[0], polygon[k], polygon[k + 1]]);
+            }
+        }
+        if texcoord.is_some() {
+            let corners_in_face = out.triangles.len() - first + 2;
+            if uvs.len() != corners_in_face {
+                return Err(r.located(
+                    at,
+                    ErrorKind::Syntax {
+                        expected: format!(
+                            "one texcoord pair per corner of face {face} ({corners_in_face})"
+                        ),
+                        found: format!("{} pairs", uvs.len()),
+                    },
+                ));
+            }
+            for (k, t) in (first..out.triangles.len()).enumerate() {
+                corners.triangles.push((t, [uvs[0], uvs[k + 1], uvs[k + 2]]));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Reads `element tristrips` (Stanford's scans, MeshLab): each record is
+/// one list of vertex indices in OpenGL `GL_TRIANGLE_STRIP` order, `-1`
+/// restarting the strip. Triangle `k` of a strip is `(s[k], s[k+1],
+/// s[k+2])` for even `k` and `(s[k+1], s[k], s[k+2])` for odd `k`, so that
+/// every triangle keeps the first one's winding (OpenGL 4.6 core
+/// specification, Sec. 10.1.8); triangles with a repeated vertex (the
+/// degenerate ones that join strips) are dropped.
+fn read_strips(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -> Result<()> {
+    let Some(indices) = element
+        .properties
+        .iter()
+        .position(|p| p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index"))
+    else {
+        if element.count > 0 {
+            return Err(Error::new(
+                r.c.path(),
+                ErrorKind::Syntax {
+                    expected: "a tristrips element with a vertex_indices list".into(),
+                    found: format!("{} strips without one", element.count),
+                },
+            ));
+        }
+        return Ok(());
+    };
+    warn_unread(r, element, &[indices], out);
+    let mut strip: Vec<Option<u32>> = Vec::new();
+    for _ in 0..element.count {
+        let at = r.record_start();
+        for (i, p) in element.properties.iter().enumerate() {
+            let Some(count_kind) = p.list.filter(|_| i == indices) else {
+                r.property(p)?;
+                continue;
+            };
+            index_list(r, p, count_kind, at, true, &mut strip)?;
+            for run in strip.split(Option::is_none) {
+                for k in 0..run.len().saturating_sub(2) {
+                    let (a, b, c) = (run[k].unwrap_or(0), run[k + 1].unwrap_or(0), run[k + 2].unwrap_or(0));
+                    if a == b || b == c || a == c {
+                        continue;
+                    }
+                    out.triangles.push(if k % 2 == 0 { [a, b, c] } else { [b, a, c] });
+                }
             }
         }
     }
@@ -680,6 +961,15 @@ pub fn to_bytes(path: impl AsRef<Path>, data: &PlyData, format: Format) -> Resul
         Format::BinaryBigEndian => "format binary_big_endian 1.0\n",
     });
     header.push_str("comment written by trilux-io\n");
+    if let Some(texture) = &data.texture_file {
+        if texture.trim().is_empty() || texture.trim() != texture || texture.contains(['\n', '\r']) {
+            return Err(invalid(format!(
+                "texture file {texture:?} cannot be written as a PLY comment (empty, a line \
+                 break, or surrounding spaces)"
+            )));
+        }
+        let _ = writeln!(header, "comment TextureFile {texture}");
+    }
     let _ = writeln!(header, "element vertex {n}");
     let coordinate = if shifted { "double" } else { "float" };
     for axis in ["x", "y", "z"] {

@@ -199,6 +199,7 @@ fn finish(parts: Parts, c: &Cursor<'_>) -> Result<TetMesh> {
         tets,
         regions,
         attributes: Vec::new(),
+        warnings: Vec::new(),
     })
 }
 

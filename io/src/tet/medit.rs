@@ -160,6 +160,7 @@ pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<TetMesh> {
         tets,
         regions,
         attributes: Vec::new(),
+        warnings: Vec::new(),
     })
 }
 

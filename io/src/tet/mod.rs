@@ -28,6 +28,10 @@ pub struct TetMesh {
     /// column when all its values are integers (TetGen's region tags),
     /// and empty otherwise. Empty for the other formats.
     pub attributes: Vec<Vec<f64>>,
+    /// What the reader skipped without refusing the file (elements other
+    /// than tetrahedra, for instance), each naming the file, the element
+    /// and what was skipped. Empty for a file read whole.
+    pub warnings: Vec<crate::Warning>,
 }
 
 /// The faces of tetrahedron `(0, 1, 2, 3)` with outward normals (right-hand
@@ -205,6 +209,7 @@ mod tests {
             tets: vec![[0, 1, 2, 3]],
             regions: Vec::new(),
             attributes: Vec::new(),
+            warnings: Vec::new(),
         }
     }
 

@@ -70,6 +70,7 @@ fn parse_pair(node: &[u8], ele: &[u8], path: &Path) -> Result<(TetMesh, i64)> {
         tets,
         regions: region_tags(&attributes),
         attributes,
+        warnings: Vec::new(),
     };
     Ok((mesh, first_index))
 }
