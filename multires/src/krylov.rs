@@ -27,7 +27,9 @@ pub struct SolveOptions {
     /// Turn a solve that does not reach `tolerance` — the iteration cap,
     /// a breakdown, or stagnation above the tolerance — into
     /// [`Error::NotConverged`] (carrying the [`Report`] with the true
-    /// residual; `x` still holds the last iterate). On by default; turn it
+    /// residual of `x`). CG leaves in `x` the best iterate by residual
+    /// (finite, never worse than the start), BiCGSTAB the last one or the
+    /// start, whichever is better. On by default; turn it
     /// off to take whatever a fixed budget of iterations gives (an
     /// interactive preview) and read [`Report::converged`] yourself. A
     /// monitor's `Break` is never an error.
@@ -94,8 +96,9 @@ pub enum Stop {
     /// The iteration cap came first.
     MaxIterations,
     /// A scalar of the recurrence vanished or stopped being finite (for
-    /// CG: the matrix or preconditioner is not positive definite); `x` is
-    /// the last finite iterate.
+    /// CG: the matrix or preconditioner is not positive definite, or a
+    /// singular system is inconsistent); `x` is the best finite iterate
+    /// (CG), never worse than the start.
     Breakdown,
     /// The monitor asked to stop (a time budget, an outside error target).
     Interrupted,
@@ -300,6 +303,12 @@ pub(crate) fn pcg_checked(
     let mut q = vec![0.0; n];
     let mut done = 0;
     let mut residual = residual_into(a, b, x, &mut r) / scale;
+    let mut best = Best::new(x, residual);
+    let report = |stop, iterations, residual| Report {
+        stop,
+        iterations,
+        residual,
+    };
     while done < options.max_iterations && residual > options.tolerance {
         // One CG run; it ends when its recurrence says converged, then the
         // true residual decides whether to restart.
@@ -317,6 +326,7 @@ pub(crate) fn pcg_checked(
                 break;
             }
             let rr = cg_update(alpha, &p, &q, x, &mut r);
+            best.step(x, rr.sqrt() / scale, alpha, &p);
             done += 1;
             if monitor(done, x).is_break() {
                 interrupted = true;
@@ -337,37 +347,118 @@ pub(crate) fn pcg_checked(
         let before = residual;
         residual = residual_into(a, b, x, &mut r) / scale;
         if broke || !residual.is_finite() {
-            return Ok(Report {
-                stop: Stop::Breakdown,
-                iterations: done,
-                residual,
-            });
+            let residual = best.restore(a, b, x, &mut r, residual, scale);
+            return Ok(report(Stop::Breakdown, done, residual));
         }
         if interrupted {
-            return Ok(Report {
-                stop: Stop::Interrupted,
-                iterations: done,
-                residual,
-            });
+            return Ok(report(Stop::Interrupted, done, residual));
         }
         if residual > options.tolerance && residual >= before && done < options.max_iterations {
             // A restart that gains nothing would loop: the attainable accuracy is reached.
-            return Ok(Report {
-                stop: Stop::Stagnated,
-                iterations: done,
-                residual,
-            });
+            let residual = best.restore(a, b, x, &mut r, residual, scale);
+            return Ok(report(Stop::Stagnated, done, residual));
+        }
+        best.restarted(residual);
+    }
+    if residual <= options.tolerance {
+        return Ok(report(Stop::Converged, done, residual));
+    }
+    let residual = best.restore(a, b, x, &mut r, residual, scale);
+    Ok(report(Stop::MaxIterations, done, residual))
+}
+
+/// The best iterate of a CG solve by residual, kept so that a solve that
+/// breaks down, stagnates or hits its cap returns the best `x` it saw
+/// (finite, and never worse than the start) instead of the last one,
+/// which on a semidefinite inconsistent system or an indefinite matrix
+/// may have grown without bound.
+///
+/// Copies are rare: `x` is copied only when a step makes it worse than
+/// the best so far right after the best (the best is then the previous
+/// iterate, `x − α p`), so a monotone run copies nothing but its start.
+struct Best {
+    /// The start vector, the fallback of last resort.
+    start: Vec<f64>,
+    start_residual: f64,
+    /// The best earlier iterate, when it is not the current `x`.
+    saved: Option<(Vec<f64>, f64)>,
+    /// The residual of the best iterate so far (the current `x` when
+    /// `current_is_best`).
+    residual: f64,
+    current_is_best: bool,
+}
+
+impl Best {
+    fn new(x: &[f64], residual: f64) -> Self {
+        Self {
+            start: x.to_vec(),
+            start_residual: residual,
+            saved: None,
+            residual,
+            current_is_best: true,
         }
     }
-    Ok(Report {
-        stop: if residual <= options.tolerance {
-            Stop::Converged
+
+    /// After `x += α p` gave the recurrence residual `residual`.
+    fn step(&mut self, x: &[f64], residual: f64, alpha: f64, p: &[f64]) {
+        if residual < self.residual {
+            self.residual = residual;
+            self.current_is_best = true;
+        } else if self.current_is_best {
+            // The previous iterate was the best: keep it.
+            let previous = match self.saved.take() {
+                Some((mut v, _)) => {
+                    v.iter_mut()
+                        .zip(x.iter().zip(p))
+                        .for_each(|(v, (x, p))| *v = x - alpha * p);
+                    v
+                }
+                None => x.iter().zip(p).map(|(x, p)| x - alpha * p).collect(),
+            };
+            self.saved = Some((previous, self.residual));
+            self.current_is_best = false;
+        }
+    }
+
+    /// After a restart recomputed the true residual of `x` (which
+    /// replaces the recurrence's when `x` was the best).
+    fn restarted(&mut self, residual: f64) {
+        if self.current_is_best || residual < self.residual {
+            self.residual = residual;
+            self.current_is_best = true;
+        }
+    }
+
+    /// Puts the best of the current `x` (true residual `residual`), the
+    /// saved iterate and the start into `x`, and returns its true
+    /// residual (`r` is scratch).
+    fn restore(
+        self,
+        a: &CsMat<f64>,
+        b: &[f64],
+        x: &mut [f64],
+        r: &mut [f64],
+        residual: f64,
+        scale: f64,
+    ) -> f64 {
+        let mut chosen = if residual.is_finite() {
+            residual
         } else {
-            Stop::MaxIterations
-        },
-        iterations: done,
-        residual,
-    })
+            f64::INFINITY
+        };
+        if let Some((saved, _)) = self.saved {
+            let saved_residual = residual_into(a, b, &saved, r) / scale;
+            if saved_residual < chosen {
+                x.copy_from_slice(&saved);
+                chosen = saved_residual;
+            }
+        }
+        if chosen > self.start_residual {
+            x.copy_from_slice(&self.start);
+            chosen = self.start_residual;
+        }
+        chosen
+    }
 }
 
 /// `z ← M⁻¹ r`, returning `r · z`.
@@ -425,6 +516,23 @@ pub(crate) fn bicgstab_checked(
     let mut r = vec![0.0; n];
     let mut done = 0;
     let mut residual = residual_into(a, b, x, &mut r) / scale;
+    // The start, put back if the solve ends worse than it began.
+    let (start, start_residual) = (x.to_vec(), residual);
+    let settle = |x: &mut [f64], stop: Stop, iterations: usize, residual: f64| {
+        let worse = residual.is_nan() || residual > start_residual;
+        if worse && stop != Stop::Converged && stop != Stop::Interrupted {
+            x.copy_from_slice(&start);
+        }
+        Report {
+            stop,
+            iterations,
+            residual: if worse && stop != Stop::Interrupted {
+                start_residual
+            } else {
+                residual
+            },
+        }
+    };
     let (mut p, mut v, mut y, mut s, mut z, mut t) = (
         vec![0.0; n],
         vec![0.0; n],
@@ -489,46 +597,27 @@ pub(crate) fn bicgstab_checked(
         let before = residual;
         residual = residual_into(a, b, x, &mut r) / scale;
         if !residual.is_finite() {
-            return Ok(Report {
-                stop: Stop::Breakdown,
-                iterations: done,
-                residual,
-            });
+            return Ok(settle(x, Stop::Breakdown, done, residual));
         }
         if residual <= options.tolerance {
             break;
         }
         if interrupted {
-            return Ok(Report {
-                stop: Stop::Interrupted,
-                iterations: done,
-                residual,
-            });
+            return Ok(settle(x, Stop::Interrupted, done, residual));
         }
         if broke && residual >= before {
-            return Ok(Report {
-                stop: Stop::Breakdown,
-                iterations: done,
-                residual,
-            });
+            return Ok(settle(x, Stop::Breakdown, done, residual));
         }
         if !broke && residual >= before && done < options.max_iterations {
-            return Ok(Report {
-                stop: Stop::Stagnated,
-                iterations: done,
-                residual,
-            });
+            return Ok(settle(x, Stop::Stagnated, done, residual));
         }
     }
-    Ok(Report {
-        stop: if residual <= options.tolerance {
-            Stop::Converged
-        } else {
-            Stop::MaxIterations
-        },
-        iterations: done,
-        residual,
-    })
+    let stop = if residual <= options.tolerance {
+        Stop::Converged
+    } else {
+        Stop::MaxIterations
+    };
+    Ok(settle(x, stop, done, residual))
 }
 
 /// `r ← b − A x`, returning `‖r‖`.

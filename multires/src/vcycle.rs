@@ -5,7 +5,11 @@
 //! restriction is `Pᵀ`, smoothing is damped Jacobi with as many sweeps
 //! after the coarse correction as before it, and the coarsest level is
 //! solved exactly by Cholesky — so the V-cycle is a symmetric positive
-//! definite operator and CG's theory holds.
+//! definite operator and CG's theory holds. On a singular but consistent
+//! system (a pure Neumann Laplacian) the coarsest factorisation is the
+//! semidefinite one and its solve a symmetric generalised inverse, exact
+//! on the operator's range (see `dense`), so V-cycle-preconditioned CG
+//! converges where plain CG does.
 
 use std::borrow::Cow;
 
@@ -83,7 +87,7 @@ impl<'m> VCycle<'m> {
     /// # Errors
     /// Those of [`Hierarchy::new`]; [`Error::NotSymmetric`];
     /// [`Error::BadDiagonal`] for a diagonal entry ≤ 0; [`Error::NotPositiveDefinite`] if the coarsest operator
-    /// cannot be factored; [`Error::InvalidOption`] for a damping outside
+    /// is indefinite (a singular, semidefinite one is factored); [`Error::InvalidOption`] for a damping outside
     /// (0, 1].
     pub fn new(
         m: &'m CsMat<f64>,
