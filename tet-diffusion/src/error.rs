@@ -38,6 +38,20 @@ pub enum Error {
         /// The repeated index.
         index: u32,
     },
+    /// A vertex that no tetrahedron uses: its row of the diffusion system
+    /// would be empty (a zero diagonal). Drop such vertices first
+    /// (`trilux_io::tet::TetMesh::without_unused_nodes` keeps the map back
+    /// to the file's numbering).
+    #[error(
+        "vertex {vertex} is used by no tetrahedron ({count} such vertices); drop unused vertices \
+         before solving"
+    )]
+    UnusedVertex {
+        /// The first unused vertex.
+        vertex: usize,
+        /// How many vertices are unused.
+        count: usize,
+    },
     /// A position is NaN or infinite.
     #[error("vertex {vertex} has a non-finite position {position:?}")]
     NonFinitePosition {

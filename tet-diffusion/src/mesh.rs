@@ -127,7 +127,8 @@ impl TetMesh {
     /// # Errors
     /// [`Error::EmptyMesh`], [`Error::TooLarge`],
     /// [`Error::NonFinitePosition`], [`Error::IndexOutOfRange`],
-    /// [`Error::RepeatedVertex`], [`Error::DegenerateTet`] (zero volume
+    /// [`Error::RepeatedVertex`], [`Error::UnusedVertex`] (a vertex no
+    /// tetrahedron uses), [`Error::DegenerateTet`] (zero volume
     /// relative to the tet's size, naming the tet),
     /// [`Error::NonManifoldFace`].
     ///
@@ -141,7 +142,25 @@ impl TetMesh {
     /// ```
     pub fn new(positions: &[DVec3], tets: &[[u32; 4]]) -> Result<Self, Error> {
         let original = (0..tets.len() as u32).collect();
-        Self::with_original(positions.to_vec(), tets.to_vec(), original)
+        let mesh = Self::with_original(positions.to_vec(), tets.to_vec(), original)?;
+        // A vertex without tetrahedra has an empty row in every system
+        // built on the mesh: named here, not a zero diagonal in a solver.
+        // (The indices are valid now.)
+        if let Some(vertex) = mesh
+            .vertex_tets
+            .offsets
+            .windows(2)
+            .position(|w| w[0] == w[1])
+        {
+            let count = mesh
+                .vertex_tets
+                .offsets
+                .windows(2)
+                .filter(|w| w[0] == w[1])
+                .count();
+            return Err(Error::UnusedVertex { vertex, count });
+        }
+        Ok(mesh)
     }
 
     /// [`new`](Self::new) with each tet's id in the mesh it was cut from.
@@ -833,6 +852,17 @@ pub(crate) mod tests {
             TetMesh::new(&p, &[[0, 1, 1, 3]]),
             Err(Error::RepeatedVertex { tet: 0, index: 1 })
         ));
+        // Vertex 4 is in no tetrahedron: named, never a zero diagonal in
+        // a solver later.
+        let e = TetMesh::new(&p, &[[0, 1, 2, 3]]).unwrap_err();
+        assert_eq!(
+            e,
+            Error::UnusedVertex {
+                vertex: 4,
+                count: 1
+            }
+        );
+        assert!(e.to_string().contains("vertex 4 is used by no tetrahedron"));
         let mut q = p;
         q[2].y = f64::NAN;
         assert!(matches!(
