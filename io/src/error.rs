@@ -73,22 +73,9 @@ pub enum ErrorKind {
     /// A face corner of a surface file references a vertex, texture
     /// coordinate or normal the file does not have; names what is indexed
     /// in the format's own words ("texture coordinate 3 of face 0, but the
-    /// file has 0 `vt` lines").
-    #[error("{what} {reference} of {element} {index}, but the file has {count} {records}")]
-    ReferenceOutOfRange {
-        /// What is indexed ("vertex", "texture coordinate", "normal").
-        what: &'static str,
-        /// The reference as written in the file.
-        reference: i64,
-        /// The kind of element holding the reference ("face", "strip").
-        element: &'static str,
-        /// The element's position in the file (0-based).
-        index: usize,
-        /// How many of what is indexed the file has.
-        count: usize,
-        /// What they are in the file ("`vt` lines", "vertices").
-        records: &'static str,
-    },
+    /// file has 0 `vt` lines"). Boxed: it keeps [`Error`] small.
+    #[error("{0}")]
+    ReferenceOutOfRange(Box<Reference>),
     /// A coordinate is NaN or infinite.
     #[error("point {index} (0-based) has a non-finite coordinate ({value})")]
     NonFinite {
@@ -126,6 +113,25 @@ pub enum ErrorKind {
     /// length, a tetrahedron referencing a missing node).
     #[error("cannot write this data: {0}")]
     InvalidInput(String),
+}
+
+/// What an out-of-range face-corner reference indexes
+/// ([`ErrorKind::ReferenceOutOfRange`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{what} {reference} of {element} {index}, but the file has {count} {records}")]
+pub struct Reference {
+    /// What is indexed ("vertex", "texture coordinate", "normal").
+    pub what: &'static str,
+    /// The reference as written in the file.
+    pub reference: i64,
+    /// The kind of element holding the reference ("face", "triangle").
+    pub element: &'static str,
+    /// The element's position in the file (0-based).
+    pub index: usize,
+    /// How many of what is indexed the file has.
+    pub count: usize,
+    /// What they are in the file ("`vt` lines", "vertices").
+    pub records: &'static str,
 }
 
 /// A failure to read or write a file: the file, the line or byte offset

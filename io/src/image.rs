@@ -2,6 +2,13 @@
 //! 16 bit, sRGB-encoded) and OpenEXR (f32 or f16, linear) out. Pixels are
 //! always linear `f32` RGBA, so samplers and colour conversion see the same
 //! numbers whatever the file.
+//!
+//! Files are read the way image tools read them: Radiance HDR with the
+//! `#?RGBE` signature as well as `#?RADIANCE`, and any of the eight
+//! orientations of its resolution line (`-Y H +X W` … `+X W -Y H`),
+//! rotated into top-down rows; OpenEXR layouts the image crate refuses
+//! (a lone `Y` channel as grey, `Y RY BY` luminance/chroma, half, float or
+//! uint samples, channels in any order) through the `exr` crate.
 
 use std::io::Cursor as IoCursor;
 use std::path::Path;
@@ -120,6 +127,40 @@ pub fn read_with(path: impl AsRef<Path>, options: ReadOptions) -> Result<Image> 
 pub fn decode(bytes: &[u8], name: impl AsRef<Path>, options: ReadOptions) -> Result<Image> {
     let name = name.as_ref();
     let format = format_of(name)?;
+    match format {
+        ImageFormat::Hdr => {
+            // Other signatures and orientations than the image crate's
+            // `#?RADIANCE` `-Y H +X W`: rewritten for it, then rotated.
+            let header = crate::image_hdr::parse(bytes, name)?;
+            let Some(rewritten) = header.rewritten(bytes) else {
+                return decode_with_image(bytes, name, format, options);
+            };
+            let stored = decode_with_image(&rewritten, name, format, options)?;
+            Ok(header.orientation.to_top_down(stored))
+        }
+        ImageFormat::OpenExr => {
+            check_exr_blocks(bytes, name, options)?;
+            match decode_with_image(bytes, name, format, options) {
+                Ok(image) => Ok(image),
+                // Layouts the image crate refuses (a lone `Y`, `Y RY BY`,
+                // channels without R G B): read through the exr crate.
+                Err(e) if matches!(e.kind, ErrorKind::Codec { .. }) => {
+                    crate::image_exr::decode(bytes, name, options, e)
+                }
+                Err(e) => Err(e),
+            }
+        }
+        _ => decode_with_image(bytes, name, format, options),
+    }
+}
+
+/// Decodes through the image crate, with the budgets checked first.
+fn decode_with_image(
+    bytes: &[u8],
+    name: &Path,
+    format: ImageFormat,
+    options: ReadOptions,
+) -> Result<Image> {
     let mut limits = Limits::default();
     limits.max_image_width = Some(options.max_dimension);
     limits.max_image_height = Some(options.max_dimension);
@@ -131,9 +172,6 @@ pub fn decode(bytes: &[u8], name: impl AsRef<Path>, options: ReadOptions) -> Res
     let (width, height) = contain_codec_panic(name, format, || probe.into_dimensions())?
         .map_err(|e| codec_error(name, format, e))?;
     check_conversion_budget(name, width, height, options)?;
-    if format == ImageFormat::OpenExr {
-        check_exr_blocks(bytes, name, options)?;
-    }
     let mut reader = ImageReader::with_format(IoCursor::new(bytes), format);
     reader.limits(limits);
     let image = contain_codec_panic(name, format, || reader.decode())?
@@ -148,7 +186,7 @@ pub fn decode(bytes: &[u8], name: impl AsRef<Path>, options: ReadOptions) -> Res
 /// other crates', and fuzzing found inputs on which one panics (an
 /// arithmetic overflow in OpenEXR's B44 decompression, with overflow
 /// checks on). Our own code never runs inside.
-fn contain_codec_panic<T>(
+pub(crate) fn contain_codec_panic<T>(
     name: &Path,
     format: ImageFormat,
     codec: impl FnOnce() -> T,
@@ -216,7 +254,7 @@ fn check_exr_blocks(bytes: &[u8], name: &Path, options: ReadOptions) -> Result<(
 /// codec's `f32` RGBA buffer and our `[f32; 4]` pixels.
 const CONVERSION_BYTES_PER_PIXEL: u64 = 32;
 
-fn check_conversion_budget(
+pub(crate) fn check_conversion_budget(
     name: &Path,
     width: u32,
     height: u32,

@@ -48,12 +48,14 @@ pub use glam;
 mod base64;
 mod error;
 pub mod image;
+mod image_exr;
+mod image_hdr;
 pub mod mesh;
 pub mod tet;
 mod text;
 mod warning;
 
-pub use error::{Error, ErrorKind, Location, Result};
+pub use error::{Error, ErrorKind, Location, Reference, Result};
 pub use warning::Warning;
 
 /// The README's examples, compiled as doctests.

@@ -46,7 +46,11 @@ fn ply_triangle_strips() {
     let first = mesh.indices[0].map(|i| mesh.positions[i as usize]);
     assert_eq!(
         first,
-        [Vec3::new(0.0, 1.0, 0.0), Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)]
+        [
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::ZERO,
+            Vec3::new(1.0, 1.0, 0.0)
+        ]
     );
     assert!(mesh.warnings.is_empty(), "{}", warnings_text(&mesh));
 }
@@ -62,8 +66,17 @@ fn ply_strip_siblings() {
              end_header\n"
         )
     };
-    let points = [[0.0f32, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0], [0.0, 2.0]];
-    let mut ascii = header("ascii", "element edge 1\nproperty int vertex1\nproperty int vertex2\n");
+    let points = [
+        [0.0f32, 0.0],
+        [1.0, 0.0],
+        [0.0, 1.0],
+        [1.0, 1.0],
+        [0.0, 2.0],
+    ];
+    let mut ascii = header(
+        "ascii",
+        "element edge 1\nproperty int vertex1\nproperty int vertex2\n",
+    );
     for p in points {
         ascii.push_str(&format!("{} {} 0\n", p[0], p[1]));
     }
@@ -73,7 +86,10 @@ fn ply_strip_siblings() {
     assert_eq!(mesh.triangles, vec![[0, 1, 2], [2, 1, 3], [3, 2, 4]]);
     assert_eq!(mesh.warnings.len(), 1);
     let warning = mesh.warnings[0].to_string();
-    assert!(warning.contains("strips.ply") && warning.contains("`edge`"), "{warning}");
+    assert!(
+        warning.contains("strips.ply") && warning.contains("`edge`"),
+        "{warning}"
+    );
 
     let mut be = header("binary_big_endian", "").into_bytes();
     for p in points {
@@ -86,11 +102,17 @@ fn ply_strip_siblings() {
         be.extend_from_slice(&i.to_be_bytes());
     }
     let mesh = ply::from_bytes(&be, "strips_be.ply").unwrap();
-    assert_eq!(mesh.triangles, vec![[0, 1, 2]], "a 2-vertex strip has no triangle");
+    assert_eq!(
+        mesh.triangles,
+        vec![[0, 1, 2]],
+        "a 2-vertex strip has no triangle"
+    );
 
     // An index past the vertices is named with what it indexes.
     let bad = ascii.replace("7 0 1 2 3 3 2 4", "3 0 1 9");
-    let e = ply::from_bytes(bad.as_bytes(), "bad.ply").unwrap_err().to_string();
+    let e = ply::from_bytes(bad.as_bytes(), "bad.ply")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("vertex 9") && e.contains("5 vertices"), "{e}");
 }
 
@@ -99,8 +121,11 @@ fn ply_strip_siblings() {
 #[test]
 fn ply_per_corner_texcoords_and_texture_file() {
     let dir = support::scratch("ply-texcoord");
-    std::fs::write(dir.join("wood.png"), std::fs::read(file("mtl-keyword-case", "wood.png")).unwrap())
-        .unwrap();
+    std::fs::write(
+        dir.join("wood.png"),
+        std::fs::read(file("mtl-keyword-case", "wood.png")).unwrap(),
+    )
+    .unwrap();
     let text = "ply\nformat ascii 1.0\ncomment TextureFile wood.png\nelement vertex 4\n\
                 property float x\nproperty float y\nproperty float z\nelement face 2\n\
                 property list uchar int vertex_indices\nproperty list uchar float texcoord\n\
@@ -128,12 +153,21 @@ fn ply_per_corner_texcoords_and_texture_file() {
     std::fs::remove_file(dir.join("wood.png")).unwrap();
     let mesh = TriMesh::read(&path).unwrap();
     assert_eq!(mesh.indices.len(), 2);
-    assert_eq!(mesh.materials[0].diffuse_texture, Some(dir.join("wood.png")));
-    assert!(warnings_text(&mesh).contains("wood.png"), "{}", warnings_text(&mesh));
+    assert_eq!(
+        mesh.materials[0].diffuse_texture,
+        Some(dir.join("wood.png"))
+    );
+    assert!(
+        warnings_text(&mesh).contains("wood.png"),
+        "{}",
+        warnings_text(&mesh)
+    );
 
     // A texcoord list of the wrong length is an error naming the face.
     let bad = text.replace("6 0.5 0.5 1 1 0 1", "4 0.5 0.5 1 1");
-    let e = ply::from_bytes(bad.as_bytes(), "bad.ply").unwrap_err().to_string();
+    let e = ply::from_bytes(bad.as_bytes(), "bad.ply")
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("face 1"), "{e}");
 }
 
@@ -163,22 +197,33 @@ fn obj_face_texcoords_without_vt_lines() {
     assert!(mesh.normals.is_some());
     assert_eq!(mesh.warnings.len(), 1);
     let w = mesh.warnings[0].to_string();
-    assert!(w.contains("square.obj") && w.contains("line 7") && w.contains("`vt`"), "{w}");
+    assert!(
+        w.contains("square.obj") && w.contains("line 7") && w.contains("`vt`"),
+        "{w}"
+    );
 
     // Siblings: `f v//vn` without `vn` lines, and an index past the `vt`
     // lines there are, which is an error naming what is indexed.
     let mesh = obj::from_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n", "n.obj").unwrap();
     assert_eq!((mesh.indices.len(), mesh.normals.is_none()), (1, true));
     assert!(mesh.warnings[0].message.contains("`vn`"));
-    let e = obj::from_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/4 3/1\n", "t.obj")
-        .unwrap_err()
-        .to_string();
+    let e = obj::from_bytes(
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/4 3/1\n",
+        "t.obj",
+    )
+    .unwrap_err()
+    .to_string();
     assert!(
         e.contains("texture coordinate 4 of face 0, but the file has 1 `vt` lines"),
         "{e}"
     );
-    let e = obj::from_bytes(b"v 0 0 0\nf 1 2 3\n", "v.obj").unwrap_err().to_string();
-    assert!(e.contains("vertex 2 of face 0, but the file has 1 `v` lines"), "{e}");
+    let e = obj::from_bytes(b"v 0 0 0\nf 1 2 3\n", "v.obj")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("vertex 2 of face 0, but the file has 1 `v` lines"),
+        "{e}"
+    );
 }
 
 /// `map_kd` and `Map_Kd`: MTL keywords compared ignoring case.
@@ -187,7 +232,12 @@ fn mtl_keywords_ignore_case() {
     let mesh = obj::read(file("mtl-keyword-case", "two_planes.obj")).unwrap();
     let texture = |name: &str| {
         let m = mesh.materials.iter().find(|m| m.name == name).unwrap();
-        m.diffuse_texture.as_ref().unwrap().file_name().unwrap().to_owned()
+        m.diffuse_texture
+            .as_ref()
+            .unwrap()
+            .file_name()
+            .unwrap()
+            .to_owned()
     };
     assert_eq!(texture("lower"), "wood.png");
     assert_eq!(texture("capital"), "stone.png");
@@ -211,14 +261,29 @@ fn obj_side_files_never_refuse_the_mesh() {
     let mesh = obj::read(&path).unwrap();
     assert_eq!(mesh.indices.len(), 2);
     let known = &mesh.materials[0];
-    assert_eq!((known.name.as_str(), known.diffuse), ("known", [0.5, 0.25, 1.0]));
+    assert_eq!(
+        (known.name.as_str(), known.diffuse),
+        ("known", [0.5, 0.25, 1.0])
+    );
     assert_eq!(known.diffuse_texture, Some(dir.join("gone.png")));
     let text = warnings_text(&mesh);
     assert_eq!(mesh.warnings.len(), 4, "{text}");
-    assert!(text.contains("missing.mtl") && text.contains("line 1"), "{text}");
-    assert!(text.contains("gone.png") && text.contains("\"known\""), "{text}");
-    assert!(text.contains("\"ghost\"") && text.contains("line 9"), "{text}");
-    assert!(text.contains("2 statement(s)") && text.contains("`weird`"), "{text}");
+    assert!(
+        text.contains("missing.mtl") && text.contains("line 1"),
+        "{text}"
+    );
+    assert!(
+        text.contains("gone.png") && text.contains("\"known\""),
+        "{text}"
+    );
+    assert!(
+        text.contains("\"ghost\"") && text.contains("line 9"),
+        "{text}"
+    );
+    assert!(
+        text.contains("2 statement(s)") && text.contains("`weird`"),
+        "{text}"
+    );
 }
 
 /// A glTF texture whose only image is in `KHR_texture_basisu`: the
@@ -233,9 +298,15 @@ fn gltf_texture_without_source() {
     assert_eq!(mesh.materials[0].name, "albedo");
     assert!(mesh.materials[0].diffuse_image.is_none());
     let text = warnings_text(&mesh);
-    assert!(text.contains("texture 0") && text.contains("KHR_texture_basisu"), "{text}");
-    let mesh =
-        TriMesh::read(file("gltf-texture-without-source", "basisu_with_png_fallback.gltf")).unwrap();
+    assert!(
+        text.contains("texture 0") && text.contains("KHR_texture_basisu"),
+        "{text}"
+    );
+    let mesh = TriMesh::read(file(
+        "gltf-texture-without-source",
+        "basisu_with_png_fallback.gltf",
+    ))
+    .unwrap();
     assert!(mesh.materials[0].diffuse_image.is_some());
     assert!(mesh.warnings.is_empty(), "{}", warnings_text(&mesh));
 }
@@ -263,7 +334,9 @@ fn second_set_controls_keep_passing() {
 fn gmsh_inverted_and_flat_keep_passing() {
     let mesh = TetMesh::read(file("tet-inverted-and-flat", "inverted.msh")).unwrap();
     assert!((mesh.volume() - 0.5).abs() < 1e-12);
-    let inverted = (0..mesh.tets.len()).filter(|&t| mesh.signed_volume6(t) < 0.0).count();
+    let inverted = (0..mesh.tets.len())
+        .filter(|&t| mesh.signed_volume6(t) < 0.0)
+        .count();
     assert_eq!(inverted, 1);
     let boundary = mesh.boundary();
     assert_eq!(boundary.len(), 6);

@@ -189,7 +189,14 @@ fn gmsh_22_binary() -> Vec<u8> {
 
 #[test]
 fn gmsh_22_binary_equals_ascii() {
-    assert_eq!(gmsh_from(&gmsh_22_binary()), gmsh_from(GMSH_22));
+    // The same mesh, and the same skipped elements said (from another
+    // scratch file).
+    let (mut binary, mut ascii) = (gmsh_from(&gmsh_22_binary()), gmsh_from(GMSH_22));
+    for w in binary.warnings.iter_mut().chain(ascii.warnings.iter_mut()) {
+        w.path = std::path::PathBuf::new();
+    }
+    assert_eq!(binary, ascii);
+    assert_eq!(binary.warnings.len(), 1);
 }
 
 #[test]

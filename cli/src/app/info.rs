@@ -276,13 +276,54 @@ fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
             let _ = writeln!(text, "  dihedral angles: undefined (a flat tetrahedron)");
         }
     }
-    Ok((
+    // What a solver would choke on: nodes without tetrahedra (empty
+    // rows), repeated tetrahedra, edges where the boundary is not a
+    // closed manifold. Named, so the user can fix the file.
+    let unused = mesh.unused_nodes();
+    let duplicates = mesh.duplicate_tets();
+    let non_manifold = mesh.non_manifold_boundary_edges();
+    let first = |list: Vec<String>| {
+        let shown: Vec<String> = list.iter().take(5).cloned().collect();
+        let more = if list.len() > 5 { ", …" } else { "" };
+        format!("{}{more}", shown.join(", "))
+    };
+    let _ = writeln!(text, "  unused nodes: {}", unused.len());
+    if !unused.is_empty() {
+        let nodes = first(unused.iter().map(u32::to_string).collect());
+        let _ = writeln!(text, "    nodes {nodes} are used by no tetrahedron");
+    }
+    let _ = writeln!(text, "  duplicate tetrahedra: {}", duplicates.len());
+    if !duplicates.is_empty() {
+        let pairs = first(
+            duplicates
+                .iter()
+                .map(|(a, b)| format!("{b} repeats {a}"))
+                .collect(),
+        );
+        let _ = writeln!(text, "    tetrahedron {pairs}");
+    }
+    let _ = writeln!(
         text,
-        json!({"file": super::shown(path), "kind": "tetrahedral mesh", "nodes": mesh.positions.len(),
+        "  non-manifold boundary edges: {}",
+        non_manifold.len()
+    );
+    if !non_manifold.is_empty() {
+        let edges = first(
+            non_manifold
+                .iter()
+                .map(|e| format!("({}, {})", e[0], e[1]))
+                .collect(),
+        );
+        let _ = writeln!(text, "    edges {edges}");
+    }
+    let mut json = json!({"file": super::shown(path), "kind": "tetrahedral mesh", "nodes": mesh.positions.len(),
                "tetrahedra": mesh.tets.len(), "boundary_triangles": boundary,
                "bounds": [lo.to_array(), hi.to_array()], "volume": volume, "inverted": inverted,
-               "dihedral_degrees": dihedral.map(|(a, b)| [a, b])}),
-    ))
+               "dihedral_degrees": dihedral.map(|(a, b)| [a, b]),
+               "unused_nodes": unused, "duplicate_tetrahedra": duplicates,
+               "non_manifold_boundary_edges": non_manifold});
+    add_warnings(&mut text, &mut json, &mesh.warnings);
+    Ok((text, json))
 }
 
 /// A TetGen `.face` file: its triangles as a surface (parts, holes,

@@ -556,14 +556,16 @@ impl Reader<'_> {
         let start = mesh.indices.len();
         for (t, tri) in triangles.into_iter().enumerate() {
             if let Some(&bad) = tri.iter().find(|&&i| i as usize >= count) {
-                return Err(self.error(ErrorKind::ReferenceOutOfRange {
-                    what: "vertex",
-                    reference: i64::from(bad),
-                    element: "triangle",
-                    index: start + t,
-                    count,
-                    records: "vertices in its primitive",
-                }));
+                return Err(self.error(ErrorKind::ReferenceOutOfRange(Box::new(
+                    crate::error::Reference {
+                        what: "vertex",
+                        reference: i64::from(bad),
+                        element: "triangle",
+                        index: start + t,
+                        count,
+                        records: "vertices in its primitive",
+                    },
+                ))));
             }
             let [a, b, c] = tri.map(|i| i + base as u32);
             mesh.indices

@@ -183,8 +183,6 @@ fn from_ply(path: &Path, ply: ply::PlyData) -> TriMesh {
         let folder = path.parent().unwrap_or(Path::new("."));
         let file = folder.join(name);
         if !file.is_file() {
-
-
             warnings.push(Warning::new(
                 &file,
                 None,

@@ -77,7 +77,11 @@ pub fn read(path: impl AsRef<Path>) -> Result<TriMesh> {
             }
         }
     }
-    for ((material, defined), line) in mesh.materials.iter().zip(&defined).zip(&parsed.usemtl_lines)
+    for ((material, defined), line) in mesh
+        .materials
+        .iter()
+        .zip(&defined)
+        .zip(&parsed.usemtl_lines)
     {
         if !defined {
             mesh.warnings.push(Warning::new(
@@ -353,14 +357,16 @@ fn resolve(at: &At<'_>, token: &str, len: usize, indexed: Indexed, face: usize) 
         .map_err(|_| at.syntax(&format!("a {} index", indexed.what), token))?;
     let index = if raw > 0 { raw - 1 } else { len as i64 + raw };
     if raw == 0 || index < 0 || index >= len as i64 {
-        return Err(at.error(ErrorKind::ReferenceOutOfRange {
-            what: indexed.what,
-            reference: raw,
-            element: "face",
-            index: face,
-            count: len,
-            records: indexed.records,
-        }));
+        return Err(at.error(ErrorKind::ReferenceOutOfRange(Box::new(
+            crate::error::Reference {
+                what: indexed.what,
+                reference: raw,
+                element: "face",
+                index: face,
+                count: len,
+                records: indexed.records,
+            },
+        ))));
     }
     Ok(index as u32)
 }
@@ -608,10 +614,43 @@ struct MtlLibrary {
 /// other colours, exponents, transparency, illumination model, the other
 /// maps): known, so not counted as unknown.
 const MTL_IGNORED: &[&str] = &[
-    "ka", "ks", "ke", "kt", "ns", "ni", "d", "tr", "tf", "illum", "sharpness", "map_ka", "map_ks",
-    "map_ke", "map_ns", "map_d", "map_tr", "map_bump", "bump", "map_disp", "disp", "decal", "refl",
-    "norm", "map_norm", "pr", "pm", "ps", "pc", "pcr", "aniso", "anisor", "map_pr", "map_pm",
-    "map_ps", "map_refl", "map_aat",
+    "ka",
+    "ks",
+    "ke",
+    "kt",
+    "ns",
+    "ni",
+    "d",
+    "tr",
+    "tf",
+    "illum",
+    "sharpness",
+    "map_ka",
+    "map_ks",
+    "map_ke",
+    "map_ns",
+    "map_d",
+    "map_tr",
+    "map_bump",
+    "bump",
+    "map_disp",
+    "disp",
+    "decal",
+    "refl",
+    "norm",
+    "map_norm",
+    "pr",
+    "pm",
+    "ps",
+    "pc",
+    "pcr",
+    "aniso",
+    "anisor",
+    "map_pr",
+    "map_pm",
+    "map_ps",
+    "map_refl",
+    "map_aat",
 ];
 
 /// Parses an MTL library: `newmtl`, `Kd`, `map_Kd` (options parsed, the

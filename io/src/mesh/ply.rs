@@ -335,14 +335,14 @@ pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<PlyData> {
         if let Some(&bad) = tri.iter().find(|&&i| i as usize >= n) {
             return Err(Error::new(
                 path,
-                ErrorKind::ReferenceOutOfRange {
+                ErrorKind::ReferenceOutOfRange(Box::new(crate::error::Reference {
                     what: "vertex",
                     reference: i64::from(bad),
                     element: "triangle",
                     index,
                     count: n,
                     records: "vertices",
-                },
+                })),
             ));
         }
     }
@@ -709,7 +709,12 @@ fn read_faces(
         }
         return Ok(());
     };
-    warn_unread(r, element, &[Some(indices), texcoord].map(|i| i.unwrap_or(usize::MAX)), out);
+    warn_unread(
+        r,
+        element,
+        &[Some(indices), texcoord].map(|i| i.unwrap_or(usize::MAX)),
+        out,
+    );
     let mut polygon: Vec<Option<u32>> = Vec::new();
     let mut uvs: Vec<Vec2> = Vec::new();
     for face in 0..element.count {
@@ -737,7 +742,11 @@ fn read_faces(
                     ));
                 }
                 // PLY's v grows upwards; TriMesh's grows downwards.
-                uvs.extend(values.chunks_exact(2).map(|uv| Vec2::new(uv[0], 1.0 - uv[1])));
+                uvs.extend(
+                    values
+                        .chunks_exact(2)
+                        .map(|uv| Vec2::new(uv[0], 1.0 - uv[1])),
+                );
                 continue;
             }
             let n = index_list(r, p, count_kind, at, false, &mut polygon)?;
@@ -769,7 +778,9 @@ fn read_faces(
                 ));
             }
             for (k, t) in (first..out.triangles.len()).enumerate() {
-                corners.triangles.push((t, [uvs[0], uvs[k + 1], uvs[k + 2]]));
+                corners
+                    .triangles
+                    .push((t, [uvs[0], uvs[k + 1], uvs[k + 2]]));
             }
         }
     }
@@ -812,11 +823,16 @@ fn read_strips(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -> 
             index_list(r, p, count_kind, at, true, &mut strip)?;
             for run in strip.split(Option::is_none) {
                 for k in 0..run.len().saturating_sub(2) {
-                    let (a, b, c) = (run[k].unwrap_or(0), run[k + 1].unwrap_or(0), run[k + 2].unwrap_or(0));
+                    let (a, b, c) = (
+                        run[k].unwrap_or(0),
+                        run[k + 1].unwrap_or(0),
+                        run[k + 2].unwrap_or(0),
+                    );
                     if a == b || b == c || a == c {
                         continue;
                     }
-                    out.triangles.push(if k % 2 == 0 { [a, b, c] } else { [b, a, c] });
+                    out.triangles
+                        .push(if k % 2 == 0 { [a, b, c] } else { [b, a, c] });
                 }
             }
         }
@@ -962,7 +978,8 @@ pub fn to_bytes(path: impl AsRef<Path>, data: &PlyData, format: Format) -> Resul
     });
     header.push_str("comment written by trilux-io\n");
     if let Some(texture) = &data.texture_file {
-        if texture.trim().is_empty() || texture.trim() != texture || texture.contains(['\n', '\r']) {
+        if texture.trim().is_empty() || texture.trim() != texture || texture.contains(['\n', '\r'])
+        {
             return Err(invalid(format!(
                 "texture file {texture:?} cannot be written as a PLY comment (empty, a line \
                  break, or surrounding spaces)"

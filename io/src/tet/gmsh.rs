@@ -1,9 +1,15 @@
 //! Gmsh `.msh` files: version 2.2 ASCII and binary (what TetWild and
-//! fTetWild write) and version 4.1 ASCII (what Gmsh and meshio write).
+//! fTetWild write) and version 4.1 ASCII and binary (what Gmsh and meshio
+//! write; meshio's default is binary). Binary files are read in the byte
+//! order their header's `int 1` shows, little- or big-endian (Gmsh
+//! reference manual, Sec. 10.1, "MSH file format").
 //!
 //! Tetrahedra (element types 4 and, by their corners, 11) are kept with
-//! their physical tag as region; other elements are skipped. Node tags may
-//! be any positive numbers; nodes are indexed in file order.
+//! their physical tag as region (4.1: the physical tag of their volume
+//! entity, or the entity tag itself when no volume has a physical tag);
+//! other elements are skipped and counted in [`TetMesh::warnings`]. Node
+//! tags may be any positive numbers; nodes are indexed in file order.
+//! Every count is checked against the bytes left before allocating.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -16,7 +22,7 @@ use crate::text::Cursor;
 
 /// Nodes per element for Gmsh's element types 1..=19 (index 0 unused),
 /// needed to skip elements of binary files.
-const NODES_PER_TYPE: [usize; 20] = [
+pub(super) const NODES_PER_TYPE: [usize; 20] = [
     0, 2, 3, 4, 4, 8, 6, 5, 3, 6, 9, 10, 27, 18, 14, 1, 8, 20, 15, 13,
 ];
 
@@ -60,14 +66,40 @@ impl TagMap {
 
 /// What the sections read so far hold.
 #[derive(Default)]
-struct Parts {
-    tags: Vec<u64>,
-    positions: Vec<DVec3>,
+pub(super) struct Parts {
+    pub(super) tags: Vec<u64>,
+    pub(super) positions: Vec<DVec3>,
     /// Tetrahedra as node tags, with their region, until nodes are known.
-    tets: Vec<([i64; 4], i32, usize)>,
+    pub(super) tets: Vec<([i64; 4], i32, usize)>,
     /// 4.1: volume entity tag to its first physical tag.
-    volume_physical: HashMap<i64, i32>,
-    nodes_seen: bool,
+    pub(super) volume_physical: HashMap<i64, i32>,
+    pub(super) nodes_seen: bool,
+    /// Elements other than tetrahedra, skipped: (type, count).
+    pub(super) skipped: Vec<(u64, u64)>,
+}
+
+impl Parts {
+    /// The region of a 4.1 tetrahedron of volume entity `entity`: its
+    /// physical tag, 0 for an entity without one, or the entity tag when
+    /// no volume has a physical tag (meshio without `gmsh:physical`).
+    pub(super) fn region_41(&self, entity: i64) -> i32 {
+        if self.volume_physical.is_empty() {
+            i32::try_from(entity).unwrap_or(0)
+        } else {
+            self.volume_physical.get(&entity).copied().unwrap_or(0)
+        }
+    }
+
+    /// Counts `count` skipped elements of `kind`.
+    pub(super) fn skip(&mut self, kind: u64, count: u64) {
+        if count == 0 {
+            return;
+        }
+        match self.skipped.iter_mut().find(|(k, _)| *k == kind) {
+            Some((_, n)) => *n += count,
+            None => self.skipped.push((kind, count)),
+        }
+    }
 }
 
 /// Reads a `.msh` file.
@@ -115,24 +147,32 @@ pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<TetMesh> {
             ));
         }
     };
-    if binary && v41 {
-        return Err(c.error_at(at, ErrorKind::Unsupported("binary Gmsh 4.1".into())));
-    }
+    let mut big_endian = false;
     if binary {
         // One int 1 in the writer's byte order follows the header line.
         c.skip_line();
         let at = c.offset();
         let one = c.take(4, "the binary endianness check")?;
-        if i32::from_le_bytes([one[0], one[1], one[2], one[3]]) != 1 {
-            return Err(c.error_at_byte(
-                at,
-                ErrorKind::Unsupported("big-endian binary Gmsh files".into()),
-            ));
-        }
+        let one = [one[0], one[1], one[2], one[3]];
+        big_endian = match (i32::from_le_bytes(one), i32::from_be_bytes(one)) {
+            (1, _) => false,
+            (_, 1) if v41 => true,
+            (_, 1) => {
+                return Err(c.error_at_byte(
+                    at,
+                    ErrorKind::Unsupported("big-endian binary Gmsh 2.2 files".into()),
+                ));
+            }
+            _ => return Err(c.syntax(at, "the int 1 of a binary header", &one)),
+        };
     }
     c.keyword("$EndMeshFormat")?;
 
     let mut parts = Parts::default();
+    if binary && v41 {
+        return super::gmsh_binary::sections(&mut c, &mut parts, big_endian)
+            .and_then(|()| finish(parts, &c));
+    }
     while let Some((at, section)) = c.token() {
         match section {
             b"$Nodes" if v41 => nodes_41(&mut c, &mut parts)?,
@@ -146,17 +186,33 @@ pub fn from_bytes(data: &[u8], path: impl AsRef<Path>) -> Result<TetMesh> {
             other => return Err(c.syntax(at, "a section such as $Nodes", other)),
         }
     }
-    if !parts.nodes_seen {
-        return Err(Error::new(
-            path,
-            ErrorKind::Truncated("a $Nodes section".into()),
-        ));
-    }
     finish(parts, &c)
 }
 
+/// One warning listing the elements other than tetrahedra that were
+/// skipped (triangles, lines, points: a tet mesh's boundary and
+/// annotations, which the tetrahedra define again).
+fn skipped_warnings(path: &Path, skipped: &[(u64, u64)]) -> Vec<crate::Warning> {
+    if skipped.is_empty() {
+        return Vec::new();
+    }
+    let list: Vec<String> = skipped
+        .iter()
+        .map(|(kind, n)| format!("{n} of type {kind}"))
+        .collect();
+    vec![crate::Warning::new(
+        path,
+        None,
+        format!(
+            "elements other than tetrahedra are not read: {} (Gmsh element types; 2 is a \
+             triangle, 1 a line, 15 a point)",
+            list.join(", ")
+        ),
+    )]
+}
+
 /// Skips an unknown section up to its `$End…` line.
-fn skip_section(c: &mut Cursor<'_>, name: &[u8]) -> Result<()> {
+pub(super) fn skip_section(c: &mut Cursor<'_>, name: &[u8]) -> Result<()> {
     let mut end = b"$End".to_vec();
     end.extend_from_slice(&name[1..]);
     loop {
@@ -169,6 +225,13 @@ fn skip_section(c: &mut Cursor<'_>, name: &[u8]) -> Result<()> {
 
 /// Converts tag-addressed tetrahedra to indices.
 fn finish(parts: Parts, c: &Cursor<'_>) -> Result<TetMesh> {
+    if !parts.nodes_seen {
+        return Err(Error::new(
+            c.path(),
+            ErrorKind::Truncated("a $Nodes section".into()),
+        ));
+    }
+    let warnings = skipped_warnings(c.path(), &parts.skipped);
     let map = TagMap::new(&parts.tags);
     let count = parts.positions.len();
     let mut tets = Vec::with_capacity(parts.tets.len());
@@ -199,12 +262,12 @@ fn finish(parts: Parts, c: &Cursor<'_>) -> Result<TetMesh> {
         tets,
         regions,
         attributes: Vec::new(),
-        warnings: Vec::new(),
+        warnings,
     })
 }
 
 /// A physical tag, which must fit 32 bits.
-fn physical_tag(c: &Cursor<'_>, at: usize, value: i64) -> Result<i32> {
+pub(super) fn physical_tag(c: &Cursor<'_>, at: usize, value: i64) -> Result<i32> {
     i32::try_from(value).map_err(|_| {
         c.syntax(
             at,
@@ -238,6 +301,7 @@ fn elements_22(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
         c.u64("an element tag")?;
         let kind = c.u64("an element type")?;
         if kind != 4 && kind != 11 {
+            parts.skip(kind, 1);
             c.skip_line();
             continue;
         }
@@ -351,7 +415,9 @@ fn elements_22_binary(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
         let bytes_needed = count.saturating_mul(4 * ints);
         let block_at = c.offset();
         let block = c.take(bytes_needed, "element records")?;
-        if kind == 4 || kind == 11 {
+        if kind != 4 && kind != 11 {
+            parts.skip(kind as u64, count as u64);
+        } else {
             for (k, record) in block.chunks_exact(4 * ints).enumerate() {
                 let region = if ntags > 0 { i32_at(record, 1) } else { 0 };
                 let tags = [0, 1, 2, 3].map(|j| i64::from(i32_at(record, 1 + ntags + j)));
@@ -458,9 +524,10 @@ fn elements_41(c: &mut Cursor<'_>, parts: &mut Parts) -> Result<()> {
         let kind = c.u64("an element type")?;
         let in_block = c.u64("the number of elements in the block")?;
         let n = c.check_count("elements", in_block, 4)?;
-        let region = parts.volume_physical.get(&entity).copied().unwrap_or(0);
+        let region = parts.region_41(entity);
         c.skip_line();
         if kind != 4 && kind != 11 {
+            parts.skip(kind, n as u64);
             for _ in 0..n {
                 c.skip_line();
             }

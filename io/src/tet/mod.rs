@@ -8,6 +8,7 @@ use glam::DVec3;
 use crate::error::{Error, ErrorKind, Result};
 
 pub mod gmsh;
+mod gmsh_binary;
 pub mod medit;
 pub mod tetgen;
 pub mod vtu;
@@ -161,6 +162,110 @@ impl TetMesh {
         boundary
     }
 
+    /// The nodes no tetrahedron uses, ascending. A solver on the mesh
+    /// would give them an empty row (a zero diagonal); drop them with
+    /// [`without_unused_nodes`](Self::without_unused_nodes) first.
+    pub fn unused_nodes(&self) -> Vec<u32> {
+        let mut used = vec![false; self.positions.len()];
+        for &n in self.tets.iter().flatten() {
+            if let Some(u) = used.get_mut(n as usize) {
+                *u = true;
+            }
+        }
+        (0..self.positions.len() as u32)
+            .filter(|&n| !used[n as usize])
+            .collect()
+    }
+
+    /// The mesh without the nodes no tetrahedron uses, and the map from
+    /// each new node to its index in `self` (`map[new] = old`), to write
+    /// per-node results back onto the original numbering. The tetrahedra,
+    /// regions, attributes and warnings are kept, renumbered.
+    pub fn without_unused_nodes(&self) -> (TetMesh, Vec<u32>) {
+        let mut new_index = vec![u32::MAX; self.positions.len()];
+        let mut map = Vec::with_capacity(self.positions.len());
+        for &n in self.tets.iter().flatten() {
+            if let Some(slot) = new_index.get_mut(n as usize)
+                && *slot == u32::MAX
+            {
+                *slot = map.len() as u32;
+                map.push(n);
+            }
+        }
+        // Ascending old indices, so that the kept nodes keep their order.
+        map.sort_unstable();
+        for (new, &old) in map.iter().enumerate() {
+            new_index[old as usize] = new as u32;
+        }
+        let mesh = TetMesh {
+            positions: map
+                .iter()
+                .map(|&old| self.positions[old as usize])
+                .collect(),
+            tets: self
+                .tets
+                .iter()
+                .map(|t| t.map(|n| new_index.get(n as usize).copied().unwrap_or(u32::MAX)))
+                .collect(),
+            regions: self.regions.clone(),
+            attributes: self.attributes.clone(),
+            warnings: self.warnings.clone(),
+        };
+        (mesh, map)
+    }
+
+    /// Tetrahedra that repeat an earlier one's nodes (in any order), as
+    /// `(earlier, repeat)` pairs in file order.
+    pub fn duplicate_tets(&self) -> Vec<(usize, usize)> {
+        let mut keyed: Vec<([u32; 4], usize)> = self
+            .tets
+            .iter()
+            .enumerate()
+            .map(|(t, tet)| {
+                let mut key = *tet;
+                key.sort_unstable();
+                (key, t)
+            })
+            .collect();
+        keyed.sort_unstable();
+        let mut pairs: Vec<(usize, usize)> = keyed
+            .windows(2)
+            .filter(|w| w[0].0 == w[1].0)
+            .map(|w| (w[0].1, w[1].1))
+            .collect();
+        pairs.sort_unstable_by_key(|&(_, repeat)| repeat);
+        pairs
+    }
+
+    /// Edges of the [`boundary`](Self::boundary) that belong to other
+    /// than two boundary triangles (two tetrahedra touching along an edge
+    /// only, or a surface that is not closed): sorted node pairs.
+    pub fn non_manifold_boundary_edges(&self) -> Vec<[u32; 2]> {
+        let mut edges: Vec<[u32; 2]> = self
+            .boundary()
+            .iter()
+            .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+            .map(|mut e| {
+                e.sort_unstable();
+                e
+            })
+            .collect();
+        edges.sort_unstable();
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i < edges.len() {
+            let mut j = i + 1;
+            while j < edges.len() && edges[j] == edges[i] {
+                j += 1;
+            }
+            if j - i != 2 {
+                out.push(edges[i]);
+            }
+            i = j;
+        }
+        out
+    }
+
     /// Checks that every tetrahedron references existing nodes; the readers
     /// guarantee it, this is for meshes built by hand.
     pub(crate) fn check_indices(&self, path: &Path) -> Result<()> {
@@ -226,6 +331,43 @@ mod tests {
         assert!(inverted.signed_volume6(0) < 0.0);
         let b = inverted.boundary();
         assert!((enclosed_volume(&inverted.positions, &b) - 1.0 / 6.0).abs() < 1e-15);
+    }
+
+    /// A node no tetrahedron uses is found, dropped with a map back, and
+    /// the volume and boundary are unchanged; a repeated tetrahedron and
+    /// two tetrahedra sharing only an edge are named.
+    #[test]
+    fn unused_nodes_duplicates_and_non_manifold_edges() {
+        let mut mesh = unit_tet();
+        mesh.positions.insert(1, DVec3::splat(9.0));
+        mesh.tets = vec![[0, 2, 3, 4]];
+        assert_eq!(mesh.unused_nodes(), vec![1]);
+        let (compact, map) = mesh.without_unused_nodes();
+        assert_eq!(map, vec![0, 2, 3, 4]);
+        assert_eq!(compact.tets, vec![[0, 1, 2, 3]]);
+        assert!(compact.unused_nodes().is_empty());
+        assert!((compact.volume() - mesh.volume()).abs() < 1e-15);
+        for (new, &old) in map.iter().enumerate() {
+            assert_eq!(compact.positions[new], mesh.positions[old as usize]);
+        }
+        assert!(mesh.duplicate_tets().is_empty());
+        assert!(mesh.non_manifold_boundary_edges().is_empty());
+        mesh.tets.push([4, 3, 2, 0]);
+        assert_eq!(mesh.duplicate_tets(), vec![(0, 1)]);
+        // Two tetrahedra sharing only the edge (0, 1).
+        let bowtie = TetMesh {
+            positions: vec![
+                DVec3::ZERO,
+                DVec3::Z,
+                DVec3::X,
+                DVec3::Y,
+                -DVec3::X,
+                -DVec3::Y,
+            ],
+            tets: vec![[0, 2, 3, 1], [0, 4, 5, 1]],
+            ..TetMesh::default()
+        };
+        assert_eq!(bowtie.non_manifold_boundary_edges(), vec![[0, 1]]);
     }
 
     #[test]

@@ -4,7 +4,7 @@
 
 mod common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use common::{stderr, trilux};
 
@@ -17,7 +17,7 @@ fn regression(folder: &str, name: &str) -> PathBuf {
 
 /// Runs `trilux info FILE --json` and `trilux info FILE`, expects success,
 /// and returns the JSON and the text.
-fn info(file: &PathBuf) -> (serde_json::Value, String) {
+fn info(file: &Path) -> (serde_json::Value, String) {
     let dir = tempfile::tempdir().unwrap();
     let out = trilux(dir.path())
         .args(["info", file.to_str().unwrap(), "--json"])
@@ -42,7 +42,10 @@ fn info_lists_what_the_readers_skipped() {
     assert_eq!(warnings.len(), 1);
     let w = warnings[0].as_str().unwrap();
     assert!(w.contains("square.obj") && w.contains("`vt`"), "{w}");
-    assert!(text.contains("warnings: 1") && text.contains("`vt`"), "{text}");
+    assert!(
+        text.contains("warnings: 1") && text.contains("`vt`"),
+        "{text}"
+    );
 
     // Strips are triangles now, not a point cloud, and nothing is skipped.
     let (json, _) = info(&regression("ply-tristrips", "strips.ply"));
@@ -50,7 +53,10 @@ fn info_lists_what_the_readers_skipped() {
     assert_eq!(json["warnings"].as_array().unwrap().len(), 0);
 
     // A texture only in an extension: named with the extension.
-    let (json, text) = info(&regression("gltf-texture-without-source", "basisu_only.gltf"));
+    let (json, text) = info(&regression(
+        "gltf-texture-without-source",
+        "basisu_only.gltf",
+    ));
     assert_eq!(json["triangles"], 1);
     assert!(text.contains("KHR_texture_basisu"), "{text}");
 
