@@ -1,0 +1,94 @@
+// End-to-end test of trilux view's page in headless Chromium: load, first
+// frame with radiance, orbit, stroke cut, paint, relight, undo, redo,
+// screenshot. Prints one JSON object with what it saw; the Rust test
+// asserts on it. Usage: node e2e.mjs URL SCREENSHOT_DIR
+import { chromium } from 'playwright-core';
+
+const [url, dir] = process.argv.slice(2);
+const browser = await chromium.launch({
+  executablePath: process.env.TRILUX_BROWSER || '/usr/bin/chromium',
+  args: ['--headless', '--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader-webgl',
+    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
+});
+const out = { steps: {} };
+try {
+  // The page's CSP forbids eval, which Playwright's argument passing needs.
+  const page = await browser.newPage({ viewport: { width: 800, height: 600 }, bypassCSP: true });
+  const logs = [];
+  page.on('console', (m) => logs.push(m.text()));
+  page.on('pageerror', (e) => logs.push('pageerror: ' + e.message));
+  const t0 = Date.now();
+  await page.goto(url);
+  await page.waitForFunction(() => window.trilux && window.trilux.firstFrameAt !== null && window.trilux.renderer.frames > 2, null, { timeout: 60000 });
+  out.first_frame_ms = Date.now() - t0;
+  const stats = () => page.evaluate(() => ({
+    radiance: window.trilux.radianceFrames, surfaces: window.trilux.surfaceFrames,
+    pieces: window.trilux.renderer.pieces.filter(Boolean).length,
+    triangles: window.trilux.renderer.pieces.filter(Boolean).reduce((a, p) => a + p.count / 3, 0),
+    history: window.trilux.status && window.trilux.status.history, tets: window.trilux.status && window.trilux.status.tets,
+    errors: window.trilux.errors.length, edit: window.trilux.status && window.trilux.status.edit,
+    answered: window.trilux.answered.length,
+  }));
+  // The mean colour of the canvas's centre and how much of it is lit.
+  const pixels = () => page.evaluate(() => {
+    const c = document.getElementById('view');
+    const gl = window.trilux.renderer.gl;
+    const w = c.width, h = c.height, px = new Uint8Array(w * h * 4);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    let lit = 0, sum = [0, 0, 0];
+    for (let i = 0; i < px.length; i += 4) {
+      if (Math.abs(px[i] - 27) + Math.abs(px[i + 1] - 28) + Math.abs(px[i + 2] - 31) > 12) { lit++; sum[0] += px[i]; sum[1] += px[i + 1]; sum[2] += px[i + 2]; }
+    }
+    return { lit: lit / (w * h), mean: sum.map((s) => lit ? s / lit : 0) };
+  });
+  const waitEdit = async (name, before) => page.waitForFunction(([n, b]) => window.trilux.answered.length > b && window.trilux.answered[window.trilux.answered.length - 1] === n && window.trilux.pending.size === 0, [name, before], { timeout: 120000 });
+  out.steps.load = { ...(await stats()), ...(await pixels()) };
+  await page.screenshot({ path: dir + '/1-load.png' });
+  // Orbit: drag in orbit mode; the picture changes, no server round trip.
+  const beforeOrbit = await pixels();
+  await page.mouse.move(300, 300); await page.mouse.down(); await page.mouse.move(420, 260, { steps: 8 }); await page.mouse.up();
+  await page.waitForTimeout(300);
+  out.steps.orbit = { ...(await stats()), ...(await pixels()), before: beforeOrbit };
+  // Stroke cut across the middle, top to bottom.
+  let s = await stats();
+  await page.keyboard.press('c');
+  await page.mouse.move(400, 80); await page.mouse.down(); await page.mouse.move(400, 520, { steps: 12 }); await page.mouse.up();
+  await waitEdit('cut', s.answered);
+  out.steps.cut = { ...(await stats()), ...(await pixels()) };
+  await page.screenshot({ path: dir + '/2-cut.png' });
+  // Paint a stroke of ketchup on the object.
+  s = await stats();
+  await page.keyboard.press('p');
+  await page.selectOption('#material', 'ketchup');
+  await page.mouse.move(330, 280); await page.mouse.down(); await page.mouse.move(360, 320, { steps: 6 }); await page.mouse.up();
+  await waitEdit('paint', s.answered);
+  out.steps.paint = { ...(await stats()), ...(await pixels()) };
+  // Relight: drag the light to the left.
+  s = await stats();
+  await page.keyboard.press('l');
+  await page.mouse.move(480, 150); await page.mouse.down(); await page.mouse.move(120, 250, { steps: 6 }); await page.mouse.up();
+  await waitEdit('lights', s.answered);
+  out.steps.light = { ...(await stats()), ...(await pixels()) };
+  await page.screenshot({ path: dir + '/3-relit.png' });
+  // Undo the light, then the paint; redo the paint.
+  for (const [key, name] of [['z', 'undo'], ['z', 'undo']]) {
+    s = await stats();
+    await page.keyboard.press('Control+' + key);
+    await waitEdit(name, s.answered);
+  }
+  out.steps.undo = { ...(await stats()), ...(await pixels()) };
+  s = await stats();
+  await page.keyboard.press('Control+Shift+Z');
+  await waitEdit('redo', s.answered);
+  out.steps.redo = { ...(await stats()), ...(await pixels()) };
+  // The help overlay.
+  await page.keyboard.press('?');
+  out.help_visible = await page.evaluate(() => !document.getElementById('helpbox').hidden);
+  await page.screenshot({ path: dir + '/4-help.png' });
+  out.logs = logs;
+} catch (e) {
+  out.error = String(e && e.stack || e);
+} finally {
+  await browser.close();
+}
+console.log(JSON.stringify(out));

@@ -1,0 +1,149 @@
+//! `trilux view`'s page in a real browser: headless Chromium (software
+//! WebGL through SwiftShader) driven by `tests/browser/e2e.mjs` with
+//! playwright-core — load, first frame with radiance, orbit, stroke cut,
+//! paint, relight, undo, redo, screenshots — asserting on pixels, mesh
+//! counts and the server's numbers.
+//!
+//! Needs `node`, Chromium (`TRILUX_BROWSER` names it; default
+//! `/usr/bin/chromium`) and playwright-core installed under
+//! `target/browser-e2e` (`.ci/run` installs all three). Without them the
+//! test prints a notice and passes, unless `CI` is set.
+#![cfg(feature = "view")]
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use serde_json::{Value, json};
+use tet_diffusion::Light;
+use tet_diffusion::glam::DVec3;
+
+fn missing(what: &str) {
+    assert!(
+        std::env::var_os("CI").is_none(),
+        "CI must run the browser test, but {what}"
+    );
+    eprintln!("notice: the browser test of trilux view is skipped: {what}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_page_cuts_paints_relights_undoes_and_redoes_in_chromium() {
+    let browser = std::env::var("TRILUX_BROWSER").unwrap_or_else(|_| "/usr/bin/chromium".into());
+    if !std::path::Path::new(&browser).exists() {
+        return missing(&format!("no browser at {browser} (set TRILUX_BROWSER)"));
+    }
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let modules = root.join("target/browser-e2e/node_modules/playwright-core");
+    if !modules.exists() {
+        return missing("playwright-core is not installed in target/browser-e2e (see .ci/run)");
+    }
+    if Command::new("node").arg("--version").output().is_err() {
+        return missing("no node");
+    }
+    let script_dir = root.join("target/browser-e2e");
+    std::fs::copy(
+        root.join("cli/tests/browser/e2e.mjs"),
+        script_dir.join("e2e.mjs"),
+    )
+    .unwrap();
+    let shots = tempfile::tempdir().unwrap();
+    let mut object = trilux::view::builtin::object(10).unwrap();
+    object
+        .add_light(Light::Directional {
+            to_light: DVec3::new(0.4, 1.0, 0.7),
+            irradiance: [1.0; 3],
+        })
+        .unwrap();
+    let running = trilux::view::start(
+        object,
+        json!({"mesh": null}),
+        None,
+        trilux::view::Options {
+            export_dir: shots.path().to_path_buf(),
+            ..Default::default()
+        },
+        Box::new(NoExport),
+    )
+    .await
+    .unwrap();
+    let url = running.url();
+    let dir = std::env::var("TRILUX_SCREENSHOTS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| shots.path().to_path_buf());
+    let out = tokio::task::spawn_blocking(move || {
+        Command::new("node")
+            .arg(script_dir.join("e2e.mjs"))
+            .arg(url)
+            .arg(&dir)
+            .env("TRILUX_BROWSER", browser)
+            .output()
+            .unwrap()
+    })
+    .await
+    .unwrap();
+    running.stop().await.unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    let v: Value = serde_json::from_str(text.trim())
+        .unwrap_or_else(|e| panic!("{e}: {text}\n{}", String::from_utf8_lossy(&out.stderr)));
+    assert!(v.get("error").is_none(), "{v:#}");
+    let step = |s: &str| &v["steps"][s];
+    // First frame: a surface of the ball, lit, with radiance.
+    let load = step("load");
+    assert_eq!(load["pieces"], 1);
+    assert!(load["triangles"].as_u64().unwrap() > 500);
+    assert!(load["lit"].as_f64().unwrap() > 0.05, "{load}");
+    eprintln!(
+        "browser: first frame with radiance {} ms after load (load {})",
+        v["first_frame_ms"],
+        std::fs::read_to_string("/proc/loadavg")
+            .unwrap_or_default()
+            .trim()
+    );
+    // Orbit is local: no new radiance frames, but different pixels.
+    let orbit = step("orbit");
+    assert_eq!(orbit["radiance"], load["radiance"]);
+    assert_ne!(orbit["mean"], orbit["before"]["mean"]);
+    // The cut removed tets and sent a new surface.
+    let cut = step("cut");
+    assert!(cut["tets"][0].as_u64().unwrap() < 6000);
+    assert!(cut["surfaces"].as_u64().unwrap() > load["surfaces"].as_u64().unwrap());
+    assert_eq!(cut["history"]["done"], json!(["cut"]));
+    // Paint and relight are in the history (a stroke or drag may arrive
+    // as several edits); the picture changed.
+    let done = |st: &str| -> Vec<String> {
+        step(st)["history"]["done"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_str().unwrap().to_string())
+            .collect()
+    };
+    let paint = done("paint");
+    assert!(paint.len() >= 2 && paint[0] == "cut" && paint[1..].iter().all(|e| e == "paint"));
+    let lit = done("light");
+    assert!(lit.len() > paint.len() && lit[paint.len()..].iter().all(|e| e == "lights"));
+    assert_ne!(step("light")["mean"], step("paint")["mean"]);
+    // Undo twice, redo once.
+    assert_eq!(done("undo").len(), lit.len() - 2);
+    assert_eq!(step("undo")["history"]["redo"].as_array().unwrap().len(), 2);
+    assert_eq!(done("redo").len(), lit.len() - 1);
+    assert_eq!(v["help_visible"], true);
+    for s in ["load", "cut", "paint", "light", "undo", "redo"] {
+        assert_eq!(step(s)["errors"], 0, "{s}: {v:#}");
+    }
+}
+
+struct NoExport;
+
+impl trilux::view::Exporter for NoExport {
+    fn export(
+        &self,
+        _: &tet_diffusion::Session,
+        _: trilux::view::protocol::ExportKind,
+        _: &std::path::Path,
+        _: u32,
+        _: Option<DVec3>,
+        _: bool,
+    ) -> Result<(), String> {
+        Err("not in this test".into())
+    }
+}
