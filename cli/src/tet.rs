@@ -1,6 +1,7 @@
 //! trilux-io tetrahedral meshes → solver positions, surfaces, quality.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
+use tet_diffusion::Light;
 use trilux_io::mesh::{Object, TriMesh};
 use trilux_io::tet::TetMesh;
 
@@ -102,5 +103,207 @@ pub fn from_stuffing(mesh: &tet_stuffing::TetMesh, origin: DVec3) -> TetMesh {
         positions: mesh.positions.iter().map(|&p| p + origin).collect(),
         tets: mesh.tets.clone(),
         ..TetMesh::default()
+    }
+}
+
+/// The lattice spacing `trilux tetra` uses without `--size`: 1/40 of the
+/// diagonal of the bounding box of the triangles' vertices (in `f64`: an
+/// `f32` diagonal overflows for coordinates near 10³⁸); 0 without
+/// triangles.
+pub fn default_spacing(mesh: &TriMesh) -> f64 {
+    let (lo, hi) = crate::mesh::bounds(mesh).unwrap_or_default();
+    (hi.as_dvec3() - lo.as_dvec3()).length() / 40.0
+}
+
+/// A boundary to draw: positions, triangles, (unused) colours, normals.
+type Shape = (Vec<Vec3>, Vec<[u32; 3]>, Vec<[f32; 3]>, Vec<Vec3>);
+
+/// A rendered picture, and what the tone map needs to expose the objects
+/// alone.
+#[derive(Debug, Clone)]
+pub struct Picture {
+    /// Linear radiance (RGBA), the objects over the background gradient:
+    /// what the EXR holds.
+    pub image: trilux_io::image::Image,
+    /// Per pixel (row-major), the fraction of it the objects cover.
+    pub coverage: Vec<f32>,
+    /// The background gradient alone.
+    pub background: trilux_io::image::Image,
+}
+
+/// The objects' boundaries shaded per pixel with the radiance in air
+/// toward the eye ([`fragment_radiance`]: `J⁺` interpolated from the
+/// vertices, `F_t` from each fragment's direction to the eye), plus a
+/// Blinn–Phong specular term of the directional and point lights.
+pub fn render(
+    objects: &[tet_diffusion::Object],
+    lights: &[Light],
+    size: u32,
+    view: Option<Vec3>,
+) -> Picture {
+    use crate::preview::{Camera, Renderer};
+    let shapes: Vec<Shape> = objects
+        .iter()
+        .map(|o| {
+            let m = o.mesh();
+            let positions: Vec<Vec3> = o.display_positions().iter().map(|p| p.as_vec3()).collect();
+            (
+                positions,
+                m.boundary().to_vec(),
+                Vec::new(),
+                display_normals(o),
+            )
+        })
+        .collect();
+    let all: Vec<Vec3> = shapes.iter().flat_map(|s| s.0.iter().copied()).collect();
+    let camera = match crate::preview::bounds(&all) {
+        Some((lo, hi)) => match view {
+            Some(from) => Camera::fit_from(lo, hi, from),
+            None => Camera::fit(lo, hi),
+        },
+        None => Camera::fit(Vec3::splat(-1.0), Vec3::ONE),
+    };
+    let mut r = Renderer::new(size, size, camera);
+    for (o, (positions, faces, _, normals)) in objects.iter().zip(&shapes) {
+        let m = o.mesh();
+        let mut flux = vec![[0.0f32; 3]; m.vertex_count()];
+        for (&v, j) in m.boundary_vertices().iter().zip(o.boundary_flux()) {
+            flux[v as usize] = j.map(|x| x as f32);
+        }
+        let eta = o.eta();
+        let scale = (1.0 / (4.0 * std::f64::consts::PI)) as f32;
+        r.draw_mesh(positions, faces, |f| {
+            let t = faces[f.face as usize];
+            let b = f.barycentric;
+            let mut j = [0.0f32; 3];
+            for k in 0..3 {
+                for (ch, x) in j.iter_mut().enumerate() {
+                    *x += b[k] * flux[t[k] as usize][ch];
+                }
+            }
+            let n = (normals[t[0] as usize] * b[0]
+                + normals[t[1] as usize] * b[1]
+                + normals[t[2] as usize] * b[2])
+                .normalize_or(f.normal);
+            let mut c = fragment_radiance(j, n, f.to_eye, eta);
+            for light in lights {
+                let (l, rgb) = match light {
+                    Light::Directional {
+                        to_light,
+                        irradiance,
+                    } => (to_light.as_vec3().normalize_or_zero(), *irradiance),
+                    Light::Point {
+                        position,
+                        intensity,
+                    } => (
+                        (position.as_vec3() - f.position).normalize_or_zero(),
+                        *intensity,
+                    ),
+                    Light::Environment(_) => continue,
+                };
+                let h = (l + f.to_eye).normalize_or_zero();
+                let spec = 0.04 * n.dot(h).max(0.0).powf(80.0) * f32::from(n.dot(l) > 0.0) * scale;
+                for (x, c) in c.iter_mut().zip(rgb) {
+                    *x += spec * c as f32;
+                }
+            }
+            c
+        });
+    }
+    Picture {
+        image: r.image(),
+        coverage: r.coverage(),
+        background: r.background(),
+    }
+}
+
+/// The object's outward vertex normals turned by its display transform.
+fn display_normals(o: &tet_diffusion::Object) -> Vec<Vec3> {
+    let turn = o.transform().matrix3;
+    o.mesh()
+        .vertex_normals()
+        .iter()
+        .map(|n| (turn * *n).normalize_or_zero().as_vec3())
+        .collect()
+}
+
+/// The radiance in air toward the eye at a fragment: the hemispherical
+/// flux `J⁺` meeting the boundary from inside (interpolated from the
+/// vertices, [`Object::boundary_flux`](tet_diffusion::Object::boundary_flux)) times `F_t(n·v) / (π η²)`
+/// ([`tet_diffusion::fresnel::exit_radiance_factor`]), with `n` the unit
+/// outward normal and `v` the unit direction from *this* fragment to the
+/// eye — not the camera's central direction, which makes `F_t` up to 35 %
+/// too large at the limb of a perspective view. Linear RGB, W/(mm² sr).
+pub fn fragment_radiance(flux: [f32; 3], normal: Vec3, to_eye: Vec3, eta: f64) -> [f32; 3] {
+    let cos = f64::from(normal.dot(to_eye));
+    let f = tet_diffusion::fresnel::exit_radiance_factor(cos, eta) as f32;
+    flux.map(|j| j * f)
+}
+
+/// Rec. 709 luminance of linear RGB.
+fn luminance(p: [f32; 4]) -> f32 {
+    0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+}
+
+/// The exposure's white: the 99th-percentile luminance of the pixels the
+/// objects cover fully (of those they cover at all when none is fully
+/// covered; 1 when nothing is covered). The background never counts, so a
+/// dim or back-lit object is exposed as brightly as a bright one.
+pub fn exposure_white(picture: &Picture) -> f32 {
+    let covered = |full: bool| -> Vec<f32> {
+        let mut lum: Vec<f32> = picture
+            .image
+            .pixels
+            .iter()
+            .zip(&picture.coverage)
+            .filter(|&(_, &c)| if full { c >= 1.0 } else { c > 0.0 })
+            .map(|(p, _)| luminance(*p))
+            .filter(|l| *l > 0.0)
+            .collect();
+        lum.sort_by(f32::total_cmp);
+        lum
+    };
+    let mut lum = covered(true);
+    if lum.is_empty() {
+        lum = covered(false);
+    }
+    lum.get(lum.len() * 99 / 100)
+        .copied()
+        .unwrap_or(1.0)
+        .max(1e-12)
+}
+
+/// Exposure so that the brightest 1 % of the objects' pixels reach white
+/// ([`exposure_white`]), the background gradient left as it is (a pixel
+/// the objects do not cover is copied unchanged; an edge pixel scales only
+/// its covered part), then the PNG writer's sRGB encoding.
+#[allow(
+    clippy::needless_range_loop,
+    reason = "each of R, G, B reads three per-channel arrays"
+)]
+pub fn tone_map(picture: &Picture) -> trilux_io::image::Image {
+    let white = exposure_white(picture);
+    let pixels = picture
+        .image
+        .pixels
+        .iter()
+        .zip(&picture.coverage)
+        .zip(&picture.background.pixels)
+        .map(|((p, &c), bg)| {
+            if c <= 0.0 {
+                return *p;
+            }
+            let behind = 1.0 - c;
+            let mut out = [0.0, 0.0, 0.0, 1.0];
+            for k in 0..3 {
+                let object = (p[k] - behind * bg[k]).max(0.0);
+                out[k] = object / white + behind * bg[k];
+            }
+            out
+        })
+        .collect();
+    trilux_io::image::Image {
+        pixels,
+        ..picture.image.clone()
     }
 }

@@ -321,9 +321,9 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             )
             .map_err(solver)?;
         let report = object.solve().map_err(solver)?;
-        let image = super::diffuse::render(std::slice::from_ref(&object), &[light], d.size, None);
+        let image = trilux::tet::render(std::slice::from_ref(&object), &[light], d.size, None);
         let mut files = files;
-        files.push(d.write_image("blob_marble.png", &super::diffuse::tone_map(&image))?);
+        files.push(d.write_image("blob_marble.png", &trilux::tet::tone_map(&image))?);
         let r = &stuffed.report;
         Ok((
             format!(

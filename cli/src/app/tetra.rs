@@ -62,8 +62,7 @@ pub(crate) fn stuff(
     let (h, given) = match spacing {
         Spacing::Given { h: Some(h), .. } => (h, true),
         Spacing::Given { h: None, .. } | Spacing::Default => {
-            // In f64: an f32 diagonal overflows for coordinates near 1e38.
-            ((hi.as_dvec3() - lo.as_dvec3()).length() / 40.0, false)
+            (trilux::tet::default_spacing(mesh), false)
         }
     };
     // What to do about a spacing too fine or too coarse for this surface.

@@ -124,8 +124,9 @@ const SHIFT_ABOVE: f64 = 1e5;
 const SHIFT_RATIO: f64 = 4096.0;
 
 /// The global shift for points with coordinates `points` (see
-/// [`TriMesh::origin`]) and the points relative to it as `f32`.
-pub(crate) fn recenter(points: &[DVec3]) -> (DVec3, Vec<Vec3>) {
+/// [`TriMesh::origin`]) and the points relative to it as `f32`: what the
+/// readers do, for meshes made of arrays elsewhere (the Python package).
+pub fn recenter(points: &[DVec3]) -> (DVec3, Vec<Vec3>) {
     let origin = shift_for(points);
     let relative = points.iter().map(|&p| (p - origin).as_vec3()).collect();
     (origin, relative)
