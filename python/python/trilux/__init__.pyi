@@ -1,0 +1,264 @@
+# Type stubs of trilux (the compiled module trilux._trilux, re-exported).
+# Checked against the module by `mypy --strict` on tests/typing_usage.py
+# and by the stub test in tests/test_api.py.
+import os
+from typing import Any, Literal, Optional, Sequence, Tuple, Union, overload
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+ArrayLike = npt.ArrayLike
+PathLike = Union[str, "os.PathLike[str]"]
+F64 = npt.NDArray[np.float64]
+F32 = npt.NDArray[np.float32]
+I64 = npt.NDArray[np.int64]
+MeshLike = Any
+Channel = Union[Literal["r", "g", "b", "a", "luminance"], int]
+Method = Literal["uniform", "subdivision", "exact", "rejection"]
+MediumLike = Union[str, Tuple[Sequence[float], Sequence[float]]]
+
+class Error(Exception): ...
+class InputError(Error, ValueError): ...
+class FileError(Error, OSError): ...
+class InternalError(Error, RuntimeError): ...
+
+class Mesh:
+    def __init__(
+        self,
+        vertices: ArrayLike,
+        faces: ArrayLike,
+        uv: Optional[ArrayLike] = None,
+        normals: Optional[ArrayLike] = None,
+    ) -> None: ...
+    @property
+    def vertices(self) -> F64: ...
+    @property
+    def faces(self) -> I64: ...
+    @property
+    def uv(self) -> Optional[F64]: ...
+    @property
+    def normals(self) -> Optional[F64]: ...
+    @property
+    def origin(self) -> F64: ...
+    @property
+    def materials(self) -> list[dict[str, Any]]: ...
+    @property
+    def objects(self) -> list[Tuple[str, int, int, Optional[int]]]: ...
+
+def load(path: PathLike) -> Mesh: ...
+def save(path: PathLike, mesh: MeshLike) -> None: ...
+
+@overload
+def sample_surface(
+    mesh: MeshLike,
+    count: int,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64]: ...
+@overload
+def sample_surface(
+    mesh: MeshLike,
+    count: int,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    return_barycentric: bool = False,
+    return_pdf: bool = False,
+    return_normal: bool = False,
+) -> Tuple[npt.NDArray[Any], ...]: ...
+@overload
+def blue_noise(
+    mesh: MeshLike,
+    count: Optional[int] = None,
+    *,
+    radius: Optional[float] = None,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    progressive: bool = False,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64]: ...
+@overload
+def blue_noise(
+    mesh: MeshLike,
+    count: Optional[int] = None,
+    *,
+    radius: Optional[float] = None,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    progressive: bool = False,
+    return_barycentric: bool = False,
+    return_pdf: bool = False,
+    return_normal: bool = False,
+) -> Tuple[npt.NDArray[Any], ...]: ...
+def sample_surface_even(
+    mesh: MeshLike, count: int, radius: Optional[float] = None, seed: Optional[int] = None
+) -> Tuple[F64, I64]: ...
+
+class Distribution1D:
+    def __init__(self, weights: ArrayLike) -> None: ...
+    def sample(self, n: int, seed: Optional[int] = None) -> I64: ...
+    def sample_u(self, u: ArrayLike) -> I64: ...
+    def pdf(self, index: ArrayLike) -> F64: ...
+    def invert(self, index: ArrayLike) -> F64: ...
+    def __len__(self) -> int: ...
+
+class Distribution2D:
+    def __init__(self, image: ArrayLike) -> None: ...
+    @staticmethod
+    def from_equirect(image: ArrayLike) -> Distribution2D: ...
+    @property
+    def shape(self) -> Tuple[int, int]: ...
+    def sample(self, n: int, seed: Optional[int] = None) -> Tuple[F64, F64]: ...
+    def sample_u(self, u: ArrayLike) -> Tuple[F64, F64]: ...
+    def pdf(self, points: ArrayLike) -> F64: ...
+    def sample_direction(self, n: int, seed: Optional[int] = None) -> Tuple[F64, F64]: ...
+    def pdf_direction(self, directions: ArrayLike) -> F64: ...
+
+class MeshColors:
+    @staticmethod
+    def from_texture(
+        mesh: MeshLike,
+        image: Union[ArrayLike, PathLike, None] = None,
+        *,
+        density: float = 1.0,
+        max_level: int = 8,
+        max_samples: Optional[int] = None,
+    ) -> MeshColors: ...
+    @staticmethod
+    def load(path: PathLike, mesh: MeshLike) -> MeshColors: ...
+    def save(self, path: PathLike) -> None: ...
+    def lookup(
+        self,
+        face: ArrayLike,
+        barycentric: ArrayLike,
+        *,
+        filter: Literal["linear", "nearest", "mip"] = "linear",
+        footprint: Optional[ArrayLike] = None,
+    ) -> F32: ...
+    def bake(self, *, gutter: int = 1) -> Tuple[Mesh, F32]: ...
+    @property
+    def channels(self) -> int: ...
+    @property
+    def face_count(self) -> int: ...
+    @property
+    def sample_count(self) -> int: ...
+    @property
+    def resolutions(self) -> I64: ...
+    @property
+    def samples(self) -> F32: ...
+    @property
+    def vertices(self) -> F64: ...
+    @property
+    def faces(self) -> I64: ...
+
+@overload
+def tetrahedralize(
+    mesh: MeshLike,
+    *,
+    spacing: Optional[float] = None,
+    graded: bool = False,
+    return_report: Literal[False] = False,
+) -> Tuple[F64, I64]: ...
+@overload
+def tetrahedralize(
+    mesh: MeshLike,
+    *,
+    spacing: Optional[float] = None,
+    graded: bool = False,
+    return_report: Literal[True],
+) -> Tuple[F64, I64, dict[str, Any]]: ...
+def load_tets(path: PathLike) -> Tuple[F64, I64]: ...
+def save_tets(path: PathLike, nodes: ArrayLike, tets: ArrayLike) -> None: ...
+def save_points(
+    path: PathLike,
+    points: ArrayLike,
+    *,
+    normals: Optional[ArrayLike] = None,
+    face_index: Optional[ArrayLike] = None,
+) -> None: ...
+def media() -> list[str]: ...
+
+class Object:
+    def __init__(
+        self,
+        nodes: ArrayLike,
+        tets: ArrayLike,
+        *,
+        medium: Optional[MediumLike] = None,
+        unit_mm: float = 1.0,
+        eta: float = 1.3,
+    ) -> None: ...
+    def add_light(
+        self,
+        direction: Optional[Sequence[float]] = None,
+        *,
+        irradiance: Tuple[float, float, float] = (1.0, 1.0, 1.0),
+        position: Optional[Sequence[float]] = None,
+        intensity: Tuple[float, float, float] = (1.0, 1.0, 1.0),
+        envmap: Optional[ArrayLike] = None,
+        envmap_samples: int = 256,
+    ) -> int: ...
+    def solve(self) -> dict[str, Any]: ...
+    def radiance(self, toward: Optional[Sequence[float]] = None) -> F64: ...
+    @property
+    def fluence(self) -> F64: ...
+    def cut(
+        self, point: Sequence[float], normal: Sequence[float], *, relax_sweeps: int = 20
+    ) -> dict[str, int]: ...
+    def paint(
+        self, center: Sequence[float], radius: float, medium: MediumLike, *, strength: float = 1.0
+    ) -> int: ...
+    def fracture(
+        self, point: Sequence[float], normal: Sequence[float], *, offset: float = 0.0
+    ) -> Tuple[Object, Object]: ...
+    @staticmethod
+    def recombine(a: Object, b: Object) -> Object: ...
+    def render(
+        self,
+        *,
+        view: Optional[Sequence[float]] = None,
+        size: int = 512,
+        exposure: Optional[Literal["auto"]] = "auto",
+    ) -> F32: ...
+    @property
+    def mesh(self) -> Tuple[F64, I64]: ...
+    @property
+    def boundary(self) -> I64: ...
+    @property
+    def boundary_vertices(self) -> I64: ...
+
+def render(
+    objects: Sequence[Object],
+    *,
+    view: Optional[Sequence[float]] = None,
+    size: int = 512,
+    exposure: Optional[Literal["auto"]] = "auto",
+) -> F32: ...

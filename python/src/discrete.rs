@@ -1,0 +1,265 @@
+//! 1D and 2D discrete distributions (discrete-sampling): the lookup-table
+//! CDF of Šik & Křivánek 2013, Sec. 4, and environment-map directions.
+
+use discrete_sampling::{DiscreteSampler, GuideTable, InvertibleSampler, Sample2D};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use rand::SeedableRng;
+
+use crate::arrays;
+use crate::error::{Failure, detached};
+
+fn rng(seed: Option<i128>) -> PyResult<rand_pcg::Pcg64Mcg> {
+    let s = match seed {
+        None => 0,
+        Some(s) => {
+            u64::try_from(s).map_err(|_| Failure::input(format!("seed: {s} is not in 0..2**64")))?
+        }
+    };
+    Ok(rand_pcg::Pcg64Mcg::seed_from_u64(s))
+}
+
+fn count(n: i128) -> PyResult<usize> {
+    usize::try_from(n)
+        .map_err(|_| Failure::input(format!("n: {n} is not a count (0 or more)")).into())
+}
+
+/// A discrete distribution over `len(weights)` entries, entry `i` with
+/// probability `weights[i] / sum(weights)`, sampled by the lookup-table
+/// (guide-table) CDF of Šik & Křivánek 2013, Sec. 4: the index bisection
+/// would give, for every variate, in one or two loads.
+///
+/// `weights`: a 1-D array-like of finite non-negative reals, not all zero
+/// (else `trilux.InputError` naming the first bad index).
+#[pyclass(module = "trilux", frozen)]
+pub(crate) struct Distribution1D {
+    table: GuideTable,
+}
+
+#[pymethods]
+impl Distribution1D {
+    #[new]
+    fn new(weights: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let w = arrays::values_f64(weights, "weights")?;
+        Ok(Self {
+            table: GuideTable::new(&w).map_err(Failure::from)?,
+        })
+    }
+
+    /// `n` indices drawn with `seed` (default 0), `(n,)` int64.
+    #[pyo3(signature = (n, seed = None))]
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        n: i128,
+        seed: Option<i128>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = count(n)?;
+        let mut rng = rng(seed)?;
+        let out = detached(py, || {
+            let mut out = vec![0usize; n];
+            self.table.sample_into(&mut rng, &mut out);
+            Ok(out.into_iter().map(|i| i as i64).collect::<Vec<i64>>())
+        })?;
+        Ok(arrays::vector(py, out))
+    }
+
+    /// The indices for your own variates `u` in `[0, 1)` (stratified, QMC),
+    /// `(n,)` int64; the order of `u` is kept (inversion of the CDF).
+    fn sample_u<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let u = arrays::values_f64(u, "u")?;
+        let out: Vec<i64> = u.iter().map(|&x| self.table.sample_u(x) as i64).collect();
+        Ok(arrays::vector(py, out))
+    }
+
+    /// The probability of each index, `(n,)` float64 (0 outside the range).
+    fn pdf<'py>(&self, py: Python<'py>, index: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let index = arrays::values_i64(index, "index")?;
+        let out: Vec<f64> = index
+            .iter()
+            .map(|&i| {
+                usize::try_from(i)
+                    .ok()
+                    .filter(|&i| i < self.table.len())
+                    .map_or(0.0, |i| self.table.pdf(i))
+            })
+            .collect();
+        Ok(arrays::vector(py, out))
+    }
+
+    /// The smallest variate `u` that `sample_u` maps to each index (the
+    /// start of its CDF interval), `(n,)` float64; NaN for an index out of
+    /// range.
+    fn invert<'py>(
+        &self,
+        py: Python<'py>,
+        index: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let index = arrays::values_i64(index, "index")?;
+        let out: Vec<f64> = index
+            .iter()
+            .map(|&i| {
+                usize::try_from(i)
+                    .ok()
+                    .and_then(|i| self.table.invert(i))
+                    .unwrap_or(f64::NAN)
+            })
+            .collect();
+        Ok(arrays::vector(py, out))
+    }
+
+    fn __len__(&self) -> usize {
+        self.table.len()
+    }
+}
+
+/// A piecewise-constant density over `[0, 1)²` from an image of weights
+/// (marginal over rows + conditional per row, each a guide table):
+/// `Distribution2D(image)`, `image` `(H, W)` weights or `(H, W, C)` colour
+/// (its Rec. 709 luminance). Points are `[x, y]`, `x` along a row, `y`
+/// down the rows (row 0 at `y = 0`), as in the image.
+///
+/// `Distribution2D.from_equirect(image)` weights row `r` by `sin θ` of
+/// its centre, for a latitude–longitude environment map (row 0 the top,
+/// `θ = 0`); then `sample_direction` / `pdf_direction` give directions
+/// with densities per steradian, in the axes of discrete-sampling's
+/// `equirect_direction` (`+y` up: row 0 is `+y`).
+#[pyclass(module = "trilux", frozen)]
+pub(crate) struct Distribution2D {
+    inner: discrete_sampling::Distribution2D,
+}
+
+fn weights_2d(image: &Bound<'_, PyAny>) -> PyResult<(Vec<f64>, usize, usize)> {
+    let a = arrays::image_array(image, "image")?;
+    let w: Vec<f64> = match a.channels {
+        1 | 2 => a
+            .values
+            .chunks_exact(a.channels)
+            .map(|p| f64::from(p[0]))
+            .collect(),
+        _ => a
+            .values
+            .chunks_exact(a.channels)
+            .map(|p| f64::from(discrete_sampling::luminance([p[0], p[1], p[2]])))
+            .collect(),
+    };
+    Ok((w, a.width, a.height))
+}
+
+fn samples_out<'py>(py: Python<'py>, s: &[Sample2D]) -> PyResult<Bound<'py, PyTuple>> {
+    let points = s.iter().flat_map(|s| s.point).collect();
+    let pdf = s.iter().map(|s| s.pdf).collect();
+    PyTuple::new(
+        py,
+        [arrays::matrix(py, points, 2)?, arrays::vector(py, pdf)],
+    )
+}
+
+#[pymethods]
+impl Distribution2D {
+    #[new]
+    fn new(image: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (w, width, height) = weights_2d(image)?;
+        Ok(Self {
+            inner: discrete_sampling::Distribution2D::new(&w, width, height)
+                .map_err(Failure::from)?,
+        })
+    }
+
+    /// The distribution of an equirectangular environment map (rows
+    /// weighted by `sin θ`).
+    #[staticmethod]
+    fn from_equirect(image: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let (w, width, height) = weights_2d(image)?;
+        Ok(Self {
+            inner: discrete_sampling::Distribution2D::from_equirect(&w, width, height)
+                .map_err(Failure::from)?,
+        })
+    }
+
+    /// `(width, height)` of the image.
+    #[getter]
+    fn shape(&self) -> (usize, usize) {
+        (self.inner.width(), self.inner.height())
+    }
+
+    /// `n` points drawn with `seed`: `(points (n, 2) float64, pdf (n,)
+    /// float64)`, the density w.r.t. area in `[0, 1)²`.
+    #[pyo3(signature = (n, seed = None))]
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        n: i128,
+        seed: Option<i128>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let n = count(n)?;
+        let mut rng = rng(seed)?;
+        let out = detached(py, || {
+            let mut out = vec![Sample2D::default(); n];
+            self.inner.sample_into(&mut rng, &mut out);
+            Ok(out)
+        })?;
+        samples_out(py, &out)
+    }
+
+    /// The points for your own variates `u` `(n, 2)` in `[0, 1)²`.
+    fn sample_u<'py>(
+        &self,
+        py: Python<'py>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        let u = arrays::rows_f64::<2>(u, "u")?;
+        let out: Vec<Sample2D> = u.iter().map(|&u| self.inner.sample_u(u)).collect();
+        samples_out(py, &out)
+    }
+
+    /// The density w.r.t. area at `points` `(n, 2)`, `(n,)` float64.
+    fn pdf<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let p = arrays::rows_f64::<2>(points, "points")?;
+        Ok(arrays::vector(
+            py,
+            p.iter().map(|&p| self.inner.pdf(p)).collect(),
+        ))
+    }
+
+    /// `n` directions drawn with `seed`: `(directions (n, 3) float64 unit
+    /// vectors, pdf (n,) float64 per steradian)`, for a path tracer's
+    /// light sampling.
+    #[pyo3(signature = (n, seed = None))]
+    fn sample_direction<'py>(
+        &self,
+        py: Python<'py>,
+        n: i128,
+        seed: Option<i128>,
+    ) -> PyResult<Bound<'py, PyTuple>> {
+        use rand::RngExt;
+        let n = count(n)?;
+        let mut rng = rng(seed)?;
+        let out = detached(py, || {
+            Ok((0..n)
+                .map(|_| {
+                    let u = [rng.random::<f64>(), rng.random::<f64>()];
+                    self.inner.sample_direction(u)
+                })
+                .collect::<Vec<_>>())
+        })?;
+        let dirs = out.iter().flat_map(|s| s.direction).collect();
+        let pdf = out.iter().map(|s| s.pdf).collect();
+        PyTuple::new(py, [arrays::matrix(py, dirs, 3)?, arrays::vector(py, pdf)])
+    }
+
+    /// The density per steradian with which `sample_direction` draws each
+    /// of `directions` `(n, 3)` (any length; 0 for a zero direction): what
+    /// multiple importance sampling needs for a BSDF-sampled direction.
+    fn pdf_direction<'py>(
+        &self,
+        py: Python<'py>,
+        directions: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let d = arrays::rows_f64::<3>(directions, "directions")?;
+        Ok(arrays::vector(
+            py,
+            d.iter().map(|&d| self.inner.pdf_direction(d)).collect(),
+        ))
+    }
+}

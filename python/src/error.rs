@@ -1,0 +1,216 @@
+//! The exceptions: `trilux.Error` and its subclasses, each carrying the
+//! Rust error's message unchanged.
+//!
+//! | exception | bases | raised for |
+//! |---|---|---|
+//! | `trilux.Error` | `Exception` | the base of all below |
+//! | `trilux.InputError` | `Error`, `ValueError` | arguments and data the Rust crates refuse (bad arrays, weights, options, meshes) |
+//! | `trilux.FileError` | `Error`, `OSError` | a file that cannot be read, written or parsed (trilux-io's errors: the message names the file and line) |
+//! | `trilux.InternalError` | `Error`, `RuntimeError` | a Rust panic (a bug): never a crash of the interpreter |
+
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyType};
+
+/// The four classes, made once per interpreter by running a few lines of
+/// Python (PyO3's `create_exception!` takes one base, and `InputError`
+/// must be both a `trilux.Error` and a `ValueError`).
+struct Classes {
+    error: Py<PyType>,
+    input: Py<PyType>,
+    file: Py<PyType>,
+    internal: Py<PyType>,
+}
+
+static CLASSES: PyOnceLock<Classes> = PyOnceLock::new();
+
+const DEFINITIONS: &str = r#"
+class Error(Exception):
+    """The base of every exception trilux raises; the message is the Rust
+    crate's, unchanged."""
+    __module__ = "trilux"
+
+class InputError(Error, ValueError):
+    """An argument or input data that trilux refuses (a bad array, weight,
+    option or mesh); the message names the argument and the element."""
+    __module__ = "trilux"
+
+class FileError(Error, OSError):
+    """A file that cannot be read, written or parsed; the message names the
+    file, the line or byte, and what was wrong."""
+    __module__ = "trilux"
+
+class InternalError(Error, RuntimeError):
+    """A Rust panic: a bug in trilux (please report it with the message)."""
+    __module__ = "trilux"
+"#;
+
+fn classes(py: Python<'_>) -> PyResult<&Classes> {
+    CLASSES.get_or_try_init(py, || {
+        let scope = PyDict::new(py);
+        let code = std::ffi::CString::new(DEFINITIONS)
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(e.to_string()))?;
+        py.run(&code, Some(&scope), Some(&scope))?;
+        let get = |name: &str| -> PyResult<Py<PyType>> {
+            Ok(scope
+                .get_item(name)?
+                .ok_or_else(|| pyo3::exceptions::PyRuntimeError::new_err(name.to_owned()))?
+                .cast_into::<PyType>()?
+                .unbind())
+        };
+        Ok(Classes {
+            error: get("Error")?,
+            input: get("InputError")?,
+            file: get("FileError")?,
+            internal: get("InternalError")?,
+        })
+    })
+}
+
+/// Adds the classes to the module.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    let c = classes(py)?;
+    m.add("Error", c.error.bind(py))?;
+    m.add("InputError", c.input.bind(py))?;
+    m.add("FileError", c.file.bind(py))?;
+    m.add("InternalError", c.internal.bind(py))?;
+    Ok(())
+}
+
+/// Which exception an error becomes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Kind {
+    Input,
+    File,
+    Internal,
+}
+
+/// An error on its way to Python: its class and the Rust message. Made
+/// without the GIL (inside `Python::detach`) and raised after.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct Failure {
+    pub(crate) kind: Kind,
+    pub(crate) message: String,
+}
+
+impl Failure {
+    /// A `trilux.InputError` with `message`.
+    pub(crate) fn input(message: impl Into<String>) -> Self {
+        Self {
+            kind: Kind::Input,
+            message: message.into(),
+        }
+    }
+}
+
+impl From<Failure> for PyErr {
+    fn from(f: Failure) -> Self {
+        Python::attach(|py| match classes(py) {
+            Ok(c) => {
+                let ty = match f.kind {
+                    Kind::Input => &c.input,
+                    Kind::File => &c.file,
+                    Kind::Internal => &c.internal,
+                };
+                PyErr::from_type(ty.bind(py).clone(), f.message)
+            }
+            Err(e) => e,
+        })
+    }
+}
+
+impl From<trilux_io::Error> for Failure {
+    fn from(e: trilux_io::Error) -> Self {
+        Self {
+            kind: Kind::File,
+            message: chain(&e),
+        }
+    }
+}
+
+impl From<trilux::Error> for Failure {
+    fn from(e: trilux::Error) -> Self {
+        let kind = match &e {
+            trilux::Error::Io(_) | trilux::Error::File { .. } | trilux::Error::Exists(_) => {
+                Kind::File
+            }
+            _ => Kind::Input,
+        };
+        Self {
+            kind,
+            message: chain(&e),
+        }
+    }
+}
+
+/// The algorithm crates' errors are about arguments and data.
+macro_rules! input_error {
+    ($($t:ty),*) => {$(
+        impl From<$t> for Failure {
+            fn from(e: $t) -> Self {
+                Self::input(chain(&e))
+            }
+        }
+    )*};
+}
+input_error!(
+    mesh_sampling::Error,
+    discrete_sampling::Error,
+    tet_diffusion::Error,
+    tet_stuffing::Error
+);
+
+impl From<mesh_colors::Error> for Failure {
+    fn from(e: mesh_colors::Error) -> Self {
+        let kind = match &e {
+            mesh_colors::Error::Io { .. } | mesh_colors::Error::File { .. } => Kind::File,
+            _ => Kind::Input,
+        };
+        Self {
+            kind,
+            message: chain(&e),
+        }
+    }
+}
+
+/// An error's message with its causes, joined by ": " (as the `trilux`
+/// command prints them).
+pub(crate) fn chain(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    text
+}
+
+/// `Result` with a [`Failure`].
+pub(crate) type Result<T> = std::result::Result<T, Failure>;
+
+/// Runs `f` without the GIL (so that other Python threads run, and rayon
+/// uses every core), turning a Rust panic into `trilux.InternalError`
+/// instead of PyO3's `PanicException`.
+pub(crate) fn detached<T: Send>(
+    py: Python<'_>,
+    f: impl FnOnce() -> Result<T> + Send,
+) -> PyResult<T> {
+    py.detach(|| guarded(f)).map_err(PyErr::from)
+}
+
+/// `f`, with a panic caught and reported as [`Kind::Internal`].
+pub(crate) fn guarded<T>(f: impl FnOnce() -> Result<T>) -> Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
+        let what = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        Err(Failure {
+            kind: Kind::Internal,
+            message: format!("internal error (a bug in trilux, please report it): {what}"),
+        })
+    })
+}

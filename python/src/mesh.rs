@@ -1,0 +1,377 @@
+//! Triangle meshes: `trilux.Mesh` (what `trilux.load` returns), files in
+//! and out, and duck-typed meshes (`.vertices` / `.faces`, a
+//! `trimesh.Trimesh` with its `visual.uv` and texture image) turned into
+//! the `TriMesh` the `trilux` library's adapters take.
+//!
+//! **UVs** cross the Python boundary in the OpenGL / OBJ / trimesh
+//! convention (`v = 0` at the bottom row of the image), and images as
+//! numpy arrays row 0 first (the top row, as PIL and imageio give them).
+//! Inside, `TriMesh` UVs are glTF's (`v = 0` at row 0): the flip
+//! `v ↦ 1 − v` happens here, on the way in and out, and nowhere else.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use glam::{DVec3, Vec2, Vec3};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use trilux_io::image::Image;
+use trilux_io::mesh::{Material as IoMaterial, Object, TriMesh};
+
+use crate::arrays;
+use crate::error::{Failure, detached};
+
+/// A triangle mesh as trilux holds it: `float32` positions relative to an
+/// `origin` (kept in `float64`, so georeferenced scans keep their
+/// precision), triangles, and the normals, UVs and materials (with
+/// decoded textures) the file had.
+///
+/// `Mesh(vertices, faces, uv=None, normals=None)` makes one from arrays;
+/// `trilux.load(path)` reads one. A `Mesh` has `.vertices` and `.faces`
+/// like a `trimesh.Trimesh`, so it goes wherever a mesh is asked for, and
+/// `trimesh.Trimesh(m.vertices, m.faces)` turns it into one.
+#[pyclass(module = "trilux", frozen)]
+pub(crate) struct Mesh {
+    pub(crate) inner: Arc<TriMesh>,
+}
+
+fn flip_v(uv: [f64; 2]) -> Vec2 {
+    Vec2::new(uv[0] as f32, (1.0 - uv[1]) as f32)
+}
+
+/// `positions` (absolute, `f64`) relative to the shift trilux-io's
+/// readers choose (zero unless the coordinates are far from it).
+fn recentered(positions: &[[f64; 3]]) -> (DVec3, Vec<Vec3>) {
+    let points: Vec<DVec3> = positions.iter().map(|&p| DVec3::from_array(p)).collect();
+    trilux_io::mesh::recenter(&points)
+}
+
+/// A `TriMesh` of arrays: vertices `(n, 3)`, faces `(m, 3)`, optional UVs
+/// `(n, 2)` (OpenGL convention) and normals `(n, 3)`.
+pub(crate) fn from_arrays(
+    vertices: &Bound<'_, PyAny>,
+    faces: &Bound<'_, PyAny>,
+    uv: Option<&Bound<'_, PyAny>>,
+    normals: Option<&Bound<'_, PyAny>>,
+) -> PyResult<TriMesh> {
+    let positions = arrays::rows_f64::<3>(vertices, "vertices")?;
+    let n = positions.len();
+    let indices = arrays::index_rows::<3>(faces, "faces", n, ("vertex", "vertices"))?;
+    let (origin, positions) = recentered(&positions);
+    let uvs = uv.map(|uv| per_vertex::<2>(uv, "uv", n)).transpose()?;
+    let normals = normals
+        .map(|a| per_vertex::<3>(a, "normals", n))
+        .transpose()?;
+    let m = indices.len();
+    Ok(TriMesh {
+        positions,
+        origin,
+        indices,
+        normals: normals.map(|v| v.iter().map(|p| DVec3::from_array(*p).as_vec3()).collect()),
+        uvs: uvs.map(|v| v.into_iter().map(flip_v).collect()),
+        objects: vec![Object {
+            name: String::new(),
+            triangles: 0..m,
+            material: None,
+        }],
+        ..TriMesh::default()
+    })
+}
+
+fn per_vertex<const K: usize>(
+    obj: &Bound<'_, PyAny>,
+    what: &str,
+    n: usize,
+) -> PyResult<Vec<[f64; K]>> {
+    let rows = arrays::rows_f64::<K>(obj, what)?;
+    if rows.len() != n {
+        return Err(Failure::input(format!(
+            "{what}: {} rows for {n} vertices (one per vertex)",
+            rows.len()
+        ))
+        .into());
+    }
+    Ok(rows)
+}
+
+/// An image given as a numpy array (or anything `numpy.asarray` takes, a
+/// PIL image included) as trilux-io's linear RGBA `Image`: integer images
+/// are scaled to `[0, 1]`, and with `srgb` their colour channels decoded
+/// from sRGB (as trilux-io decodes PNG and JPEG colour textures); float
+/// images are taken as linear. One channel is grey, two grey and alpha.
+pub(crate) fn image_from(obj: &Bound<'_, PyAny>, what: &str, srgb: bool) -> PyResult<Image> {
+    let a = arrays::image_array(obj, what)?;
+    let decode = |x: f32| {
+        if srgb && a.integer {
+            trilux_io::image::srgb_to_linear(x)
+        } else {
+            x
+        }
+    };
+    let pixels = a
+        .values
+        .chunks_exact(a.channels)
+        .map(|p| match a.channels {
+            1 => [decode(p[0]), decode(p[0]), decode(p[0]), 1.0],
+            2 => [decode(p[0]), decode(p[0]), decode(p[0]), p[1]],
+            3 => [decode(p[0]), decode(p[1]), decode(p[2]), 1.0],
+            _ => [decode(p[0]), decode(p[1]), decode(p[2]), p[3]],
+        })
+        .collect();
+    Ok(Image {
+        width: a.width as u32,
+        height: a.height as u32,
+        pixels,
+    })
+}
+
+/// An `Image` as an `(H, W, 4)` float32 array (linear RGBA).
+pub(crate) fn image_to<'py>(py: Python<'py>, image: &Image) -> PyResult<Bound<'py, PyAny>> {
+    let data: Vec<f32> = image.pixels.iter().flatten().copied().collect();
+    arrays::image(py, data, image.height as usize, image.width as usize, 4)
+}
+
+/// The texture image of a trimesh-like visual: `visual.material.image`
+/// (trimesh's `SimpleMaterial`) or `visual.material.baseColorTexture`
+/// (its `PBRMaterial`), when there is one.
+fn visual_texture(visual: &Bound<'_, PyAny>) -> PyResult<Option<Image>> {
+    let Ok(material) = visual.getattr("material") else {
+        return Ok(None);
+    };
+    for name in ["image", "baseColorTexture"] {
+        if let Ok(img) = material.getattr(name)
+            && !img.is_none()
+        {
+            return image_from(&img, &format!("mesh.visual.material.{name}"), true).map(Some);
+        }
+    }
+    Ok(None)
+}
+
+/// The mesh a function was given: a `trilux.Mesh` (used as it is), an
+/// object with `.vertices` and `.faces` (a `trimesh.Trimesh`: its
+/// `visual.uv` and texture image come along), or a `(vertices, faces)`
+/// pair. `uv`, when given, replaces the mesh's UVs.
+pub(crate) fn mesh_arg(
+    obj: &Bound<'_, PyAny>,
+    uv: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Arc<TriMesh>> {
+    if let Ok(m) = obj.cast::<Mesh>() {
+        let inner = m.get().inner.clone();
+        return match uv {
+            None => Ok(inner),
+            Some(uv) => {
+                let n = inner.positions.len();
+                let uvs = per_vertex::<2>(uv, "uv", n)?;
+                let mut copy = (*inner).clone();
+                copy.uvs = Some(uvs.into_iter().map(flip_v).collect());
+                Ok(Arc::new(copy))
+            }
+        };
+    }
+    if obj.hasattr("vertices")? && obj.hasattr("faces")? {
+        let visual = obj.getattr("visual").ok();
+        let own_uv = match &visual {
+            Some(v) if uv.is_none() => v.getattr("uv").ok().filter(|u| !u.is_none()),
+            _ => None,
+        };
+        let mut mesh = from_arrays(
+            &obj.getattr("vertices")?,
+            &obj.getattr("faces")?,
+            uv.or(own_uv.as_ref()),
+            None,
+        )?;
+        if let Some(image) = visual.as_ref().map(visual_texture).transpose()?.flatten() {
+            mesh.materials.push(IoMaterial {
+                name: "texture".into(),
+                diffuse: [1.0; 3],
+                diffuse_texture: None,
+                diffuse_image: Some(image),
+                wrap: Default::default(),
+            });
+            for o in &mut mesh.objects {
+                o.material = Some(0);
+            }
+        }
+        return Ok(Arc::new(mesh));
+    }
+    if let Ok((v, f)) = obj.extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>)>() {
+        return Ok(Arc::new(from_arrays(&v, &f, uv, None)?));
+    }
+    let name = obj.get_type().name()?.to_string();
+    Err(Failure::input(format!(
+        "mesh: expected a trilux.Mesh, an object with .vertices and .faces (a trimesh.Trimesh), \
+         or a (vertices, faces) pair; got {name}"
+    ))
+    .into())
+}
+
+/// A path argument.
+pub(crate) fn path_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<PathBuf> {
+    obj.extract::<PathBuf>()
+        .map_err(|_| Failure::input(format!("{what}: expected a path (str or os.PathLike)")).into())
+}
+
+#[pymethods]
+impl Mesh {
+    /// A mesh of arrays: vertices `(n, 3)` (any real dtype), faces `(m, 3)`
+    /// (any integer dtype, indices into the vertices), and optionally
+    /// per-vertex UVs `(n, 2)` (OpenGL convention, `v = 0` at the image's
+    /// bottom row) and normals `(n, 3)`.
+    #[new]
+    #[pyo3(signature = (vertices, faces, uv = None, normals = None))]
+    fn new(
+        vertices: &Bound<'_, PyAny>,
+        faces: &Bound<'_, PyAny>,
+        uv: Option<&Bound<'_, PyAny>>,
+        normals: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        Ok(Self {
+            inner: Arc::new(from_arrays(vertices, faces, uv, normals)?),
+        })
+    }
+
+    /// Vertex positions, `(n, 3)` float64, in the file's coordinates
+    /// (`origin` added back).
+    #[getter]
+    fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let o = self.inner.origin;
+        let data = self
+            .inner
+            .positions
+            .iter()
+            .flat_map(|p| (o + p.as_dvec3()).to_array())
+            .collect();
+        arrays::matrix(py, data, 3)
+    }
+
+    /// Triangles, `(m, 3)` int64 vertex indices, counter-clockwise as the
+    /// file orders them.
+    #[getter]
+    fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let data = self
+            .inner
+            .indices
+            .iter()
+            .flatten()
+            .map(|&v| i64::from(v))
+            .collect();
+        arrays::matrix(py, data, 3)
+    }
+
+    /// Per-vertex texture coordinates, `(n, 2)` float64, OpenGL convention
+    /// (`v = 0` at the image's bottom row, as trimesh's `visual.uv`), or
+    /// `None`.
+    #[getter]
+    fn uv<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.inner
+            .uvs
+            .as_ref()
+            .map(|uv| {
+                let data = uv
+                    .iter()
+                    .flat_map(|t| [f64::from(t.x), 1.0 - f64::from(t.y)])
+                    .collect();
+                arrays::matrix(py, data, 2)
+            })
+            .transpose()
+    }
+
+    /// Per-vertex normals, `(n, 3)` float64, or `None` when the file had
+    /// none.
+    #[getter]
+    fn normals<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.inner
+            .normals
+            .as_ref()
+            .map(|n| {
+                let data = n.iter().flat_map(|v| v.as_dvec3().to_array()).collect();
+                arrays::matrix(py, data, 3)
+            })
+            .transpose()
+    }
+
+    /// The global shift, `(3,)` float64: zero for ordinary files, the
+    /// centre of the bounding box for coordinates far from zero.
+    #[getter]
+    fn origin<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arrays::vector(py, self.inner.origin.to_array().to_vec())
+    }
+
+    /// The materials, each a dict: `name`, `diffuse` (linear RGB),
+    /// `texture` (an `(H, W, 4)` float32 linear RGBA array or `None`),
+    /// `texture_path` (the file it names, or `None`).
+    #[getter]
+    fn materials<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for m in &self.inner.materials {
+            let d = PyDict::new(py);
+            d.set_item("name", &m.name)?;
+            d.set_item("diffuse", m.diffuse.to_vec())?;
+            match &m.diffuse_image {
+                Some(img) => d.set_item("texture", image_to(py, img)?)?,
+                None => d.set_item("texture", py.None())?,
+            }
+            d.set_item("texture_path", m.diffuse_texture.clone())?;
+            list.append(d)?;
+        }
+        Ok(list)
+    }
+
+    /// The named parts: a list of `(name, first_face, end_face,
+    /// material_index or None)`.
+    #[getter]
+    fn objects(&self) -> Vec<(String, usize, usize, Option<usize>)> {
+        self.inner
+            .objects
+            .iter()
+            .map(|o| {
+                (
+                    o.name.clone(),
+                    o.triangles.start,
+                    o.triangles.end,
+                    o.material,
+                )
+            })
+            .collect()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "trilux.Mesh({} vertices, {} faces{}{})",
+            self.inner.positions.len(),
+            self.inner.indices.len(),
+            if self.inner.uvs.is_some() { ", uv" } else { "" },
+            if self.inner.normals.is_some() {
+                ", normals"
+            } else {
+                ""
+            },
+        )
+    }
+}
+
+/// Reads a triangle mesh: OBJ (with its MTL and textures), glTF/GLB or
+/// PLY, by extension. Raises `trilux.FileError` naming the file and line.
+#[pyfunction]
+pub(crate) fn load(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Mesh> {
+    let path = path_arg(path, "path")?;
+    let inner = detached(py, || Ok(TriMesh::read(&path)?))?;
+    Ok(Mesh {
+        inner: Arc::new(inner),
+    })
+}
+
+/// Writes a triangle mesh (a `trilux.Mesh`, a `trimesh.Trimesh` or a
+/// `(vertices, faces)` pair) as OBJ (with MTL and textures) or PLY, by
+/// extension. An existing file is replaced.
+#[pyfunction]
+pub(crate) fn save(
+    py: Python<'_>,
+    path: &Bound<'_, PyAny>,
+    mesh: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let path = path_arg(path, "path")?;
+    let mesh = mesh_arg(mesh, None)?;
+    detached(py, || Ok(mesh.write(&path)?))
+}

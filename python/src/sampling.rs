@@ -1,0 +1,610 @@
+//! Points on surfaces: `sample_surface` (trimesh's `sample.sample_surface`
+//! shape), `blue_noise` and `sample_surface_even` (point-cloud-utils' and
+//! trimesh's Poisson-disk shapes), over mesh-sampling's samplers.
+
+use std::sync::{Arc, Mutex};
+
+use glam::DVec3;
+use mesh_sampling::{
+    BlueNoiseOptions, BlueNoiseTarget, Channel, Density, DensitySampler, DensityTexture, Mode,
+    Options, RejectionSampler, SurfacePoint, SurfaceSampler, UniformSampler,
+};
+use pyo3::prelude::*;
+use pyo3::types::PyTuple;
+use trilux_io::mesh::TriMesh;
+
+use crate::arrays;
+use crate::error::{Failure, Result, detached};
+use crate::mesh::{mesh_arg, path_arg};
+
+/// Which values to return besides positions and faces.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Want {
+    barycentric: bool,
+    pdf: bool,
+    normal: bool,
+}
+
+/// The arrays of a batch of points, filled without the GIL.
+#[derive(Debug, Default)]
+pub(crate) struct Points {
+    positions: Vec<f64>,
+    faces: Vec<i64>,
+    barycentric: Option<Vec<f64>>,
+    pdf: Option<Vec<f64>>,
+    normals: Option<Vec<f64>>,
+}
+
+impl Points {
+    fn zeroed(n: usize, want: Want) -> Self {
+        Self {
+            positions: vec![0.0; 3 * n],
+            faces: vec![0; n],
+            barycentric: want.barycentric.then(|| vec![0.0; 3 * n]),
+            pdf: want.pdf.then(|| vec![0.0; n]),
+            normals: want.normal.then(|| vec![0.0; 3 * n]),
+        }
+    }
+
+    /// From points already drawn (blue noise).
+    fn of(points: &[SurfacePoint], origin: DVec3, want: Want) -> Self {
+        let mut out = Self::zeroed(points.len(), want);
+        let sinks = Sinks::new(&mut out, points.len().max(1));
+        sinks.write(0, points, origin);
+        out
+    }
+
+    /// The Python tuple: `(points, face_index[, barycentric][, pdf][, normals])`.
+    fn into_tuple<'py>(self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let mut items = vec![
+            arrays::matrix(py, self.positions, 3)?,
+            arrays::vector(py, self.faces),
+        ];
+        if let Some(b) = self.barycentric {
+            items.push(arrays::matrix(py, b, 3)?);
+        }
+        if let Some(p) = self.pdf {
+            items.push(arrays::vector(py, p));
+        }
+        if let Some(n) = self.normals {
+            items.push(arrays::matrix(py, n, 3)?);
+        }
+        PyTuple::new(py, items)
+    }
+}
+
+/// The output arrays cut into blocks of `block` points, each behind its
+/// own lock: the sampler's chunks (filled on several threads at once)
+/// write their own blocks, so the locks are never contended when a
+/// chunk is a block, and any chunk size stays correct.
+struct Sinks<'a> {
+    block: usize,
+    positions: Vec<Mutex<&'a mut [f64]>>,
+    faces: Vec<Mutex<&'a mut [i64]>>,
+    barycentric: Option<Vec<Mutex<&'a mut [f64]>>>,
+    pdf: Option<Vec<Mutex<&'a mut [f64]>>>,
+    normals: Option<Vec<Mutex<&'a mut [f64]>>>,
+}
+
+fn blocks<T>(data: &mut [T], size: usize) -> Vec<Mutex<&mut [T]>> {
+    data.chunks_mut(size.max(1)).map(Mutex::new).collect()
+}
+
+fn put<T, const K: usize>(
+    parts: &[Mutex<&mut [T]>],
+    block: usize,
+    start: usize,
+    values: impl Fn(usize) -> [T; K],
+    len: usize,
+) {
+    let mut i = start;
+    while i < start + len {
+        let b = i / block;
+        let end = (start + len).min((b + 1) * block);
+        // A poisoned lock means another chunk panicked; that panic is
+        // reported, so this chunk's values do not matter.
+        let mut part = match parts[b].lock() {
+            Ok(p) => p,
+            Err(p) => p.into_inner(),
+        };
+        for k in i..end {
+            let at = (k - b * block) * K;
+            let v = values(k - start);
+            for (slot, x) in part[at..at + K].iter_mut().zip(v) {
+                *slot = x;
+            }
+        }
+        i = end;
+    }
+}
+
+impl<'a> Sinks<'a> {
+    fn new(out: &'a mut Points, block: usize) -> Self {
+        Self {
+            block,
+            positions: blocks(&mut out.positions, 3 * block),
+            faces: blocks(&mut out.faces, block),
+            barycentric: out.barycentric.as_mut().map(|b| blocks(b, 3 * block)),
+            pdf: out.pdf.as_mut().map(|p| blocks(p, block)),
+            normals: out.normals.as_mut().map(|n| blocks(n, 3 * block)),
+        }
+    }
+
+    fn write(&self, start: usize, chunk: &[SurfacePoint], origin: DVec3) {
+        let b = self.block;
+        let n = chunk.len();
+        put(
+            &self.positions,
+            b,
+            start,
+            |k| (origin + chunk[k].position.as_dvec3()).to_array(),
+            n,
+        );
+        put(&self.faces, b, start, |k| [i64::from(chunk[k].face)], n);
+        if let Some(s) = &self.barycentric {
+            put(s, b, start, |k| chunk[k].barycentric.map(f64::from), n);
+        }
+        if let Some(s) = &self.pdf {
+            put(s, b, start, |k| [f64::from(chunk[k].pdf)], n);
+        }
+        if let Some(s) = &self.normals {
+            put(s, b, start, |k| chunk[k].normal.as_dvec3().to_array(), n);
+        }
+    }
+}
+
+/// The chunk size of mesh-sampling's batches (documented on
+/// `SurfaceSampler`): blocks of this size take one lock per chunk.
+const CHUNK: usize = 16_384;
+
+fn draw<S: SurfaceSampler>(
+    sampler: &S,
+    seed: u64,
+    n: usize,
+    origin: DVec3,
+    want: Want,
+) -> Result<Points> {
+    if n as u64 > mesh_sampling::MAX_POINTS as u64 {
+        // The same check (and message) as sample_n's, before allocating.
+        return Err(mesh_sampling::Error::TooManyPoints {
+            requested: n as f64,
+            budget: mesh_sampling::MAX_POINTS,
+        }
+        .into());
+    }
+    let mut out = Points::zeroed(n, want);
+    {
+        let sinks = Sinks::new(&mut out, CHUNK);
+        sampler.sample_stream(seed, n, |start, chunk| sinks.write(start, chunk, origin));
+    }
+    Ok(out)
+}
+
+/// Where the density comes from.
+pub(crate) enum DensityArg {
+    None,
+    Texture(DensityTexture),
+    PerFace(Vec<f32>),
+    PerVertex(Vec<f32>),
+}
+
+fn channel_arg(channel: Option<&Bound<'_, PyAny>>, channels: usize) -> PyResult<Channel> {
+    let Some(c) = channel else {
+        return Ok(if channels >= 3 {
+            Channel::Luminance
+        } else {
+            Channel::Index(0)
+        });
+    };
+    let index = |i: i64| {
+        if (0..channels as i64).contains(&i) {
+            Ok(Channel::Index(i as usize))
+        } else {
+            Err(PyErr::from(Failure::input(format!(
+                "channel: {i} is not a channel of a {channels}-channel density image (0..{})",
+                channels - 1
+            ))))
+        }
+    };
+    if let Ok(i) = c.extract::<i64>() {
+        return index(i);
+    }
+    let name: String = c.extract().map_err(|_| {
+        Failure::input("channel: expected 'r', 'g', 'b', 'a', 'luminance' or an index")
+    })?;
+    let i = match name.to_ascii_lowercase().as_str() {
+        "luminance" | "l" | "y" => return Ok(Channel::Luminance),
+        "r" | "red" => 0,
+        "g" | "green" => 1,
+        "b" | "blue" => 2,
+        "a" | "alpha" => 3,
+        _ => {
+            return Err(Failure::input(format!(
+                "channel: {name:?} is not one of 'r', 'g', 'b', 'a', 'luminance'"
+            ))
+            .into());
+        }
+    };
+    index(i)
+}
+
+/// The density texture of `density`: a path (read with its stored values,
+/// no sRGB decoding, as `trilux sample --density` reads it) or an image
+/// array (`(H, W)` weights or `(H, W, C)`; integer dtypes scaled to
+/// `[0, 1]`), row 0 at the top (`v = 1` in OpenGL UVs).
+fn density_texture(
+    density: &Bound<'_, PyAny>,
+    channel: Option<&Bound<'_, PyAny>>,
+) -> PyResult<DensityTexture> {
+    if arrays::is_path(density)? {
+        let path = path_arg(density, "density")?;
+        let options = trilux_io::image::ReadOptions {
+            raw: true,
+            ..Default::default()
+        };
+        let image = trilux_io::image::read_with(&path, options).map_err(Failure::from)?;
+        let channel = channel_arg(channel, 4)?;
+        return Ok(trilux::density_texture(&image, channel).map_err(Failure::from)?);
+    }
+    let a = arrays::image_array(density, "density")?;
+    let channel = channel_arg(channel, a.channels)?;
+    Ok(
+        DensityTexture::from_channels(a.width, a.height, &a.values, a.channels, channel)
+            .map_err(Failure::from)?,
+    )
+}
+
+fn weights(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f32>> {
+    Ok(arrays::values_f64(obj, what)?
+        .into_iter()
+        .map(|w| w as f32)
+        .collect())
+}
+
+/// The density arguments of `sample_surface` and `blue_noise`: at most one
+/// of `density`, `face_weight`, `vertex_weight`.
+pub(crate) fn density_arg(
+    density: Option<&Bound<'_, PyAny>>,
+    channel: Option<&Bound<'_, PyAny>>,
+    face_weight: Option<&Bound<'_, PyAny>>,
+    vertex_weight: Option<&Bound<'_, PyAny>>,
+) -> PyResult<DensityArg> {
+    let given = [
+        density.is_some(),
+        face_weight.is_some(),
+        vertex_weight.is_some(),
+    ];
+    if given.iter().filter(|&&g| g).count() > 1 {
+        return Err(
+            Failure::input("give at most one of density, face_weight and vertex_weight").into(),
+        );
+    }
+    if channel.is_some() && density.is_none() {
+        return Err(
+            Failure::input("channel: only with density (an image or an image file)").into(),
+        );
+    }
+    Ok(match (density, face_weight, vertex_weight) {
+        (Some(d), _, _) => DensityArg::Texture(density_texture(d, channel)?),
+        (_, Some(w), _) => DensityArg::PerFace(weights(w, "face_weight")?),
+        (_, _, Some(w)) => DensityArg::PerVertex(weights(w, "vertex_weight")?),
+        _ => DensityArg::None,
+    })
+}
+
+/// A sampling method.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Method {
+    Uniform,
+    Subdivision,
+    Exact,
+    Rejection,
+}
+
+fn method_arg(method: Option<&str>, density: &DensityArg) -> Result<Method> {
+    let m = match method {
+        None => match density {
+            DensityArg::None => Method::Uniform,
+            DensityArg::Texture(_) => Method::Subdivision,
+            DensityArg::PerFace(_) | DensityArg::PerVertex(_) => Method::Exact,
+        },
+        Some("uniform") => Method::Uniform,
+        Some("subdivision") => Method::Subdivision,
+        Some("exact") => Method::Exact,
+        Some("rejection") => Method::Rejection,
+        Some(other) => {
+            return Err(Failure::input(format!(
+                "method: {other:?} is not one of 'uniform', 'subdivision', 'exact', 'rejection'"
+            )));
+        }
+    };
+    match (m, density) {
+        (Method::Uniform, DensityArg::None) => Ok(m),
+        (Method::Uniform, _) => Err(Failure::input(
+            "method='uniform' samples by area: drop the density, or choose 'subdivision' or 'exact'",
+        )),
+        (_, DensityArg::None) => Err(Failure::input(format!(
+            "method={:?} needs a density (density=, face_weight= or vertex_weight=)",
+            method.unwrap_or_default()
+        ))),
+        (
+            Method::Subdivision | Method::Rejection,
+            DensityArg::PerFace(_) | DensityArg::PerVertex(_),
+        ) => Err(Failure::input(
+            "face and vertex weights are sampled exactly: use method='exact' (or no method)",
+        )),
+        _ => Ok(m),
+    }
+}
+
+/// Runs `f` on the sampler that `density` and `method` ask for.
+fn with_sampler<T>(
+    mesh: &TriMesh,
+    density: &DensityArg,
+    method: Method,
+    f: impl FnOnce(Sampler<'_>) -> Result<T>,
+) -> Result<T> {
+    let mesh_ref = trilux::mesh_ref(mesh);
+    let options = |mode| Options {
+        mode,
+        ..Options::default()
+    };
+    match (density, method) {
+        (DensityArg::None, _) => f(Sampler::Uniform(UniformSampler::new(mesh_ref)?)),
+        (DensityArg::Texture(t), Method::Rejection) => {
+            f(Sampler::Rejection(RejectionSampler::new(mesh_ref, t)?))
+        }
+        (DensityArg::Texture(t), Method::Exact) => f(Sampler::Density(
+            DensitySampler::with_options(mesh_ref, Density::Texture(t), &options(Mode::Exact))?,
+        )),
+        (DensityArg::Texture(t), _) => f(Sampler::Density(DensitySampler::with_options(
+            mesh_ref,
+            Density::Texture(t),
+            &options(Mode::Approximate),
+        )?)),
+        (DensityArg::PerFace(w), _) => {
+            // trimesh's meaning: face i with probability ∝ w_i, so the
+            // density over the face is w_i / A_i (none on a face of no area).
+            if w.len() != mesh.indices.len() {
+                return Err(mesh_sampling::Error::WeightLength {
+                    what: "face",
+                    len: w.len(),
+                    expected: mesh.indices.len(),
+                }
+                .into());
+            }
+            let per_area: Vec<f32> = w
+                .iter()
+                .enumerate()
+                .map(|(f, &w)| {
+                    let a = mesh_ref.area(f);
+                    if a > 0.0 && w.is_finite() && w >= 0.0 {
+                        (f64::from(w) / a) as f32
+                    } else if a > 0.0 {
+                        w
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            f(Sampler::Density(DensitySampler::new(
+                mesh_ref,
+                Density::PerFace(&per_area),
+            )?))
+        }
+        (DensityArg::PerVertex(w), _) => f(Sampler::Density(DensitySampler::new(
+            mesh_ref,
+            Density::PerVertex(w),
+        )?)),
+    }
+}
+
+/// One of the samplers.
+pub(crate) enum Sampler<'a> {
+    Uniform(UniformSampler<'a>),
+    Density(DensitySampler<'a>),
+    Rejection(RejectionSampler<'a>),
+}
+
+fn seed_arg(seed: Option<i128>) -> Result<u64> {
+    match seed {
+        None => Ok(0),
+        Some(s) => {
+            u64::try_from(s).map_err(|_| Failure::input(format!("seed: {s} is not in 0..2**64")))
+        }
+    }
+}
+
+fn count_arg(count: i128, what: &str) -> Result<usize> {
+    usize::try_from(count)
+        .map_err(|_| Failure::input(format!("{what}: {count} is not a count (0 or more)")))
+}
+
+/// Random points on a mesh, uniform by area or with a density
+/// (Šik & Křivánek 2013, *Fast Random Sampling of Triangular Meshes*).
+///
+/// The call shape of `trimesh.sample.sample_surface(mesh, count)`:
+/// returns `(points, face_index)`, `points` an `(count, 3)` float64 array
+/// in the mesh's coordinates and `face_index` a `(count,)` int64 array,
+/// then, in this order and only when asked, `barycentric` `(count, 3)`
+/// float64, `pdf` `(count,)` float64 (density w.r.t. area, per mesh unit²,
+/// for multiple importance sampling) and `normals` `(count, 3)` float64
+/// (the triangles' geometric normals).
+///
+/// `mesh`: a `trilux.Mesh`, a `trimesh.Trimesh` (or anything with
+/// `.vertices` and `.faces`; its `visual.uv` is used for a density
+/// texture) or a `(vertices, faces)` pair. `density`: an image array
+/// (`(H, W)` or `(H, W, C)`, row 0 at the top, integer dtypes scaled to
+/// `[0, 1]`) or an image file (values as stored), looked up at the UVs
+/// (`uv=`, `(n, 2)`, OpenGL convention, replaces the mesh's);
+/// `channel` picks `'r'`, `'g'`, `'b'`, `'a'`, `'luminance'` (the default
+/// for colour images, Rec. 709) or an index. `face_weight` `(m,)`:
+/// trimesh's meaning, face `i` is chosen with probability proportional to
+/// `face_weight[i]` (not multiplied by its area; uniform within it).
+/// `vertex_weight` `(n,)`: a density per vertex, linear over each face
+/// (probability ∝ density × area). Weights are finite and `>= 0`; both
+/// are sampled exactly.
+/// `method`: `'uniform'` (default without a density), `'subdivision'`
+/// (the paper's adaptive subdivision, default with a texture), `'exact'`
+/// (the bilinear density itself) or `'rejection'` (the paper's
+/// baseline). `seed` (default 0): the same seed gives the same points, on
+/// any number of threads, bit for bit the Rust `sample_n(seed, count)`.
+///
+/// Raises `trilux.InputError` (a `ValueError`) for bad arguments, meshes
+/// or densities, with the Rust message; `trilux.FileError` for an
+/// unreadable density file. The GIL is released while sampling.
+#[pyfunction]
+#[pyo3(signature = (mesh, count, *, density = None, uv = None, channel = None, face_weight = None,
+    vertex_weight = None, method = None, seed = None, return_barycentric = false, return_pdf = false,
+    return_normal = false))]
+#[allow(clippy::too_many_arguments, reason = "the Python keyword arguments")]
+pub(crate) fn sample_surface<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, PyAny>,
+    count: i128,
+    density: Option<&Bound<'py, PyAny>>,
+    uv: Option<&Bound<'py, PyAny>>,
+    channel: Option<&Bound<'py, PyAny>>,
+    face_weight: Option<&Bound<'py, PyAny>>,
+    vertex_weight: Option<&Bound<'py, PyAny>>,
+    method: Option<&str>,
+    seed: Option<i128>,
+    return_barycentric: bool,
+    return_pdf: bool,
+    return_normal: bool,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let n = count_arg(count, "count")?;
+    let seed = seed_arg(seed)?;
+    let mesh: Arc<TriMesh> = mesh_arg(mesh, uv)?;
+    let density = density_arg(density, channel, face_weight, vertex_weight)?;
+    let method = method_arg(method, &density)?;
+    let want = Want {
+        barycentric: return_barycentric,
+        pdf: return_pdf,
+        normal: return_normal,
+    };
+    let origin = mesh.origin;
+    let points = detached(py, || {
+        with_sampler(&mesh, &density, method, |s| match &s {
+            Sampler::Uniform(s) => draw(s, seed, n, origin, want),
+            Sampler::Density(s) => draw(s, seed, n, origin, want),
+            Sampler::Rejection(s) => draw(s, seed, n, origin, want),
+        })
+    })?;
+    points.into_tuple(py)
+}
+
+/// Blue-noise (Poisson-disk) points on a mesh that follow a density:
+/// weighted sample elimination (Yuksel 2015, *Sample Elimination for
+/// Generating Poisson Disk Sample Sets*) of `5 × count` candidates from
+/// the sampler `sample_surface` would use.
+///
+/// Give `count` (exactly this many points) or `radius` (the points of a
+/// hexagonal packing of disks of this radius, in mesh units: neighbours
+/// end up about `2 × radius` apart; point-cloud-utils'
+/// `sample_mesh_poisson_disk(v, f, -1, radius=...)` is the same idea).
+/// `density`, `uv`, `channel`, `face_weight`, `vertex_weight` and
+/// `method` (`'subdivision'` or `'exact'`) as for `sample_surface`; with a
+/// density the local spacing scales as `1/sqrt(density)`.
+/// `progressive=True` orders the points so that every prefix of length
+/// `count / 2**j` is itself well spread (Sec. 5; about twice the time).
+///
+/// Returns `(points, face_index)` and the optional arrays, as
+/// `sample_surface`; same seed, same points.
+#[pyfunction]
+#[pyo3(signature = (mesh, count = None, *, radius = None, density = None, uv = None, channel = None,
+    face_weight = None, vertex_weight = None, method = None, seed = None, progressive = false,
+    return_barycentric = false, return_pdf = false, return_normal = false))]
+#[allow(clippy::too_many_arguments, reason = "the Python keyword arguments")]
+pub(crate) fn blue_noise<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, PyAny>,
+    count: Option<i128>,
+    radius: Option<f64>,
+    density: Option<&Bound<'py, PyAny>>,
+    uv: Option<&Bound<'py, PyAny>>,
+    channel: Option<&Bound<'py, PyAny>>,
+    face_weight: Option<&Bound<'py, PyAny>>,
+    vertex_weight: Option<&Bound<'py, PyAny>>,
+    method: Option<&str>,
+    seed: Option<i128>,
+    progressive: bool,
+    return_barycentric: bool,
+    return_pdf: bool,
+    return_normal: bool,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let target = match (count, radius) {
+        (Some(c), None) => BlueNoiseTarget::Count(count_arg(c, "count")?),
+        (None, Some(r)) => BlueNoiseTarget::Radius(r),
+        _ => return Err(Failure::input("give exactly one of count and radius").into()),
+    };
+    let seed = seed_arg(seed)?;
+    let mesh = mesh_arg(mesh, uv)?;
+    let density = density_arg(density, channel, face_weight, vertex_weight)?;
+    let method = method_arg(method, &density)?;
+    if method == Method::Rejection {
+        return Err(Failure::input(
+            "blue_noise: method='rejection' is not offered (use 'subdivision' or 'exact')",
+        )
+        .into());
+    }
+    let want = Want {
+        barycentric: return_barycentric,
+        pdf: return_pdf,
+        normal: return_normal,
+    };
+    let options = BlueNoiseOptions {
+        progressive,
+        ..BlueNoiseOptions::default()
+    };
+    let origin = mesh.origin;
+    let points = detached(py, || {
+        with_sampler(&mesh, &density, method, |s| {
+            let points = match &s {
+                Sampler::Uniform(s) => mesh_sampling::blue_noise(s, target, seed, &options)?,
+                Sampler::Density(s) => mesh_sampling::blue_noise(s, target, seed, &options)?,
+                Sampler::Rejection(_) => {
+                    return Err(Failure::input("blue_noise: no rejection sampling"));
+                }
+            };
+            Ok(Points::of(&points, origin, want))
+        })
+    })?;
+    points.into_tuple(py)
+}
+
+/// Evenly spread points, in trimesh's shape
+/// (`trimesh.sample.sample_surface_even(mesh, count, radius=None,
+/// seed=None)` → `(points, face_index)`), by `blue_noise`: exactly `count`
+/// points when `radius` is `None`; with `radius` (the smallest distance
+/// between points, as trimesh means it) the points of disks of radius
+/// `radius / 2`, progressively ordered and cut to at most `count`.
+#[pyfunction]
+#[pyo3(signature = (mesh, count, radius = None, seed = None))]
+pub(crate) fn sample_surface_even<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, PyAny>,
+    count: i128,
+    radius: Option<f64>,
+    seed: Option<i128>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let n = count_arg(count, "count")?;
+    let seed = seed_arg(seed)?;
+    let mesh = mesh_arg(mesh, None)?;
+    let (target, progressive) = match radius {
+        None => (BlueNoiseTarget::Count(n), false),
+        Some(r) => (BlueNoiseTarget::Radius(r / 2.0), true),
+    };
+    let options = BlueNoiseOptions {
+        progressive,
+        ..BlueNoiseOptions::default()
+    };
+    let origin = mesh.origin;
+    let points = detached(py, || {
+        let sampler = UniformSampler::new(trilux::mesh_ref(&mesh))?;
+        let mut points = mesh_sampling::blue_noise(&sampler, target, seed, &options)?;
+        points.truncate(n);
+        Ok(Points::of(&points, origin, Want::default()))
+    })?;
+    points.into_tuple(py)
+}

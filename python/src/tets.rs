@@ -1,0 +1,192 @@
+//! Tetrahedral meshes: isosurface stuffing (Labelle & Shewchuk 2007, on
+//! generalized winding numbers, Barill et al. 2018), and TetGen / Gmsh /
+//! MEDIT / VTU files.
+
+use glam::DVec3;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyTuple};
+use tet_stuffing as stuffing;
+
+use crate::arrays;
+use crate::error::{Failure, detached};
+use crate::mesh::{mesh_arg, path_arg};
+
+/// `(nodes, tets)` as numpy: `(n, 3)` float64 and `(m, 4)` int64.
+pub(crate) fn tets_out<'py>(
+    py: Python<'py>,
+    positions: &[DVec3],
+    tets: &[[u32; 4]],
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let nodes = positions.iter().flat_map(|p| p.to_array()).collect();
+    let t = tets.iter().flatten().map(|&v| i64::from(v)).collect();
+    Ok(vec![
+        arrays::matrix(py, nodes, 3)?,
+        arrays::matrix(py, t, 4)?,
+    ])
+}
+
+/// `(nodes, tets)` arrays as plain data, indices checked.
+pub(crate) fn tets_in(
+    nodes: &Bound<'_, PyAny>,
+    tets: &Bound<'_, PyAny>,
+) -> PyResult<(Vec<DVec3>, Vec<[u32; 4]>)> {
+    let nodes: Vec<DVec3> = arrays::rows_f64::<3>(nodes, "nodes")?
+        .into_iter()
+        .map(DVec3::from_array)
+        .collect();
+    let tets = arrays::index_rows::<4>(tets, "tets", nodes.len(), ("node", "nodes"))?;
+    Ok((nodes, tets))
+}
+
+/// Fills a closed surface with tetrahedra by isosurface stuffing
+/// (Labelle & Shewchuk 2007, *Isosurface Stuffing: Fast Tetrahedral
+/// Meshes with Good Dihedral Angles*), inside decided by the generalized
+/// winding number (Barill et al. 2018), so holes and overlaps are fine.
+///
+/// The shape of pytetwild's and tetgen's calls: returns `(nodes, tets)`,
+/// `(n, 3)` float64 positions in the mesh's coordinates and `(m, 4)`
+/// int64 node indices (positive volume), plus a report dict when
+/// `return_report=True`: `tets`, `vertices`, `boundary_triangles`,
+/// `spacing`, `min_dihedral_deg`, `max_dihedral_deg` (the dihedral-angle
+/// range, the stuffing's quality bound), `seconds`.
+///
+/// `spacing`: the lattice spacing in mesh units (default: 1/40 of the
+/// bounding box's diagonal, as `trilux tetra`); `graded=True` makes the
+/// tetrahedra coarser deep inside (an octree). The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (mesh, *, spacing = None, graded = false, return_report = false))]
+pub(crate) fn tetrahedralize<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, PyAny>,
+    spacing: Option<f64>,
+    graded: bool,
+    return_report: bool,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let mesh = mesh_arg(mesh, None)?;
+    let h = spacing.unwrap_or_else(|| trilux::tet::default_spacing(&mesh));
+    let options = stuffing::Options {
+        graded,
+        ..stuffing::Options::new(h)
+    };
+    let stuffed = detached(py, || {
+        Ok(stuffing::tetrahedralize(
+            &mesh.positions,
+            &mesh.indices,
+            &options,
+        )?)
+    })?;
+    let out = trilux::tet::from_stuffing(&stuffed, mesh.origin);
+    let mut items = tets_out(py, &out.positions, &out.tets)?;
+    if return_report {
+        let r = &stuffed.report;
+        let d = PyDict::new(py);
+        d.set_item("tets", r.tets)?;
+        d.set_item("vertices", r.vertices)?;
+        d.set_item("boundary_triangles", r.boundary_triangles)?;
+        d.set_item("spacing", h)?;
+        d.set_item("min_dihedral_deg", r.min_dihedral_deg)?;
+        d.set_item("max_dihedral_deg", r.max_dihedral_deg)?;
+        d.set_item("seconds", r.elapsed.as_secs_f64())?;
+        items.push(d.into_any());
+    }
+    PyTuple::new(py, items)
+}
+
+/// Reads a tetrahedral mesh: TetGen `.node`/`.ele`, Gmsh `.msh`, MEDIT
+/// `.mesh`, by extension. Returns `(nodes, tets)`, `(n, 3)` float64 and
+/// `(m, 4)` int64 (0-based, whatever the file's numbering).
+#[pyfunction]
+pub(crate) fn load_tets<'py>(
+    py: Python<'py>,
+    path: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let path = path_arg(path, "path")?;
+    let mesh = detached(py, || Ok(trilux_io::tet::TetMesh::read(&path)?))?;
+    PyTuple::new(py, tets_out(py, &mesh.positions, &mesh.tets)?)
+}
+
+/// Writes a tetrahedral mesh `(nodes (n, 3), tets (m, 4))` as TetGen
+/// `.node` + `.ele`, MEDIT `.mesh` or VTK `.vtu`, by extension.
+#[pyfunction]
+pub(crate) fn save_tets(
+    py: Python<'_>,
+    path: &Bound<'_, PyAny>,
+    nodes: &Bound<'_, PyAny>,
+    tets: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let path = path_arg(path, "path")?;
+    let (positions, tets) = tets_in(nodes, tets)?;
+    let mesh = trilux_io::tet::TetMesh {
+        positions,
+        tets,
+        ..Default::default()
+    };
+    detached(py, || Ok(trilux_io::tet::write(&path, &mesh)?))
+}
+
+/// Writes a point cloud as PLY (binary little-endian): `points` `(n, 3)`,
+/// optional `normals` `(n, 3)` and `face_index` `(n,)` (PLY `face_id`),
+/// as `trilux sample` writes them.
+#[pyfunction]
+#[pyo3(signature = (path, points, *, normals = None, face_index = None))]
+pub(crate) fn save_points(
+    py: Python<'_>,
+    path: &Bound<'_, PyAny>,
+    points: &Bound<'_, PyAny>,
+    normals: Option<&Bound<'_, PyAny>>,
+    face_index: Option<&Bound<'_, PyAny>>,
+) -> PyResult<()> {
+    let path = path_arg(path, "path")?;
+    let p = arrays::rows_f64::<3>(points, "points")?;
+    let absolute: Vec<DVec3> = p.into_iter().map(DVec3::from_array).collect();
+    let (origin, positions) = trilux_io::mesh::recenter(&absolute);
+    let n = positions.len();
+    let normals = normals
+        .map(|a| {
+            let rows = arrays::rows_f64::<3>(a, "normals")?;
+            if rows.len() != n {
+                return Err(PyErr::from(Failure::input(format!(
+                    "normals: {} rows for {n} points",
+                    rows.len()
+                ))));
+            }
+            Ok(rows
+                .into_iter()
+                .map(|r| DVec3::from_array(r).as_vec3())
+                .collect())
+        })
+        .transpose()?;
+    let face_ids = face_index
+        .map(|a| {
+            let ids = arrays::values_i64(a, "face_index")?;
+            if ids.len() != n {
+                return Err(PyErr::from(Failure::input(format!(
+                    "face_index: {} entries for {n} points",
+                    ids.len()
+                ))));
+            }
+            ids.iter()
+                .enumerate()
+                .map(|(i, &f)| {
+                    u32::try_from(f).map_err(|_| {
+                        PyErr::from(Failure::input(format!("face_index: entry {i} is {f}")))
+                    })
+                })
+                .collect::<PyResult<Vec<u32>>>()
+        })
+        .transpose()?;
+    let data = trilux_io::mesh::ply::PlyData {
+        positions,
+        origin,
+        normals,
+        face_ids,
+        ..Default::default()
+    };
+    detached(py, || {
+        Ok(trilux_io::mesh::ply::write(
+            &path,
+            &data,
+            trilux_io::mesh::ply::Format::BinaryLittleEndian,
+        )?)
+    })
+}

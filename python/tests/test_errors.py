@@ -1,0 +1,110 @@
+"""Every error path raises a trilux.Error subclass (InputError is a
+ValueError, FileError an OSError) whose message is the Rust message."""
+
+import numpy as np
+import pytest
+
+import trilux
+from conftest import grid
+
+V, F, UV = grid(3)
+
+
+def raises(kind, message, call, *args, **kwargs):
+    with pytest.raises(kind) as info:
+        call(*args, **kwargs)
+    assert isinstance(info.value, trilux.Error)
+    if message is not None:
+        assert str(info.value) == message, str(info.value)
+    return info.value
+
+
+def test_hierarchy():
+    assert issubclass(trilux.InputError, ValueError) and issubclass(trilux.InputError, trilux.Error)
+    assert issubclass(trilux.FileError, OSError) and issubclass(trilux.FileError, trilux.Error)
+    assert issubclass(trilux.InternalError, RuntimeError)
+    assert trilux.Error.__module__ == "trilux"
+
+
+def test_array_errors():
+    raises(trilux.InputError, "vertices: expected an array of shape (n, 3), got shape (16, 2)",
+           trilux.sample_surface, (V[:, :2], F), 10)
+    raises(trilux.InputError, "faces: expected an integer dtype, got float64",
+           trilux.sample_surface, (V, F.astype(float)), 10)
+    raises(trilux.InputError, "faces: row 0 references vertex 99, but there are only 16 vertices",
+           trilux.sample_surface, (V, np.array([[0, 1, 99]])), 10)
+    raises(trilux.InputError, "faces: row 0 references vertex -1, but there are only 16 vertices",
+           trilux.sample_surface, (V, np.array([[0, 1, -1]])), 10)
+    raises(trilux.InputError, "uv: 3 rows for 16 vertices (one per vertex)",
+           trilux.sample_surface, (V, F), 10, uv=UV[:3], density=np.ones((2, 2)))
+    raises(trilux.InputError, None, trilux.sample_surface, "not a mesh", 10)
+
+
+def test_argument_errors():
+    raises(trilux.InputError, "count: -1 is not a count (0 or more)", trilux.sample_surface, (V, F), -1)
+    raises(trilux.InputError, "seed: -1 is not in 0..2**64", trilux.sample_surface, (V, F), 1, seed=-1)
+    raises(trilux.InputError, "method: \"bogus\" is not one of 'uniform', 'subdivision', 'exact', 'rejection'",
+           trilux.sample_surface, (V, F), 1, method="bogus")
+    raises(trilux.InputError, "give at most one of density, face_weight and vertex_weight",
+           trilux.sample_surface, (V, F), 1, density=np.ones((2, 2)), face_weight=np.ones(len(F)))
+    raises(trilux.InputError, "give exactly one of count and radius", trilux.blue_noise, (V, F))
+    raises(trilux.InputError, "channel: 5 is not a channel of a 3-channel density image (0..2)",
+           trilux.sample_surface, (V, F), 1, uv=UV, density=np.ones((2, 2, 3)), channel=5)
+
+
+def test_rust_errors_keep_their_message():
+    # mesh-sampling's own messages, unchanged.
+    raises(trilux.InputError, "a texture density needs texture coordinates, and the mesh has none",
+           trilux.sample_surface, (V, F), 10, density=np.ones((2, 2)))
+    w = np.ones(len(F))
+    w[3] = -1
+    raises(trilux.InputError, "face 3 has weight -1: weights must be finite and >= 0",
+           trilux.sample_surface, (V, F), 10, face_weight=w)
+    raises(trilux.InputError, "the mesh has no triangles", trilux.sample_surface, (V, np.zeros((0, 3), int)), 10)
+    raises(trilux.InputError, "weight 1 is negative (-1); weights must be >= 0", trilux.Distribution1D, [1, -1])
+    raises(trilux.InputError, "no weights: a distribution needs at least one entry", trilux.Distribution1D, [])
+    raises(trilux.InputError,
+           "no measured material is called \"jelly\"; the names are those of Jensen et al. 2001 (apple, chicken1, "
+           "chicken2, cream, ketchup, marble, potato, skimmilk, skin1, skin2, spectralon, wholemilk)",
+           trilux.Object, np.eye(4, 3), [[0, 1, 2, 3]], medium="jelly")
+    raises(trilux.InputError, "converting a texture to mesh colours needs texture coordinates, and the mesh has none",
+           trilux.MeshColors.from_texture, (V, F), np.ones((2, 2, 3)))
+    one = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    e = raises(trilux.InputError, None, trilux.tetrahedralize, (one, [[0, 1, 2]]), spacing=0.1)
+    assert str(e).startswith("the surface encloses no volume at h = 0.1")
+
+
+def test_file_errors(tmp_path):
+    missing = tmp_path / "missing.obj"
+    e = raises(trilux.FileError, None, trilux.load, missing)
+    assert isinstance(e, OSError) and str(missing) in str(e)
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n")
+    e = raises(trilux.FileError, None, trilux.load, bad)
+    assert "bad.obj" in str(e) and "line 4" in str(e)
+    raises(trilux.FileError, None, trilux.load_tets, tmp_path / "missing.node")
+    e = raises(trilux.FileError, None, trilux.save, tmp_path / "mesh.xyz", (V, F))
+    assert "xyz" in str(e)
+    junk = tmp_path / "junk.meshcolors"
+    junk.write_bytes(b"not mesh colours")
+    e = raises(trilux.FileError, None, trilux.MeshColors.load, junk, (V, F))
+    assert str(junk) in str(e)
+
+
+def test_wrong_mesh_for_mesh_colors(tmp_path):
+    colors = trilux.MeshColors.from_texture(trilux.Mesh(V, F, uv=UV), np.ones((4, 4, 3)))
+    path = tmp_path / "c.meshcolors"
+    colors.save(path)
+    other_v, other_f, _ = grid(4)
+    e = raises(trilux.InputError, None, trilux.MeshColors.load, path, (other_v, other_f))
+    assert str(e).startswith(f"{path}: these mesh colours belong to a mesh of 16 vertices and 18 faces")
+
+
+def test_transcut_errors():
+    nodes = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    obj = trilux.Object(nodes, [[0, 1, 2, 3]])
+    raises(trilux.InputError, "add_light: give exactly one of direction, position and envmap", obj.add_light)
+    raises(trilux.InputError, "the cut removes all 1 tetrahedra: nothing would be left",
+           obj.cut, [-1, 0, 0], [1, 0, 0])
+    raises(trilux.InputError, "tets: row 0 references node 4, but there are only 4 nodes",
+           trilux.Object, nodes, [[1, 2, 3, 4]])

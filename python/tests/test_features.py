@@ -1,0 +1,97 @@
+"""The tour of the README, as tests: files, mesh colours, tetrahedra and
+TransCut from Python."""
+
+import numpy as np
+
+import trilux
+from conftest import grid
+
+
+def test_save_and_load_round_trip(tmp_path):
+    v, f, uv = grid(4)
+    m = trilux.Mesh(v, f, uv=uv)
+    for ext in ("obj", "ply"):
+        path = tmp_path / f"m.{ext}"
+        trilux.save(path, m)
+        back = trilux.load(path)
+        assert np.array_equal(back.faces, f)
+        assert np.abs(back.vertices - v).max() < 1e-6
+        assert np.abs(back.uv - uv).max() < 1e-6
+    assert "trilux.Mesh(25 vertices, 32 faces, uv)" == repr(trilux.load(tmp_path / "m.obj"))
+
+
+def test_points_to_ply(tmp_path):
+    v, f, _ = grid(4)
+    p, faces, normals = trilux.sample_surface((v, f), 100, seed=1, return_normal=True)
+    path = tmp_path / "points.ply"
+    trilux.save_points(path, p, normals=normals, face_index=faces)
+    assert path.stat().st_size > 100 * 12
+
+
+def test_mesh_colors_lookup_bake_save_load(tmp_path):
+    v, f, uv = grid(6)
+    # A texture that is linear in u: mesh colours reproduce it.
+    image = np.zeros((32, 32, 3))
+    image[..., 0] = np.linspace(0, 1, 32)[None, :]
+    colors = trilux.MeshColors.from_texture(trilux.Mesh(v, f, uv=uv), image)
+    assert colors.channels == 3 and colors.face_count == len(f)
+    faces = np.arange(len(f))
+    bary = np.full((len(f), 3), 1 / 3)
+    rgb = colors.lookup(faces, bary)
+    u_centre = uv[f].mean(axis=1)[:, 0]
+    assert np.abs(rgb[:, 0] - np.interp(u_centre * 32 - 0.5, np.arange(32), np.linspace(0, 1, 32))).max() < 0.05
+    nearest = colors.lookup(faces, bary, filter="nearest")
+    mip = colors.lookup(faces, bary, filter="mip", footprint=np.full(len(f), 0.5))
+    assert nearest.shape == mip.shape == rgb.shape
+    baked, atlas = colors.bake()
+    assert atlas.ndim == 3 and atlas.shape[2] == 4 and atlas.dtype == np.float32
+    assert len(baked.faces) == len(f) and baked.uv is not None
+    path = tmp_path / "c.meshcolors"
+    colors.save(path)
+    again = trilux.MeshColors.load(path, (v, f))
+    assert np.array_equal(again.samples, colors.samples)
+
+
+def test_tetrahedralize_and_tet_files(tmp_path):
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    nodes, tets, report = trilux.tetrahedralize(sphere, spacing=0.15, return_report=True)
+    assert nodes.dtype == np.float64 and tets.dtype == np.int64
+    assert report["tets"] == len(tets) and report["min_dihedral_deg"] > 5
+    t = nodes[tets]
+    volume = np.einsum("ij,ij->i", np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), t[:, 3] - t[:, 0]) / 6
+    assert (volume > 0).all() and abs(volume.sum() - 4 / 3 * np.pi) < 0.15
+    graded = trilux.tetrahedralize(sphere, spacing=0.05, graded=True)
+    assert len(graded[1]) < len(trilux.tetrahedralize(sphere, spacing=0.05)[1])
+    trilux.save_tets(tmp_path / "s.node", nodes, tets)
+    n2, t2 = trilux.load_tets(tmp_path / "s.node")
+    assert np.array_equal(t2, tets) and np.abs(n2 - nodes).max() < 1e-9
+
+
+def test_transcut_object_solve_cut_paint_fracture_render():
+    import trimesh
+
+    nodes, tets = trilux.tetrahedralize(trimesh.creation.icosphere(subdivisions=2), spacing=0.2)
+    assert "marble" in trilux.media()
+    obj = trilux.Object(nodes, tets, medium="marble", unit_mm=10.0)
+    assert obj.add_light([0.3, 1.0, 0.6]) == 0
+    report = obj.solve()
+    assert report["levels"] >= 1 and len(report["iterations"]) == 3
+    radiance = obj.radiance()
+    assert radiance.shape == (len(obj.boundary_vertices), 3) and (radiance >= 0).all()
+    lit = radiance[np.asarray(nodes)[obj.boundary_vertices] @ np.array([0.3, 1, 0.6]) > 0].mean()
+    dark = radiance[np.asarray(nodes)[obj.boundary_vertices] @ np.array([0.3, 1, 0.6]) < -0.5].mean()
+    assert lit > dark  # the lit side glows more
+    image = obj.render(size=64)
+    assert image.shape == (64, 64, 3) and image.dtype == np.float32 and image.max() > 0
+    painted = obj.paint([0, 0, 0], 0.3, "ketchup")
+    assert painted > 0
+    cut = obj.cut([0, 0, 0], [0, 0, 1])
+    assert cut["removed_tets"] > 0
+    obj.solve()
+    a, b = trilux.Object(nodes, tets).fracture([0, 0, 0], [1, 0, 0], offset=0.5)
+    whole = trilux.Object.recombine(a, b)
+    assert whole.mesh[1].shape == tets.shape
+    both = trilux.render([a, b], size=32, exposure=None)
+    assert both.shape == (32, 32, 3)

@@ -1,0 +1,41 @@
+"""A typed use of the API: `mypy --strict` checks it against the stubs
+(run by .ci/run; see test_stubs.py for the runtime side)."""
+
+from typing import Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+import trilux
+
+
+def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    mesh: trilux.Mesh = trilux.load(path)
+    vertices: npt.NDArray[np.float64] = mesh.vertices
+    points, faces = trilux.sample_surface(mesh, 1000, seed=1)
+    more = trilux.sample_surface(mesh, 10, return_pdf=True, return_barycentric=True)
+    assert len(more) == 4
+    blue, _ = trilux.blue_noise((vertices, mesh.faces), 100, seed=2)
+    even, _ = trilux.sample_surface_even(mesh, 100)
+    d = trilux.Distribution1D([1.0, 2.0])
+    idx: npt.NDArray[np.int64] = d.sample(10, seed=3)
+    env = trilux.Distribution2D.from_equirect(np.ones((4, 8)))
+    dirs, pdf = env.sample_direction(10)
+    nodes, tets = trilux.tetrahedralize(mesh, spacing=0.1)
+    nodes2, tets2, report = trilux.tetrahedralize(mesh, return_report=True)
+    tmin: float = report["min_dihedral_deg"]
+    obj = trilux.Object(nodes, tets, medium="marble", unit_mm=1000.0)
+    light: int = obj.add_light([0.0, 1.0, 0.0])
+    obj.solve()
+    image: npt.NDArray[np.float32] = obj.render(size=16)
+    a, b = obj.fracture([0, 0, 0], [1, 0, 0])
+    whole: trilux.Object = trilux.Object.recombine(a, b)
+    colors = trilux.MeshColors.from_texture(mesh, np.ones((2, 2, 3)))
+    rgb: npt.NDArray[np.float32] = colors.lookup(faces, np.ones((len(faces), 3)) / 3)
+    baked, atlas = colors.bake()
+    try:
+        trilux.load("missing.obj")
+    except trilux.FileError as e:
+        message: str = str(e)
+    del idx, dirs, pdf, nodes2, tets2, tmin, light, image, whole, rgb, baked, atlas, blue, even, message
+    return points, faces
