@@ -30,7 +30,7 @@ fn as_array<'py>(
         };
         return Err(Failure::input(format!("{what}: expected {wanted}, got {name}")).into());
     }
-    Ok(np.call_method1("asarray", (arr, dtype))?)
+    np.call_method1("asarray", (arr, dtype))
 }
 
 fn shape_text(shape: &[usize]) -> String {

@@ -509,8 +509,9 @@ pub(crate) fn sample_surface<'py>(
 /// `progressive=True` orders the points so that every prefix of length
 /// `count / 2**j` is itself well spread (Sec. 5; about twice the time).
 ///
-/// Returns `(points, face_index)` and the optional arrays, as
-/// `sample_surface`; same seed, same points.
+/// Returns `(points, face_index)`, `(N, 3)` float64 and `(N,)` int64, and
+/// the optional arrays, as `sample_surface`; same seed, same points (bit
+/// for bit Rust's `mesh_sampling::blue_noise`). The GIL is released.
 #[pyfunction]
 #[pyo3(signature = (mesh, count = None, *, radius = None, density = None, uv = None, channel = None,
     face_weight = None, vertex_weight = None, method = None, seed = None, progressive = false,

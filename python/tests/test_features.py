@@ -14,9 +14,9 @@ def test_save_and_load_round_trip(tmp_path):
         path = tmp_path / f"m.{ext}"
         trilux.save(path, m)
         back = trilux.load(path)
-        assert np.array_equal(back.faces, f)
-        assert np.abs(back.vertices - v).max() < 1e-6
-        assert np.abs(back.uv - uv).max() < 1e-6
+        # The OBJ reader numbers vertices by first use: compare corners.
+        assert np.abs(back.vertices[back.faces] - v[f]).max() < 1e-6
+        assert np.abs(back.uv[back.faces] - uv[f]).max() < 1e-6
     assert "trilux.Mesh(25 vertices, 32 faces, uv)" == repr(trilux.load(tmp_path / "m.obj"))
 
 
