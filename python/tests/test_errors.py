@@ -106,5 +106,6 @@ def test_transcut_errors():
     raises(trilux.InputError, "add_light: give exactly one of direction, position and envmap", obj.add_light)
     raises(trilux.InputError, "the cut removes all 1 tetrahedra: nothing would be left",
            obj.cut, [-1, 0, 0], [1, 0, 0])
+    raises(trilux.InputError, "method: \"saw\" is not 'exact' or 'relax'", obj.cut, [0, 0, 0], [1, 0, 0], method="saw")
     raises(trilux.InputError, "tets: row 0 references node 4, but there are only 4 nodes",
            trilux.Object, nodes, [[1, 2, 3, 4]])

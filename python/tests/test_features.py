@@ -88,7 +88,9 @@ def test_transcut_object_solve_cut_paint_fracture_render():
     painted = obj.paint([0, 0, 0], 0.3, "ketchup")
     assert painted > 0
     cut = obj.cut([0, 0, 0], [0, 0, 1])
-    assert cut["removed_tets"] > 0
+    assert cut["removed_tets"] > 0 and cut["split_tets"] > 0
+    relaxed = trilux.Object(nodes, tets).cut([0, 0, 0], [0, 1, 0], method="relax", relax_sweeps=5)
+    assert relaxed["removed_tets"] > 0 and relaxed["split_tets"] == 0
     obj.solve()
     a, b = trilux.Object(nodes, tets).fracture([0, 0, 0], [1, 0, 0], offset=0.5)
     whole = trilux.Object.recombine(a, b)

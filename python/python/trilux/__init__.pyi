@@ -231,8 +231,13 @@ class Object:
     @property
     def fluence(self) -> F64: ...
     def cut(
-        self, point: Sequence[float], normal: Sequence[float], *, relax_sweeps: int = 20
-    ) -> dict[str, int]: ...
+        self,
+        point: Sequence[float],
+        normal: Sequence[float],
+        *,
+        method: Literal["exact", "relax"] = "exact",
+        relax_sweeps: int = 20,
+    ) -> dict[str, float]: ...
     def paint(
         self, center: Sequence[float], radius: float, medium: MediumLike, *, strength: float = 1.0
     ) -> int: ...
