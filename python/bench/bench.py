@@ -58,8 +58,8 @@ def rho(points, area):
         # Grid hashing in numpy: exact nearest neighbours within a cell radius.
         r_max = np.sqrt(area / (2 * np.sqrt(3) * len(points)))
         best = np.inf
-        for i in range(0, len(points), 2000):
-            block = points[i : i + 2000]
+        for i in range(0, len(points), 200):
+            block = points[i : i + 200]
             d = np.linalg.norm(block[:, None, :] - points[None, :, :], axis=2)
             d[np.arange(len(block)), np.arange(i, i + len(block))] = np.inf
             best = min(best, d.min())

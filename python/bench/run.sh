@@ -11,7 +11,7 @@ cd "$(dirname "$0")/../.."
 VENV=target/py-bench-venv
 [ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"
 "$VENV/bin/python" -m pip install -q --upgrade pip
-"$VENV/bin/python" -m pip install -q "maturin>=1.9.4,<2" numpy trimesh
+"$VENV/bin/python" -m pip install -q "maturin>=1.9.4,<2" numpy scipy pillow trimesh
 for peer in open3d point-cloud-utils pytetwild tetgen; do
   "$VENV/bin/python" -m pip install -q "$peer" >/dev/null 2>&1 || echo "note: $peer did not install; its rows are skipped" >&2
 done
