@@ -120,8 +120,8 @@ impl Cut {
 pub enum CutMethod {
     /// Split the tets the cut surface crosses along it (snapping vertices
     /// within [`SNAP`] of an edge onto it first): the cross-section lies on
-    /// the surface, and no created tet has a dihedral angle below
-    /// [`MIN_CREATED_DIHEDRAL_DEGREES`] on the data folder's meshes.
+    /// the surface; on meshes without slivers no created tet has a dihedral
+    /// angle below [`MIN_CREATED_DIHEDRAL_DEGREES`] (measured, see there).
     #[default]
     Exact,
     /// TransCut's cut (Sec. 5): remove the tets entirely on the cut side,
