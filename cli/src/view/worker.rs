@@ -58,7 +58,7 @@ fn cpu_ms() -> f64 {
 
 impl Worker {
     pub(crate) fn run(mut self) {
-        self.send_all();
+        self.send_all(&[]);
         loop {
             let next = if self.session.needs_refinement() {
                 self.cancel.store(false, Ordering::SeqCst);
@@ -177,7 +177,7 @@ impl Worker {
         let c = cpu_ms();
         match r {
             Request::Edit(_) => {}
-            Request::Hello => self.send_all(),
+            Request::Hello => self.send_all(&[seq]),
             Request::Undo | Request::Redo => {
                 let undo = matches!(r, Request::Undo);
                 let result = if undo {
@@ -302,13 +302,14 @@ impl Worker {
         (lo, hi)
     }
 
-    fn send_all(&mut self) {
+    /// Everything a page needs; the status answers `seqs` (a hello's).
+    fn send_all(&mut self, seqs: &[u64]) {
         let hello = self.hello();
         self.latest_mut().hello = Some(hello.clone());
         self.send(Out::Text(hello));
         self.send_surfaces();
         self.send_radiance(!self.session.needs_refinement(), 0);
-        self.send_status(&[], "hello", &[], Instant::now(), cpu_ms(), false);
+        self.send_status(seqs, "hello", &[], Instant::now(), cpu_ms(), false);
     }
 
     fn latest_mut(&self) -> std::sync::MutexGuard<'_, Latest> {
