@@ -105,13 +105,13 @@ def main():
         row([f"{n:.0e}", fmt(t), fmt(tm), fmt(to), fmt(tp), f"{tm / t:.1f}×", "—" if tp is None else f"{tp / t:.1f}×"])
     print()
 
-    print("#### With a density (10⁶ points on the textured cow, s)\n")
     spot = trilux.load(data / "meshes" / "spot.obj")
     texture = trimesh.load(data / "meshes" / "spot.obj", process=False)
     from PIL import Image
 
     image = np.asarray(Image.open(data / "textures" / "spot_texture.png").convert("L"), dtype=np.float64) / 255
     n = counts[0]
+    print(f"#### With a density ({n:.0e} points on the textured cow, s)\n")
     t = median_seconds(lambda: trilux.sample_surface(spot, n, density=image, seed=1), repeats)
     te = median_seconds(lambda: trilux.sample_surface(spot, n, density=image, method="exact", seed=1), repeats)
 
