@@ -573,3 +573,42 @@ fn far_node_translations_keep_the_triangles() {
     let first = mesh.absolute_positions()[0];
     assert!((first - glam::DVec3::new(412_345.5, 4_612_345.5, 231.0)).length() < 1e-6);
 }
+
+/// The 19 bytes on which the fuzzer found the `gltf` crate's GLB split
+/// overflowing (`length - 12` with a total length of 1), and a GLB made
+/// from a real glTF triangle: the broken header is an `Err` naming the
+/// file and the field, and the intact container still reads.
+#[test]
+fn glb_headers_are_checked_before_the_gltf_crate_splits_them() {
+    let crash = b"glTFdxte\x01\x00\x00\x00nsUsem ";
+    let err = gltf::from_bytes(crash, "fuzzed.glb", Options::default()).unwrap_err();
+    let text = err.to_string();
+    assert!(text.starts_with("fuzzed.glb: byte 4:"), "{text}");
+    assert!(text.contains("GLB version"), "{text}");
+
+    let dir = scratch("gltf-glb-header");
+    let (bin, json) = triangle("unused.bin", 44, r#"{"mesh":0}"#);
+    // The same triangle as a GLB: the buffer without a URI is the BIN chunk.
+    let json = json.replace(r#""uri":"unused.bin","#, "");
+    let mut json = json.into_bytes();
+    json.resize(json.len().next_multiple_of(4), b' ');
+    let mut glb = b"glTF\x02\x00\x00\x00\0\0\0\0".to_vec();
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend((bin.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(&bin);
+    let total = glb.len() as u32;
+    glb[8..12].copy_from_slice(&total.to_le_bytes());
+    let mesh = gltf::from_bytes(&glb, dir.join("tri.glb"), Options::default()).unwrap();
+    assert_eq!(mesh.indices.len(), 1);
+
+    for (field, value) in [(8, 1u32), (8, total + 1), (12, u32::MAX)] {
+        let mut broken = glb.clone();
+        broken[field..field + 4].copy_from_slice(&value.to_le_bytes());
+        let err = gltf::from_bytes(&broken, dir.join("tri.glb"), Options::default()).unwrap_err();
+        let text = err.to_string();
+        assert!(text.contains(&format!("tri.glb: byte {field}:")), "{text}");
+    }
+}

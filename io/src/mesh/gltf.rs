@@ -12,7 +12,8 @@
 //! applied to the UVs. A file that requires any other extension is refused
 //! with an error naming it: a silently wrong mesh is worse than none.
 //!
-//! The `gltf` crate parses the JSON and GLB container; buffers and images
+//! The `gltf` crate parses the JSON and GLB container (its headers checked
+//! here first); buffers and images
 //! are resolved here, so that a file cannot make the reader open anything
 //! outside its own folder: absolute paths, `..` and remote schemes are
 //! refused unless [`Options::allow_outside_folder`] is set. Every accessor
@@ -162,6 +163,12 @@ impl Reader<'_> {
                 source: Box::new(e),
             })
         };
+        // The gltf crate's GLB split subtracts before it compares (an
+        // overflow on a total length below 12, found by fuzzing), so the
+        // container is checked here first.
+        if super::glb::is_glb(bytes) {
+            super::glb::check(bytes, self.path)?;
+        }
         // The gltf crate's validation indexes the arrays a file references
         // without bounds checks (found by fuzzing: a primitive naming an
         // accessor that does not exist panics inside it), so every

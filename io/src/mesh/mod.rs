@@ -9,6 +9,7 @@ use crate::error::{Error, ErrorKind, Result};
 use crate::image::Image;
 use crate::warning::Warning;
 
+mod glb;
 pub mod gltf;
 pub mod obj;
 pub mod ply;
