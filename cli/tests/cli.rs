@@ -893,43 +893,6 @@ fn errors_are_one_line_naming_the_file_or_argument_first_in_every_subcommand() {
             "--budget 0: ",
         ),
         (&["bench", "sampling", "--repeats", "0"], "--repeats 0: "),
-        (
-            &["diffuse", "torus.obj", "--material", "jade", "-o", "a.png"],
-            "--material jade: ",
-        ),
-        (
-            &["diffuse", "torus.obj", "--light", "dir:0,1", "-o", "a.png"],
-            "--light dir:0,1: ",
-        ),
-        (
-            &[
-                "diffuse",
-                "torus.obj",
-                "--cut",
-                "plane:0,0,0,1",
-                "-o",
-                "a.png",
-            ],
-            "--cut plane:0,0,0,1: ",
-        ),
-        (
-            &["diffuse", "torus.obj", "--size", "0", "-o", "a.png"],
-            "--size 0: ",
-        ),
-        (&["demo", "--out", "demo", "--size", "0"], "--size 0: "),
-        (
-            &[
-                "colors",
-                "render",
-                "torus.obj",
-                "bad.meshcolors",
-                "--size",
-                "0",
-                "-o",
-                "x.png",
-            ],
-            "--size 0: ",
-        ),
     ];
     for &(args, start) in cases {
         fails(d, args, &[start]);
@@ -948,6 +911,65 @@ fn errors_are_one_line_naming_the_file_or_argument_first_in_every_subcommand() {
         assert_eq!(line.matches(place).count(), 1, "{args:?}: {line:?}");
     }
     assert!(!d.join("demo").exists(), "a refused demo made its folder");
+}
+
+#[test]
+fn a_bad_spec_is_a_usage_error_naming_the_argument_before_any_work() {
+    // The output exists and the input does not: a spec checked after
+    // either would report those instead.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("exists.png"), "an earlier picture").unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &["--material", "jade"],
+            "'jade' for '--material <MATERIAL>'",
+        ),
+        (&["--light", "dir:0,1"], "'dir:0,1' for '--light <SPEC>'"),
+        (
+            &["--cut", "plane:0,0,0,1"],
+            "'plane:0,0,0,1' for '--cut <SPEC>'",
+        ),
+        (
+            &["--paint", "0,0,0:0:ketchup"],
+            "'0,0,0:0:ketchup' for '--paint <SPEC>'",
+        ),
+        (&["--fracture", "x"], "'x' for '--fracture <SPEC>'"),
+        (&["--view", "0,0,0"], "'0,0,0' for '--view <X,Y,Z>'"),
+        (&["--size", "0"], "'0' for '--size <SIZE>'"),
+        (&["--unit-mm=-1"], "'-1' for '--unit-mm <X>'"),
+    ];
+    for &(spec, named) in cases {
+        let args = [&["diffuse", "missing.node", "-o", "exists.png"][..], spec].concat();
+        let err = fails_with(d, 2, &args, &[]);
+        assert!(
+            err.starts_with(&format!("error: invalid value {named}: ")),
+            "{args:?}: {err:?}"
+        );
+    }
+    let err = fails_with(
+        d,
+        2,
+        &[
+            "colors",
+            "render",
+            "missing.obj",
+            "missing.meshcolors",
+            "--view",
+            "1,2",
+            "-o",
+            "exists.png",
+        ],
+        &[],
+    );
+    assert!(
+        err.starts_with("error: invalid value '1,2' for '--view <X,Y,Z>': "),
+        "{err:?}"
+    );
+    assert_eq!(
+        std::fs::read(d.join("exists.png")).unwrap(),
+        b"an earlier picture"
+    );
 }
 
 #[test]

@@ -463,7 +463,7 @@ fn diffuse_paints_the_side_of_a_plane_with_one_flag() {
             "-o",
             "p.png",
         ],
-        &["--paint plane:0,0,0,1", "zero"],
+        &["'plane:0,0,0,1:skin1' for '--paint <SPEC>'", "zero"],
     );
     fails(
         d,
@@ -475,7 +475,7 @@ fn diffuse_paints_the_side_of_a_plane_with_one_flag() {
             "-o",
             "p.png",
         ],
-        &["--paint plane:1,0,0,0:jade", "marble"],
+        &["'plane:1,0,0,0:jade' for '--paint <SPEC>'", "marble"],
     );
     assert!(!d.join("p.png").exists());
 }

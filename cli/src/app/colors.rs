@@ -78,13 +78,8 @@ pub(crate) struct RenderArgs {
     /// How colours are filtered per pixel.
     #[arg(long, value_enum, default_value_t = Filter::Linear)]
     pub(crate) filter: Filter,
-    /// Picture width and height in pixels.
-    #[arg(long, default_value_t = 768)]
-    pub(crate) size: u32,
-    /// Look from this direction (x,y,z from the mesh's centre toward the
-    /// camera; default a three-quarter view from +z, above and right).
-    #[arg(long, value_name = "X,Y,Z")]
-    pub(crate) view: Option<String>,
+    #[command(flatten)]
+    pub(crate) picture: super::args::PictureArgs,
     /// The picture: .png or .exr.
     #[arg(short, long, value_name = "OUT.png")]
     pub(crate) output: PathBuf,
@@ -356,15 +351,14 @@ pub(crate) fn render_colors_from(
 }
 
 fn render(context: &mut Context, args: RenderArgs) -> Result<()> {
-    super::check_size(args.size, 8192)?;
     super::check_output(context, &args.output, &["png", "exr"])?;
-    let view = args.view.as_deref().map(super::parse_view).transpose()?;
+    let (size, view) = (args.picture.size, args.picture.direction());
     let mesh = super::read_mesh(context, &args.mesh)?;
     let (surface, colors) = context.step("reading the mesh colours", || {
         load_for(&mesh, &args.mesh, &args.colors)
     })?;
     let image = context.step("rendering", || {
-        render_colors_from(&surface, &colors, args.filter, args.size, view)
+        render_colors_from(&surface, &colors, args.filter, size, view)
     });
     super::write_image(context, &args.output, &image)?;
     let text = format!(

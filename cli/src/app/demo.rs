@@ -10,6 +10,11 @@ use trilux_io::mesh::TriMesh;
 use super::sample::{Method, Source, draw};
 use super::{Context, Result};
 
+/// `--size` of the previews: 1 to 4096 pixels.
+fn preview_size(text: &str) -> std::result::Result<u32, String> {
+    super::args::pixels(text, 4096)
+}
+
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Run every pipeline on built-in data (meshes and images made in code), writing outputs and a preview of each",
@@ -20,7 +25,7 @@ pub(crate) struct Args {
     #[arg(long, default_value = "trilux-demo")]
     pub(crate) out: PathBuf,
     /// Preview size in pixels.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, value_parser = preview_size)]
     pub(crate) size: u32,
 }
 
@@ -114,7 +119,6 @@ fn points_pipeline(
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
-    super::check_size(args.size, 4096)?;
     let out = args.out.clone();
     if out.exists() && !out.is_dir() {
         return Err(super::file_error(
@@ -286,10 +290,10 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         // The blob stuffed (isosurface stuffing), then TransCut's diffusion
         // in marble, lit from the upper front and cut open to show the
         // light bleeding through the inside.
-        let (stuffed, _) = super::tetra::stuff(
+        let (stuffed, _) = super::ops::stuff::stuff(
             &blob,
             Path::new("blob.obj"),
-            super::tetra::Spacing::Given {
+            super::ops::stuff::Spacing::Given {
                 h: Some(0.06),
                 option: "--spacing",
             },

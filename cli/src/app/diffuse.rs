@@ -2,13 +2,15 @@
 //! materials, cuts, paint, fracture), shaded with Eq. 3's outgoing
 //! radiance plus a specular term, and rendered.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::DVec3;
-use tet_diffusion::{Cut, CutMethod, Light, Medium, Noise, Object, Stroke};
+use tet_diffusion::{Cut, CutMethod, Light, Medium, Object};
 
-use super::{Context, Result, arg_cause, arg_error, file_cause, file_error};
+use super::args::{LightSpec, Material, Paint, PaintSpec, PictureArgs, Plane};
+use super::ops::object::{check_volume, default_light, diagonal, read_volume, unit_mm};
+use super::{Context, Result, arg_cause, file_cause};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -20,23 +22,23 @@ pub(crate) struct Args {
     /// (.obj, .gltf, .glb, .ply), which is tetrahedralized first.
     pub(crate) input: PathBuf,
     /// A measured material (Jensen et al. 2001) or noise:A,B.
-    #[arg(long, default_value = "marble")]
-    pub(crate) material: String,
+    #[arg(long, default_value = "marble", value_parser = Material::parse)]
+    pub(crate) material: Material,
     /// Millimetres per mesh unit (default: 1000 when the mesh's diagonal is
     /// under 5 units, as for scans in metres; 1 otherwise).
-    #[arg(long, value_name = "X")]
+    #[arg(long, value_name = "X", value_parser = super::args::unit_mm)]
     pub(crate) unit_mm: Option<f64>,
     /// dir:x,y,z[:r,g,b] (toward the light) or point:x,y,z[:r,g,b];
     /// repeatable. Default: one light from the upper front.
-    #[arg(long, value_name = "SPEC")]
-    pub(crate) light: Vec<String>,
+    #[arg(long, value_name = "SPEC", value_parser = LightSpec::parse)]
+    pub(crate) light: Vec<LightSpec>,
     /// An equirectangular environment map as a light.
     #[arg(long, value_name = "IMAGE")]
     pub(crate) envmap: Option<PathBuf>,
     /// plane:nx,ny,nz,d removes the side n·x > d; repeatable. The cut
     /// splits the tetrahedra the plane crosses, so its face is flat.
-    #[arg(long, value_name = "SPEC")]
-    pub(crate) cut: Vec<String>,
+    #[arg(long, value_name = "SPEC", value_parser = Plane::parse)]
+    pub(crate) cut: Vec<Plane>,
     /// Cut as TransCut does instead: remove the tetrahedra entirely on the
     /// cut side and relax the cross-section toward the plane (a jagged
     /// face, one tetrahedron deep).
@@ -46,18 +48,13 @@ pub(crate) struct Args {
     /// (Gaussian, σ = radius); plane:nx,ny,nz,d:material paints the whole
     /// side n·x > d (the side --cut would remove); repeatable (planes are
     /// painted first, then balls, each in the order given).
-    #[arg(long, value_name = "SPEC")]
-    pub(crate) paint: Vec<String>,
+    #[arg(long, value_name = "SPEC", value_parser = PaintSpec::parse)]
+    pub(crate) paint: Vec<PaintSpec>,
     /// plane:nx,ny,nz,d breaks the object in two along the plane.
-    #[arg(long, value_name = "SPEC")]
-    pub(crate) fracture: Option<String>,
-    /// Look from this direction (x,y,z from the mesh's centre toward the
-    /// camera; default a three-quarter view from +z, above and right).
-    #[arg(long, value_name = "X,Y,Z")]
-    pub(crate) view: Option<String>,
-    /// Picture width and height in pixels.
-    #[arg(long, default_value_t = 768)]
-    pub(crate) size: u32,
+    #[arg(long, value_name = "SPEC", value_parser = Plane::parse)]
+    pub(crate) fracture: Option<Plane>,
+    #[command(flatten)]
+    pub(crate) picture: PictureArgs,
     /// The picture (tone-mapped, 8-bit sRGB PNG).
     #[arg(short, long, value_name = "OUT.png")]
     pub(crate) output: PathBuf,
@@ -73,154 +70,6 @@ pub(crate) struct Args {
 /// `--relax-cut`: that cut removes whole tetrahedra, so the fresh face is
 /// as jagged as the mesh until its vertices are pulled toward the plane.
 pub(crate) const CUT_RELAX_SWEEPS: usize = 20;
-
-/// The per-tetrahedron media for a mesh, given the noise's feature size.
-type MediaFn = Box<dyn Fn(&tet_diffusion::TetMesh, f64) -> Result<Vec<Medium>>>;
-
-/// `text` as `n` finite comma-separated numbers; `argument` is the option
-/// as typed, which names the problem.
-fn numbers(text: &str, argument: &str, n: usize) -> Result<Vec<f64>> {
-    let v: Option<Vec<f64>> = text
-        .split(',')
-        .map(|s| s.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
-        .collect();
-    match v {
-        Some(v) if v.len() == n => Ok(v),
-        _ => Err(arg_error(
-            argument,
-            if argument.ends_with(&format!(" {text}")) {
-                format!("expected {n} finite comma-separated numbers")
-            } else {
-                format!("expected {n} finite comma-separated numbers, found {text:?}")
-            },
-        )),
-    }
-}
-
-fn vec3(v: &[f64]) -> DVec3 {
-    DVec3::new(v[0], v[1], v[2])
-}
-
-/// `kind:x,y,z[:r,g,b]`.
-pub(crate) fn parse_light(spec: &str) -> Result<Light> {
-    let argument = format!("--light {spec}");
-    let parts: Vec<&str> = spec.split(':').collect();
-    let (kind, xyz, rgb) = match parts.as_slice() {
-        [k, xyz] => (*k, *xyz, None),
-        [k, xyz, rgb] => (*k, *xyz, Some(*rgb)),
-        _ => {
-            return Err(arg_error(
-                argument,
-                "expected dir:x,y,z[:r,g,b] or point:x,y,z[:r,g,b]",
-            ));
-        }
-    };
-    let p = vec3(&numbers(xyz, &argument, 3)?);
-    let c = match rgb {
-        Some(rgb) => {
-            let c = numbers(rgb, &argument, 3)?;
-            [c[0], c[1], c[2]]
-        }
-        None => [1.0; 3],
-    };
-    match kind {
-        "dir" if p.length_squared() == 0.0 => Err(arg_error(argument, "the direction is zero")),
-        "dir" => Ok(Light::Directional {
-            to_light: p,
-            irradiance: c,
-        }),
-        "point" => Ok(Light::Point {
-            position: p,
-            intensity: c,
-        }),
-        other => Err(arg_error(
-            argument,
-            format!("unknown kind of light {other:?} (dir or point)"),
-        )),
-    }
-}
-
-/// `plane:nx,ny,nz,d` as (point, unit normal); `argument` is the option
-/// as typed.
-fn parse_plane(spec: &str, argument: &str) -> Result<(DVec3, DVec3)> {
-    let rest = spec
-        .strip_prefix("plane:")
-        .ok_or_else(|| arg_error(argument, "expected plane:nx,ny,nz,d"))?;
-    let v = numbers(rest, argument, 4)?;
-    let n = vec3(&v);
-    if n.length_squared() == 0.0 {
-        return Err(arg_error(argument, "the plane's normal is zero"));
-    }
-    let unit = n.normalize();
-    Ok((unit * (v[3] / n.length()), unit))
-}
-
-/// A measured material by name; `argument` is the option as typed.
-pub(crate) fn medium(name: &str, argument: &str) -> Result<Medium> {
-    Medium::measured(name).map_err(|_| {
-        let names = tet_diffusion::MEASURED
-            .iter()
-            .map(|m| m.0)
-            .collect::<Vec<_>>()
-            .join(", ");
-        arg_error(
-            argument,
-            if argument.ends_with(&format!(" {name}")) {
-                format!("unknown material (one of {names})")
-            } else {
-                format!("unknown material {name:?} (one of {names})")
-            },
-        )
-    })
-}
-
-/// What one `--paint` paints.
-enum Paint {
-    /// A soft-edged ball: a stroke of one point.
-    Ball(Stroke),
-    /// Every tetrahedron whose centre is on the side `(x − point) · normal
-    /// > 0`, all of it.
-    Side {
-        point: DVec3,
-        normal: DVec3,
-        medium: Medium,
-    },
-}
-
-/// `x,y,z:radius:material` (a ball) or `plane:nx,ny,nz,d:material` (a
-/// side of a plane).
-fn parse_paint(spec: &str) -> Result<Paint> {
-    let argument = format!("--paint {spec}");
-    if spec.starts_with("plane:") {
-        let Some((plane, m)) = spec.rsplit_once(':').filter(|(p, _)| *p != "plane") else {
-            return Err(arg_error(argument, "expected plane:nx,ny,nz,d:material"));
-        };
-        let (point, normal) = parse_plane(plane, &argument)?;
-        return Ok(Paint::Side {
-            point,
-            normal,
-            medium: medium(m, &argument)?,
-        });
-    }
-    let parts: Vec<&str> = spec.split(':').collect();
-    let [xyz, r, m] = parts.as_slice() else {
-        return Err(arg_error(
-            argument,
-            "expected x,y,z:radius:material or plane:nx,ny,nz,d:material",
-        ));
-    };
-    let radius: f64 = r
-        .parse()
-        .ok()
-        .filter(|r: &f64| r.is_finite() && *r > 0.0)
-        .ok_or_else(|| arg_error(&argument, "the radius must be a positive number"))?;
-    Ok(Paint::Ball(Stroke {
-        points: vec![vec3(&numbers(xyz, &argument, 3)?)],
-        radius,
-        medium: medium(m, &argument)?,
-        strength: 1.0,
-    }))
-}
 
 /// Paints `medium` into every tetrahedron of `mesh` whose centre is on
 /// the side `(x − point) · normal > 0`; returns how many.
@@ -241,7 +90,74 @@ fn paint_side(
     painted
 }
 
+/// What a run made: the solved objects and what the summary reports.
+struct Solved {
+    objects: Vec<Object>,
+    lights: Vec<Light>,
+    unit_mm: f64,
+    levels: usize,
+    painted: Vec<usize>,
+}
+
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    check(context, &args)?;
+    let (positions, tets) = read_volume(context, &args.input, false)?;
+    let mesh =
+        tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_cause(&args.input, e))?;
+    let diagonal = diagonal(&positions);
+    let unit_mm = unit_mm(args.unit_mm, diagonal);
+    let mut media = args
+        .material
+        .media(&mesh, diagonal / 6.0)
+        .map_err(|e| arg_cause(format!("--material {}", args.material), e))?;
+    // Sides of planes go into the media before assembly; balls are
+    // painted into the assembled object below.
+    let mut painted = vec![0; args.paint.len()];
+    for (spec, count) in args.paint.iter().zip(&mut painted) {
+        if let Paint::Side {
+            point,
+            normal,
+            medium,
+        } = spec.paint
+        {
+            *count = paint_side(&mesh, &mut media, point, normal, medium);
+        }
+    }
+    let mut object = context
+        .step("assembling", || Object::new(mesh, unit_mm, media, 1.3))
+        .map_err(|e| file_cause(&args.input, e))?;
+    let lights = light(context, &args, &mut object)?;
+    for (spec, count) in args.paint.iter().zip(&mut painted) {
+        if let Paint::Ball(stroke) = &spec.paint {
+            *count = object
+                .paint(stroke)
+                .map_err(|e| arg_cause(format!("--paint {}", spec.spec), e))?
+                .tets;
+        }
+    }
+    cut(context, &args, &mut object)?;
+    let mut objects = fracture(&args, object, diagonal)?;
+    let mut levels = None;
+    for o in &mut objects {
+        let report = context
+            .step("solving", || o.solve())
+            .map_err(|e| file_cause(&args.input, super::placed("the solve failed", false, e)))?;
+        levels.get_or_insert(report.levels);
+    }
+    let solved = Solved {
+        objects,
+        lights,
+        unit_mm,
+        levels: levels.unwrap_or(0),
+        painted,
+    };
+    write(context, &args, &solved)?;
+    report(context, &args, &solved);
+    Ok(())
+}
+
+/// The outputs' names and the environment map, before any long step.
+fn check(context: &Context, args: &Args) -> Result<()> {
     super::check_output(context, &args.output, &["png"])?;
     if let Some(p) = &args.exr {
         super::check_output(context, p, &["exr"])?;
@@ -249,127 +165,25 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     if let Some(p) = &args.vtu {
         super::check_output(context, p, &["vtu"])?;
     }
-    super::check_size(args.size, 8192)?;
-    // Arguments first: a typo fails before any long step.
-    if let Some(mm) = args.unit_mm
-        && !(mm.is_finite() && mm > 0.0)
-    {
-        return Err(arg_error(
-            format!("--unit-mm {mm}"),
-            "millimetres per mesh unit must be a positive number",
-        ));
-    }
     if let Some(path) = &args.envmap {
         super::check_input(path)?;
     }
-    let mut lights = args
-        .light
-        .iter()
-        .map(|s| parse_light(s))
-        .collect::<Result<Vec<_>>>()?;
-    let cuts = args
-        .cut
-        .iter()
-        .map(|s| Ok((s, parse_plane(s, &format!("--cut {s}"))?)))
-        .collect::<Result<Vec<_>>>()?;
-    let fracture = args
-        .fracture
-        .as_deref()
-        .map(|s| parse_plane(s, &format!("--fracture {s}")).map(|plane| (s, plane)))
-        .transpose()?;
-    let paints = args
-        .paint
-        .iter()
-        .map(|s| Ok((s, parse_paint(s)?)))
-        .collect::<Result<Vec<_>>>()?;
-    let view = args.view.as_deref().map(super::parse_view).transpose()?;
-    let material = args.material.clone();
-    let material_arg = format!("--material {material}");
-    let media: MediaFn = match material.strip_prefix("noise:") {
-        Some(pair) => {
-            let names: Vec<&str> = pair.split(',').collect();
-            let [a, b] = names.as_slice() else {
-                return Err(arg_error(material_arg, "expected noise:A,B"));
-            };
-            let (a, b) = (medium(a, &material_arg)?, medium(b, &material_arg)?);
-            Box::new(move |mesh, scale| {
-                Noise {
-                    a,
-                    b,
-                    scale,
-                    octaves: 4,
-                    seed: 1,
-                }
-                .media(mesh)
-                .map_err(|e| arg_cause(&material_arg, e))
-            })
-        }
-        None => {
-            let m = medium(&material, &material_arg)?;
-            Box::new(move |mesh, _| Ok(vec![m; mesh.tets().len()]))
-        }
-    };
+    check_volume(&args.input, "diffuse", false)
+}
 
-    let ext = super::extension(&args.input);
-    if !["node", "ele", "msh", "mesh", "obj", "gltf", "glb", "ply"].contains(&ext.as_str()) {
-        return Err(file_error(
-            &args.input,
-            format!(
-                "{ext:?} is not read here: diffuse takes tetrahedra (.node, .ele, .msh, .mesh) or \
-                 a surface to fill (.obj, .gltf, .glb, .ply)"
-            ),
-        ));
-    }
-    let (positions, tets) = if ["node", "ele", "msh", "mesh"].contains(&ext.as_str()) {
-        let tet = super::read_tets(context, &args.input)?;
-        (tet.positions, tet.tets)
-    } else {
-        let surface = super::read_mesh(context, &args.input)?;
-        let (stuffed, _) = context.step("tetrahedralizing", || {
-            super::tetra::stuff(&surface, &args.input, super::tetra::Spacing::Default, false)
-        })?;
-        let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
-        (out.positions, out.tets)
-    };
-    let mesh =
-        tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_cause(&args.input, e))?;
-    let (lo, hi) = positions
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| {
-            (a.min(p), b.max(p))
-        });
-    let diagonal = (hi - lo).length();
-    let unit_mm = args
-        .unit_mm
-        .unwrap_or(if diagonal < 5.0 { 1000.0 } else { 1.0 });
-    let mut media = media(&mesh, diagonal / 6.0)?;
-    // Sides of planes go into the media before assembly; balls are
-    // painted into the assembled object below.
-    let mut painted = vec![0; paints.len()];
-    for ((_, paint), count) in paints.iter().zip(&mut painted) {
-        if let Paint::Side {
-            point,
-            normal,
-            medium,
-        } = paint
-        {
-            *count = paint_side(&mesh, &mut media, *point, *normal, *medium);
-        }
-    }
-    let mut object = context
-        .step("assembling", || Object::new(mesh, unit_mm, media, 1.3))
-        .map_err(|e| file_cause(&args.input, e))?;
+/// Adds the lights (the default one when none is given) and the
+/// environment map to `object`; returns the lights the renderer shades
+/// with.
+fn light(context: &mut Context, args: &Args, object: &mut Object) -> Result<Vec<Light>> {
+    let mut lights: Vec<Light> = args.light.iter().map(|l| l.light.clone()).collect();
     if lights.is_empty() && args.envmap.is_none() {
-        lights.push(Light::Directional {
-            to_light: DVec3::new(0.4, 1.0, 0.7),
-            irradiance: [1.0; 3],
-        });
+        lights.push(default_light());
     }
     for (k, light) in lights.iter().enumerate() {
         object
             .add_light(light.clone())
             .map_err(|e| match args.light.get(k) {
-                Some(spec) => arg_cause(format!("--light {spec}"), e),
+                Some(spec) => arg_cause(format!("--light {}", spec.spec), e),
                 None => file_cause(&args.input, e),
             })?;
     }
@@ -383,14 +197,11 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             .add_light(Light::Environment(Arc::new(env)))
             .map_err(|e| file_cause(path, e))?;
     }
-    for ((spec, paint), count) in paints.iter().zip(&mut painted) {
-        if let Paint::Ball(stroke) = paint {
-            *count = object
-                .paint(stroke)
-                .map_err(|e| arg_cause(format!("--paint {spec}"), e))?
-                .tets;
-        }
-    }
+    Ok(lights)
+}
+
+/// The `--cut`s, in order.
+fn cut(context: &mut Context, args: &Args, object: &mut Object) -> Result<()> {
     let method = if args.relax_cut {
         CutMethod::Relax {
             sweeps: CUT_RELAX_SWEEPS,
@@ -398,93 +209,97 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     } else {
         CutMethod::Exact
     };
-    for (spec, (point, normal)) in &cuts {
+    for plane in &args.cut {
+        let cut = Cut::Plane {
+            point: plane.point,
+            normal: plane.normal,
+        };
         context
-            .step("cutting", || {
-                object.cut(
-                    &Cut::Plane {
-                        point: *point,
-                        normal: *normal,
-                    },
-                    method,
-                )
-            })
-            .map_err(|e| arg_cause(format!("--cut {spec}"), e))?;
+            .step("cutting", || object.cut(&cut, method))
+            .map_err(|e| arg_cause(format!("--cut {}", plane.spec), e))?;
     }
-    let mut objects = match fracture {
-        Some((spec, (point, normal))) => {
-            let [a, mut b] = object
-                .fracture(point, normal)
-                .map_err(|e| arg_cause(format!("--fracture {spec}"), e))?;
-            b.set_transform(glam::DAffine3::from_translation(normal * diagonal * 0.15));
-            vec![a, b]
-        }
-        None => vec![object],
+    Ok(())
+}
+
+/// The object, or its two pieces after `--fracture` (the second moved
+/// apart along the plane's normal).
+fn fracture(args: &Args, object: Object, diagonal: f64) -> Result<Vec<Object>> {
+    let Some(plane) = &args.fracture else {
+        return Ok(vec![object]);
     };
-    let mut reports = Vec::new();
-    for o in &mut objects {
-        reports.push(
-            context.step("solving", || o.solve()).map_err(|e| {
-                file_cause(&args.input, super::placed("the solve failed", false, e))
-            })?,
-        );
-    }
-    let image = context.step("rendering", || render(&objects, &lights, args.size, view));
+    let [a, mut b] = object
+        .fracture(plane.point, plane.normal)
+        .map_err(|e| arg_cause(format!("--fracture {}", plane.spec), e))?;
+    b.set_transform(glam::DAffine3::from_translation(
+        plane.normal * diagonal * 0.15,
+    ));
+    Ok(vec![a, b])
+}
+
+/// The picture, and the EXR and VTU when asked for.
+fn write(context: &mut Context, args: &Args, solved: &Solved) -> Result<()> {
+    let image = context.step("rendering", || {
+        render(
+            &solved.objects,
+            &solved.lights,
+            args.picture.size,
+            args.picture.direction(),
+        )
+    });
     super::write_image(context, &args.output, &tone_map(&image))?;
     if let Some(p) = &args.exr {
         super::write_image(context, p, &image.image)?;
     }
     if let Some(p) = &args.vtu {
-        let o = &objects[0];
-        let m = o.mesh();
-        let io_mesh = trilux_io::tet::TetMesh {
-            positions: m.positions().to_vec(),
-            tets: m.tets().to_vec(),
-            ..Default::default()
-        };
-        let radiance = o.radiance(None);
-        let mut lum = vec![0.0; m.vertex_count()];
-        for (k, &v) in m.boundary_vertices().iter().enumerate() {
-            let l = radiance[k];
-            lum[v as usize] = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
-        }
-        use trilux_io::tet::vtu::{Encoding, Field};
-        let fields = [
-            Field {
-                name: "phi_r",
-                values: o.phi(0),
-            },
-            Field {
-                name: "phi_g",
-                values: o.phi(1),
-            },
-            Field {
-                name: "phi_b",
-                values: o.phi(2),
-            },
-            Field {
-                name: "radiance",
-                values: &lum,
-            },
-        ];
-        trilux::output::write_atomic(p, context.force, |tmp| {
-            Ok(trilux_io::tet::vtu::write(
-                tmp,
-                &io_mesh,
-                &fields,
-                &[],
-                Encoding::Base64,
-            )?)
-        })?;
+        write_vtu(context, p, &solved.objects[0])?;
     }
+    Ok(())
+}
+
+/// φ per colour channel and the boundary's luminance per node of `o`.
+fn write_vtu(context: &Context, path: &Path, o: &Object) -> Result<()> {
+    use trilux_io::tet::vtu::{Encoding, Field};
+    let m = o.mesh();
+    let io_mesh = trilux_io::tet::TetMesh {
+        positions: m.positions().to_vec(),
+        tets: m.tets().to_vec(),
+        ..Default::default()
+    };
+    let radiance = o.radiance(None);
+    let mut lum = vec![0.0; m.vertex_count()];
+    for (k, &v) in m.boundary_vertices().iter().enumerate() {
+        let l = radiance[k];
+        lum[v as usize] = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
+    }
+    let field = |name, values| Field { name, values };
+    let fields = [
+        field("phi_r", o.phi(0)),
+        field("phi_g", o.phi(1)),
+        field("phi_b", o.phi(2)),
+        field("radiance", &lum),
+    ];
+    trilux::output::write_atomic(path, context.force, |tmp| {
+        Ok(trilux_io::tet::vtu::write(
+            tmp,
+            &io_mesh,
+            &fields,
+            &[],
+            Encoding::Base64,
+        )?)
+    })
+}
+
+/// The summary line, or the JSON object.
+fn report(context: &Context, args: &Args, solved: &Solved) {
+    let objects = &solved.objects;
     let tets: usize = objects.iter().map(|o| o.mesh().tets().len()).sum();
-    let levels = reports.first().map_or(0, |r| r.levels);
+    let painted = &solved.painted;
     let text = format!(
         "{} tetrahedra ({} object{}), {} mm per unit{}, solved ({} levels); picture written to {}\n",
         tets,
         objects.len(),
         if objects.len() > 1 { "s" } else { "" },
-        unit_mm,
+        solved.unit_mm,
         if painted.is_empty() {
             String::new()
         } else {
@@ -497,7 +312,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                     .join(" + ")
             )
         },
-        levels,
+        solved.levels,
         args.output.display()
     );
     let json = serde_json::json!({
@@ -505,18 +320,18 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "input": super::shown(&args.input),
         "tetrahedra": tets,
         "objects": objects.len(),
-        "unit_mm": unit_mm,
-        "material": args.material,
-        "paint": paints
+        "unit_mm": solved.unit_mm,
+        "material": args.material.spec,
+        "paint": args
+            .paint
             .iter()
-            .zip(&painted)
-            .map(|((spec, _), n)| serde_json::json!({"spec": spec, "tetrahedra": n}))
+            .zip(painted)
+            .map(|(spec, n)| serde_json::json!({"spec": spec.spec, "tetrahedra": n}))
             .collect::<Vec<_>>(),
         "output": super::shown(&args.output),
         "seconds": context.timings_json(),
     });
     context.report(&text, json);
-    Ok(())
 }
 
 // The picture is drawn by the library (the Python package renders with

@@ -12,11 +12,13 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use trilux::Error;
 
+mod args;
 mod bench;
 mod colors;
 mod demo;
 mod diffuse;
 mod info;
+mod ops;
 mod plot;
 mod sample;
 mod tetra;
@@ -102,33 +104,6 @@ pub(crate) fn check_input(path: &Path) -> Result<()> {
     } else {
         Ok(())
     }
-}
-
-/// `x,y,z` as a non-zero direction, for `--view`.
-pub(crate) fn parse_view(spec: &str) -> Result<glam::Vec3> {
-    let v: Vec<f32> = spec
-        .split(',')
-        .map(|x| x.trim().parse::<f32>())
-        .collect::<std::result::Result<_, _>>()
-        .ok()
-        .filter(|v: &Vec<f32>| v.len() == 3 && v.iter().all(|x| x.is_finite()))
-        .ok_or_else(|| arg_error(format!("--view {spec}"), "expected three numbers x,y,z"))?;
-    let v = glam::Vec3::new(v[0], v[1], v[2]);
-    if v.length_squared() == 0.0 {
-        return Err(arg_error(format!("--view {spec}"), "the direction is zero"));
-    }
-    Ok(v)
-}
-
-/// Checks `--size` (pixels of a square picture) against `max`.
-pub(crate) fn check_size(size: u32, max: u32) -> Result<()> {
-    if size == 0 || size > max {
-        return Err(arg_error(
-            format!("--size {size}"),
-            format!("the picture must be 1 to {max} pixels wide"),
-        ));
-    }
-    Ok(())
 }
 
 /// The help heading of the options every subcommand takes, so that a

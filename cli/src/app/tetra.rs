@@ -1,12 +1,11 @@
 //! `trilux tetra`: a closed surface to tetrahedra by isosurface stuffing
 //! (the algorithm is `tet_stuffing`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use tet_stuffing as stuffing;
-use trilux_io::mesh::TriMesh;
-
-use super::{Context, Result, arg_error, file_cause, file_error};
+use super::Context;
+use super::Result;
+use super::ops::stuff::{Spacing, number, stuff};
 
 #[derive(Debug, clap::Args)]
 #[command(
@@ -34,109 +33,6 @@ pub(crate) struct Args {
     /// Also render the boundary to a PNG.
     #[arg(long, value_name = "OUT.png")]
     pub(crate) preview: Option<PathBuf>,
-}
-
-/// How the spacing of [`stuff`] is chosen: `--spacing` of `trilux tetra`,
-/// or the default of a command without that option (`trilux diffuse`).
-pub(crate) enum Spacing {
-    /// The option as given (`h`, and `option`, its name as typed, for
-    /// errors), or its default when absent.
-    Given {
-        h: Option<f64>,
-        option: &'static str,
-    },
-    /// Always the default; errors suggest `trilux tetra --spacing`.
-    Default,
-}
-
-/// Stuffs `mesh` (read from `path`) at the spacing `spacing` says, by
-/// default 1/40 of the bounding box's diagonal; returns the mesh and the
-/// spacing used.
-pub(crate) fn stuff(
-    mesh: &TriMesh,
-    path: &Path,
-    spacing: Spacing,
-    graded: bool,
-) -> Result<(stuffing::TetMesh, f64)> {
-    let (lo, hi) = trilux::mesh::bounds(mesh).unwrap_or_default();
-    let (h, given) = match spacing {
-        Spacing::Given { h: Some(h), .. } => (h, true),
-        Spacing::Given { h: None, .. } | Spacing::Default => {
-            (trilux::tet::default_spacing(mesh), false)
-        }
-    };
-    // What to do about a spacing too fine or too coarse for this surface.
-    let option = match spacing {
-        Spacing::Given { option, .. } => option,
-        Spacing::Default => "--spacing",
-    };
-    let (larger, smaller) = match spacing {
-        Spacing::Default => (
-            "tetrahedralize it with `trilux tetra --spacing H` first".to_string(),
-            "tetrahedralize it with `trilux tetra --spacing H` and a smaller H first".to_string(),
-        ),
-        Spacing::Given { .. } => (
-            format!("use a larger {option}"),
-            format!("try a smaller {option}"),
-        ),
-    };
-    if !(h.is_finite() && h > 0.0) {
-        return Err(if given {
-            arg_error(
-                format!("{option} {}", number(h)),
-                "the lattice spacing must be a positive length",
-            )
-        } else {
-            let fix = match spacing {
-                Spacing::Default => larger.clone(),
-                Spacing::Given { .. } => format!("give {option}"),
-            };
-            file_error(
-                path,
-                format!("no default lattice spacing from bounds {lo} .. {hi}; {fix}"),
-            )
-        });
-    }
-    let options = stuffing::Options {
-        graded,
-        ..stuffing::Options::new(h)
-    };
-    let too_fine = |problem: String| {
-        let problem = format!("too fine for this surface: {problem}; {larger}");
-        if given {
-            arg_error(format!("{option} {}", number(h)), problem)
-        } else {
-            file_error(path, problem)
-        }
-    };
-    let stuffed = stuffing::tetrahedralize(&mesh.positions, &mesh.indices, &options).map_err(
-        |e| match e {
-            stuffing::Error::EmptyVolume { h } => file_error(
-                path,
-                format!(
-                    "the surface encloses nothing at spacing {h} (an open sheet, or thinner than \
-                     the lattice: {smaller})"
-                ),
-            ),
-            stuffing::Error::LatticeTooLarge {
-                vertices, limit, ..
-            } => too_fine(format!(
-                "the lattice would need {} vertices, more than the limit of {limit}",
-                if vertices == u128::MAX {
-                    "more than 10^36".to_string()
-                } else {
-                    vertices.to_string()
-                }
-            )),
-            stuffing::Error::TooManyTetrahedra {
-                estimated, limit, ..
-            } => too_fine(format!(
-                "about {estimated} tetrahedra, more than the limit of {limit}"
-            )),
-            other => file_cause(path, other),
-        },
-    )?;
-    Ok((stuffed, h))
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
@@ -212,14 +108,4 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     });
     context.report(&text, json);
     Ok(())
-}
-
-/// A length as a person reads it: plain for everyday values, in
-/// scientific notation when tiny or huge (not 300 zeros).
-fn number(x: f64) -> String {
-    if x == 0.0 || (1e-4..1e7).contains(&x.abs()) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
 }

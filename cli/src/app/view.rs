@@ -7,9 +7,11 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use serde_json::{Value, json};
-use tet_diffusion::{Light, Noise, Object, Session};
+use tet_diffusion::{Object, Session};
 use trilux::view::protocol::ExportKind;
 
+use super::args::Material;
+use super::ops::object::{check_volume, default_light, diagonal, read_volume};
 use super::{Context, Result, arg_error, file_error};
 
 #[derive(Debug, clap::Args)]
@@ -23,10 +25,10 @@ pub(crate) struct Args {
     /// built-in object.
     pub(crate) input: Option<PathBuf>,
     /// A measured material (Jensen et al. 2001) or noise:A,B.
-    #[arg(long)]
-    pub(crate) material: Option<String>,
+    #[arg(long, value_parser = Material::parse)]
+    pub(crate) material: Option<Material>,
     /// Millimetres per mesh unit (default as for `trilux diffuse`).
-    #[arg(long, value_name = "X")]
+    #[arg(long, value_name = "X", value_parser = super::args::unit_mm)]
     pub(crate) unit_mm: Option<f64>,
     /// Port (default: a free one).
     #[arg(long, default_value_t = 0)]
@@ -46,85 +48,73 @@ pub(crate) struct Args {
     pub(crate) export_dir: PathBuf,
 }
 
+/// The object and edits of the session file at `path`.
+fn replay(context: &mut Context, path: &Path) -> Result<(Object, Value, tet_diffusion::Log)> {
+    super::check_input(path)?;
+    let text = std::fs::read_to_string(path).map_err(|e| file_error(path, e))?;
+    let (source, log) =
+        trilux::view::session_file::from_json(&text).map_err(|e| file_error(path, e))?;
+    let mesh = source
+        .get("mesh")
+        .and_then(Value::as_str)
+        .map(PathBuf::from);
+    let material = source
+        .get("material")
+        .and_then(Value::as_str)
+        .map(|m| Material::parse(m).map_err(|e| file_error(path, format!("material {m:?}: {e}"))))
+        .transpose()?;
+    let unit = source.get("unit_mm").and_then(Value::as_f64);
+    if let Some(mm) = unit
+        && !(mm.is_finite() && mm > 0.0)
+    {
+        return Err(file_error(
+            path,
+            format!("unit_mm {mm}: millimetres per mesh unit must be a positive number"),
+        ));
+    }
+    let (object, source) = load(context, mesh.as_deref(), material.as_ref(), unit)?;
+    Ok((object, source, log))
+}
+
 /// Loads the object a session file's `source` or the arguments describe.
 pub(crate) fn load(
     context: &mut Context,
     input: Option<&Path>,
-    material: Option<&str>,
+    material: Option<&Material>,
     unit_mm: Option<f64>,
 ) -> Result<(Object, Value)> {
-    if let Some(mm) = unit_mm
-        && !(mm.is_finite() && mm > 0.0)
-    {
-        return Err(arg_error(
-            format!("--unit-mm {mm}"),
-            "millimetres per mesh unit must be a positive number",
-        ));
-    }
     let source = json!({
         "mesh": input.map(|p| p.display().to_string()),
-        "material": material,
+        "material": material.map(|m| m.spec.as_str()),
         "unit_mm": unit_mm,
     });
     let Some(input) = input else {
         let mut object =
             trilux::view::builtin::object(16).map_err(|e| super::invalid(e.to_string()))?;
         if let Some(m) = material {
-            let m = super::diffuse::medium(m, &format!("--material {m}"))?;
-            let media = vec![m; object.media().len()];
+            let media = vec![m.a; object.media().len()];
             object = Object::new(object.mesh().clone(), 1.0, media, 1.3)
                 .map_err(|e| super::invalid(e.to_string()))?;
         }
         add_default_light(&mut object)?;
         return Ok((object, source));
     };
-    let ext = super::extension(input);
-    let (positions, tets) = if ["node", "ele", "msh", "mesh", "vtu"].contains(&ext.as_str()) {
-        let t = super::read_tets(context, input)?;
-        (t.positions, t.tets)
-    } else if ["obj", "gltf", "glb", "ply"].contains(&ext.as_str()) {
-        let surface = super::read_mesh(context, input)?;
-        let (stuffed, _) = context.step("tetrahedralizing", || {
-            super::tetra::stuff(&surface, input, super::tetra::Spacing::Default, false)
-        })?;
-        let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
-        (out.positions, out.tets)
-    } else {
-        return Err(file_error(
-            input,
-            format!(
-                "{ext:?} is not read here: view takes tetrahedra (.node, .ele, .msh, .mesh, .vtu) or a surface (.obj, .gltf, .glb, .ply)"
-            ),
-        ));
-    };
+    check_volume(input, "view", true)?;
+    let (positions, tets) = read_volume(context, input, true)?;
     let mesh = tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_error(input, e))?;
-    let (lo, hi) = positions
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| {
-            (a.min(p), b.max(p))
-        });
-    let diagonal = (hi - lo).length();
-    let unit = unit_mm.unwrap_or(if diagonal < 5.0 { 1000.0 } else { 1.0 });
-    let material = material.unwrap_or("marble");
-    let argument = format!("--material {material}");
-    let media = match material.strip_prefix("noise:") {
-        Some(pair) => {
-            let names: Vec<&str> = pair.split(',').collect();
-            let [a, b] = names.as_slice() else {
-                return Err(arg_error(argument, "expected noise:A,B"));
-            };
-            Noise {
-                a: super::diffuse::medium(a, &argument)?,
-                b: super::diffuse::medium(b, &argument)?,
-                scale: diagonal / 6.0,
-                octaves: 4,
-                seed: 1,
-            }
-            .media(&mesh)
-            .map_err(|e| arg_error(&argument, e))?
+    let diagonal = diagonal(&positions);
+    let unit = super::ops::object::unit_mm(unit_mm, diagonal);
+    let marble;
+    let material = match material {
+        Some(m) => m,
+        None => {
+            marble = Material::parse("marble").map_err(super::invalid)?;
+            &marble
         }
-        None => vec![super::diffuse::medium(material, &argument)?; mesh.tets().len()],
     };
+    let media = material
+        .media(&mesh, diagonal / 6.0)
+        .map_err(|e| arg_error(format!("--material {material}"), e))?;
     let mut object = context
         .step("assembling", || Object::new(mesh, unit, media, 1.3))
         .map_err(|e| file_error(input, e))?;
@@ -134,10 +124,7 @@ pub(crate) fn load(
 
 fn add_default_light(object: &mut Object) -> Result<()> {
     object
-        .add_light(Light::Directional {
-            to_light: DVec3::new(0.4, 1.0, 0.7),
-            irradiance: [1.0; 3],
-        })
+        .add_light(default_light())
         .map_err(|e| super::invalid(e.to_string()))?;
     Ok(())
 }
@@ -171,14 +158,10 @@ impl trilux::view::Exporter for Cli {
         match kind {
             ExportKind::Png | ExportKind::Exr => {
                 let lights = session.pieces()[0].lights();
-                let picture = super::diffuse::render(
-                    session.pieces(),
-                    &lights,
-                    size,
-                    view.map(|v| v.as_vec3()),
-                );
+                let picture =
+                    trilux::tet::render(session.pieces(), &lights, size, view.map(|v| v.as_vec3()));
                 let image = if kind == ExportKind::Png {
-                    super::diffuse::tone_map(&picture)
+                    trilux::tet::tone_map(&picture)
                 } else {
                     picture.image
                 };
@@ -270,27 +253,14 @@ impl trilux::view::Exporter for Cli {
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let (object, source, log) = match &args.replay {
         Some(path) => {
-            super::check_input(path)?;
-            let text = std::fs::read_to_string(path).map_err(|e| file_error(path, e))?;
-            let (source, log) =
-                trilux::view::session_file::from_json(&text).map_err(|e| file_error(path, e))?;
-            let mesh = source
-                .get("mesh")
-                .and_then(Value::as_str)
-                .map(PathBuf::from);
-            let material = source
-                .get("material")
-                .and_then(Value::as_str)
-                .map(str::to_string);
-            let unit = source.get("unit_mm").and_then(Value::as_f64);
-            let (object, source) = load(context, mesh.as_deref(), material.as_deref(), unit)?;
-            (object, source, Some(log))
+            let (o, s, log) = replay(context, path)?;
+            (o, s, Some(log))
         }
         None => {
             let (o, s) = load(
                 context,
                 args.input.as_deref(),
-                args.material.as_deref(),
+                args.material.as_ref(),
                 args.unit_mm,
             )?;
             (o, s, None)

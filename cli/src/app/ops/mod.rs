@@ -1,0 +1,6 @@
+//! The work behind the subcommands, shared by them (cargo's
+//! `commands/*` → `ops::*`): each subcommand module parses its arguments
+//! into a job and calls these; no subcommand module imports another.
+
+pub(crate) mod object;
+pub(crate) mod stuff;

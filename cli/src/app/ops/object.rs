@@ -1,0 +1,98 @@
+//! A translucent object from a file: tetrahedra as read, or a closed
+//! surface stuffed first (`diffuse`, `view`).
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::stuff::{Spacing, stuff};
+use crate::app::{Context, Result, file_error};
+
+/// The extensions read as tetrahedra; `vtu` only where `with_vtu`.
+fn tet_extensions(with_vtu: bool) -> &'static [&'static str] {
+    if with_vtu {
+        &["node", "ele", "msh", "mesh", "vtu"]
+    } else {
+        &["node", "ele", "msh", "mesh"]
+    }
+}
+
+/// The surfaces that are stuffed first.
+const SURFACES: [&str; 4] = ["obj", "gltf", "glb", "ply"];
+
+/// Checks that `subcommand` reads `input` (by its extension) before any
+/// long step.
+pub(crate) fn check_volume(input: &Path, subcommand: &str, with_vtu: bool) -> Result<()> {
+    let ext = crate::app::extension(input);
+    let tets = tet_extensions(with_vtu);
+    if tets.contains(&ext.as_str()) || SURFACES.contains(&ext.as_str()) {
+        return Ok(());
+    }
+    let dotted = |list: &[&str]| {
+        list.iter()
+            .map(|e| format!(".{e}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    Err(file_error(
+        input,
+        if with_vtu {
+            format!(
+                "{ext:?} is not read here: {subcommand} takes tetrahedra ({}) or a surface ({})",
+                dotted(tets),
+                dotted(&SURFACES)
+            )
+        } else {
+            format!(
+                "{ext:?} is not read here: {subcommand} takes tetrahedra ({}) or \
+                 a surface to fill ({})",
+                dotted(tets),
+                dotted(&SURFACES)
+            )
+        },
+    ))
+}
+
+/// The positions and tetrahedra of `input`: read, or stuffed from a
+/// surface at the default spacing. [`check_volume`] said it is read here.
+pub(crate) fn read_volume(
+    context: &mut Context,
+    input: &Path,
+    with_vtu: bool,
+) -> Result<(Vec<DVec3>, Vec<[u32; 4]>)> {
+    let ext = crate::app::extension(input);
+    if tet_extensions(with_vtu).contains(&ext.as_str()) {
+        let tet = crate::app::read_tets(context, input)?;
+        return Ok((tet.positions, tet.tets));
+    }
+    let surface = crate::app::read_mesh(context, input)?;
+    let (stuffed, _) = context.step("tetrahedralizing", || {
+        stuff(&surface, input, Spacing::Default, false)
+    })?;
+    let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
+    Ok((out.positions, out.tets))
+}
+
+/// The length of the bounding box's diagonal.
+pub(crate) fn diagonal(positions: &[DVec3]) -> f64 {
+    let (lo, hi) = positions
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| {
+            (a.min(p), b.max(p))
+        });
+    (hi - lo).length()
+}
+
+/// Millimetres per mesh unit: `given`, else 1000 when the diagonal is
+/// under 5 units (scans in metres), 1 otherwise.
+pub(crate) fn unit_mm(given: Option<f64>, diagonal: f64) -> f64 {
+    given.unwrap_or(if diagonal < 5.0 { 1000.0 } else { 1.0 })
+}
+
+/// The light of a scene given none: from the upper front.
+pub(crate) fn default_light() -> tet_diffusion::Light {
+    tet_diffusion::Light::Directional {
+        to_light: DVec3::new(0.4, 1.0, 0.7),
+        irradiance: [1.0; 3],
+    }
+}
