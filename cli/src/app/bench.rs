@@ -12,7 +12,7 @@ use mesh_sampling::{
 use serde_json::{Value, json};
 use trilux_io::mesh::TriMesh;
 
-use super::plot::{Series, line_plot};
+use super::ops::plot::{Series, line_plot};
 use super::{Context, Result, invalid};
 
 #[derive(Debug, clap::Args)]
@@ -322,7 +322,7 @@ fn colors(context: &mut Context, args: &Args, data: Option<&Path>) -> Result<()>
     let mut rows = Vec::new();
     let mut curve = Vec::new();
     let source = trilux::SurfaceTexture::new(&mesh, Some(&texture))?;
-    let points = super::colors::surface_points(&mesh, 200_000, 3)?;
+    let points = super::ops::colors::surface_points(&mesh, 200_000, 3)?;
     let mut finest = None;
     for fraction in [0.0625, 0.125, 0.25, 0.5, 1.0, 2.0] {
         let options = trilux::ConvertOptions {

@@ -1,14 +1,9 @@
 //! `trilux colors convert|bake|render`: textured meshes to mesh colours,
 //! mesh colours to an atlas, and pictures of mesh colours.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use clap::ValueEnum;
-use mesh_colors::{MeshColors, MipMap};
-use mesh_sampling::{SurfaceSampler, UniformSampler};
-use trilux::{ColorMesh, SurfaceTexture};
-use trilux_io::mesh::TriMesh;
-
+use super::ops::colors::{Filter, convert_mesh, load_for, render_colors, render_colors_from};
 use super::{Context, Result, arg_error, file_cause, file_error};
 
 #[derive(Debug, clap::Subcommand)]
@@ -85,55 +80,12 @@ pub(crate) struct RenderArgs {
     pub(crate) output: PathBuf,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub(crate) enum Filter {
-    Nearest,
-    Linear,
-    Mip,
-    Aniso,
-}
-
 pub(crate) fn run(context: &mut Context, command: Command) -> Result<()> {
     match command {
         Command::Convert(args) => convert(context, args),
         Command::Bake(args) => bake(context, args),
         Command::Render(args) => render(context, args),
     }
-}
-
-/// `n` uniform surface points as `(face, barycentrics)`.
-pub(crate) fn surface_points(mesh: &TriMesh, n: usize, seed: u64) -> Result<Vec<(u32, [f32; 3])>> {
-    Ok(UniformSampler::new(trilux::mesh_ref(mesh))?
-        .sample_n(seed, n)?
-        .iter()
-        .map(|p| (p.face, p.barycentric))
-        .collect())
-}
-
-/// Converts, and measures the PSNR against the source at 200,000 points.
-pub(crate) fn convert_mesh(
-    context: &mut Context,
-    mesh: &TriMesh,
-    texture: Option<&trilux_io::image::Image>,
-    options: &trilux::ConvertOptions,
-) -> Result<(ColorMesh, MeshColors, f64)> {
-    let (surface, colors) = context.step("converting to mesh colours", || {
-        trilux::to_mesh_colors(mesh, texture, options)
-    })?;
-    let source = SurfaceTexture::new(mesh, texture)?;
-    let points = surface_points(mesh, 200_000, 1)?;
-    let psnr = context.step("measuring PSNR", || {
-        trilux::colors::psnr(
-            &points,
-            |f, b| source.color(f, b),
-            |f, b| {
-                let mut out = [0.0f32; 3];
-                let _ = colors.linear(f as usize, b, &mut out);
-                out
-            },
-        )
-    });
-    Ok((surface, colors, psnr))
 }
 
 fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
@@ -223,20 +175,6 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
     Ok(())
 }
 
-/// Loads mesh colours and checks they belong to the mesh (read from
-/// `mesh_path`).
-pub(crate) fn load_for(
-    mesh: &TriMesh,
-    mesh_path: &Path,
-    path: &Path,
-) -> Result<(ColorMesh, MeshColors)> {
-    super::check_input(path)?;
-    let (colors, _) = mesh_colors::file::load(path).map_err(|e| file_cause(path, e))?;
-    let surface = ColorMesh::new(mesh).map_err(|e| super::at(mesh_path.display(), e))?;
-    surface.check(&colors, path)?;
-    Ok((surface, colors))
-}
-
 fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
     let ext = super::extension(&args.output);
     if ext == "gltf" || ext == "glb" {
@@ -295,59 +233,6 @@ fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
     });
     context.report(&text, json);
     Ok(())
-}
-
-/// A picture of mesh colours on their surface, filtered per pixel.
-pub(crate) fn render_colors(
-    surface: &ColorMesh,
-    colors: &MeshColors,
-    filter: Filter,
-    size: u32,
-) -> trilux_io::image::Image {
-    render_colors_from(surface, colors, filter, size, None)
-}
-
-/// [`render_colors`] looking from direction `view` (towards the centre).
-pub(crate) fn render_colors_from(
-    surface: &ColorMesh,
-    colors: &MeshColors,
-    filter: Filter,
-    size: u32,
-    view: Option<glam::Vec3>,
-) -> trilux_io::image::Image {
-    use trilux::preview::{Camera, Renderer, lambert};
-    let Some((lo, hi)) = trilux::preview::bounds(&surface.positions) else {
-        return trilux::preview::render_mesh(&[], &[], size, size);
-    };
-    let mip: Option<MipMap> =
-        matches!(filter, Filter::Mip | Filter::Aniso).then(|| colors.mip_map());
-    let c = colors.channels();
-    let camera = match view {
-        Some(v) => Camera::fit_from(lo, hi, v),
-        None => Camera::fit(lo, hi),
-    };
-    let mut r = Renderer::new(size, size, camera);
-    r.draw_mesh(&surface.positions, &surface.faces, |frag| {
-        let mut out = [0.0f32; mesh_colors::MAX_CHANNELS];
-        let out = &mut out[..c];
-        let face = frag.face as usize;
-        let b = frag.barycentric;
-        let _ = match (filter, &mip) {
-            (Filter::Nearest, _) => colors.nearest(face, b, out),
-            (Filter::Mip, Some(m)) => {
-                let width = |d: [f32; 3]| d.iter().fold(0.0f32, |a, x| a.max(x.abs()));
-                m.trilinear(face, b, width(frag.db_dx).max(width(frag.db_dy)), out)
-            }
-            (Filter::Aniso, Some(m)) => m.anisotropic(face, b, frag.db_dx, frag.db_dy, 16, out),
-            _ => colors.linear(face, b, out),
-        };
-        let rgb = match c {
-            1 | 2 => [out[0]; 3],
-            _ => [out[0], out[1], out[2]],
-        };
-        lambert(rgb.map(|x| x.max(0.0) * 1.1), frag)
-    });
-    r.image()
 }
 
 fn render(context: &mut Context, args: RenderArgs) -> Result<()> {

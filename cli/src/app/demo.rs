@@ -7,7 +7,7 @@ use mesh_sampling::Channel;
 use trilux::shapes;
 use trilux_io::mesh::TriMesh;
 
-use super::sample::{Method, Source, draw};
+use super::ops::sample::{Method, Source, draw};
 use super::{Context, Result};
 
 /// `--size` of the previews: 1 to 4096 pixels.
@@ -113,7 +113,7 @@ fn points_pipeline(
     let ply = demo.write_points(&format!("{stem}.ply"), mesh, &points)?;
     let png = demo.write_image(
         &format!("{stem}.png"),
-        &super::sample::preview(mesh, &points, demo.size, demo.size),
+        &super::ops::sample::preview(mesh, &points, demo.size, demo.size),
     )?;
     Ok(vec![ply, png])
 }
@@ -237,7 +237,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             timings: Vec::new(),
         };
         let (surface, colors, psnr) =
-            super::colors::convert_mesh(&mut quiet, &torus, Some(&checker), &Default::default())?;
+            super::ops::colors::convert_mesh(&mut quiet, &torus, Some(&checker), &Default::default())?;
         let file = d.path("torus.meshcolors");
         trilux::output::write_atomic(&file, d.context.force, |tmp| {
             mesh_colors::file::save(tmp, &colors, None).map_err(|e| super::file_cause(&file, e))
@@ -252,7 +252,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         )?);
         files.push(d.write_image(
             "torus_colors.png",
-            &super::colors::render_colors(&surface, &colors, super::colors::Filter::Mip, d.size),
+            &super::ops::colors::render_colors(&surface, &colors, super::ops::colors::Filter::Mip, d.size),
         )?);
         let what = format!(
             "checkerboard torus → {} mesh colours ({psnr:.1} dB) → {}×{} atlas OBJ; MIP-filtered render",
@@ -266,7 +266,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     demo.run("colors-density", |d| {
         let n = 200_000;
         let file = d.path("torus.meshcolors");
-        let source = super::sample::meshcolors_source(
+        let source = super::ops::sample::meshcolors_source(
             &torus,
             &d.path("torus.obj"),
             &file,

@@ -19,7 +19,6 @@ mod demo;
 mod diffuse;
 mod info;
 mod ops;
-mod plot;
 mod sample;
 mod tetra;
 #[cfg(feature = "view")]

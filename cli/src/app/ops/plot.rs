@@ -6,7 +6,7 @@ use std::sync::OnceLock;
 
 use plotters::prelude::*;
 
-use super::{Context, Result, invalid};
+use crate::app::{Context, Result, invalid};
 
 /// Fonts plotters can draw labels with (the DejaVu and Liberation fonts
 /// most Linux systems have); `None` when none is installed.
@@ -137,6 +137,6 @@ pub(crate) fn line_plot(
             })
             .collect(),
     };
-    super::write_image(context, path, &image)?;
+    crate::app::write_image(context, path, &image)?;
     Ok(true)
 }
