@@ -4,7 +4,8 @@
 
 use std::path::PathBuf;
 
-use mesh_sampling::BlueNoiseTarget;
+use mesh_sampling::{BlueNoiseTarget, Channel, SurfacePoint};
+use trilux_io::mesh::TriMesh;
 use trilux_io::mesh::ply;
 
 use super::ops::sample::{
@@ -84,6 +85,29 @@ pub(crate) struct Args {
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    let wanted = wanted(&args)?;
+    let channel = args.channel.unwrap_or(ChannelArg::Luminance).channel();
+    super::check_output(context, &args.output, &["ply"])?;
+    if let Some(p) = &args.preview {
+        super::check_output(context, p, &["png", "exr"])?;
+    }
+    let mesh = super::read_mesh(context, &args.mesh)?;
+    let method = method(&args)?;
+    let source = source(context, &args, &mesh, channel)?;
+    let points = super::with_threads(args.threads, || {
+        context.step("sampling", || {
+            draw_points(&mesh, &source, method, args.seed, wanted)
+        })
+    })?
+    .map_err(|e| super::at(args.mesh.display(), e))?;
+    write(context, &args, &mesh, &points)?;
+    report(context, &args, &mesh, &points, method);
+    Ok(())
+}
+
+/// How many points `-n` or `--radius` asks for; a `--channel` needs a
+/// density with channels.
+fn wanted(args: &Args) -> Result<Points> {
     let wanted = match (args.count, args.radius) {
         (Some(count), _) if count <= 0 || count.unsigned_abs() > MAX_POINTS => {
             return Err(arg_error(
@@ -121,12 +145,12 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             ),
         ));
     }
-    let channel = args.channel.unwrap_or(ChannelArg::Luminance).channel();
-    super::check_output(context, &args.output, &["ply"])?;
-    if let Some(p) = &args.preview {
-        super::check_output(context, p, &["png", "exr"])?;
-    }
-    let mesh = super::read_mesh(context, &args.mesh)?;
+    Ok(wanted)
+}
+
+/// The method: `--method`, or by default subdivision with a density and
+/// uniform without; checked against the density and `--blue-noise`.
+fn method(args: &Args) -> Result<Method> {
     let has_density =
         args.density.is_some() || args.face_weights.is_some() || args.density_meshcolors.is_some();
     let method = args.method.unwrap_or(if has_density {
@@ -158,6 +182,12 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             "rejection needs a texture density; per-face weights are sampled exactly by subdivision",
         ));
     }
+    Ok(method)
+}
+
+/// The density to sample: a texture, per-face weights, a mesh-colours
+/// channel, or none.
+fn source(context: &mut Context, args: &Args, mesh: &TriMesh, channel: Channel) -> Result<Source> {
     let source = if let Some(path) = &args.density {
         if mesh.uvs.is_none() {
             return Err(file_error(
@@ -180,19 +210,23 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         Source::FaceWeights(read_face_weights(path, mesh.indices.len())?)
     } else if let Some(path) = &args.density_meshcolors {
         context.step("baking the mesh colours", || {
-            meshcolors_source(&mesh, &args.mesh, path, channel)
+            meshcolors_source(mesh, &args.mesh, path, channel)
         })?
     } else {
         Source::Uniform
     };
-    let points = super::with_threads(args.threads, || {
-        context.step("sampling", || {
-            draw_points(&mesh, &source, method, args.seed, wanted)
-        })
-    })?
-    .map_err(|e| super::at(args.mesh.display(), e))?;
+    Ok(source)
+}
+
+/// The PLY file, and the preview when asked for.
+fn write(
+    context: &mut Context,
+    args: &Args,
+    mesh: &TriMesh,
+    points: &[SurfacePoint],
+) -> Result<()> {
     let cloud = context.step("building the point cloud", || {
-        trilux::point_cloud(&mesh, &points)
+        trilux::point_cloud(mesh, points)
     });
     let format = if args.ascii {
         ply::Format::Ascii
@@ -206,11 +240,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         })
     })?;
     if let Some(path) = &args.preview {
-        let image = context.step("rendering the preview", || {
-            preview(&mesh, &points, 768, 768)
-        });
+        let image = context.step("rendering the preview", || preview(mesh, points, 768, 768));
         super::write_image(context, path, &image)?;
     }
+    Ok(())
+}
+
+/// The summary line, or the JSON object.
+fn report(context: &Context, args: &Args, mesh: &TriMesh, points: &[SurfacePoint], method: Method) {
     let kind = if args.blue_noise {
         format!("{}, blue noise", method.name())
     } else {
@@ -240,5 +277,4 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "seconds": context.timings_json(),
     });
     context.report(&text, json);
-    Ok(())
 }

@@ -237,116 +237,10 @@ pub fn parse(text: &str) -> Result<(u64, Request), BadField> {
         "hello" => Request::Hello,
         "undo" => Request::Undo,
         "redo" => Request::Redo,
-        "paint" => {
-            let m = medium(get(o, "material")?, "material")?;
-            let radius = number(get(o, "radius")?, "radius")?;
-            if radius <= 0.0 {
-                return Err(BadField::new("radius", "must be positive"));
-            }
-            let strength = number(get(o, "strength")?, "strength")?;
-            if !(0.0..=1.0).contains(&strength) {
-                return Err(BadField::new("strength", "must be in [0, 1]"));
-            }
-            let pts = points(get(o, "points")?, "points", 1)?;
-            Request::Edit(Edit::Paint(vec![Stroke {
-                points: pts,
-                radius,
-                medium: m,
-                strength,
-            }]))
-        }
+        "paint" => paint(o)?,
         "material" => Request::Edit(Edit::Material(medium(get(o, "material")?, "material")?)),
-        "lights" => {
-            let a = get(o, "lights")?
-                .as_array()
-                .ok_or_else(|| BadField::new("lights", "expected an array"))?;
-            if a.len() > MAX_LIGHTS {
-                return Err(BadField::new(
-                    "lights",
-                    format!("at most {MAX_LIGHTS} lights"),
-                ));
-            }
-            let mut lights = Vec::with_capacity(a.len());
-            for (k, l) in a.iter().enumerate() {
-                let f = |name: &str| format!("lights[{k}].{name}");
-                let lo = l
-                    .as_object()
-                    .ok_or_else(|| BadField::new(format!("lights[{k}]"), "expected an object"))?;
-                let kind = lo
-                    .get("kind")
-                    .and_then(Value::as_str)
-                    .ok_or_else(|| BadField::new(f("kind"), "expected \"dir\" or \"point\""))?;
-                let color = rgb(lo.get("rgb"), &f("rgb"))?;
-                lights.push(match kind {
-                    "dir" => Light::Directional {
-                        to_light: nonzero(
-                            vec3(
-                                lo.get("dir")
-                                    .ok_or_else(|| BadField::new(f("dir"), "missing"))?,
-                                &f("dir"),
-                            )?,
-                            &f("dir"),
-                        )?,
-                        irradiance: color,
-                    },
-                    "point" => Light::Point {
-                        position: vec3(
-                            lo.get("pos")
-                                .ok_or_else(|| BadField::new(f("pos"), "missing"))?,
-                            &f("pos"),
-                        )?,
-                        intensity: color,
-                    },
-                    other => {
-                        return Err(BadField::new(
-                            f("kind"),
-                            format!("unknown kind {other:?} (dir or point)"),
-                        ));
-                    }
-                });
-            }
-            Request::Edit(Edit::Lights(lights))
-        }
-        "cut" => {
-            if let Some(p) = o.get("plane") {
-                let po = p
-                    .as_object()
-                    .ok_or_else(|| BadField::new("plane", "expected {point, normal}"))?;
-                Request::Edit(Edit::Cut(Cut::Plane {
-                    point: vec3(
-                        get(po, "point").map_err(|_| missing("plane.point"))?,
-                        "plane.point",
-                    )?,
-                    normal: nonzero(
-                        vec3(
-                            get(po, "normal").map_err(|_| missing("plane.normal"))?,
-                            "plane.normal",
-                        )?,
-                        "plane.normal",
-                    )?,
-                }))
-            } else if let Some(s) = o.get("stroke") {
-                let so = s
-                    .as_object()
-                    .ok_or_else(|| BadField::new("stroke", "expected {points, view}"))?;
-                Request::Edit(Edit::Cut(Cut::Stroke {
-                    points: points(
-                        get(so, "points").map_err(|_| missing("stroke.points"))?,
-                        "stroke.points",
-                        2,
-                    )?,
-                    view: nonzero(
-                        vec3(
-                            get(so, "view").map_err(|_| missing("stroke.view"))?,
-                            "stroke.view",
-                        )?,
-                        "stroke.view",
-                    )?,
-                }))
-            } else {
-                return Err(BadField::new("plane", "a cut needs plane or stroke"));
-            }
-        }
+        "lights" => lights(o)?,
+        "cut" => cut(o)?,
         "fracture" => Request::Edit(Edit::Fracture {
             piece: index(get(o, "piece")?, "piece")?,
             point: vec3(get(o, "point")?, "point")?,
@@ -368,56 +262,174 @@ pub fn parse(text: &str) -> Result<(u64, Request), BadField> {
             piece: index(get(o, "piece")?, "piece")?,
             point: vec3(get(o, "point")?, "point")?,
         },
-        "export" => {
-            let kind = match get(o, "kind")?.as_str() {
-                Some("png") => ExportKind::Png,
-                Some("exr") => ExportKind::Exr,
-                Some("vtu") => ExportKind::Vtu,
-                Some("tet") => ExportKind::Tet,
-                Some("session") => ExportKind::Session,
-                _ => {
-                    return Err(BadField::new(
-                        "kind",
-                        "expected png, exr, vtu, tet or session",
-                    ));
-                }
-            };
-            let name = get(o, "name")?
-                .as_str()
-                .ok_or_else(|| BadField::new("name", "expected a file name"))?
-                .to_string();
-            check_name(&name, kind)?;
-            let size = match o.get("size") {
-                None => 1024,
-                Some(v) => v
-                    .as_u64()
-                    .filter(|s| (16..=8192).contains(s))
-                    .ok_or_else(|| BadField::new("size", "expected 16 to 8192 pixels"))?
-                    as u32,
-            };
-            let overwrite = match o.get("overwrite") {
-                None => false,
-                Some(v) => v
-                    .as_bool()
-                    .ok_or_else(|| BadField::new("overwrite", "expected true or false"))?,
-            };
-            let view = match o.get("view") {
-                None => None,
-                Some(v) => Some(nonzero(vec3(v, "view")?, "view")?),
-            };
-            Request::Export {
-                kind,
-                name,
-                size,
-                overwrite,
-                view,
-            }
-        }
+        "export" => export(o)?,
         other => {
             return Err(BadField::new("op", format!("unknown op {other:?}")));
         }
     };
     Ok((seq, request))
+}
+
+/// A paint stroke of one or more points.
+fn paint(o: &Map<String, Value>) -> Result<Request, BadField> {
+    let m = medium(get(o, "material")?, "material")?;
+    let radius = number(get(o, "radius")?, "radius")?;
+    if radius <= 0.0 {
+        return Err(BadField::new("radius", "must be positive"));
+    }
+    let strength = number(get(o, "strength")?, "strength")?;
+    if !(0.0..=1.0).contains(&strength) {
+        return Err(BadField::new("strength", "must be in [0, 1]"));
+    }
+    let pts = points(get(o, "points")?, "points", 1)?;
+    Ok(Request::Edit(Edit::Paint(vec![Stroke {
+        points: pts,
+        radius,
+        medium: m,
+        strength,
+    }])))
+}
+
+/// The scene's lights (replacing all of them).
+fn lights(o: &Map<String, Value>) -> Result<Request, BadField> {
+    let a = get(o, "lights")?
+        .as_array()
+        .ok_or_else(|| BadField::new("lights", "expected an array"))?;
+    if a.len() > MAX_LIGHTS {
+        return Err(BadField::new(
+            "lights",
+            format!("at most {MAX_LIGHTS} lights"),
+        ));
+    }
+    let mut lights = Vec::with_capacity(a.len());
+    for (k, l) in a.iter().enumerate() {
+        let f = |name: &str| format!("lights[{k}].{name}");
+        let lo = l
+            .as_object()
+            .ok_or_else(|| BadField::new(format!("lights[{k}]"), "expected an object"))?;
+        let kind = lo
+            .get("kind")
+            .and_then(Value::as_str)
+            .ok_or_else(|| BadField::new(f("kind"), "expected \"dir\" or \"point\""))?;
+        let color = rgb(lo.get("rgb"), &f("rgb"))?;
+        lights.push(match kind {
+            "dir" => Light::Directional {
+                to_light: nonzero(
+                    vec3(
+                        lo.get("dir")
+                            .ok_or_else(|| BadField::new(f("dir"), "missing"))?,
+                        &f("dir"),
+                    )?,
+                    &f("dir"),
+                )?,
+                irradiance: color,
+            },
+            "point" => Light::Point {
+                position: vec3(
+                    lo.get("pos")
+                        .ok_or_else(|| BadField::new(f("pos"), "missing"))?,
+                    &f("pos"),
+                )?,
+                intensity: color,
+            },
+            other => {
+                return Err(BadField::new(
+                    f("kind"),
+                    format!("unknown kind {other:?} (dir or point)"),
+                ));
+            }
+        });
+    }
+    Ok(Request::Edit(Edit::Lights(lights)))
+}
+
+/// A cut by a plane or a screen stroke.
+fn cut(o: &Map<String, Value>) -> Result<Request, BadField> {
+    Ok(if let Some(p) = o.get("plane") {
+        let po = p
+            .as_object()
+            .ok_or_else(|| BadField::new("plane", "expected {point, normal}"))?;
+        Request::Edit(Edit::Cut(Cut::Plane {
+            point: vec3(
+                get(po, "point").map_err(|_| missing("plane.point"))?,
+                "plane.point",
+            )?,
+            normal: nonzero(
+                vec3(
+                    get(po, "normal").map_err(|_| missing("plane.normal"))?,
+                    "plane.normal",
+                )?,
+                "plane.normal",
+            )?,
+        }))
+    } else if let Some(s) = o.get("stroke") {
+        let so = s
+            .as_object()
+            .ok_or_else(|| BadField::new("stroke", "expected {points, view}"))?;
+        Request::Edit(Edit::Cut(Cut::Stroke {
+            points: points(
+                get(so, "points").map_err(|_| missing("stroke.points"))?,
+                "stroke.points",
+                2,
+            )?,
+            view: nonzero(
+                vec3(
+                    get(so, "view").map_err(|_| missing("stroke.view"))?,
+                    "stroke.view",
+                )?,
+                "stroke.view",
+            )?,
+        }))
+    } else {
+        return Err(BadField::new("plane", "a cut needs plane or stroke"));
+    })
+}
+
+/// An export: its kind, file name, size, overwrite flag and view.
+fn export(o: &Map<String, Value>) -> Result<Request, BadField> {
+    let kind = match get(o, "kind")?.as_str() {
+        Some("png") => ExportKind::Png,
+        Some("exr") => ExportKind::Exr,
+        Some("vtu") => ExportKind::Vtu,
+        Some("tet") => ExportKind::Tet,
+        Some("session") => ExportKind::Session,
+        _ => {
+            return Err(BadField::new(
+                "kind",
+                "expected png, exr, vtu, tet or session",
+            ));
+        }
+    };
+    let name = get(o, "name")?
+        .as_str()
+        .ok_or_else(|| BadField::new("name", "expected a file name"))?
+        .to_string();
+    check_name(&name, kind)?;
+    let size = match o.get("size") {
+        None => 1024,
+        Some(v) => v
+            .as_u64()
+            .filter(|s| (16..=8192).contains(s))
+            .ok_or_else(|| BadField::new("size", "expected 16 to 8192 pixels"))?
+            as u32,
+    };
+    let overwrite = match o.get("overwrite") {
+        None => false,
+        Some(v) => v
+            .as_bool()
+            .ok_or_else(|| BadField::new("overwrite", "expected true or false"))?,
+    };
+    let view = match o.get("view") {
+        None => None,
+        Some(v) => Some(nonzero(vec3(v, "view")?, "view")?),
+    };
+    Ok(Request::Export {
+        kind,
+        name,
+        size,
+        overwrite,
+        view,
+    })
 }
 
 fn missing(field: &str) -> BadField {
