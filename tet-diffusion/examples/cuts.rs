@@ -3,7 +3,7 @@
 //! and the angles of the tets it makes.
 //!
 //! ```sh
-//! TRILUX_DATA=../shared/data cargo run --release -p tet-diffusion --example cuts -- [MESH.node ...] [--runs R] [--planes P]
+//! TRILUX_DATA=../shared/data cargo run --release -p tet-diffusion --example cuts -- [MESH.node ...] [--runs R] [--planes P] [--angles-only]
 //! ```
 //!
 //! Default mesh `$TRILUX_DATA/tets/bunny_500k.node` (in metres: 1 unit =
@@ -19,7 +19,10 @@
 //! box diagonal (for the relaxation, of the vertices it could not pull onto
 //! it). The second table: the smallest dihedral angle the exact cut made
 //! over `P` planes (default 24) through random points of the box with random
-//! normals (fixed seed), with the mesh's own smallest angle.
+//! normals (fixed seed), with the mesh's own smallest angle and the planes
+//! the angle bound refused (`Error::CutAngleBound`). The timing table gives
+//! the cut's phases from `CutReport::times` and the output starts with
+//! `/proc/loadavg`; `--angles-only` skips the timing.
 
 use std::time::Instant;
 
@@ -37,6 +40,7 @@ struct Args {
     meshes: Vec<std::path::PathBuf>,
     runs: usize,
     planes: usize,
+    angles_only: bool,
 }
 
 fn args() -> Result<Args, String> {
@@ -44,6 +48,7 @@ fn args() -> Result<Args, String> {
         meshes: Vec::new(),
         runs: 5,
         planes: 24,
+        angles_only: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(x) = it.next() {
@@ -56,6 +61,7 @@ fn args() -> Result<Args, String> {
         match x.as_str() {
             "--runs" => a.runs = number("--runs")?,
             "--planes" => a.planes = number("--planes")?,
+            "--angles-only" => a.angles_only = true,
             _ if x.starts_with("--") => return Err(format!("unknown option {x}")),
             _ => a.meshes.push(x.into()),
         }
@@ -134,13 +140,20 @@ impl Random {
     }
 }
 
+/// The first line of `/proc/loadavg`, to print beside the timings.
+fn loadavg() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map_or_else(|_| "unknown".into(), |l| l.trim().to_owned())
+}
+
 fn run() -> Result<(), String> {
     let a = args()?;
+    let load_start = loadavg();
     let mut timing = String::from(
-        "| mesh | #tets | cut | cut ms | re-solve ms | cut + re-solve ms | exact / relax | split tets | min created dihedral ° | off plane |\n|---|---|---|---|---|---|---|---|---|---|\n",
+        "| mesh | #tets | cut | split ms | mesh ms | assembly ms | lights ms | cut ms | re-solve ms | cut + re-solve ms | exact / relax | split tets | min created dihedral ° | off plane |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let mut angles = String::from(
-        "| mesh | mesh's min dihedral ° | planes | min created dihedral ° | median over planes ° |\n|---|---|---|---|---|\n",
+        "| mesh | mesh's min dihedral ° | planes | refused | min created dihedral ° | median over planes ° |\n|---|---|---|---|---|---|\n",
     );
     for path in &a.meshes {
         let name = path
@@ -176,14 +189,17 @@ fn run() -> Result<(), String> {
             normal,
         };
         let mut totals = [0.0; 2];
-        for (k, (label, method)) in [
-            ("exact", CutMethod::Exact),
-            ("relax (5 sweeps)", CutMethod::Relax { sweeps: 5 }),
-        ]
-        .into_iter()
-        .enumerate()
-        {
+        let methods = if a.angles_only {
+            Vec::new()
+        } else {
+            vec![
+                ("exact", CutMethod::Exact),
+                ("relax (5 sweeps)", CutMethod::Relax { sweeps: 5 }),
+            ]
+        };
+        for (k, (label, method)) in methods.into_iter().enumerate() {
             let (mut cut_ms, mut solve_ms, mut sum_ms) = (Vec::new(), Vec::new(), Vec::new());
+            let mut phases: [Vec<f64>; 4] = Default::default();
             let mut last = None;
             for _ in 0..a.runs {
                 let mut o = object.clone();
@@ -193,6 +209,14 @@ fn run() -> Result<(), String> {
                 let t = Instant::now();
                 o.solve().map_err(|e| e.to_string())?;
                 let s = ms(t);
+                let p = report.times;
+                for (v, x) in
+                    phases
+                        .iter_mut()
+                        .zip([p.split_ms, p.mesh_ms, p.assembly_ms, p.lights_ms])
+                {
+                    v.push(x);
+                }
                 cut_ms.push(c);
                 solve_ms.push(s);
                 sum_ms.push(c + s);
@@ -213,8 +237,9 @@ fn run() -> Result<(), String> {
             } else {
                 "—".into()
             };
+            let [p0, p1, p2, p3] = phases.map(median);
             timing.push_str(&format!(
-                "| {name} | {tets} | {label} | {:.0} | {:.0} | {:.0} | {ratio} | {} | {min_created} | {off:.1e} |\n",
+                "| {name} | {tets} | {label} | {p0:.0} | {p1:.0} | {p2:.0} | {p3:.0} | {:.0} | {:.0} | {:.0} | {ratio} | {} | {min_created} | {off:.1e} |\n",
                 median(cut_ms),
                 median(solve_ms),
                 totals[k],
@@ -224,6 +249,7 @@ fn run() -> Result<(), String> {
         // Angles over random planes.
         let mut rng = Random(0x5EED);
         let mut mins = Vec::new();
+        let mut refused = 0;
         for _ in 0..a.planes {
             let p = lo
                 + (hi - lo)
@@ -249,6 +275,10 @@ fn run() -> Result<(), String> {
             ) {
                 Ok(r) if r.min_created_dihedral.is_finite() => mins.push(r.min_created_dihedral),
                 Ok(_) | Err(tet_diffusion::Error::CutRemovesEverything { .. }) => {}
+                Err(e @ tet_diffusion::Error::CutAngleBound { .. }) => {
+                    refused += 1;
+                    eprintln!("{name}: plane through {p} normal {n} refused: {e}");
+                }
                 Err(e) => return Err(e.to_string()),
             }
         }
@@ -260,10 +290,15 @@ fn run() -> Result<(), String> {
             median(mins)
         };
         angles.push_str(&format!(
-            "| {name} | {own_min:.2} | {planes} | {worst:.2} | {med:.2} |\n"
+            "| {name} | {own_min:.2} | {planes} | {refused} | {worst:.2} | {med:.2} |\n"
         ));
     }
+    let threads = rayon::current_num_threads();
+    println!(
+        "Medians of {} runs, {threads} threads; /proc/loadavg at the start: {load_start}, at the end: {}.\n",
+        a.runs,
+        loadavg()
+    );
     println!("{timing}\n{angles}");
-    println!("(cat /proc/loadavg beside any figure quoted)");
     Ok(())
 }

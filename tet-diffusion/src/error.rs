@@ -113,6 +113,19 @@ pub enum Error {
         /// Tetrahedra before the cut.
         tets: usize,
     },
+    /// An exact cut (or a fracture) would make a tet below the angle bound
+    /// (`cut::created_angle_bound`) and no snap of a vertex avoids it.
+    #[error(
+        "the exact cut would split input tet {tet} into a tet with a {angle:.3}° dihedral angle, below the bound {bound:.3}° there, and no vertex of it can snap onto the cut; cut a little elsewhere or use the relaxation cut"
+    )]
+    CutAngleBound {
+        /// The input tet (index in the mesh before the cut).
+        tet: usize,
+        /// The smallest dihedral angle of its pieces, degrees.
+        angle: f64,
+        /// Its bound, degrees.
+        bound: f64,
+    },
     /// A fracture plane leaves one side empty.
     #[error("the fracture plane leaves {side} side empty: all tetrahedra lie on one side")]
     EmptyPiece {

@@ -36,7 +36,8 @@ impl Object {
     ///
     /// # Errors
     /// [`Error::BadArgument`] for a non-finite point or a zero normal,
-    /// [`Error::EmptyPiece`] when the plane does not split the object.
+    /// [`Error::EmptyPiece`] when the plane does not split the object,
+    /// [`Error::CutAngleBound`] as for the exact cut.
     pub fn fracture(&self, point: DVec3, normal: DVec3) -> Result<[Object; 2], Error> {
         finite_vec("the fracture plane's point", point)?;
         finite_vec("the fracture plane's normal", normal)?;
@@ -49,7 +50,7 @@ impl Object {
         }
         let unit = normal.normalize();
         let level = move |x: DVec3| (x - point).dot(unit);
-        let split = split::split(&self.mesh, &level, Keep::Both);
+        let split = split::split(&self.mesh, &level, Keep::Both)?;
         let upper: Vec<bool> = split.side.iter().map(|&s| s > 0).collect();
         let count = upper.iter().filter(|&&u| u).count();
         if count == 0 {

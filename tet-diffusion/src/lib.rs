@@ -82,7 +82,7 @@ pub mod session;
 #[path = "../tests/common/kuhn.rs"]
 mod kuhn;
 
-pub use cut::{Cut, CutMethod, CutReport};
+pub use cut::{Cut, CutMethod, CutReport, CutTimes};
 pub use error::Error;
 pub use fem::{Integration, P1Matrices};
 pub use light::{Environment, Light};

@@ -276,9 +276,12 @@ impl Object {
 
     /// Recomputes everything that depends on the mesh: geometry, matrices,
     /// shadows, visibility, `q` and `b`.
-    pub(crate) fn rebuild(&mut self) {
+    /// Returns the time (ms) of the matrices' assembly and of the lights'
+    /// re-tracing with the right-hand sides, for the cut's report.
+    pub(crate) fn rebuild(&mut self) -> [f64; 2] {
         self.kept = None;
-        self.reassemble();
+        let assembly_ms = self.reassemble();
+        let start = Instant::now();
         let lights: Vec<Light> = self.lights.drain(..).map(|l| l.light).collect();
         self.shadows = None;
         for light in lights {
@@ -286,6 +289,7 @@ impl Object {
         }
         self.incident = None;
         self.update_rhs();
+        [assembly_ms, start.elapsed().as_secs_f64() * 1e3]
     }
 
     /// Per-tet coefficients in mesh units.

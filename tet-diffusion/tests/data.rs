@@ -212,7 +212,7 @@ fn exact_plane_cuts_of_bunny_500k_lie_on_the_plane() {
     let mut o =
         Object::homogeneous(mesh, 1000.0, Medium::measured("marble").unwrap(), 1.3).unwrap();
     o.set_shadows(false);
-    let bound = tet_diffusion::cut::MIN_CREATED_DIHEDRAL_DEGREES;
+    let bound = tet_diffusion::cut::created_angle_bound(o.mesh().quality().min_dihedral);
     for (point, normal) in [
         (centre, DVec3::new(1.0, 0.0, 0.2)),
         (
@@ -226,8 +226,7 @@ fn exact_plane_cuts_of_bunny_500k_lie_on_the_plane() {
             .cut(&Cut::Plane { point, normal }, CutMethod::Exact)
             .unwrap();
         assert!(report.min_created_dihedral >= bound, "{report:?}");
-        let (off, deviation, vertices) =
-            check_exact_plane_cut(o.mesh(), cut.mesh(), point, normal, bound);
+        let (off, deviation, vertices) = check_exact_plane_cut(o.mesh(), cut.mesh(), point, normal);
         let analytic = clipped_volume(o.mesh(), point, normal);
         let error = (cut.mesh().volume() / analytic - 1.0).abs();
         eprintln!(

@@ -270,19 +270,14 @@ fn exact_plane_cut_lies_on_the_plane() {
     let cut = Cut::Plane { point, normal };
     let report = o.cut(&cut, CutMethod::Exact).unwrap();
     assert!(report.split_tets > 0 && report.created_vertices > 0 && report.created_tets > 0);
-    assert!(report.min_created_dihedral >= tet_diffusion::cut::MIN_CREATED_DIHEDRAL_DEGREES);
-    let (off, deviation, vertices) = check_exact_plane_cut(
-        before.mesh(),
-        o.mesh(),
-        point,
-        normal,
-        tet_diffusion::cut::MIN_CREATED_DIHEDRAL_DEGREES,
-    );
+    let bound = tet_diffusion::cut::created_angle_bound(before.mesh().quality().min_dihedral);
+    assert!(report.min_created_dihedral >= bound, "{report:?}");
+    let (off, deviation, vertices) = check_exact_plane_cut(before.mesh(), o.mesh(), point, normal);
     eprintln!(
         "{vertices} cut vertices, at most {off:e} of the box off the plane, normals within {deviation:.2e}°; {report:?}"
     );
     // The volume left is the analytic clipped volume, up to the vertices
-    // snapped onto the plane (each moved less than SNAP of an edge).
+    // snapped onto the plane (each moved at most half an edge).
     let analytic = clipped_volume(before.mesh(), point, normal);
     let left = o.mesh().volume();
     let error = (left / analytic - 1.0).abs();
@@ -360,6 +355,6 @@ fn fracture_pieces_meet_on_the_plane_with_the_analytic_volumes() {
     for (piece, analytic, n) in [(&a, below, normal), (&b, above, -normal)] {
         let error = (piece.mesh().volume() / analytic - 1.0).abs();
         assert!(error < 5e-3, "{error}");
-        check_exact_plane_cut(o.mesh(), piece.mesh(), point, n, 0.0);
+        check_exact_plane_cut(o.mesh(), piece.mesh(), point, n);
     }
 }

@@ -13,6 +13,8 @@
 //! Either way the system is rebuilt and `φ` carried over as the warm
 //! start (interpolated along the edge for a vertex the cut creates).
 
+use std::time::Instant;
+
 use glam::DVec3;
 
 use crate::error::finite_vec;
@@ -22,7 +24,7 @@ mod relax;
 pub mod split;
 
 pub use relax::RHO;
-pub use split::{MIN_CREATED_DIHEDRAL_DEGREES, SNAP, SNAP_MIN_DIHEDRAL_DEGREES};
+pub use split::{ANGLE_BOUND_DEGREES, ANGLE_BOUND_FRACTION, SNAP, created_angle_bound};
 
 /// What to cut away.
 #[derive(Debug, Clone, PartialEq)]
@@ -120,8 +122,13 @@ impl Cut {
 pub enum CutMethod {
     /// Split the tets the cut surface crosses along it (snapping vertices
     /// within [`SNAP`] of an edge onto it first): the cross-section lies on
-    /// the surface; on meshes without slivers no created tet has a dihedral
-    /// angle below [`MIN_CREATED_DIHEDRAL_DEGREES`] (measured, see there).
+    /// the surface, and every tet the cut makes from an input tet `P` (a
+    /// piece of it, or `P` with snapped corners) has a smallest dihedral
+    /// angle of at least [`created_angle_bound`]`(θ(P)) =
+    /// min(`[`ANGLE_BOUND_DEGREES`]` = 0.5°, `[`ANGLE_BOUND_FRACTION`]` = 0.25 ·
+    /// θ(P))`, `θ(P)` the smallest dihedral angle of `P` before the cut.
+    /// Guaranteed: the cut snaps further vertices to keep it and, when no
+    /// snap can, fails with [`Error::CutAngleBound`] ([`split`]).
     #[default]
     Exact,
     /// TransCut's cut (Sec. 5): remove the tets entirely on the cut side,
@@ -156,6 +163,24 @@ pub struct CutReport {
     /// or whose corners it snapped (∞ when there are none, and for the
     /// relaxation).
     pub min_created_dihedral: f64,
+    /// Where the cut's time went.
+    pub times: CutTimes,
+}
+
+/// Wall-clock time of a cut's phases, ms (for benchmarks; it varies from
+/// run to run, unlike the rest of [`CutReport`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CutTimes {
+    /// Classifying the vertices and moving or splitting: the exact cut's
+    /// snap and split, the relaxation's removal and sweeps.
+    pub split_ms: f64,
+    /// Building the new [`TetMesh`] (adjacency, boundary, its areas and
+    /// normals) and carrying `φ` over.
+    pub mesh_ms: f64,
+    /// The per-tet geometry and the three matrices.
+    pub assembly_ms: f64,
+    /// Re-tracing the lights' shadows and the right-hand sides.
+    pub lights_ms: f64,
 }
 
 impl Object {
@@ -170,7 +195,8 @@ impl Object {
     ///
     /// # Errors
     /// [`Error::BadArgument`] for a non-finite or zero plane/stroke,
-    /// [`Error::CutRemovesEverything`]; the object is then unchanged.
+    /// [`Error::CutRemovesEverything`], [`Error::CutAngleBound`] (exact cut
+    /// only); the object is then unchanged.
     pub fn cut(&mut self, cut: &Cut, method: CutMethod) -> Result<CutReport, Error> {
         cut.check()?;
         match method {
@@ -184,11 +210,15 @@ impl Object {
         let old_tets = self.mesh.tets().len();
         let old_vertices = self.mesh.vertex_count();
         let level = |x: DVec3| cut.side(x);
-        let split = split::split(&self.mesh, &level, split::Keep::Negative);
+        let start = Instant::now();
+        let split = split::split(&self.mesh, &level, split::Keep::Negative)?;
         if split.tets.is_empty() {
             return Err(Error::CutRemovesEverything { tets: old_tets });
         }
+        let split_ms = ms(start);
+        let start = Instant::now();
         let parts = self.split_parts(&split, true)?;
+        let mesh_ms = ms(start);
         let whole = split.piece.iter().filter(|&&p| !p).count();
         let report = CutReport {
             removed_tets: old_tets - whole - split.split_tets,
@@ -199,13 +229,22 @@ impl Object {
             created_tets: split.piece.iter().filter(|&&p| p).count(),
             created_vertices: split.new.len(),
             min_created_dihedral: parts.min_created_dihedral,
+            times: CutTimes::default(),
         };
         self.mesh = parts.mesh;
         self.media = parts.media;
         self.phi = parts.phi;
         self.lineage = None;
-        self.rebuild();
-        Ok(report)
+        let [assembly_ms, lights_ms] = self.rebuild();
+        Ok(CutReport {
+            times: CutTimes {
+                split_ms,
+                mesh_ms,
+                assembly_ms,
+                lights_ms,
+            },
+            ..report
+        })
     }
 
     /// The mesh, media and `φ` of a split (its tets' vertices renumbered in
@@ -284,6 +323,11 @@ impl Object {
             min_created_dihedral,
         })
     }
+}
+
+/// Milliseconds since `start`.
+pub(crate) fn ms(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
 }
 
 /// What a split object is made of.

@@ -5,7 +5,9 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{Cut, CutReport};
+use std::time::Instant;
+
+use super::{Cut, CutReport, CutTimes, ms};
 use crate::mesh::{POOR_DIHEDRAL_DEGREES, dihedral_angles, volume6};
 use crate::{Error, Object, TetMesh};
 
@@ -27,6 +29,7 @@ impl Object {
     /// [`Error::BadArgument`] for a non-finite or zero plane/stroke,
     /// [`Error::CutRemovesEverything`].
     pub(super) fn cut_relax(&mut self, cut: &Cut, relax_sweeps: usize) -> Result<CutReport, Error> {
+        let start = Instant::now();
         let mesh = &self.mesh;
         let n = mesh.vertex_count();
         let side: Vec<f64> = mesh.positions().par_iter().map(|&x| cut.side(x)).collect();
@@ -54,7 +57,11 @@ impl Object {
         }
         let removed_tets = mesh.tets().len() - keep.len();
         let removed_vertices = n - old_of_new.len();
+        let mut split_ms = ms(start);
+        let start = Instant::now();
         let mut new_mesh = mesh.subset(&keep, &new_index, &old_of_new)?;
+        let mut mesh_ms = ms(start);
+        let start = Instant::now();
         let mut positions = new_mesh.positions().to_vec();
         // Only vertices inside the object before the cut move: the object's
         // own surface keeps its shape.
@@ -63,15 +70,18 @@ impl Object {
             .map(|&v| mesh.boundary_index(v).is_none())
             .collect();
         let (moved, sweeps) = relax(&new_mesh, cut, &inside, &mut positions, relax_sweeps);
+        split_ms += ms(start);
+        let start = Instant::now();
         if moved > 0 {
             // Every move kept its tets positively oriented: same topology.
             new_mesh.move_vertices(positions);
         }
         let phi = std::array::from_fn(|c| old_of_new.iter().map(|&v| self.phi[c][v]).collect());
+        mesh_ms += ms(start);
         self.mesh = new_mesh;
         self.phi = phi;
         self.lineage = None;
-        self.rebuild();
+        let [assembly_ms, lights_ms] = self.rebuild();
         Ok(CutReport {
             removed_tets,
             removed_vertices,
@@ -81,6 +91,12 @@ impl Object {
             created_tets: 0,
             created_vertices: 0,
             min_created_dihedral: f64::INFINITY,
+            times: CutTimes {
+                split_ms,
+                mesh_ms,
+                assembly_ms,
+                lights_ms,
+            },
         })
     }
 }

@@ -215,7 +215,8 @@ pub(crate) fn clipped_volume(mesh: &TetMesh, point: DVec3, normal: DVec3) -> f64
 /// the normal points to) of `before` into `after`: every boundary vertex
 /// the cut made (not an old boundary vertex where it was) lies on the plane
 /// to `1e-9` of the bounding box; every tet has a dihedral angle of at
-/// least `min(bound, before's smallest)`; the cut face's normal is within
+/// least `cut::created_angle_bound(before's smallest)` (each tet the cut
+/// made is above its parent's bound, which is at least that); the cut face's normal is within
 /// 1° of the plane's at every vertex of it. Returns (the largest distance
 /// of a cut vertex from the plane relative to the box, the largest normal
 /// deviation in degrees, the number of cut vertices).
@@ -224,7 +225,6 @@ pub(crate) fn check_exact_plane_cut(
     after: &TetMesh,
     point: DVec3,
     normal: DVec3,
-    bound: f64,
 ) -> (f64, f64, usize) {
     let n = normal.normalize();
     let (lo, hi) = before
@@ -266,8 +266,9 @@ pub(crate) fn check_exact_plane_cut(
             .to_degrees()
     };
     let (was, now) = (min_of(before), min_of(after));
+    let bound = tet_diffusion::cut::created_angle_bound(was);
     assert!(
-        now >= bound.min(was) - 1e-9,
+        now >= bound - 1e-9,
         "smallest dihedral {now}° (before {was}°, bound {bound}°)"
     );
     // The cut face: boundary faces with every vertex on the plane.
