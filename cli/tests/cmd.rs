@@ -4,7 +4,7 @@
 //! each typed option, a bad spec) and every one-line error about a file
 //! (no such file, a bad format, an output that exists). Each case is a
 //! `cmd/<kind>/<name>.toml` with the exact stdout, stderr and exit code
-//! beside it; the inputs are the tiny files of `cmd/inputs/`, copied into
+//! beside it (and `cmd/outputs/`: what `info` prints on them); the inputs are the tiny files of `cmd/inputs/`, copied into
 //! a fresh folder for each case.
 //!
 //! After a deliberate change of a text, regenerate the snapshots with
@@ -19,5 +19,6 @@ fn help_usage_and_error_texts_match_their_snapshots() {
         .env("NO_COLOR", "1")
         .case("tests/cmd/help/*.toml")
         .case("tests/cmd/usage/*.toml")
-        .case("tests/cmd/errors/*.toml");
+        .case("tests/cmd/errors/*.toml")
+        .case("tests/cmd/outputs/*.toml");
 }

@@ -117,15 +117,7 @@ fn describe_mesh(
         .map(|(lo, hi)| (lo.as_dvec3() + mesh.origin, hi.as_dvec3() + mesh.origin));
     let (lo, hi) = bounds.unwrap_or_default();
     let diagonal = (hi - lo).length();
-    let used = {
-        let mut used = vec![false; mesh.positions.len()];
-        for &v in mesh.indices.iter().flatten() {
-            if let Some(u) = used.get_mut(v as usize) {
-                *u = true;
-            }
-        }
-        used.iter().filter(|&&u| u).count()
-    };
+    let used = used_vertices(mesh);
     // `+ 0.0` turns the empty sum's -0 into 0.
     let area = mesh.area() + 0.0;
     let mut text = format!(
@@ -172,7 +164,48 @@ fn describe_mesh(
         "  normals: {}",
         if mesh.normals.is_some() { "yes" } else { "no" }
     );
-    let uv_json = match &mesh.uvs {
+    let uv_json = describe_uvs(&mut text, mesh.uvs.as_deref());
+    let materials = describe_materials(&mut text, mesh);
+    let _ = writeln!(text, "  objects: {}", mesh.objects.len());
+    let mut json = json!({
+        "file": super::shown(path),
+        "kind": kind,
+        "vertices": mesh.positions.len(),
+        "used_vertices": used,
+        "welded_vertices": shape.welded_vertices,
+        "triangles": mesh.indices.len(),
+        "bounds": bounds.map(|(lo, hi)| json!([lo.to_array(), hi.to_array()])),
+        "diagonal": diagonal,
+        "unit_guess": trilux::mesh::unit_guess(diagonal as f32),
+        "area": area,
+        "parts": shape.parts,
+        "holes": shape.holes,
+        "boundary_edges": shape.boundary_edges,
+        "non_manifold_edges": shape.non_manifold_edges,
+        "closed": closed,
+        "normals": mesh.normals.is_some(),
+        "uvs": uv_json,
+        "objects": mesh.objects.len(),
+        "materials": materials,
+    });
+    add_warnings(&mut text, &mut json, &mesh.warnings);
+    (text, json)
+}
+
+/// How many vertices the triangles use.
+fn used_vertices(mesh: &trilux_io::mesh::TriMesh) -> usize {
+    let mut used = vec![false; mesh.positions.len()];
+    for &v in mesh.indices.iter().flatten() {
+        if let Some(u) = used.get_mut(v as usize) {
+            *u = true;
+        }
+    }
+    used.iter().filter(|&&u| u).count()
+}
+
+/// The UVs' range (and whether they tile) as a line of `text` and JSON.
+fn describe_uvs(text: &mut String, uvs: Option<&[glam::Vec2]>) -> Value {
+    match uvs {
         Some(uvs) => {
             let (ulo, uhi) = uvs.iter().fold(
                 (glam::Vec2::INFINITY, glam::Vec2::NEG_INFINITY),
@@ -198,9 +231,12 @@ fn describe_mesh(
             let _ = writeln!(text, "  UVs: none");
             Value::Null
         }
-    };
-    let materials: Vec<Value> = mesh
-        .materials
+    }
+}
+
+/// One line of `text` and one JSON object per material.
+fn describe_materials(text: &mut String, mesh: &trilux_io::mesh::TriMesh) -> Vec<Value> {
+    mesh.materials
         .iter()
         .map(|m| {
             let texture = m
@@ -220,31 +256,7 @@ fn describe_mesh(
             );
             json!({"name": m.name, "diffuse": m.diffuse, "texture": texture})
         })
-        .collect();
-    let _ = writeln!(text, "  objects: {}", mesh.objects.len());
-    let mut json = json!({
-        "file": super::shown(path),
-        "kind": kind,
-        "vertices": mesh.positions.len(),
-        "used_vertices": used,
-        "welded_vertices": shape.welded_vertices,
-        "triangles": mesh.indices.len(),
-        "bounds": bounds.map(|(lo, hi)| json!([lo.to_array(), hi.to_array()])),
-        "diagonal": diagonal,
-        "unit_guess": trilux::mesh::unit_guess(diagonal as f32),
-        "area": area,
-        "parts": shape.parts,
-        "holes": shape.holes,
-        "boundary_edges": shape.boundary_edges,
-        "non_manifold_edges": shape.non_manifold_edges,
-        "closed": closed,
-        "normals": mesh.normals.is_some(),
-        "uvs": uv_json,
-        "objects": mesh.objects.len(),
-        "materials": materials,
-    });
-    add_warnings(&mut text, &mut json, &mesh.warnings);
-    (text, json)
+        .collect()
 }
 
 fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
