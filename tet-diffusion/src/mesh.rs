@@ -289,6 +289,144 @@ impl TetMesh {
         Ok(mesh)
     }
 
+    /// A mesh made mostly of this one's tets: what an exact cut or a
+    /// fracture leaves. `tets` are positively oriented; `tets[k]` with
+    /// `from[k] = t` (not [`NONE`]) is this mesh's tet `t` with vertex `v`
+    /// renumbered `new_index[v]`, so its face adjacency to another such tet
+    /// is kept; only the faces of the new tets and of the kept tets next to
+    /// a tet not kept whole are matched (no re-validation, no sort of all
+    /// the faces). Equal to building it with
+    /// [`with_original`](Self::with_original).
+    ///
+    /// # Errors
+    /// [`Error::EmptyMesh`], [`Error::TooLarge`],
+    /// [`Error::NonManifoldFace`].
+    pub(crate) fn derived(
+        &self,
+        positions: Vec<DVec3>,
+        tets: Vec<[u32; 4]>,
+        original: Vec<u32>,
+        from: &[u32],
+        new_index: &[u32],
+    ) -> Result<Self, Error> {
+        if positions.is_empty() || tets.is_empty() {
+            return Err(Error::EmptyMesh {
+                vertices: positions.len(),
+                tets: tets.len(),
+            });
+        }
+        if positions.len() >= NONE as usize || tets.len() >= NONE as usize {
+            return Err(Error::TooLarge {
+                what: "vertices or tetrahedra",
+                count: positions.len().max(tets.len()),
+            });
+        }
+        // A kept tet is one of ours only if it is ours renumbered.
+        let from: Vec<u32> = from
+            .par_iter()
+            .zip(&tets)
+            .map(|(&t, tet)| {
+                let ours =
+                    t != NONE && self.tets[t as usize].map(|v| new_index[v as usize]) == *tet;
+                if ours { t } else { NONE }
+            })
+            .collect();
+        let mut kept = vec![NONE; self.tets.len()];
+        for (k, &t) in from.iter().enumerate() {
+            if t != NONE {
+                kept[t as usize] = k as u32;
+            }
+        }
+        // Adjacency: kept where both sides are kept whole; the other faces
+        // (`PENDING`) are matched below.
+        const PENDING: u32 = NONE - 1;
+        let mut tet_neighbors: Vec<[u32; 4]> = from
+            .par_iter()
+            .map(|&t| {
+                if t == NONE {
+                    return [PENDING; 4];
+                }
+                self.tet_neighbors[t as usize].map(|o| {
+                    if o == NONE {
+                        NONE
+                    } else if kept[o as usize] != NONE {
+                        kept[o as usize]
+                    } else {
+                        PENDING
+                    }
+                })
+            })
+            .collect();
+        let mut keys: Vec<([u32; 3], u32)> = tet_neighbors
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(t, adjacent)| {
+                let tet = tets[t];
+                (0..4).filter(|&k| adjacent[k] == PENDING).map(move |k| {
+                    let mut f = OUTWARD_FACES[k].map(|l| tet[l]);
+                    f.sort_unstable();
+                    (f, (t * 4 + k) as u32)
+                })
+            })
+            .collect();
+        keys.par_sort_unstable();
+        let mut i = 0;
+        while i < keys.len() {
+            let mut j = i + 1;
+            while j < keys.len() && keys[j].0 == keys[i].0 {
+                j += 1;
+            }
+            let at = |key: u32| ((key / 4) as usize, (key % 4) as usize);
+            match j - i {
+                1 => {
+                    let (t, k) = at(keys[i].1);
+                    tet_neighbors[t][k] = NONE;
+                }
+                2 => {
+                    let ((a, ka), (b, kb)) = (at(keys[i].1), at(keys[i + 1].1));
+                    tet_neighbors[a][ka] = b as u32;
+                    tet_neighbors[b][kb] = a as u32;
+                }
+                _ => {
+                    return Err(Error::NonManifoldFace {
+                        face: keys[i].0,
+                        tet: (keys[i + 2].1 / 4) as usize,
+                    });
+                }
+            }
+            i = j;
+        }
+        // Ordered by (tet, local face), as `faces` orders them.
+        let mut boundary = Vec::new();
+        for (t, adjacent) in tet_neighbors.iter().enumerate() {
+            for (k, &o) in adjacent.iter().enumerate() {
+                if o == NONE {
+                    boundary.push(OUTWARD_FACES[k].map(|l| tets[t][l]));
+                }
+            }
+        }
+        let n = positions.len();
+        let vertex_tets = vertex_tets(n, &tets);
+        let (neighbors, slots) = neighbors(&vertex_tets, &tets);
+        let mut mesh = Self {
+            positions,
+            tets,
+            original,
+            reoriented: 0,
+            vertex_tets,
+            neighbors,
+            slots,
+            tet_neighbors,
+            boundary,
+            boundary_vertices: Vec::new(),
+            boundary_index: Vec::new(),
+            vertex_area: Vec::new(),
+            vertex_normal: Vec::new(),
+        };
+        mesh.boundary_attributes();
+        Ok(mesh)
+    }
+
     /// Boundary vertex list, per-vertex areas `S_i` and area-weighted
     /// normals.
     fn boundary_attributes(&mut self) {

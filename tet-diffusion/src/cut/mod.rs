@@ -315,7 +315,17 @@ impl Object {
                 min_created_dihedral = min_created_dihedral.min(split::min_dihedral_deg(&c));
             }
         }
-        let mesh = TetMesh::with_original(positions, tets, original)?;
+        // The tets left whole keep their adjacency: only the faces around
+        // the split are matched again.
+        let from: Vec<u32> = split
+            .parent
+            .iter()
+            .zip(&split.piece)
+            .map(|(&t, &piece)| if piece { crate::mesh::NONE } else { t })
+            .collect();
+        let mesh = self
+            .mesh
+            .derived(positions, tets, original, &from, &index[..old])?;
         Ok(SplitParts {
             mesh,
             media,

@@ -451,9 +451,19 @@ impl Snapper<'_> {
             .into_par_iter()
             .with_min_len(4096)
             .filter(|&v| {
-                self.targets(v, true)
-                    .first()
-                    .is_some_and(|&(t, _)| t < SNAP)
+                // Most vertices have no crossing edge: skip them without
+                // gathering their targets.
+                let sv = self.s[v];
+                sv != 0.0
+                    && self
+                        .mesh
+                        .one_ring(v)
+                        .iter()
+                        .any(|&u| self.s[u as usize] * sv < 0.0)
+                    && self
+                        .targets(v, true)
+                        .first()
+                        .is_some_and(|&(t, _)| t < SNAP)
             })
             .collect();
         for v in candidates {

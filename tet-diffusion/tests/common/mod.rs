@@ -217,7 +217,8 @@ pub(crate) fn clipped_volume(mesh: &TetMesh, point: DVec3, normal: DVec3) -> f64
 /// to `1e-9` of the bounding box; every tet has a dihedral angle of at
 /// least `cut::created_angle_bound(before's smallest)` (each tet the cut
 /// made is above its parent's bound, which is at least that); the cut face's normal is within
-/// 1° of the plane's at every vertex of it. Returns (the largest distance
+/// 1° of the plane's at every vertex of it; the mesh is the one built from
+/// scratch from its positions and tets. Returns (the largest distance
 /// of a cut vertex from the plane relative to the box, the largest normal
 /// deviation in degrees, the number of cut vertices).
 pub(crate) fn check_exact_plane_cut(
@@ -226,6 +227,19 @@ pub(crate) fn check_exact_plane_cut(
     point: DVec3,
     normal: DVec3,
 ) -> (f64, f64, usize) {
+    // The cut mesh, derived from `before` around the split, is the mesh
+    // built from scratch from its positions and tets.
+    let scratch = TetMesh::new(after.positions(), after.tets()).unwrap();
+    assert_eq!(scratch.reoriented(), 0);
+    assert_eq!(after.tet_neighbors(), scratch.tet_neighbors());
+    assert_eq!(after.boundary(), scratch.boundary());
+    assert_eq!(after.boundary_vertices(), scratch.boundary_vertices());
+    assert_eq!(after.vertex_areas(), scratch.vertex_areas());
+    assert_eq!(after.vertex_normals(), scratch.vertex_normals());
+    for v in 0..after.vertex_count() {
+        assert_eq!(after.one_ring(v), scratch.one_ring(v));
+        assert_eq!(after.vertex_tets(v), scratch.vertex_tets(v));
+    }
     let n = normal.normalize();
     let (lo, hi) = before
         .positions()
