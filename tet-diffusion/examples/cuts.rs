@@ -127,18 +127,9 @@ fn off_plane(before: &TetMesh, after: &TetMesh, point: DVec3, n: DVec3, size: f6
         .fold(0.0, f64::max)
 }
 
-/// A SplitMix64 stream in [0, 1).
-struct Random(u64);
-
-impl Random {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+#[path = "../tests/common/splitmix.rs"]
+mod splitmix;
+use splitmix::Random;
 
 /// The first line of `/proc/loadavg`, to print beside the timings.
 fn loadavg() -> String {

@@ -31,18 +31,9 @@ const RADIUS: f64 = 10.0;
 const ETA: f64 = 1.3;
 const CONE_DEGREES: f64 = 15.0;
 
-/// SplitMix64 in [0, 1).
-struct Random(u64);
-
-impl Random {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+#[path = "../tests/common/splitmix.rs"]
+mod splitmix;
+use splitmix::Random;
 
 /// Unpolarised Fresnel reflectance between indices `n1` (incident side)
 /// and `n2`, incident cosine `ci`; 1 under total internal reflection.

@@ -258,35 +258,12 @@ impl TetMesh {
                 self.tet_neighbors[t].map(|o| if o == NONE { NONE } else { new_tet[o as usize] })
             })
             .collect();
-        // Ordered by (tet, local face), as `faces` orders them.
-        let mut boundary = Vec::new();
-        for (t, adjacent) in tet_neighbors.iter().enumerate() {
-            for (k, &o) in adjacent.iter().enumerate() {
-                if o == NONE {
-                    boundary.push(OUTWARD_FACES[k].map(|l| tets[t][l]));
-                }
-            }
-        }
-        let n = positions.len();
-        let vertex_tets = vertex_tets(n, &tets);
-        let (neighbors, slots) = neighbors(&vertex_tets, &tets);
-        let mut mesh = Self {
+        Ok(Self::with_adjacency(
             positions,
             tets,
             original,
-            reoriented: 0,
-            vertex_tets,
-            neighbors,
-            slots,
             tet_neighbors,
-            boundary,
-            boundary_vertices: Vec::new(),
-            boundary_index: Vec::new(),
-            vertex_area: Vec::new(),
-            vertex_normal: Vec::new(),
-        };
-        mesh.boundary_attributes();
-        Ok(mesh)
+        ))
     }
 
     /// A mesh made mostly of this one's tets: what an exact cut or a
@@ -396,6 +373,22 @@ impl TetMesh {
             }
             i = j;
         }
+        Ok(Self::with_adjacency(
+            positions,
+            tets,
+            original,
+            tet_neighbors,
+        ))
+    }
+
+    /// The mesh of validated, positively oriented `tets` whose face
+    /// adjacency is known: the boundary, one-rings and boundary areas.
+    fn with_adjacency(
+        positions: Vec<DVec3>,
+        tets: Vec<[u32; 4]>,
+        original: Vec<u32>,
+        tet_neighbors: Vec<[u32; 4]>,
+    ) -> Self {
         // Ordered by (tet, local face), as `faces` orders them.
         let mut boundary = Vec::new();
         for (t, adjacent) in tet_neighbors.iter().enumerate() {
@@ -424,7 +417,7 @@ impl TetMesh {
             vertex_normal: Vec::new(),
         };
         mesh.boundary_attributes();
-        Ok(mesh)
+        mesh
     }
 
     /// Boundary vertex list, per-vertex areas `S_i` and area-weighted

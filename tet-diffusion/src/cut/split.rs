@@ -755,6 +755,10 @@ fn prism<T: Copy + Ord>(a: [T; 3], b: [T; 3]) -> Vec<[T; 4]> {
 mod data_dir;
 
 #[cfg(test)]
+#[path = "../../tests/common/splitmix.rs"]
+mod splitmix;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -876,18 +880,15 @@ mod tests {
         Ok((below, checked))
     }
 
-    /// A SplitMix64 stream in [0, 1).
-    struct Random(u64);
+    use super::splitmix::Random;
 
-    impl Random {
-        fn next(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        }
+    /// Points and directions for the surveys.
+    trait Draw {
+        fn in_box(&mut self, lo: DVec3, hi: DVec3) -> DVec3;
+        fn direction(&mut self) -> DVec3;
+    }
 
+    impl Draw for Random {
         fn in_box(&mut self, lo: DVec3, hi: DVec3) -> DVec3 {
             lo + (hi - lo) * DVec3::new(self.next(), self.next(), self.next())
         }
