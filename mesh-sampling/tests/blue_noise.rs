@@ -5,14 +5,8 @@
 //! determinism across thread counts, errors.
 #![cfg(feature = "blue-noise")]
 
-#[path = "../../io/tests/support/data_dir.rs"]
-mod data_dir;
-#[path = "../../discrete-sampling/tests/support/stats.rs"]
-#[allow(
-    dead_code,
-    reason = "shared statistics helpers; this test uses a subset"
-)]
-mod stats;
+use test_support::data as data_dir;
+use test_support::stats;
 
 use glam::{Vec2, Vec3};
 use mesh_sampling::{

@@ -3,12 +3,7 @@
 //! against rejection sampling; per-face and per-vertex weights; pdfs;
 //! determinism; errors.
 
-#[path = "../../discrete-sampling/tests/support/stats.rs"]
-#[allow(
-    dead_code,
-    reason = "shared statistics helpers; this test uses a subset"
-)]
-mod stats;
+use test_support::stats;
 
 use glam::{DVec2, Vec2, Vec3};
 use mesh_sampling::{
@@ -817,9 +812,8 @@ fn bad_input_is_an_error() {
     ));
 }
 
-#[path = "../../io/tests/support/data_dir.rs"]
-mod data_dir;
 use data_dir::data_dir;
+use test_support::data as data_dir;
 
 /// Each HDR image of `$TRILUX_DATA/hdr`, its luminance box-filtered to
 /// 64×32 (the sun stays thousands of times brighter than the sky), on a

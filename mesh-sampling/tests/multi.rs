@@ -2,12 +2,7 @@
 //! density is uniform over the union, replacing a mesh changes only what
 //! it should, errors name the mesh.
 
-#[path = "../../discrete-sampling/tests/support/stats.rs"]
-#[allow(
-    dead_code,
-    reason = "shared statistics helpers; this test uses a subset"
-)]
-mod stats;
+use test_support::stats;
 
 use glam::Vec3;
 use mesh_sampling::{

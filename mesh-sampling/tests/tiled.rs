@@ -3,12 +3,7 @@
 //! constant density is one piece per triangle, the piece budget holds,
 //! and the exact mode stays exact when the budget coarsens it.
 
-#[path = "../../discrete-sampling/tests/support/stats.rs"]
-#[allow(
-    dead_code,
-    reason = "shared statistics helpers; this test uses a subset"
-)]
-mod stats;
+use test_support::stats;
 
 use glam::{Vec2, Vec3};
 use mesh_sampling::{

@@ -2,12 +2,8 @@
 //! uniform sampler, fails for the naive one), chi-square of per-triangle
 //! counts against area, pdfs, determinism across thread counts, errors.
 
-#[path = "../../discrete-sampling/tests/support/stats.rs"]
-#[allow(
-    dead_code,
-    reason = "shared statistics helpers; this test uses a subset"
-)]
-mod stats;
+use test_support::data as data_dir;
+use test_support::stats;
 
 use glam::{Vec2, Vec3};
 use mesh_sampling::{Error, MeshRef, NaiveSampler, SurfacePoint, SurfaceSampler, UniformSampler};
@@ -282,9 +278,6 @@ fn bad_meshes_are_errors() {
 /// 1.07 / 1.05 / 0.97 per axis, as an unbiased sampler's must. So this
 /// test uses the article's statistic at α = 0.001 per axis (3.29 SEM);
 /// the naive sampler is far beyond it.
-#[path = "../../io/tests/support/data_dir.rs"]
-mod data_dir;
-
 #[test]
 #[cfg_attr(
     not(trilux_data),

@@ -22,8 +22,8 @@ fn temp_dir(name: &str) -> PathBuf {
 
 /// A value with any exponent, sign and mantissa (never NaN or ∞).
 fn any_value(rng: &mut Rng) -> f64 {
-    let v = f64::from_bits(rng.next());
-    if v.is_finite() { v } else { rng.unit() - 0.5 }
+    let v = f64::from_bits(rng.next_u64());
+    if v.is_finite() { v } else { rng.f64() - 0.5 }
 }
 
 #[test]
@@ -31,12 +31,15 @@ fn matrices_and_vectors_round_trip_through_matrix_market_files() {
     let dir = temp_dir("round-trip");
     let mut rng = Rng(41);
     for case in 0..60 {
-        let rows = 1 + (rng.next() % 40) as usize;
-        let cols = 1 + (rng.next() % 40) as usize;
-        let nnz = (rng.next() % (rows * cols + 1) as u64) as usize;
+        let rows = 1 + (rng.next_u64() % 40) as usize;
+        let cols = 1 + (rng.next_u64() % 40) as usize;
+        let nnz = (rng.next_u64() % (rows * cols + 1) as u64) as usize;
         let mut t = TriMat::new((rows, cols));
         for _ in 0..nnz {
-            let (i, j) = ((rng.next() as usize) % rows, (rng.next() as usize) % cols);
+            let (i, j) = (
+                (rng.next_u64() as usize) % rows,
+                (rng.next_u64() as usize) % cols,
+            );
             t.add_triplet(i, j, any_value(&mut rng));
         }
         let a: CsMat<f64> = t.to_csr();
@@ -248,7 +251,7 @@ const EXTREMES: [f64; 10] = [
 #[test]
 fn extreme_arguments_give_errors_or_answers_never_panics() {
     let mut rng = Rng(7);
-    let pick = |rng: &mut Rng| EXTREMES[(rng.next() % EXTREMES.len() as u64) as usize];
+    let pick = |rng: &mut Rng| EXTREMES[(rng.next_u64() % EXTREMES.len() as u64) as usize];
     for round in 0..300 {
         let n = [0usize, 1, 2, 5][round % 4];
         let mut t = TriMat::new((n, n));
@@ -271,8 +274,8 @@ fn extreme_arguments_give_errors_or_answers_never_panics() {
         let _ = cg(&a, &b, &mut x, &options);
         let _ = bicgstab(&a, &b, &mut x, &options);
         let hierarchy = HierarchyOptions {
-            coarsest: (rng.next() % 4) as usize,
-            max_levels: (rng.next() % 4) as usize,
+            coarsest: (rng.next_u64() % 4) as usize,
+            max_levels: (rng.next_u64() % 4) as usize,
             ..HierarchyOptions::default()
         };
         let positions: Vec<[f64; 3]> = (0..n)
@@ -296,7 +299,7 @@ fn extreme_arguments_give_errors_or_answers_never_panics() {
                 let _ = c.solve(&a, &b, &mut x, &options);
             }
         }
-        let _ = grid::diffusion([n, n, (rng.next() % 3) as usize], pick(&mut rng));
+        let _ = grid::diffusion([n, n, (rng.next_u64() % 3) as usize], pick(&mut rng));
     }
     // Huge grid sizes are refused, not allocated.
     assert!(grid::diffusion([1 << 20, 1 << 20, 1 << 20], 1.0).is_err());

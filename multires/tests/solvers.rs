@@ -17,7 +17,7 @@ fn tight() -> SolveOptions {
 /// `x*` with entries in [−1, 1] and `b = A x*`.
 fn manufactured(a: &CsMat<f64>, seed: u64) -> (Vec<f64>, Vec<f64>) {
     let mut rng = Rng(seed);
-    let x: Vec<f64> = (0..a.rows()).map(|_| 2.0 * rng.unit() - 1.0).collect();
+    let x: Vec<f64> = (0..a.rows()).map(|_| 2.0 * rng.f64() - 1.0).collect();
     let b = apply(a, &x);
     (x, b)
 }
@@ -243,8 +243,7 @@ fn the_v_cycle_is_a_symmetric_positive_definite_preconditioner() {
     assert!(v.hierarchy().levels() >= 3);
     let mut rng = Rng(9);
     let n = g.rhs.len();
-    let (r1, r2): (Vec<f64>, Vec<f64>) =
-        (0..n).map(|_| (rng.unit() - 0.5, rng.unit() - 0.5)).unzip();
+    let (r1, r2): (Vec<f64>, Vec<f64>) = (0..n).map(|_| (rng.f64() - 0.5, rng.f64() - 0.5)).unzip();
     let (mut z1, mut z2) = (vec![0.0; n], vec![0.0; n]);
     v.apply(&r1, &mut z1);
     v.apply(&r2, &mut z2);

@@ -4,8 +4,7 @@
 //! exact winding numbers, and the files `trilux-io` writes. (That
 //! `tet-diffusion` accepts these meshes is checked in `trilux-tests`.)
 
-#[path = "../../io/tests/support/data_dir.rs"]
-mod data_dir;
+use test_support::data as data_dir;
 
 use std::path::PathBuf;
 

@@ -1,8 +1,7 @@
 //! Real TetGen meshes from `$TRILUX_DATA/tets`.
 
 mod common;
-#[path = "../../io/tests/support/data_dir.rs"]
-mod data_dir;
+use test_support::data as data_dir;
 
 use common::*;
 use tet_diffusion::glam::DVec3;

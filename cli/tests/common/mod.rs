@@ -15,39 +15,8 @@ pub(crate) fn trilux_bin() -> PathBuf {
     PathBuf::from(env!("CARGO_BIN_EXE_trilux"))
 }
 
-/// The data folder named by `TRILUX_DATA` (a relative path is taken from
-/// the workspace root, as CI gives it), or `None` when it is unset; a
-/// value that names no folder fails the test instead of skipping it.
-pub(crate) fn data_dir() -> Option<PathBuf> {
-    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let found = [given.clone(), workspace.join(&given)]
-        .into_iter()
-        .find(|p| p.is_dir());
-    assert!(
-        found.is_some(),
-        "TRILUX_DATA={} names no folder",
-        given.display()
-    );
-    found
-}
-
-/// A file of the data folder (only real-data tests call it, after
-/// [`data_dir`] said the folder is there).
-pub(crate) fn data(relative: &str) -> PathBuf {
-    data_dir()
-        .expect("TRILUX_DATA names the data folder")
-        .join(relative)
-}
-
-/// Whether the real-data tests can run; prints why one is skipped.
-pub(crate) fn have_data(test: &str) -> bool {
-    let present = data_dir().is_some();
-    if !present {
-        eprintln!("{test}: skipped, it needs TRILUX_DATA (the data folder, e.g. ../shared/data)");
-    }
-    present
-}
+#[allow(unused_imports, reason = "each test binary uses a subset")]
+pub(crate) use test_support::data::{data, have_data};
 
 /// The `trilux` binary, run in `dir`.
 pub(crate) fn trilux(dir: &Path) -> Command {

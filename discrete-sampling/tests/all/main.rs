@@ -4,8 +4,7 @@
 mod hdr;
 #[path = "../support/shapes.rs"]
 mod shapes;
-#[path = "../support/stats.rs"]
-mod stats;
+use test_support::stats;
 
 mod environment;
 mod errors;

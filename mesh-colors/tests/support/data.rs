@@ -20,9 +20,7 @@ pub(crate) struct Textured {
     pub(crate) texture: Texture,
 }
 
-#[path = "../../../io/tests/support/data_dir.rs"]
-mod data_dir;
-pub(crate) use data_dir::data_dir;
+pub(crate) use test_support::data::data_dir;
 
 /// An RGB texture with sRGB-encoded values (as stored in the file: the
 /// values PSNR is usually quoted on) from a linear RGBA image.

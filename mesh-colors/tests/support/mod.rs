@@ -1,37 +1,13 @@
-//! Shared test meshes and a small deterministic random generator (the
+//! Shared test meshes, and the seeded generator of test-support (the
 //! crate has no `rand` dependency and tests need no more than this).
 
 #![allow(dead_code, reason = "each test binary uses a subset")]
 
 use glam::Vec3;
 
-/// SplitMix64: deterministic, seedable, good enough to place test points.
-pub(crate) struct Rng(pub(crate) u64);
-
-impl Rng {
-    pub(crate) fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in `[0, 1)`.
-    pub(crate) fn f32(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-    pub(crate) fn below(&mut self, n: u64) -> u64 {
-        self.next_u64() % n
-    }
-    /// Uniform barycentrics (all > 0 almost surely).
-    pub(crate) fn barycentric(&mut self) -> [f32; 3] {
-        let (mut u, mut v) = (self.f32(), self.f32());
-        if u + v > 1.0 {
-            (u, v) = (1.0 - u, 1.0 - v);
-        }
-        [u, v, 1.0 - u - v]
-    }
-}
+/// SplitMix64, the workspace's one copy (test-support).
+#[allow(unused_imports, reason = "each test binary uses a subset")]
+pub(crate) use test_support::SplitMix64 as Rng;
 
 /// An `n × n` grid of the unit square (bumped in z so faces differ), two
 /// triangles per cell, counter-clockwise.

@@ -5,21 +5,9 @@
 use multires::grid;
 use sprs::{CsMat, TriMat};
 
-/// A small deterministic generator (SplitMix64).
-pub(crate) struct Rng(pub(crate) u64);
-
-impl Rng {
-    pub(crate) fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    pub(crate) fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+/// SplitMix64, the workspace's one copy (test-support).
+#[allow(unused_imports, reason = "each test binary uses a subset")]
+pub(crate) use test_support::SplitMix64 as Rng;
 
 /// A random geometric graph in the unit cube (points joined within
 /// `radius`: it has triangles, like a tetrahedral mesh), as the weighted
@@ -32,9 +20,7 @@ pub(crate) fn random_geometric(
     seed: u64,
 ) -> (CsMat<f64>, Vec<[f64; 3]>) {
     let mut rng = Rng(seed);
-    let points: Vec<[f64; 3]> = (0..n)
-        .map(|_| [rng.unit(), rng.unit(), rng.unit()])
-        .collect();
+    let points: Vec<[f64; 3]> = (0..n).map(|_| [rng.f64(), rng.f64(), rng.f64()]).collect();
     let mut t = TriMat::new((n, n));
     let mut diag = vec![mass; n];
     for i in 0..n {

@@ -2,7 +2,7 @@
 //! the samplers it judges.
 
 /// `ln Γ(x)` for `x > 0` (Lanczos, g = 7, nine terms; ~1e-15 relative).
-pub(crate) fn ln_gamma(x: f64) -> f64 {
+pub fn ln_gamma(x: f64) -> f64 {
     const G: f64 = 7.0;
     const C: [f64; 9] = [
         0.999_999_999_999_809_9,
@@ -29,7 +29,7 @@ pub(crate) fn ln_gamma(x: f64) -> f64 {
 }
 
 /// The regularised upper incomplete gamma function `Q(a, x)`.
-pub(crate) fn gamma_q(a: f64, x: f64) -> f64 {
+pub fn gamma_q(a: f64, x: f64) -> f64 {
     if x <= 0.0 {
         return 1.0;
     }
@@ -78,12 +78,14 @@ pub(crate) fn gamma_q(a: f64, x: f64) -> f64 {
 
 /// Outcome of a chi-square goodness-of-fit test.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct ChiSquare {
-    pub(crate) statistic: f64,
-    pub(crate) dof: usize,
+pub struct ChiSquare {
+    /// Pearson's statistic over the merged bins.
+    pub statistic: f64,
+    /// Degrees of freedom (bins − 1).
+    pub dof: usize,
     /// Probability of a statistic at least this large under the hypothesis;
     /// 0 when an outcome of probability zero was observed.
-    pub(crate) p_value: f64,
+    pub p_value: f64,
 }
 
 /// Tests `counts` against the exact `probabilities` (same length).
@@ -92,7 +94,7 @@ pub(crate) struct ChiSquare {
 /// `min_expected`, so heavy-tailed distributions with many tiny entries are
 /// tested on all of their mass. An observation of an outcome with
 /// probability zero fails the test outright.
-pub(crate) fn chi_square(counts: &[u64], probabilities: &[f64], min_expected: f64) -> ChiSquare {
+pub fn chi_square(counts: &[u64], probabilities: &[f64], min_expected: f64) -> ChiSquare {
     assert_eq!(counts.len(), probabilities.len());
     let samples: u64 = counts.iter().sum();
     let n = samples as f64;
@@ -141,7 +143,7 @@ pub(crate) fn chi_square(counts: &[u64], probabilities: &[f64], min_expected: f6
 }
 
 /// Neumaier-compensated sum: the reference total the tests compare against.
-pub(crate) fn exact_sum(values: impl IntoIterator<Item = f64>) -> f64 {
+pub fn exact_sum(values: impl IntoIterator<Item = f64>) -> f64 {
     let (mut sum, mut comp) = (0.0f64, 0.0f64);
     for v in values {
         let t = sum + v;
@@ -156,7 +158,7 @@ pub(crate) fn exact_sum(values: impl IntoIterator<Item = f64>) -> f64 {
 }
 
 /// Reference probabilities `w_i / Σw`.
-pub(crate) fn probabilities(weights: &[f64]) -> Vec<f64> {
+pub fn probabilities(weights: &[f64]) -> Vec<f64> {
     let total = exact_sum(weights.iter().copied());
     weights.iter().map(|&w| w / total).collect()
 }
