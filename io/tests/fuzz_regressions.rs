@@ -56,6 +56,23 @@ fn check_tet(mesh: &TetMesh) {
     let _ = mesh.boundary();
 }
 
+/// The Gmsh file target `gmsh_binary` reads: a binary 4.1 `$MeshFormat`
+/// header in the byte order the first byte picks (even: little-endian),
+/// then the rest of `data`; `None` for empty data.
+fn gmsh_binary_file(data: &[u8]) -> Option<Vec<u8>> {
+    let (&order, body) = data.split_first()?;
+    let one = if order % 2 == 0 {
+        1i32.to_le_bytes()
+    } else {
+        1i32.to_be_bytes()
+    };
+    let mut file = b"$MeshFormat\n4.1 1 8\n".to_vec();
+    file.extend(one);
+    file.extend(b"\n$EndMeshFormat\n");
+    file.extend(body);
+    Some(file)
+}
+
 /// Runs `data` through the reader of fuzz target `target` with its
 /// checks; `None` when no replay exists for that target.
 fn replay(target: &str, data: &[u8]) -> Option<()> {
@@ -69,6 +86,13 @@ fn replay(target: &str, data: &[u8]) -> Option<()> {
         }
         "gmsh" => {
             if let Ok(mesh) = gmsh::from_bytes(data, "fuzz.msh") {
+                check_tet(&mesh);
+            }
+        }
+        "gmsh_binary" => {
+            if let Some(file) = gmsh_binary_file(data)
+                && let Ok(mesh) = gmsh::from_bytes(&file, "fuzz.msh")
+            {
                 check_tet(&mesh);
             }
         }
@@ -121,7 +145,7 @@ fn replay(target: &str, data: &[u8]) -> Option<()> {
 #[test]
 fn every_fuzz_target_replays_its_crashes_and_seeds() {
     let targets = targets();
-    assert!(targets.len() >= 7, "fuzz targets: {targets:?}");
+    assert!(targets.len() >= 8, "fuzz targets: {targets:?}");
     let mut crashes = 0;
     for target in &targets {
         let crash_files = files(&manifest().join("tests/fuzz-regressions").join(target));
@@ -140,4 +164,23 @@ fn every_fuzz_target_replays_its_crashes_and_seeds() {
         }
     }
     assert!(crashes >= 4, "the saved crash inputs are missing");
+}
+
+/// The `gmsh_binary` seeds are whole meshes in both byte orders, so the
+/// fuzzer starts inside the binary section readers, not at their errors.
+#[test]
+fn the_gmsh_binary_seeds_are_meshes_in_both_byte_orders() {
+    let seeds = files(&manifest().join("fuzz/seeds/gmsh_binary"));
+    let mut orders = Vec::new();
+    for seed in &seeds {
+        let data = std::fs::read(seed).unwrap();
+        let file = gmsh_binary_file(&data).unwrap();
+        let mesh = gmsh::from_bytes(&file, seed).unwrap();
+        assert!(!mesh.tets.is_empty(), "{}", seed.display());
+        check_tet(&mesh);
+        orders.push(data[0] % 2);
+    }
+    orders.sort_unstable();
+    orders.dedup();
+    assert_eq!(orders, [0, 1], "{seeds:?}");
 }
