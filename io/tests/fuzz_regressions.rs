@@ -10,6 +10,10 @@ use trilux_io::image;
 use trilux_io::mesh::{TriMesh, gltf, obj, ply};
 use trilux_io::tet::{TetMesh, gmsh, medit, tetgen};
 
+#[path = "../fuzz/inputs/gmsh_binary.rs"]
+mod gmsh_binary_input;
+use gmsh_binary_input::gmsh_binary_file;
+
 fn manifest() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
@@ -54,23 +58,6 @@ fn check_tet(mesh: &TetMesh) {
     assert!(mesh.positions.iter().all(|p| p.is_finite()));
     assert!(mesh.regions.is_empty() || mesh.regions.len() == mesh.tets.len());
     let _ = mesh.boundary();
-}
-
-/// The Gmsh file target `gmsh_binary` reads: a binary 4.1 `$MeshFormat`
-/// header in the byte order the first byte picks (even: little-endian),
-/// then the rest of `data`; `None` for empty data.
-fn gmsh_binary_file(data: &[u8]) -> Option<Vec<u8>> {
-    let (&order, body) = data.split_first()?;
-    let one = if order % 2 == 0 {
-        1i32.to_le_bytes()
-    } else {
-        1i32.to_be_bytes()
-    };
-    let mut file = b"$MeshFormat\n4.1 1 8\n".to_vec();
-    file.extend(one);
-    file.extend(b"\n$EndMeshFormat\n");
-    file.extend(body);
-    Some(file)
 }
 
 /// Runs `data` through the reader of fuzz target `target` with its

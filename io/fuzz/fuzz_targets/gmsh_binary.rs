@@ -8,19 +8,13 @@
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
+#[path = "../inputs/gmsh_binary.rs"]
+mod input;
+
 fuzz_target!(|data: &[u8]| {
-    let Some((&order, body)) = data.split_first() else {
+    let Some(file) = input::gmsh_binary_file(data) else {
         return;
     };
-    let one = if order % 2 == 0 {
-        1i32.to_le_bytes()
-    } else {
-        1i32.to_be_bytes()
-    };
-    let mut file = b"$MeshFormat\n4.1 1 8\n".to_vec();
-    file.extend(one);
-    file.extend(b"\n$EndMeshFormat\n");
-    file.extend(body);
     if let Ok(mesh) = trilux_io::tet::gmsh::from_bytes(&file, Path::new("fuzz.msh")) {
         let n = mesh.positions.len();
         assert!(mesh.tets.iter().flatten().all(|&i| (i as usize) < n));
