@@ -97,6 +97,77 @@ pub fn diffusion_mesh(mesh: &TetMesh) -> Result<tet_diffusion::TetMesh, tet_diff
     tet_diffusion::TetMesh::new(&mesh.positions, &mesh.tets)
 }
 
+/// The nodes [`drop_unused_nodes`] took out of a file's mesh, and how to
+/// put per-node results back in the file's numbering (what TetGen and
+/// meshio users expect of a `.vtu` written from their mesh).
+#[derive(Debug, Clone)]
+pub struct DroppedNodes {
+    /// The mesh as read, every node kept.
+    pub original: TetMesh,
+    /// `map[new] = old`: each node of the solver's mesh in `original`.
+    pub map: Vec<u32>,
+    /// The dropped nodes (0-based, as `original` numbers them), ascending.
+    pub dropped: Vec<u32>,
+}
+
+impl DroppedNodes {
+    /// What to tell the user: the file, how many nodes, the first one.
+    pub fn warning(&self, path: &std::path::Path) -> String {
+        format!(
+            "{}: {} node{} used by no tetrahedron (first: node {}, 0-based) dropped before \
+             solving; per-node results are written back in the file's numbering, NaN there",
+            path.display(),
+            self.dropped.len(),
+            if self.dropped.len() == 1 {
+                " is"
+            } else {
+                "s are"
+            },
+            self.dropped[0],
+        )
+    }
+
+    /// Whether `positions` are the kept nodes, in order: the solver's mesh
+    /// is still the file's (no cut or fracture changed it).
+    pub fn is_solved(&self, positions: &[DVec3]) -> bool {
+        positions.len() == self.map.len()
+            && self
+                .map
+                .iter()
+                .zip(positions)
+                .all(|(&old, p)| self.original.positions[old as usize] == *p)
+    }
+
+    /// Per-node `values` of the solver's mesh in the file's numbering:
+    /// NaN at the dropped nodes (no tetrahedron gives them a value).
+    pub fn scatter(&self, values: &[f64]) -> Vec<f64> {
+        let mut out = vec![f64::NAN; self.original.positions.len()];
+        for (&old, &v) in self.map.iter().zip(values) {
+            out[old as usize] = v;
+        }
+        out
+    }
+}
+
+/// `mesh` without the nodes no tetrahedron uses (their rows of a
+/// diffusion system would be empty, which tet-diffusion refuses), and
+/// what was dropped; `None` when every node is used.
+pub fn drop_unused_nodes(mesh: TetMesh) -> (TetMesh, Option<DroppedNodes>) {
+    let dropped = mesh.unused_nodes();
+    if dropped.is_empty() {
+        return (mesh, None);
+    }
+    let (compact, map) = mesh.without_unused_nodes();
+    (
+        compact,
+        Some(DroppedNodes {
+            original: mesh,
+            map,
+            dropped,
+        }),
+    )
+}
+
 /// A stuffed mesh (`tet_stuffing`) as trilux-io's, to write.
 pub fn from_stuffing(mesh: &tet_stuffing::TetMesh, origin: DVec3) -> TetMesh {
     TetMesh {
@@ -305,5 +376,49 @@ pub fn tone_map(picture: &Picture) -> trilux_io::image::Image {
     trilux_io::image::Image {
         pixels,
         ..picture.image.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dropped_nodes_scatter_back_to_the_files_numbering() {
+        let mesh = TetMesh {
+            positions: vec![
+                DVec3::splat(5.0),
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::splat(7.0),
+                DVec3::Y,
+                DVec3::Z,
+            ],
+            tets: vec![[1, 2, 4, 5]],
+            ..TetMesh::default()
+        };
+        let (compact, dropped) = drop_unused_nodes(mesh.clone());
+        let dropped = dropped.unwrap();
+        assert_eq!(compact.tets, [[0, 1, 2, 3]]);
+        assert_eq!(
+            compact.positions,
+            [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z]
+        );
+        assert_eq!(dropped.dropped, [0, 3]);
+        let back = dropped.scatter(&[10.0, 20.0, 40.0, 50.0]);
+        assert!(back[0].is_nan() && back[3].is_nan());
+        assert_eq!(
+            [back[1], back[2], back[4], back[5]],
+            [10.0, 20.0, 40.0, 50.0]
+        );
+        let text = dropped.warning(std::path::Path::new("m.node"));
+        assert!(text.starts_with("m.node: 2 nodes are used by no tetrahedron (first: node 0"));
+        assert!(dropped.is_solved(&compact.positions));
+        assert!(!dropped.is_solved(&mesh.positions));
+        let (same, none) = drop_unused_nodes(compact.clone());
+        assert!(none.is_none());
+        assert_eq!(same, compact);
+        assert!(tet_diffusion::TetMesh::new(&same.positions, &same.tets).is_ok());
+        assert!(tet_diffusion::TetMesh::new(&mesh.positions, &mesh.tets).is_err());
     }
 }

@@ -65,3 +65,75 @@ fn info_lists_what_the_readers_skipped() {
     let w = json["warnings"][0].as_str().unwrap();
     assert!(w.contains("polygons_be.ply") && w.contains("`face`"), "{w}");
 }
+
+/// Every intact mesh of the second set: `trilux info` exits 0 with its
+/// right counts, and names what a user has to act on (the MTL case
+/// variants read, so nothing to warn about; the inverted tetrahedron
+/// counted; the unused-node, duplicate and non-manifold reports zero).
+#[test]
+fn info_accepts_every_intact_mesh_of_the_second_set() {
+    let cases: [(&str, &str, u64); 7] = [
+        ("mtl-keyword-case", "two_planes.obj", 4),
+        (
+            "gltf-texture-without-source",
+            "basisu_with_png_fallback.gltf",
+            1,
+        ),
+        ("obj-negative-indices", "blocks.obj", 6),
+        ("gltf-strip-fan-interleaved", "modes.gltf", 5),
+        ("ply-big-endian-polygons", "polygons_be.ply", 5),
+        ("ply-tristrips", "strips.ply", 6),
+        ("obj-face-vt-without-vt", "square.obj", 2),
+    ];
+    for (folder, name, triangles) in cases {
+        let (json, _) = info(&regression(folder, name));
+        assert_eq!(json["triangles"], triangles, "{name}: {json}");
+    }
+    let (json, _) = info(&regression("mtl-keyword-case", "two_planes.obj"));
+    assert_eq!(json["warnings"].as_array().unwrap().len(), 0, "{json}");
+
+    let (json, text) = info(&regression("tet-inverted-and-flat", "inverted.msh"));
+    assert_eq!(json["unused_nodes"].as_array().unwrap().len(), 0, "{json}");
+    assert!(text.contains("unused nodes: 0"), "{text}");
+    // The flat tetrahedron is a mesh to describe, not an error for info.
+    let (json, _) = info(&regression("tet-inverted-and-flat", "with_flat_tet.msh"));
+    assert!(json["tetrahedra"].as_u64().unwrap() >= 3, "{json}");
+}
+
+/// The inverted tetrahedron is re-oriented and the mesh solves; the flat
+/// one is refused by number (tetrahedron 2), naming the file.
+#[test]
+fn diffuse_solves_the_inverted_mesh_and_names_the_flat_tetrahedron() {
+    let dir = tempfile::tempdir().unwrap();
+    let inverted = regression("tet-inverted-and-flat", "inverted.msh");
+    let out = trilux(dir.path())
+        .args([
+            "diffuse",
+            inverted.to_str().unwrap(),
+            "--size",
+            "16",
+            "-o",
+            "i.png",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let flat = regression("tet-inverted-and-flat", "with_flat_tet.msh");
+    let out = trilux(dir.path())
+        .args([
+            "diffuse",
+            flat.to_str().unwrap(),
+            "--size",
+            "16",
+            "-o",
+            "f.png",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = stderr(&out);
+    assert!(
+        err.contains("with_flat_tet.msh") && err.contains("tetrahedron 2"),
+        "{err}"
+    );
+}

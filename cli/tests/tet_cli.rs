@@ -589,3 +589,48 @@ fn diffuse_names_the_formats_it_reads() {
         &["x.vtu", ".node", ".obj"],
     );
 }
+
+/// A TetGen mesh with nodes no tetrahedron uses (one before all others,
+/// one after: what TetGen's `-r` and meshio's point lists leave): diffuse
+/// and view drop them with a warning naming the file and the first node,
+/// and the VTU keeps the file's nodes and tetrahedra (NaN where dropped).
+#[test]
+fn diffuse_drops_nodes_no_tetrahedron_uses_and_writes_the_files_numbering() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    stuffed_blob(d, "0.3");
+    let mut mesh = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    mesh.positions.insert(0, glam::DVec3::new(9.0, 9.0, 9.0));
+    mesh.positions.push(glam::DVec3::new(-9.0, 9.0, 9.0));
+    for t in &mut mesh.tets {
+        *t = t.map(|v| v + 1);
+    }
+    trilux_io::tet::write(d.join("loose.node"), &mesh).unwrap();
+    assert_eq!(mesh.unused_nodes(), [0, mesh.positions.len() as u32 - 1]);
+    let out = run(
+        d,
+        &[
+            "diffuse",
+            "loose.node",
+            "--size",
+            "32",
+            "-o",
+            "loose.png",
+            "--vtu",
+            "loose.vtu",
+        ],
+    );
+    let err = common::stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: loose.node: 2 nodes are used by no tetrahedron (first: node 0"),
+        "{err}"
+    );
+    let vtu = std::fs::read_to_string(d.join("loose.vtu")).unwrap();
+    let piece = format!(
+        "NumberOfPoints=\"{}\" NumberOfCells=\"{}\"",
+        mesh.positions.len(),
+        mesh.tets.len()
+    );
+    assert!(vtu.contains(&piece), "{piece}");
+}

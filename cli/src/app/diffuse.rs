@@ -97,11 +97,14 @@ struct Solved {
     unit_mm: f64,
     levels: usize,
     painted: Vec<usize>,
+    /// The nodes dropped from the file's mesh, to write the VTU back in
+    /// its numbering.
+    dropped: Option<trilux::tet::DroppedNodes>,
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     check(context, &args)?;
-    let (positions, tets) = read_volume(context, &args.input, false)?;
+    let (positions, tets, dropped) = read_volume(context, &args.input, false)?;
     let mesh =
         tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_cause(&args.input, e))?;
     let diagonal = diagonal(&positions);
@@ -150,6 +153,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         unit_mm,
         levels: levels.unwrap_or(0),
         painted,
+        dropped,
     };
     write(context, &args, &solved)?;
     report(context, &args, &solved);
@@ -251,32 +255,47 @@ fn write(context: &mut Context, args: &Args, solved: &Solved) -> Result<()> {
         super::write_image(context, p, &image.image)?;
     }
     if let Some(p) = &args.vtu {
-        write_vtu(context, p, &solved.objects[0])?;
+        write_vtu(context, p, &solved.objects[0], solved.dropped.as_ref())?;
     }
     Ok(())
 }
 
 /// φ per colour channel and the boundary's luminance per node of `o`.
-fn write_vtu(context: &Context, path: &Path, o: &Object) -> Result<()> {
+fn write_vtu(
+    context: &Context,
+    path: &Path,
+    o: &Object,
+    dropped: Option<&trilux::tet::DroppedNodes>,
+) -> Result<()> {
     use trilux_io::tet::vtu::{Encoding, Field};
     let m = o.mesh();
-    let io_mesh = trilux_io::tet::TetMesh {
-        positions: m.positions().to_vec(),
-        tets: m.tets().to_vec(),
-        ..Default::default()
-    };
     let radiance = o.radiance(None);
     let mut lum = vec![0.0; m.vertex_count()];
     for (k, &v) in m.boundary_vertices().iter().enumerate() {
         let l = radiance[k];
         lum[v as usize] = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
     }
+    let mut values = [o.phi(0).to_vec(), o.phi(1).to_vec(), o.phi(2).to_vec(), lum];
+    // The file's own nodes and numbering when nodes were dropped and the
+    // object is still the file's mesh (no cut or fracture moved them).
+    let io_mesh = match dropped {
+        Some(d) if d.is_solved(m.positions()) => {
+            values = values.map(|v| d.scatter(&v));
+            d.original.clone()
+        }
+        _ => trilux_io::tet::TetMesh {
+            positions: m.positions().to_vec(),
+            tets: m.tets().to_vec(),
+            ..Default::default()
+        },
+    };
+    let [phi_r, phi_g, phi_b, lum] = &values;
     let field = |name, values| Field { name, values };
     let fields = [
-        field("phi_r", o.phi(0)),
-        field("phi_g", o.phi(1)),
-        field("phi_b", o.phi(2)),
-        field("radiance", &lum),
+        field("phi_r", phi_r),
+        field("phi_g", phi_g),
+        field("phi_b", phi_b),
+        field("radiance", lum),
     ];
     trilux::output::write_atomic(path, context.force, |tmp| {
         Ok(trilux_io::tet::vtu::write(

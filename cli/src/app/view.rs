@@ -100,7 +100,7 @@ pub(crate) fn load(
         return Ok((object, source));
     };
     check_volume(input, "view", true)?;
-    let (positions, tets) = read_volume(context, input, true)?;
+    let (positions, tets, _) = read_volume(context, input, true)?;
     let mesh = tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_error(input, e))?;
     let diagonal = diagonal(&positions);
     let unit = super::ops::object::unit_mm(unit_mm, diagonal);

@@ -53,24 +53,31 @@ pub(crate) fn check_volume(input: &Path, subcommand: &str, with_vtu: bool) -> Re
     ))
 }
 
-/// The positions and tetrahedra of `input`: read, or stuffed from a
-/// surface at the default spacing. [`check_volume`] said it is read here.
-pub(crate) fn read_volume(
-    context: &mut Context,
-    input: &Path,
-    with_vtu: bool,
-) -> Result<(Vec<DVec3>, Vec<[u32; 4]>)> {
+/// What [`read_volume`] returns: positions, tetrahedra, and the nodes
+/// dropped from the file's mesh (`None` when none were, or for a surface).
+pub(crate) type Volume = (Vec<DVec3>, Vec<[u32; 4]>, Option<trilux::tet::DroppedNodes>);
+
+/// The positions and tetrahedra of `input`: read (without the nodes no
+/// tetrahedron uses, which are returned for writing results back), or
+/// stuffed from a surface at the default spacing. [`check_volume`] said
+/// it is read here.
+pub(crate) fn read_volume(context: &mut Context, input: &Path, with_vtu: bool) -> Result<Volume> {
     let ext = crate::app::extension(input);
     if tet_extensions(with_vtu).contains(&ext.as_str()) {
-        let tet = crate::app::read_tets(context, input)?;
-        return Ok((tet.positions, tet.tets));
+        // Nodes no tetrahedron uses (TetGen and meshio files keep them)
+        // would be empty rows of the solver's system: dropped, said.
+        let (tet, dropped) = trilux::tet::drop_unused_nodes(crate::app::read_tets(context, input)?);
+        if let Some(d) = &dropped {
+            eprintln!("warning: {}", d.warning(input));
+        }
+        return Ok((tet.positions, tet.tets, dropped));
     }
     let surface = crate::app::read_mesh(context, input)?;
     let (stuffed, _) = context.step("tetrahedralizing", || {
         stuff(&surface, input, Spacing::Default, false)
     })?;
     let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
-    Ok((out.positions, out.tets))
+    Ok((out.positions, out.tets, None))
 }
 
 /// The length of the bounding box's diagonal.
