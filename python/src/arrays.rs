@@ -211,6 +211,49 @@ pub(crate) fn matrix<'py, T: numpy::Element>(
     Ok(a.into_pyarray(py).into_any())
 }
 
+/// Positions stored relative to `origin` (`f32`, as trilux-io's meshes
+/// hold them) as an `(n, 3)` float64 array in the file's coordinates:
+/// `origin` added back in `f64`.
+pub(crate) fn absolute_positions<'py>(
+    py: Python<'py>,
+    origin: glam::DVec3,
+    positions: &[glam::Vec3],
+) -> PyResult<Bound<'py, PyAny>> {
+    let data = positions
+        .iter()
+        .flat_map(|p| (origin + p.as_dvec3()).to_array())
+        .collect();
+    matrix(py, data, 3)
+}
+
+/// Index rows (triangles, tetrahedra) as an `(m, K)` int64 array, the
+/// dtype trimesh and numpy indexing use.
+pub(crate) fn index_matrix<'py, const K: usize>(
+    py: Python<'py>,
+    rows: &[[u32; K]],
+) -> PyResult<Bound<'py, PyAny>> {
+    let data = rows.iter().flatten().map(|&v| i64::from(v)).collect();
+    matrix(py, data, K)
+}
+
+/// A `seed` argument as the `u64` the samplers seed their generators
+/// with: 0 when not given, an error naming it outside `0..2**64`.
+pub(crate) fn seed(seed: Option<i128>) -> Result<u64, Failure> {
+    match seed {
+        None => Ok(0),
+        Some(s) => {
+            u64::try_from(s).map_err(|_| Failure::input(format!("seed: {s} is not in 0..2**64")))
+        }
+    }
+}
+
+/// A count argument named `what` as a `usize`: an error naming it when
+/// negative (or beyond the address space).
+pub(crate) fn count(count: i128, what: &str) -> Result<usize, Failure> {
+    usize::try_from(count)
+        .map_err(|_| Failure::input(format!("{what}: {count} is not a count (0 or more)")))
+}
+
 /// A vector as a 1-D array.
 pub(crate) fn vector<'py, T: numpy::Element>(py: Python<'py>, data: Vec<T>) -> Bound<'py, PyAny> {
     Array1::from_vec(data).into_pyarray(py).into_any()

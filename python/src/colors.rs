@@ -265,27 +265,13 @@ impl MeshColors {
     /// The welded surface's vertices, `(n, 3)` float64.
     #[getter]
     fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let o = self.surface.origin;
-        let data = self
-            .surface
-            .positions
-            .iter()
-            .flat_map(|p| (o + p.as_dvec3()).to_array())
-            .collect();
-        arrays::matrix(py, data, 3)
+        arrays::absolute_positions(py, self.surface.origin, &self.surface.positions)
     }
 
     /// The welded surface's faces, `(m, 3)` int64.
     #[getter]
     fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let data = self
-            .surface
-            .faces
-            .iter()
-            .flatten()
-            .map(|&v| i64::from(v))
-            .collect();
-        arrays::matrix(py, data, 3)
+        arrays::index_matrix(py, &self.surface.faces)
     }
 
     fn __repr__(&self) -> String {

@@ -9,19 +9,9 @@ use rand::SeedableRng;
 use crate::arrays;
 use crate::error::{Failure, detached};
 
+/// The generator of the `seed` argument (default 0).
 fn rng(seed: Option<i128>) -> PyResult<rand_pcg::Pcg64Mcg> {
-    let s = match seed {
-        None => 0,
-        Some(s) => {
-            u64::try_from(s).map_err(|_| Failure::input(format!("seed: {s} is not in 0..2**64")))?
-        }
-    };
-    Ok(rand_pcg::Pcg64Mcg::seed_from_u64(s))
-}
-
-fn count(n: i128) -> PyResult<usize> {
-    usize::try_from(n)
-        .map_err(|_| Failure::input(format!("n: {n} is not a count (0 or more)")).into())
+    Ok(rand_pcg::Pcg64Mcg::seed_from_u64(arrays::seed(seed)?))
 }
 
 /// A discrete distribution over `len(weights)` entries, entry `i` with
@@ -54,7 +44,7 @@ impl Distribution1D {
         n: i128,
         seed: Option<i128>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = count(n)?;
+        let n = arrays::count(n, "n")?;
         let mut rng = rng(seed)?;
         let out = detached(py, || {
             let mut out = vec![0usize; n];
@@ -192,7 +182,7 @@ impl Distribution2D {
         n: i128,
         seed: Option<i128>,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let n = count(n)?;
+        let n = arrays::count(n, "n")?;
         let mut rng = rng(seed)?;
         let out = detached(py, || {
             let mut out = vec![Sample2D::default(); n];
@@ -233,7 +223,7 @@ impl Distribution2D {
         seed: Option<i128>,
     ) -> PyResult<Bound<'py, PyTuple>> {
         use rand::RngExt;
-        let n = count(n)?;
+        let n = arrays::count(n, "n")?;
         let mut rng = rng(seed)?;
         let out = detached(py, || {
             Ok((0..n)

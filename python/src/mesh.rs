@@ -235,28 +235,14 @@ impl Mesh {
     /// (`origin` added back).
     #[getter]
     fn vertices<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let o = self.inner.origin;
-        let data = self
-            .inner
-            .positions
-            .iter()
-            .flat_map(|p| (o + p.as_dvec3()).to_array())
-            .collect();
-        arrays::matrix(py, data, 3)
+        arrays::absolute_positions(py, self.inner.origin, &self.inner.positions)
     }
 
     /// Triangles, `(m, 3)` int64 vertex indices, counter-clockwise as the
     /// file orders them.
     #[getter]
     fn faces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let data = self
-            .inner
-            .indices
-            .iter()
-            .flatten()
-            .map(|&v| i64::from(v))
-            .collect();
-        arrays::matrix(py, data, 3)
+        arrays::index_matrix(py, &self.inner.indices)
     }
 
     /// Per-vertex texture coordinates, `(n, 2)` float64, OpenGL convention
@@ -318,6 +304,21 @@ impl Mesh {
         Ok(list)
     }
 
+    /// What the reader skipped or replaced without refusing the file, a
+    /// list of str: a missing `.mtl` or texture, `f v/vt/vn` corners
+    /// without `vt` lines, PLY elements or properties it does not read, a
+    /// glTF texture whose image is only in an extension. Each names the
+    /// file, the line or element and what was skipped (as `trilux info`
+    /// prints them); empty for an intact file or a mesh made of arrays.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner
+            .warnings
+            .iter()
+            .map(ToString::to_string)
+            .collect()
+    }
+
     /// The named parts: a list of `(name, first_face, end_face,
     /// material_index or None)`.
     #[getter]
@@ -353,6 +354,8 @@ impl Mesh {
 
 /// Reads a triangle mesh: OBJ (with its MTL and textures), glTF/GLB or
 /// PLY, by extension. Raises `trilux.FileError` naming the file and line.
+/// What the reader skipped without refusing the file (a missing texture,
+/// an element it does not read) is in the mesh's `warnings`.
 #[pyfunction]
 pub(crate) fn load(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Mesh> {
     let path = path_arg(path, "path")?;

@@ -406,20 +406,6 @@ pub(crate) enum Sampler<'a> {
     Rejection(RejectionSampler<'a>),
 }
 
-fn seed_arg(seed: Option<i128>) -> Result<u64> {
-    match seed {
-        None => Ok(0),
-        Some(s) => {
-            u64::try_from(s).map_err(|_| Failure::input(format!("seed: {s} is not in 0..2**64")))
-        }
-    }
-}
-
-fn count_arg(count: i128, what: &str) -> Result<usize> {
-    usize::try_from(count)
-        .map_err(|_| Failure::input(format!("{what}: {count} is not a count (0 or more)")))
-}
-
 /// Random points on a mesh, uniform by area or with a density
 /// (Šik & Křivánek 2013, *Fast Random Sampling of Triangular Meshes*).
 ///
@@ -473,8 +459,8 @@ pub(crate) fn sample_surface<'py>(
     return_pdf: bool,
     return_normal: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let n = count_arg(count, "count")?;
-    let seed = seed_arg(seed)?;
+    let n = arrays::count(count, "count")?;
+    let seed = arrays::seed(seed)?;
     let mesh: Arc<TriMesh> = mesh_arg(mesh, uv)?;
     let density = density_arg(density, channel, face_weight, vertex_weight)?;
     let method = method_arg(method, &density)?;
@@ -535,11 +521,11 @@ pub(crate) fn blue_noise<'py>(
     return_normal: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let target = match (count, radius) {
-        (Some(c), None) => BlueNoiseTarget::Count(count_arg(c, "count")?),
+        (Some(c), None) => BlueNoiseTarget::Count(arrays::count(c, "count")?),
         (None, Some(r)) => BlueNoiseTarget::Radius(r),
         _ => return Err(Failure::input("give exactly one of count and radius").into()),
     };
-    let seed = seed_arg(seed)?;
+    let seed = arrays::seed(seed)?;
     let mesh = mesh_arg(mesh, uv)?;
     let density = density_arg(density, channel, face_weight, vertex_weight)?;
     let method = method_arg(method, &density)?;
@@ -589,8 +575,8 @@ pub(crate) fn sample_surface_even<'py>(
     radius: Option<f64>,
     seed: Option<i128>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let n = count_arg(count, "count")?;
-    let seed = seed_arg(seed)?;
+    let n = arrays::count(count, "count")?;
+    let seed = arrays::seed(seed)?;
     let mesh = mesh_arg(mesh, None)?;
     let (target, progressive) = match radius {
         None => (BlueNoiseTarget::Count(n), false),

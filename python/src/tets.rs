@@ -18,10 +18,9 @@ pub(crate) fn tets_out<'py>(
     tets: &[[u32; 4]],
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let nodes = positions.iter().flat_map(|p| p.to_array()).collect();
-    let t = tets.iter().flatten().map(|&v| i64::from(v)).collect();
     Ok(vec![
         arrays::matrix(py, nodes, 3)?,
-        arrays::matrix(py, t, 4)?,
+        arrays::index_matrix(py, tets)?,
     ])
 }
 
@@ -94,15 +93,25 @@ pub(crate) fn tetrahedralize<'py>(
 
 /// Reads a tetrahedral mesh: TetGen `.node`/`.ele`, Gmsh `.msh`, MEDIT
 /// `.mesh`, by extension. Returns `(nodes, tets)`, `(n, 3)` float64 and
-/// `(m, 4)` int64 (0-based, whatever the file's numbering).
+/// `(m, 4)` int64 (0-based, whatever the file's numbering), plus, when
+/// `return_warnings=True`, the list of str naming what the reader skipped
+/// without refusing the file (Gmsh elements that are not tetrahedra, for
+/// one), each with the file and the section or line.
 #[pyfunction]
+#[pyo3(signature = (path, *, return_warnings = false))]
 pub(crate) fn load_tets<'py>(
     py: Python<'py>,
     path: &Bound<'py, PyAny>,
+    return_warnings: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let path = path_arg(path, "path")?;
     let mesh = detached(py, || Ok(trilux_io::tet::TetMesh::read(&path)?))?;
-    PyTuple::new(py, tets_out(py, &mesh.positions, &mesh.tets)?)
+    let mut items = tets_out(py, &mesh.positions, &mesh.tets)?;
+    if return_warnings {
+        let warnings: Vec<String> = mesh.warnings.iter().map(ToString::to_string).collect();
+        items.push(warnings.into_pyobject(py)?.into_any());
+    }
+    PyTuple::new(py, items)
 }
 
 /// Writes a tetrahedral mesh `(nodes (n, 3), tets (m, 4))` as TetGen

@@ -334,15 +334,7 @@ impl Object {
     /// The boundary triangles, `(b, 3)` int64 node indices (outward).
     #[getter]
     fn boundary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let data = self
-            .inner
-            .mesh()
-            .boundary()
-            .iter()
-            .flatten()
-            .map(|&v| i64::from(v))
-            .collect();
-        arrays::matrix(py, data, 3)
+        arrays::index_matrix(py, self.inner.mesh().boundary())
     }
 
     /// The nodes on the boundary, `(k,)` int64: row `i` of `radiance` is

@@ -12,6 +12,7 @@ import trilux
 def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     mesh: trilux.Mesh = trilux.load(path)
     vertices: npt.NDArray[np.float64] = mesh.vertices
+    skipped: list[str] = mesh.warnings
     points, faces = trilux.sample_surface(mesh, 1000, seed=1)
     more = trilux.sample_surface(mesh, 10, return_pdf=True, return_barycentric=True)
     assert len(more) == 4
@@ -24,6 +25,8 @@ def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     nodes, tets = trilux.tetrahedralize(mesh, spacing=0.1)
     nodes2, tets2, report = trilux.tetrahedralize(mesh, return_report=True)
     tmin: float = report["min_dihedral_deg"]
+    tet_nodes, tet_ids, tet_warnings = trilux.load_tets(path, return_warnings=True)
+    first_warning: list[str] = tet_warnings
     obj = trilux.Object(nodes, tets, medium="marble", unit_mm=1000.0)
     light: int = obj.add_light([0.0, 1.0, 0.0])
     obj.solve()
@@ -37,5 +40,6 @@ def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
         trilux.load("missing.obj")
     except trilux.FileError as e:
         message: str = str(e)
+    del skipped, tet_nodes, tet_ids, first_warning
     del idx, dirs, pdf, nodes2, tets2, tmin, light, image, whole, rgb, baked, atlas, blue, even, message
     return points, faces

@@ -1,0 +1,69 @@
+"""`Mesh.warnings` and `load_tets(..., return_warnings=True)`: what a
+reader skipped without refusing the file, as the str trilux info prints,
+naming the file and what was skipped; empty for intact files and meshes
+made of arrays."""
+
+import numpy as np
+
+import trilux
+
+SQUARE_WITHOUT_VT = """v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+vn 0 0 1
+f 1/1/1 2/2/1 3/3/1
+f 1/1/1 3/3/1 4/4/1
+"""
+
+# Gmsh 2.2 ASCII: one tetrahedron and one boundary triangle (type 2).
+TET_AND_TRIANGLE = """$MeshFormat
+2.2 0 8
+$EndMeshFormat
+$Nodes
+4
+1 0 0 0
+2 1 0 0
+3 0 1 0
+4 0 0 1
+$EndNodes
+$Elements
+2
+1 2 2 0 0 1 2 3
+2 4 2 0 0 1 2 3 4
+$EndElements
+"""
+
+
+def test_mesh_warnings_name_the_file_and_what_was_skipped(tmp_path):
+    path = tmp_path / "square.obj"
+    path.write_text(SQUARE_WITHOUT_VT)
+    mesh = trilux.load(path)
+    assert mesh.faces.shape == (2, 3)
+    warnings = mesh.warnings
+    assert isinstance(warnings, list) and len(warnings) == 1
+    assert isinstance(warnings[0], str)
+    assert "square.obj" in warnings[0] and "`vt`" in warnings[0], warnings
+    # The same text as the Rust reader's, so a user can grep for it.
+    assert mesh.uv is None
+
+
+def test_intact_files_and_array_meshes_have_no_warnings(tmp_path):
+    path = tmp_path / "tri.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    assert trilux.load(path).warnings == []
+    mesh = trilux.Mesh(np.eye(3), [[0, 1, 2]])
+    assert mesh.warnings == []
+
+
+def test_load_tets_returns_the_warnings_when_asked(tmp_path):
+    path = tmp_path / "mixed.msh"
+    path.write_text(TET_AND_TRIANGLE)
+    nodes, tets = trilux.load_tets(path)
+    assert nodes.shape == (4, 3) and tets.shape == (1, 4)
+    nodes2, tets2, warnings = trilux.load_tets(path, return_warnings=True)
+    assert np.array_equal(nodes2, nodes) and np.array_equal(tets2, tets)
+    assert len(warnings) == 1 and isinstance(warnings[0], str)
+    assert "mixed.msh" in warnings[0] and "1 of type 2" in warnings[0], warnings
+    trilux.save_tets(tmp_path / "clean.node", nodes, tets)
+    assert trilux.load_tets(tmp_path / "clean.node", return_warnings=True)[2] == []
