@@ -634,3 +634,29 @@ fn diffuse_drops_nodes_no_tetrahedron_uses_and_writes_the_files_numbering() {
     );
     assert!(vtu.contains(&piece), "{piece}");
 }
+
+#[test]
+fn diffuse_warns_when_a_cut_plane_misses_the_object() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    stuffed_blob(d, "0.2");
+    let base = ["diffuse", "blob.node", "--unit-mm", "20", "--size", "32"];
+    // z > 5 is far above the unit-size blob: nothing is cut.
+    let miss = run(
+        d,
+        &[&base[..], &["--cut", "plane:0,0,1,5", "-o", "a.png"]].concat(),
+    );
+    assert!(miss.status.success());
+    let err = common::stderr(&miss);
+    assert!(
+        err.contains("warning: --cut plane:0,0,1,5: the plane misses the object"),
+        "{err}"
+    );
+    // A plane through the middle cuts and says nothing of the kind.
+    let hit = run(
+        d,
+        &[&base[..], &["--cut", "plane:0,0,1,0", "-o", "b.png"]].concat(),
+    );
+    assert!(hit.status.success());
+    assert!(!common::stderr(&hit).contains("misses"));
+}

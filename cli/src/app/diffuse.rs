@@ -218,9 +218,20 @@ fn cut(context: &mut Context, args: &Args, object: &mut Object) -> Result<()> {
             point: plane.point,
             normal: plane.normal,
         };
-        context
+        let before = object.mesh().tets().len();
+        let report = context
             .step("cutting", || object.cut(&cut, method))
             .map_err(|e| arg_cause(format!("--cut {}", plane.spec), e))?;
+        // A plane outside the object is legal but almost always a slip
+        // (metres vs millimetres, the sign of d): say so instead of
+        // rendering the whole object as if the cut had worked.
+        if report.removed_tets == 0 && report.split_tets == 0 && report.moved_vertices == 0 {
+            eprintln!(
+                "warning: --cut {}: the plane misses the object (all {before} tetrahedra are on \
+                 the kept side n·x ≤ d); nothing was cut",
+                plane.spec
+            );
+        }
     }
     Ok(())
 }
