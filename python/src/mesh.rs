@@ -134,16 +134,39 @@ pub(crate) fn image_to<'py>(py: Python<'py>, image: &Image) -> PyResult<Bound<'p
 /// The texture image of a trimesh-like visual: `visual.material.image`
 /// (trimesh's `SimpleMaterial`) or `visual.material.baseColorTexture`
 /// (its `PBRMaterial`), when there is one.
+///
+/// A texture that cannot be read (trimesh without Pillow hands out a
+/// placeholder that raises when touched) is left out with a Python
+/// `UserWarning` instead of failing the call: the geometry is intact, and
+/// only a density or mesh colours taken from the texture need it (they
+/// then say the mesh has no texture).
 fn visual_texture(visual: &Bound<'_, PyAny>) -> PyResult<Option<Image>> {
     let Ok(material) = visual.getattr("material") else {
         return Ok(None);
     };
     for name in ["image", "baseColorTexture"] {
-        if let Ok(img) = material.getattr(name)
-            && !img.is_none()
-        {
-            return image_from(&img, &format!("mesh.visual.material.{name}"), true).map(Some);
+        let Ok(img) = material.getattr(name) else {
+            continue;
+        };
+        if img.is_none() {
+            continue;
         }
+        let place = format!("mesh.visual.material.{name}");
+        return match image_from(&img, &place, true) {
+            Ok(image) => Ok(Some(image)),
+            Err(e) => {
+                let py = visual.py();
+                let message = format!(
+                    "{place} could not be read ({}); the mesh is used without its texture",
+                    e.value(py)
+                );
+                let message = std::ffi::CString::new(message.replace('\0', " "))
+                    .unwrap_or_else(|_| c"the mesh's texture could not be read".to_owned());
+                let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+                PyErr::warn(py, category.as_any(), &message, 1)?;
+                Ok(None)
+            }
+        };
     }
     Ok(None)
 }

@@ -67,3 +67,40 @@ def test_load_tets_returns_the_warnings_when_asked(tmp_path):
     assert "mixed.msh" in warnings[0] and "1 of type 2" in warnings[0], warnings
     trilux.save_tets(tmp_path / "clean.node", nodes, tets)
     assert trilux.load_tets(tmp_path / "clean.node", return_warnings=True)[2] == []
+
+
+class _Unreadable:
+    """What trimesh hands out for `material.image` when Pillow is missing:
+    a placeholder that raises as soon as it is touched."""
+
+    def __array__(self, *args, **kwargs):
+        raise ModuleNotFoundError("No module named 'PIL'")
+
+    def __getattr__(self, name):
+        raise ModuleNotFoundError("No module named 'PIL'")
+
+
+class _Material:
+    image = _Unreadable()
+
+
+class _Visual:
+    def __init__(self, n):
+        self.uv = np.zeros((n, 2))
+        self.material = _Material()
+
+
+class _TexturedMesh:
+    def __init__(self):
+        self.vertices = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+        self.faces = np.array([[0, 1, 2]])
+        self.visual = _Visual(3)
+
+
+def test_an_unreadable_texture_is_left_out_with_a_warning_not_an_error():
+    import pytest
+
+    with pytest.warns(UserWarning, match=r"mesh\.visual\.material\.image could not be read.*PIL"):
+        points, faces = trilux.sample_surface(_TexturedMesh(), 100, seed=1)
+    assert points.shape == (100, 3)
+    assert (faces == 0).all()
