@@ -95,9 +95,22 @@ fn info_accepts_every_intact_mesh_of_the_second_set() {
     let (json, text) = info(&regression("tet-inverted-and-flat", "inverted.msh"));
     assert_eq!(json["unused_nodes"].as_array().unwrap().len(), 0, "{json}");
     assert!(text.contains("unused nodes: 0"), "{text}");
-    // The flat tetrahedron is a mesh to describe, not an error for info.
-    let (json, _) = info(&regression("tet-inverted-and-flat", "with_flat_tet.msh"));
+    // The inverted tetrahedron is named, with what diffuse does with it.
+    let inverted = json["inverted_tetrahedra"].as_array().unwrap();
+    assert_eq!(inverted.len(), 1, "{json}");
+    assert!(
+        text.contains("inverted (diffuse re-orients them): 1"),
+        "{text}"
+    );
+    // The flat tetrahedron is a mesh to describe, not an error for info,
+    // but info names it as diffuse does: tetrahedron 2.
+    let (json, text) = info(&regression("tet-inverted-and-flat", "with_flat_tet.msh"));
     assert!(json["tetrahedra"].as_u64().unwrap() >= 3, "{json}");
+    assert_eq!(json["flat_tetrahedra"], serde_json::json!([2]), "{json}");
+    assert!(
+        text.contains("flat (zero volume; diffuse refuses them): 1 — tetrahedra 2 (0-based)"),
+        "{text}"
+    );
 }
 
 /// The inverted tetrahedron is re-oriented and the mesh solves; the flat

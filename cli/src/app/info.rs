@@ -259,15 +259,62 @@ fn describe_materials(text: &mut String, mesh: &trilux_io::mesh::TriMesh) -> Vec
         .collect()
 }
 
+/// The tetrahedra `trilux diffuse` refuses (flat: |6V| ≤ 1e-12 × the
+/// longest edge cubed, the rule of `tet_diffusion::TetMesh::new`) and the
+/// ones it re-orients (inverted: negative volume), 0-based, so that `info`
+/// names them instead of only counting.
+fn flat_and_inverted(mesh: &trilux_io::tet::TetMesh) -> (Vec<usize>, Vec<usize>) {
+    let mut flat = Vec::new();
+    let mut inverted = Vec::new();
+    for (t, tet) in mesh.tets.iter().enumerate() {
+        let det = mesh.signed_volume6(t);
+        let p = tet.map(|v| mesh.positions.get(v as usize).copied().unwrap_or_default());
+        let longest = (0..4)
+            .flat_map(|a| (a + 1..4).map(move |b| (a, b)))
+            .map(|(a, b)| p[a].distance(p[b]))
+            .fold(0.0, f64::max);
+        if det.is_nan() || det.abs() <= 1e-12 * longest.powi(3) {
+            flat.push(t);
+        } else if det < 0.0 {
+            inverted.push(t);
+        }
+    }
+    (flat, inverted)
+}
+
+/// The lines under "inverted or flat tetrahedra" naming the first few.
+fn write_bad_tets(text: &mut String, flat: &[usize], inverted: &[usize]) {
+    let first = |list: &[usize]| {
+        let shown: Vec<String> = list.iter().take(5).map(usize::to_string).collect();
+        let more = if list.len() > 5 { ", …" } else { "" };
+        format!("{}{more}", shown.join(", "))
+    };
+    if !flat.is_empty() {
+        let _ = writeln!(
+            text,
+            "    flat (zero volume; diffuse refuses them): {} — tetrahedra {} (0-based)",
+            flat.len(),
+            first(flat)
+        );
+    }
+    if !inverted.is_empty() {
+        let _ = writeln!(
+            text,
+            "    inverted (diffuse re-orients them): {} — tetrahedra {} (0-based)",
+            inverted.len(),
+            first(inverted)
+        );
+    }
+}
+
 fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let mesh = super::read_tets(context, path)?;
     let (lo, hi) = mesh.positions.iter().fold(
         (glam::DVec3::INFINITY, glam::DVec3::NEG_INFINITY),
         |(a, b), &p| (a.min(p), b.max(p)),
     );
-    let inverted = (0..mesh.tets.len())
-        .filter(|&t| mesh.signed_volume6(t) <= 0.0)
-        .count();
+    let (flat, inverted_only) = flat_and_inverted(&mesh);
+    let inverted = flat.len() + inverted_only.len();
     let boundary = mesh.boundary().len();
     let dihedral = context.step("measuring dihedral angles", || {
         trilux::tet::dihedral_range(&mesh)
@@ -280,6 +327,7 @@ fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let _ = writeln!(text, "  bounds: {lo} .. {hi}");
     let _ = writeln!(text, "  volume: {volume:.6e}");
     let _ = writeln!(text, "  inverted or flat tetrahedra: {inverted}");
+    write_bad_tets(&mut text, &flat, &inverted_only);
     match dihedral {
         Some((a, b)) => {
             let _ = writeln!(text, "  dihedral angles: {a:.3}° .. {b:.3}°");
@@ -331,6 +379,7 @@ fn tet_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let mut json = json!({"file": super::shown(path), "kind": "tetrahedral mesh", "nodes": mesh.positions.len(),
                "tetrahedra": mesh.tets.len(), "boundary_triangles": boundary,
                "bounds": [lo.to_array(), hi.to_array()], "volume": volume, "inverted": inverted,
+               "flat_tetrahedra": flat, "inverted_tetrahedra": inverted_only,
                "dihedral_degrees": dihedral.map(|(a, b)| [a, b]),
                "unused_nodes": unused, "duplicate_tetrahedra": duplicates,
                "non_manifold_boundary_edges": non_manifold});
