@@ -12,7 +12,13 @@ VENV=target/py-bench-venv
 [ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"
 "$VENV/bin/python" -m pip install -q --upgrade pip
 "$VENV/bin/python" -m pip install -q "maturin>=1.9.4,<2" numpy scipy pillow trimesh
-for peer in open3d point-cloud-utils pytetwild tetgen; do
+# Open3D's wheel links libusb, which a bare Debian lacks; pytetwild
+# imports pyvista without declaring it.
+if ! ldconfig -p | grep -q libusb-1.0.so.0 && command -v apt-get >/dev/null; then
+  (apt-get update -qq && apt-get install -y -qq --no-install-recommends libusb-1.0-0 >/dev/null) ||
+    echo "note: libusb-1.0-0 did not install; Open3D's rows will be skipped" >&2
+fi
+for peer in open3d point-cloud-utils pytetwild pyvista tetgen; do
   "$VENV/bin/python" -m pip install -q "$peer" >/dev/null 2>&1 || echo "note: $peer did not install; its rows are skipped" >&2
 done
 rm -rf target/py-bench-wheels
