@@ -4,9 +4,8 @@
 
 use std::path::{Path, PathBuf};
 
-mod data_dir;
 #[allow(unused_imports, reason = "each test binary uses a subset")]
-pub(crate) use data_dir::data_dir;
+pub(crate) use test_support::data::data_dir;
 
 /// A fresh scratch folder, unique even for tests running in parallel.
 pub(crate) fn scratch(name: &str) -> PathBuf {

@@ -751,10 +751,6 @@ fn prism<T: Copy + Ord>(a: [T; 3], b: [T; 3]) -> Vec<[T; 4]> {
 }
 
 #[cfg(test)]
-#[path = "../../../io/tests/support/data_dir.rs"]
-mod data_dir;
-
-#[cfg(test)]
 #[path = "../../tests/common/splitmix.rs"]
 mod splitmix;
 
@@ -991,7 +987,7 @@ mod tests {
         ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
     )]
     fn every_created_tet_keeps_its_parents_bound_on_the_data_meshes() {
-        let Some(dir) = super::data_dir::data_dir() else {
+        let Some(dir) = test_support::data::data_dir() else {
             return;
         };
         let mut rng = Random(0xDA7A);
