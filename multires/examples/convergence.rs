@@ -155,7 +155,7 @@ impl<'r> Recorder<'r> {
     fn new(reference: &'r [f64]) -> Self {
         Self {
             reference,
-            norm: multires::vector::norm(reference),
+            norm: reference.iter().map(|v| v * v).sum::<f64>().sqrt(),
             start: Instant::now(),
             excluded: 0.0,
             curve: Vec::new(),

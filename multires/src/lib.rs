@@ -54,18 +54,21 @@
 //! # Ok::<(), multires::Error>(())
 //! ```
 
-pub mod cascade;
+// Each public item has one path: the solvers and their types from the
+// root, the function families (`coarse`, `grid`, `matrix`, `mtx`) from
+// their modules, the traits also from `prelude`.
+mod cascade;
 pub mod coarse;
 mod dense;
 mod error;
-pub mod graph;
+mod graph;
 pub mod grid;
-pub mod hierarchy;
-pub mod krylov;
+mod hierarchy;
+mod krylov;
 pub mod matrix;
 pub mod mtx;
-pub mod vcycle;
-pub mod vector;
+mod vcycle;
+mod vector;
 
 /// The README's examples, compiled as doctests.
 #[cfg(doctest)]
@@ -84,3 +87,11 @@ pub use krylov::{
 /// callers build matrices with the same version.
 pub use sprs;
 pub use vcycle::{VCycle, VCycleOptions};
+
+/// The traits a caller implements or calls through, to import at once:
+/// `use multires::prelude::*;` (a [`Preconditioner`] of one's own, or
+/// `apply` on [`Jacobi`] and [`VCycle`]; a [`PositionList`] over one's own
+/// position buffer).
+pub mod prelude {
+    pub use crate::{PositionList, Preconditioner};
+}

@@ -24,17 +24,17 @@ fn reduce2(a: &[f64], b: &[f64], f: impl Fn(&[f64], &[f64]) -> f64 + Sync) -> f6
 }
 
 /// `a · b`.
-pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     reduce2(a, b, |a, b| a.iter().zip(b).map(|(x, y)| x * y).sum())
 }
 
 /// `‖a‖₂`.
-pub fn norm(a: &[f64]) -> f64 {
+pub(crate) fn norm(a: &[f64]) -> f64 {
     dot(a, a).sqrt()
 }
 
 /// `y ← y + α x`.
-pub fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
+pub(crate) fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
     y.par_chunks_mut(CHUNK)
         .zip(x.par_chunks(CHUNK))
         .for_each(|(y, x)| {
@@ -45,7 +45,7 @@ pub fn axpy(alpha: f64, x: &[f64], y: &mut [f64]) {
 }
 
 /// `y ← x + β y`.
-pub fn xpby(x: &[f64], beta: f64, y: &mut [f64]) {
+pub(crate) fn xpby(x: &[f64], beta: f64, y: &mut [f64]) {
     y.par_chunks_mut(CHUNK)
         .zip(x.par_chunks(CHUNK))
         .for_each(|(y, x)| {

@@ -232,7 +232,7 @@ fn the_cascade_and_the_v_cycle_solve_to_the_reported_residual() {
 
 #[test]
 fn the_v_cycle_is_a_symmetric_positive_definite_preconditioner() {
-    use multires::Preconditioner;
+    use multires::prelude::*;
     let g = grid::diffusion([16, 15, 14], 7.0).unwrap();
     let v = VCycle::new(
         &g.matrix,

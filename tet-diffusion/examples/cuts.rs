@@ -127,9 +127,7 @@ fn off_plane(before: &TetMesh, after: &TetMesh, point: DVec3, n: DVec3, size: f6
         .fold(0.0, f64::max)
 }
 
-#[path = "../tests/common/splitmix.rs"]
-mod splitmix;
-use splitmix::Random;
+use test_support::SplitMix64 as Random;
 
 /// The first line of `/proc/loadavg`, to print beside the timings.
 fn loadavg() -> String {
@@ -245,12 +243,12 @@ fn run() -> Result<(), String> {
             let p = lo
                 + (hi - lo)
                     * DVec3::new(
-                        0.25 + 0.5 * rng.next(),
-                        0.25 + 0.5 * rng.next(),
-                        0.25 + 0.5 * rng.next(),
+                        0.25 + 0.5 * rng.f64(),
+                        0.25 + 0.5 * rng.f64(),
+                        0.25 + 0.5 * rng.f64(),
                     );
             let n = loop {
-                let v = DVec3::new(rng.next(), rng.next(), rng.next()) * 2.0 - 1.0;
+                let v = DVec3::new(rng.f64(), rng.f64(), rng.f64()) * 2.0 - 1.0;
                 if v.length_squared() > 0.01 && v.length_squared() <= 1.0 {
                     break v;
                 }

@@ -31,9 +31,7 @@ const RADIUS: f64 = 10.0;
 const ETA: f64 = 1.3;
 const CONE_DEGREES: f64 = 15.0;
 
-#[path = "../tests/common/splitmix.rs"]
-mod splitmix;
-use splitmix::Random;
+use test_support::SplitMix64 as Random;
 
 /// Unpolarised Fresnel reflectance between indices `n1` (incident side)
 /// and `n2`, incident cosine `ci`; 1 under total internal reflection.
@@ -58,8 +56,8 @@ fn exit_distance(p: DVec3, d: DVec3) -> f64 {
 }
 
 fn isotropic(rng: &mut Random) -> DVec3 {
-    let z = 2.0 * rng.next() - 1.0;
-    let phi = 2.0 * std::f64::consts::PI * rng.next();
+    let z = 2.0 * rng.f64() - 1.0;
+    let phi = 2.0 * std::f64::consts::PI * rng.f64();
     let r = (1.0 - z * z).max(0.0).sqrt();
     DVec3::new(r * phi.cos(), r * phi.sin(), z)
 }
@@ -72,8 +70,8 @@ fn photon(rng: &mut Random, sigma_s: f64, mu_a: f64) -> f64 {
     let cone = CONE_DEGREES.to_radians().cos();
     // Enter through the disc the light (from +y) sees.
     let (r, a) = (
-        RADIUS * rng.next().sqrt(),
-        2.0 * std::f64::consts::PI * rng.next(),
+        RADIUS * rng.f64().sqrt(),
+        2.0 * std::f64::consts::PI * rng.f64(),
     );
     let (x, z) = (r * a.cos(), r * a.sin());
     let mut p = DVec3::new(x, (RADIUS * RADIUS - r * r).max(0.0).sqrt(), z);
@@ -81,21 +79,21 @@ fn photon(rng: &mut Random, sigma_s: f64, mu_a: f64) -> f64 {
     let d_in = DVec3::NEG_Y;
     let ci = -d_in.dot(n);
     let (reflect, ct) = fresnel(ci, 1.0, ETA);
-    if rng.next() < reflect {
+    if rng.f64() < reflect {
         return 0.0; // specular reflection: not subsurface light
     }
     let k = 1.0 / ETA;
     let mut d = (d_in * k + n * (k * ci - ct)).normalize();
     let mut w = 1.0;
     for _ in 0..1_000_000 {
-        let step = -(1.0 - rng.next()).ln() / sigma_t;
+        let step = -(1.0 - rng.f64()).ln() / sigma_t;
         let to_wall = exit_distance(p, d);
         if step < to_wall {
             p += d * step;
             w *= albedo;
             if w < 1e-3 {
                 // Russian roulette keeps the estimate unbiased.
-                if rng.next() < 0.5 {
+                if rng.f64() < 0.5 {
                     return 0.0;
                 }
                 w *= 2.0;
@@ -108,7 +106,7 @@ fn photon(rng: &mut Random, sigma_s: f64, mu_a: f64) -> f64 {
         let n = p / RADIUS;
         let ci = d.dot(n);
         let (reflect, ct) = fresnel(ci, ETA, 1.0);
-        if rng.next() < reflect {
+        if rng.f64() < reflect {
             d = (d - n * (2.0 * ci)).normalize();
             continue;
         }

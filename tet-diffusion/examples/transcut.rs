@@ -260,6 +260,11 @@ fn peak_mb() -> f64 {
         .map_or(f64::NAN, |kb| kb / 1024.0)
 }
 
+/// `‖x‖₂`.
+fn norm(x: &[f64]) -> f64 {
+    x.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
 fn relative_error(x: &[f64], reference: &[f64], norm: f64) -> f64 {
     x.iter()
         .zip(reference)
@@ -323,7 +328,7 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
         let _converged = multires::pcg(&matrices[c], &rhs[c], &mut reference[c], &vcycle, &tight)
             .map_err(|e| e.to_string())?;
     }
-    let norms: [f64; 3] = std::array::from_fn(|c| multires::vector::norm(&reference[c]));
+    let norms: [f64; 3] = std::array::from_fn(|c| norm(&reference[c]));
     // Iterations to 1% error for a solver, found with a monitor, then timed
     // without it.
     let to_one_percent = |solve: &SolveFn<'_>| -> (usize, f64) {
@@ -435,10 +440,7 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
             .iter()
             .map(|&i| (reference[0][i as usize] - x[i as usize]).abs() / peak)
             .fold(0.0, f64::max);
-        (
-            max,
-            relative_error(&reference[0], &x, multires::vector::norm(&x)),
-        )
+        (max, relative_error(&reference[0], &x, norm(&x)))
     };
     let (diff, diff_l2) = diff;
     if let Some(dir) = &args.export {

@@ -17,14 +17,15 @@
 use rayon::prelude::*;
 use sprs::CsMat;
 
-use crate::mesh::{EDGES, TetMesh, edge_index, volume6};
+use crate::geometry::{edge_index, tet_geometry};
+use crate::mesh::TetMesh;
 
 /// Per-tet geometry: volume and the geometric part of Eq. 10.
 #[derive(Debug, Clone)]
 pub(crate) struct Geometry {
     /// `V_t`, mesh units³.
     pub(crate) volume: Vec<f64>,
-    /// For each edge `(i, j)` of [`EDGES`]: `−(1/6) |kl| cot θ_kl`, where
+    /// For each edge `(i, j)` of [`EDGES`](crate::geometry::EDGES): `−(1/6) |kl| cot θ_kl`, where
     /// `kl` is the opposite edge and `θ_kl` the dihedral angle there.
     pub(crate) weights: Vec<[f64; 6]>,
 }
@@ -55,28 +56,6 @@ impl Geometry {
     }
 }
 
-/// Volume and Eq. 10's geometric weights of one tet.
-///
-/// For edge `(i, j)` with opposite edge `kl`, `E = x_l − x_k`,
-/// `a = x_i − x_k`, `b = x_j − x_k`: the components of `a` and `b`
-/// orthogonal to `E` span the dihedral angle `θ_kl`, so
-/// `|kl| cot θ_kl = (|E|² a·b − (a·E)(b·E)) / 6V` (their cross product has
-/// length `|(a × b)·E| / |E| = 6V / |kl|`): the cotangent without
-/// trigonometry or square roots.
-pub(crate) fn tet_geometry(c: &[glam::DVec3; 4]) -> (f64, [f64; 6]) {
-    let v6 = volume6(c);
-    let scale = -1.0 / (6.0 * v6);
-    let weights = std::array::from_fn(|e| {
-        let [i, j] = EDGES[e];
-        let [k, l] = EDGES[5 - e];
-        let edge = c[l] - c[k];
-        let (a, b) = (c[i] - c[k], c[j] - c[k]);
-        // −(1/6) |kl| cot θ_kl
-        scale * (edge.length_squared() * a.dot(b) - a.dot(edge) * b.dot(edge))
-    });
-    (v6 / 6.0, weights)
-}
-
 /// Per-tet coefficients in mesh units: `κ_t` (units) and `μa_t`
 /// (units⁻¹) per channel.
 #[derive(Debug, Clone, PartialEq)]
@@ -103,7 +82,7 @@ pub(crate) fn pattern(mesh: &TetMesh) -> (Vec<usize>, Vec<usize>) {
     (indptr, indices)
 }
 
-/// Index in [`EDGES`] of the local edge between corners `a` and `b`
+/// Index in [`EDGES`](crate::geometry::EDGES) of the local edge between corners `a` and `b`
 /// (either order; the diagonal entries are unused).
 const EDGE_OF: [[usize; 4]; 4] = [[0, 0, 1, 2], [0, 0, 3, 4], [1, 3, 0, 5], [2, 4, 5, 0]];
 
@@ -251,6 +230,7 @@ pub(crate) fn rhs(mesh: &TetMesh, q: &[[f64; 3]], a: f64, fdr: f64) -> [Vec<f64>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::EDGES;
     use crate::mesh::tests::cube;
     use glam::DVec3;
 
@@ -265,7 +245,7 @@ mod tests {
         let (_, w) = tet_geometry(&c);
         for (e, [i, j]) in EDGES.iter().enumerate() {
             let [k, l] = EDGES[5 - e];
-            let (_, cot) = crate::mesh::dihedral(c[k], c[l], c[*i], c[*j]);
+            let (_, cot) = crate::geometry::dihedral(c[k], c[l], c[*i], c[*j]);
             let expected = -c[k].distance(c[l]) * cot / 6.0;
             assert!((w[e] - expected).abs() < 1e-12, "{e}: {} {expected}", w[e]);
         }
@@ -283,7 +263,7 @@ mod tests {
         let (v, w) = tet_geometry(&c);
         // Area vector of the face opposite vertex a, pointing toward a.
         let area = |a: usize| {
-            let f = crate::mesh::OUTWARD_FACES[a].map(|k| c[k]);
+            let f = crate::geometry::OUTWARD_FACES[a].map(|k| c[k]);
             -(f[1] - f[0]).cross(f[2] - f[0]) * 0.5
         };
         for (e, [a, b]) in EDGES.iter().enumerate() {
@@ -369,7 +349,7 @@ mod tests {
                 .map(|i| ((i * 7 + k * 13) % 11) as f64 - 5.0)
                 .collect();
             multires::matrix::mul_vec(&m[1], &v, &mut y);
-            assert!(multires::vector::dot(&v, &y) > 0.0);
+            assert!(v.iter().zip(&y).map(|(a, b)| a * b).sum::<f64>() > 0.0);
         }
     }
 }

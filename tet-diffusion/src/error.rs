@@ -114,7 +114,7 @@ pub enum Error {
         tets: usize,
     },
     /// An exact cut (or a fracture) would make a tet below the angle bound
-    /// (`cut::created_angle_bound`) and no snap of a vertex avoids it.
+    /// ([`created_angle_bound`](crate::created_angle_bound)) and no snap of a vertex avoids it.
     #[error(
         "the exact cut would split input tet {tet} into a tet with a {angle:.3}° dihedral angle, below the bound {bound:.3}° there, and no vertex of it can snap onto the cut; cut a little elsewhere or use the relaxation cut"
     )]

@@ -1,29 +1,13 @@
-//! The reference formulation: the P1 finite-element system of Arbree et
-//! al. 2011 for the same diffusion equation and boundary condition,
-//!
-//! `∫ κ ∇φ·∇v + ∫ μa φ v + (1/2A) ∮ φ v = (2 / (A (1 − F_dr))) ∮ q v`,
-//!
-//! with consistent mass and boundary matrices, assembled independently of
-//! TransCut's cotangent formula, in two ways: closed-form element matrices
-//! (`∇β_a = S_a n_a / (3V)`, Eq. 4; mass `V (1 + δ_ab) / 20`; boundary
-//! `area (1 + δ_ab) / 12`), and numerical quadrature (collapsed
-//! Gauss–Legendre, 27 points per tet and 9 per boundary triangle, exact for
-//! these integrands) evaluating the coefficients and basis functions at
-//! every point, as Arbree et al. do (their material varies inside a tet;
-//! ours is constant per tet, and the quadrature still samples it per point).
-//!
-//! **The exact relation.** TransCut's matrix is
-//! `M = 4 (K + lumped(Mμ) + lumped(B) / (2A))` and its right-hand side
-//! `b = 4 × lumped P1 load` (lumping = row sums on the diagonal): the
-//! cotangent weights of Eq. 10 are the P1 stiffness entries, and Eq. 13's
-//! `V_i μ` and `2 S_i / 3A` are 4 × the lumped mass and boundary mass.
+//! The reference formulation, the P1 finite-element system of Arbree et
+//! al. 2011 (see [`P1Matrices`]).
 
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 use sprs::CsMat;
 
 use crate::assembly::{Coefficients, pattern};
-use crate::mesh::{Csr, OUTWARD_FACES, TetMesh};
+use crate::geometry::OUTWARD_FACES;
+use crate::mesh::{Csr, TetMesh};
 
 /// How the element integrals are computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -35,7 +19,27 @@ pub enum Integration {
 }
 
 /// The P1 matrices in the pattern of TransCut's `M` (per RGB channel where
-/// they depend on the material), mesh units.
+/// they depend on the material), mesh units ([`Object::fem_reference`](crate::Object::fem_reference)).
+///
+/// The reference formulation: the P1 finite-element system of Arbree et
+/// al. 2011 for the same diffusion equation and boundary condition,
+///
+/// `∫ κ ∇φ·∇v + ∫ μa φ v + (1/2A) ∮ φ v = (2 / (A (1 − F_dr))) ∮ q v`,
+///
+/// with consistent mass and boundary matrices, assembled independently of
+/// TransCut's cotangent formula, in two ways: closed-form element matrices
+/// (`∇β_a = S_a n_a / (3V)`, Eq. 4; mass `V (1 + δ_ab) / 20`; boundary
+/// `area (1 + δ_ab) / 12`), and numerical quadrature (collapsed
+/// Gauss–Legendre, 27 points per tet and 9 per boundary triangle, exact for
+/// these integrands) evaluating the coefficients and basis functions at
+/// every point, as Arbree et al. do (their material varies inside a tet;
+/// ours is constant per tet, and the quadrature still samples it per point).
+///
+/// **The exact relation.** TransCut's matrix is
+/// `M = 4 (K + lumped(Mμ) + lumped(B) / (2A))` and its right-hand side
+/// `b = 4 × lumped P1 load` (lumping = row sums on the diagonal): the
+/// cotangent weights of Eq. 10 are the P1 stiffness entries, and Eq. 13's
+/// `V_i μ` and `2 S_i / 3A` are 4 × the lumped mass and boundary mass.
 #[derive(Debug, Clone)]
 pub struct P1Matrices {
     /// `K_ij = ∫ κ ∇β_i · ∇β_j`.
@@ -221,7 +225,7 @@ pub(crate) fn assemble(
 /// (without μ): `V ∇β_a·∇β_b` with `∇β_a = S_a n_a / (3V)`, and
 /// `V (1 + δ_ab) / 20`.
 fn closed_form_row(c: &[DVec3; 4], a: usize) -> ([f64; 4], [f64; 4]) {
-    let v = crate::mesh::volume6(c) / 6.0;
+    let v = crate::geometry::volume6(c) / 6.0;
     // Area vector of the face opposite x_b, pointing toward x_b.
     let area = |b: usize| {
         let f = OUTWARD_FACES[b].map(|k| c[k]);

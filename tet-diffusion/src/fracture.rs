@@ -26,7 +26,7 @@ impl Object {
     /// Splits the object by the plane through `point` with `normal`: the
     /// tets the plane crosses are first split along it exactly (as
     /// [`CutMethod::Exact`](crate::CutMethod::Exact) splits them, vertices
-    /// within [`SNAP`](crate::cut::SNAP) of it snapped onto it, `φ`
+    /// within 0.2 of an edge's length of it snapped onto it, `φ`
     /// interpolated at the new vertices); then the tets on the side
     /// `(x − point) · normal ≥ 0` go to the second piece, the others to the
     /// first, so both crack faces lie on the plane. Each piece keeps the

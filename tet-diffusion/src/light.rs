@@ -169,7 +169,10 @@ impl Environment {
                 }
             }
         }
-        let lum: Vec<f32> = rgb.iter().map(|p| luminance(*p)).collect();
+        let lum: Vec<f32> = rgb
+            .iter()
+            .map(|p| discrete_sampling::luminance(*p))
+            .collect();
         let dist = discrete_sampling::Distribution2D::from_equirect(&lum, width, height)
             .map_err(Error::Environment)?;
         let mut out = Vec::with_capacity(samples);
@@ -187,11 +190,6 @@ impl Environment {
         }
         Ok(Self { samples: out })
     }
-}
-
-/// Rec. 709 luminance.
-pub fn luminance(rgb: [f32; 3]) -> f32 {
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
 }
 
 /// Van der Corput radical inverse in base 2.
@@ -356,15 +354,6 @@ impl LitLight {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn luminance_is_rec709() {
-        assert!((luminance([1.0, 0.0, 0.0]) - 0.2126).abs() < 1e-6);
-        assert!((luminance([0.0, 1.0, 0.0]) - 0.7152).abs() < 1e-6);
-        assert!((luminance([0.0, 0.0, 1.0]) - 0.0722).abs() < 1e-6);
-        // 0.2126·0.5 + 0.7152·0.25 + 0.0722·2 = 0.4295.
-        assert!((luminance([0.5, 0.25, 2.0]) - 0.4295).abs() < 1e-6);
-    }
 
     #[test]
     fn uniform_environment_integrates_cosine() {

@@ -6,22 +6,10 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::Error;
+use crate::geometry::{EDGES, OUTWARD_FACES, dihedral_angles, volume6};
 
 /// "No neighbour" in [`TetMesh::tet_neighbors`].
 pub const NONE: u32 = u32::MAX;
-
-/// The faces of tetrahedron `(0, 1, 2, 3)` opposite each vertex, with
-/// outward normals (right-hand rule) when it is positively oriented,
-/// `det[p1 − p0, p2 − p0, p3 − p0] > 0`.
-pub const OUTWARD_FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
-
-/// The six edges of a tetrahedron as local vertex pairs; edge `e` and edge
-/// `5 − e` are opposite (they share no vertex).
-pub const EDGES: [[usize; 2]; 6] = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
-
-/// Tets whose minimal dihedral angle is below this many degrees are
-/// "poorly shaped" (TransCut Sec. 6, Limitations).
-pub const POOR_DIHEDRAL_DEGREES: f64 = 0.5;
 
 /// Compressed rows: `items[offsets[i]..offsets[i + 1]]` belong to `i`.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -62,43 +50,6 @@ pub struct TetMesh {
     boundary_index: Vec<u32>,
     vertex_area: Vec<f64>,
     vertex_normal: Vec<DVec3>,
-}
-
-/// Shape statistics of a mesh (angles in degrees).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Quality {
-    /// Smallest dihedral angle of any tetrahedron.
-    pub min_dihedral: f64,
-    /// Largest dihedral angle of any tetrahedron.
-    pub max_dihedral: f64,
-    /// Tetrahedra whose smallest dihedral angle is below
-    /// [`POOR_DIHEDRAL_DEGREES`] (0.5°): their cotangent weights are huge.
-    pub poor_tets: usize,
-    /// Smallest and largest geometric edge weight
-    /// `Σ_t −(1/6) |kl| cot θ_kl` (Eq. 10 without `κ`), in mesh units.
-    pub edge_weight_range: [f64; 2],
-    /// Shortest and longest edge, in mesh units.
-    pub edge_length_range: [f64; 2],
-    /// Mean edge length, in mesh units.
-    pub mean_edge_length: f64,
-}
-
-/// `det[b − a, c − a, d − a]`, six times the signed volume.
-#[inline]
-pub(crate) fn volume6(p: &[DVec3; 4]) -> f64 {
-    (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]))
-}
-
-/// The dihedral angle (radians) of a tetrahedron at edge `(a, b)`, between
-/// the faces `(a, b, c)` and `(a, b, d)`, with its cotangent.
-#[inline]
-pub(crate) fn dihedral(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> (f64, f64) {
-    let e = (b - a).normalize();
-    let u = (c - a) - e * (c - a).dot(e);
-    let v = (d - a) - e * (d - a).dot(e);
-    let cos = u.dot(v);
-    let sin = u.cross(v).length();
-    (sin.atan2(cos), cos / sin)
 }
 
 impl TetMesh {
@@ -587,50 +538,10 @@ impl TetMesh {
         (c[0] + c[1] + c[2] + c[3]) * 0.25
     }
 
-    /// The six dihedral angles (radians) of tet `t`, at edges [`EDGES`].
+    /// The six dihedral angles (radians) of tet `t`, at its local edges
+    /// (0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3).
     pub fn dihedral_angles(&self, t: usize) -> [f64; 6] {
         dihedral_angles(&self.corners(t))
-    }
-
-    /// The quality report: dihedral angles, poorly shaped tets, the range
-    /// of the cotangent edge weights and of the edge lengths.
-    pub fn quality(&self) -> Quality {
-        let (min, max, poor) = (0..self.tets.len())
-            .into_par_iter()
-            .with_min_len(4096)
-            .map(|t| {
-                let a = self.dihedral_angles(t);
-                let lo = a.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = a.iter().copied().fold(0.0, f64::max);
-                (lo, hi, usize::from(lo.to_degrees() < POOR_DIHEDRAL_DEGREES))
-            })
-            .reduce(
-                || (f64::INFINITY, 0.0, 0),
-                |a, b| (a.0.min(b.0), a.1.max(b.1), a.2 + b.2),
-            );
-        let weights = crate::assembly::Geometry::new(self);
-        let mut w = [f64::INFINITY, f64::NEG_INFINITY];
-        let mut len = [f64::INFINITY, 0.0f64];
-        let mut total = 0.0;
-        for i in 0..self.vertex_count() {
-            for (k, &j) in self.one_ring(i).iter().enumerate() {
-                if (j as usize) > i {
-                    let g = weights.edge_weight(self, i, k);
-                    w = [w[0].min(g), w[1].max(g)];
-                    let l = self.positions[i].distance(self.positions[j as usize]);
-                    len = [len[0].min(l), len[1].max(l)];
-                    total += l;
-                }
-            }
-        }
-        Quality {
-            min_dihedral: min.to_degrees(),
-            max_dihedral: max.to_degrees(),
-            poor_tets: poor,
-            edge_weight_range: w,
-            edge_length_range: len,
-            mean_edge_length: total / self.edge_count().max(1) as f64,
-        }
     }
 
     /// Mean edge length (mesh units).
@@ -640,27 +551,6 @@ impl TetMesh {
             total += self.positions[e[0] as usize].distance(self.positions[e[1] as usize]);
         }
         total / self.edge_count().max(1) as f64
-    }
-}
-
-/// The six dihedral angles of a tetrahedron at [`EDGES`].
-pub(crate) fn dihedral_angles(c: &[DVec3; 4]) -> [f64; 6] {
-    EDGES.map(|[a, b]| {
-        let [o1, o2] = EDGES[5 - edge_index(a, b)];
-        dihedral(c[a], c[b], c[o1], c[o2]).0
-    })
-}
-
-/// Index in [`EDGES`] of the local edge `(a, b)`, `a < b`.
-#[inline]
-pub(crate) fn edge_index(a: usize, b: usize) -> usize {
-    match (a, b) {
-        (0, 1) => 0,
-        (0, 2) => 1,
-        (0, 3) => 2,
-        (1, 2) => 3,
-        (1, 3) => 4,
-        _ => 5,
     }
 }
 
@@ -848,8 +738,10 @@ fn faces(tets: &[[u32; 4]]) -> Result<Faces, Error> {
 pub(crate) mod tests {
     use super::*;
 
-    // The Kuhn cube lattice the unit and integration tests share.
-    pub(crate) use crate::kuhn::cube;
+    /// The Kuhn lattice of `[0, size]³` the unit tests share.
+    pub(crate) fn cube(n: usize, size: f64) -> (Vec<DVec3>, Vec<[u32; 4]>) {
+        crate::kuhn_lattice(n, DVec3::ZERO, DVec3::splat(size))
+    }
 
     #[test]
     fn subset_equals_a_mesh_built_from_scratch() {
@@ -1006,18 +898,5 @@ pub(crate) mod tests {
         ));
         let e = TetMesh::new(&p, &[[0, 1, 2, 4]]).unwrap_err().to_string();
         assert!(e.contains("tetrahedron 0"), "{e}");
-    }
-
-    #[test]
-    fn dihedral_of_regular_tet() {
-        let c = [
-            DVec3::new(1.0, 1.0, 1.0),
-            DVec3::new(1.0, -1.0, -1.0),
-            DVec3::new(-1.0, 1.0, -1.0),
-            DVec3::new(-1.0, -1.0, 1.0),
-        ];
-        for a in dihedral_angles(&c) {
-            assert!((a.cos() - 1.0 / 3.0).abs() < 1e-12);
-        }
     }
 }

@@ -17,7 +17,7 @@ use sprs::CsMat;
 use crate::assembly::{self, Coefficients, Geometry};
 use crate::fem::{self, Integration, P1Matrices};
 use crate::light::{LitLight, Shadows};
-use crate::material::ResolutionWarning;
+use crate::medium::ResolutionWarning;
 use crate::{Error, Light, Medium, TetMesh, fresnel};
 
 /// Which solver [`Object::solve`] uses (all from `multires`).
@@ -880,7 +880,7 @@ impl Object {
     }
 
     /// The P1 finite-element reference system of this object (Arbree et
-    /// al.), assembled by `how`; see [`crate::fem`].
+    /// al.), assembled by `how`; see [`P1Matrices`].
     pub fn fem_reference(&self, how: Integration) -> P1Matrices {
         fem::assemble(&self.mesh, &self.coefficients, how)
     }

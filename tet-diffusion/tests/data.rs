@@ -211,7 +211,7 @@ fn exact_plane_cuts_of_bunny_500k_lie_on_the_plane() {
     let mut o =
         Object::homogeneous(mesh, 1000.0, Medium::measured("marble").unwrap(), 1.3).unwrap();
     o.set_shadows(false);
-    let bound = tet_diffusion::cut::created_angle_bound(o.mesh().quality().min_dihedral);
+    let bound = tet_diffusion::created_angle_bound(o.mesh().quality().min_dihedral);
     for (point, normal) in [
         (centre, DVec3::new(1.0, 0.0, 0.2)),
         (

@@ -270,7 +270,7 @@ fn exact_plane_cut_lies_on_the_plane() {
     let cut = Cut::Plane { point, normal };
     let report = o.cut(&cut, CutMethod::Exact).unwrap();
     assert!(report.split_tets > 0 && report.created_vertices > 0 && report.created_tets > 0);
-    let bound = tet_diffusion::cut::created_angle_bound(before.mesh().quality().min_dihedral);
+    let bound = tet_diffusion::created_angle_bound(before.mesh().quality().min_dihedral);
     assert!(report.min_created_dihedral >= bound, "{report:?}");
     let (off, deviation, vertices) = check_exact_plane_cut(before.mesh(), o.mesh(), point, normal);
     eprintln!(

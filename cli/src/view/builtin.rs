@@ -3,7 +3,7 @@
 //! invisible from outside, lit through, and revealed by the first cut.
 
 use tet_diffusion::glam::DVec3;
-use tet_diffusion::{Error, Medium, Object, TetMesh};
+use tet_diffusion::{Error, Medium, Object, TetMesh, kuhn_lattice};
 
 /// Radius of the ball, mm (the mesh's unit).
 pub const RADIUS: f64 = 20.0;
@@ -13,46 +13,18 @@ pub const RADIUS: f64 = 20.0;
 /// (`x ← R x ‖x‖∞ / ‖x‖₂`) so that the boundary vertices lie on the sphere
 /// and every tet stays positively oriented.
 pub fn ball(n: usize) -> Result<TetMesh, Error> {
-    let m = n + 1;
-    let id = |x: usize, y: usize, z: usize| (x + m * (y + m * z)) as u32;
-    let mut positions = Vec::with_capacity(m * m * m);
-    for z in 0..m {
-        for y in 0..m {
-            for x in 0..m {
-                let c = DVec3::new(x as f64, y as f64, z as f64) * (2.0 / n as f64) - DVec3::ONE;
-                let l = c.length();
-                positions.push(if l == 0.0 {
-                    c
-                } else {
-                    c * (RADIUS * c.abs().max_element() / l)
-                });
+    let (lattice, tets) = kuhn_lattice(n, -DVec3::ONE, DVec3::ONE);
+    let positions: Vec<DVec3> = lattice
+        .into_iter()
+        .map(|c| {
+            let l = c.length();
+            if l == 0.0 {
+                c
+            } else {
+                c * (RADIUS * c.abs().max_element() / l)
             }
-        }
-    }
-    const PATHS: [[usize; 3]; 6] = [
-        [0, 1, 2],
-        [0, 2, 1],
-        [1, 0, 2],
-        [1, 2, 0],
-        [2, 0, 1],
-        [2, 1, 0],
-    ];
-    let mut tets = Vec::with_capacity(n * n * n * 6);
-    for z in 0..n {
-        for y in 0..n {
-            for x in 0..n {
-                for path in PATHS {
-                    let mut c = [x, y, z];
-                    let mut tet = [id(x, y, z); 4];
-                    for (k, &axis) in path.iter().enumerate() {
-                        c[axis] += 1;
-                        tet[k + 1] = id(c[0], c[1], c[2]);
-                    }
-                    tets.push(tet);
-                }
-            }
-        }
-    }
+        })
+        .collect();
     TetMesh::new(&positions, &tets)
 }
 

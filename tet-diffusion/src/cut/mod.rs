@@ -21,10 +21,9 @@ use crate::error::finite_vec;
 use crate::{Error, Object, TetMesh};
 
 mod relax;
-pub mod split;
+pub(crate) mod split;
 
-pub use relax::RHO;
-pub use split::{ANGLE_BOUND_DEGREES, ANGLE_BOUND_FRACTION, SNAP, created_angle_bound};
+pub use split::{ANGLE_BOUND_DEGREES, ANGLE_BOUND_FRACTION, created_angle_bound};
 
 /// What to cut away.
 #[derive(Debug, Clone, PartialEq)]
@@ -121,19 +120,19 @@ impl Cut {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum CutMethod {
     /// Split the tets the cut surface crosses along it (snapping vertices
-    /// within [`SNAP`] of an edge onto it first): the cross-section lies on
+    /// within 0.2 of an edge's length of it onto it first): the cross-section lies on
     /// the surface, and every tet the cut makes from an input tet `P` (a
     /// piece of it, or `P` with snapped corners) has a smallest dihedral
     /// angle of at least [`created_angle_bound`]`(θ(P)) =
     /// min(`[`ANGLE_BOUND_DEGREES`]` = 0.5°, `[`ANGLE_BOUND_FRACTION`]` = 0.25 ·
     /// θ(P))`, `θ(P)` the smallest dihedral angle of `P` before the cut.
     /// Guaranteed: the cut snaps further vertices to keep it and, when no
-    /// snap can, fails with [`Error::CutAngleBound`] ([`split`]).
+    /// snap can, fails with [`Error::CutAngleBound`].
     #[default]
     Exact,
     /// TransCut's cut (Sec. 5): remove the tets entirely on the cut side,
     /// then relax the remaining cut-side vertices toward the cross-section
-    /// for `sweeps` sweeps (`x ← x + ρ (x′ − x)`, [`RHO`]).
+    /// for `sweeps` sweeps (`x ← x + ρ (x′ − x)`, `ρ = 0.1`).
     Relax {
         /// Relaxation sweeps.
         sweeps: usize,

@@ -8,11 +8,12 @@ use rayon::prelude::*;
 use std::time::Instant;
 
 use super::{Cut, CutReport, CutTimes, ms};
-use crate::mesh::{POOR_DIHEDRAL_DEGREES, dihedral_angles, volume6};
+use crate::geometry::{dihedral_angles, volume6};
+use crate::quality::POOR_DIHEDRAL_DEGREES;
 use crate::{Error, Object, TetMesh};
 
 /// The relaxation step of the paper, `x ← x + ρ (x′ − x)`.
-pub const RHO: f64 = 0.1;
+pub(crate) const RHO: f64 = 0.1;
 
 impl Object {
     /// [`CutMethod::Relax`](super::CutMethod::Relax): removes every tet whose four vertices lie on the

@@ -32,19 +32,19 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::mesh::{dihedral_angles, volume6};
+use crate::geometry::{dihedral_angles, volume6};
 use crate::{Error, TetMesh};
 
 /// A vertex closer to the surface than this fraction of a crossing edge's
 /// length (measured along the edge) is snapped onto the surface when that
 /// keeps the angle bound (isosurface stuffing's `α`).
-pub const SNAP: f64 = 0.2;
+pub(crate) const SNAP: f64 = 0.2;
 
 /// The absolute part of the angle bound, degrees (see
 /// [`created_angle_bound`]): the crate's threshold of a poorly shaped tet
-/// ([`POOR_DIHEDRAL_DEGREES`](crate::mesh::POOR_DIHEDRAL_DEGREES), TransCut
+/// ([`POOR_DIHEDRAL_DEGREES`](crate::POOR_DIHEDRAL_DEGREES), TransCut
 /// Sec. 6), which the relaxation cut keeps too.
-pub const ANGLE_BOUND_DEGREES: f64 = crate::mesh::POOR_DIHEDRAL_DEGREES;
+pub const ANGLE_BOUND_DEGREES: f64 = crate::POOR_DIHEDRAL_DEGREES;
 
 /// The relative part of the angle bound (see [`created_angle_bound`]).
 pub const ANGLE_BOUND_FRACTION: f64 = 0.25;
@@ -581,10 +581,12 @@ fn split_with(
         .flat_map_iter(|&t| {
             let t = mesh.tets()[t];
             let sign = |v: u32| snapper.sign(v);
-            crate::mesh::EDGES.into_iter().filter_map(move |[i, j]| {
-                let (a, b) = (t[i].min(t[j]), t[i].max(t[j]));
-                (sign(a) * sign(b) < 0).then_some((a, b))
-            })
+            crate::geometry::EDGES
+                .into_iter()
+                .filter_map(move |[i, j]| {
+                    let (a, b) = (t[i].min(t[j]), t[i].max(t[j]));
+                    (sign(a) * sign(b) < 0).then_some((a, b))
+                })
         })
         .collect();
     edges.par_sort_unstable();
@@ -751,10 +753,6 @@ fn prism<T: Copy + Ord>(a: [T; 3], b: [T; 3]) -> Vec<[T; 4]> {
 }
 
 #[cfg(test)]
-#[path = "../../tests/common/splitmix.rs"]
-mod splitmix;
-
-#[cfg(test)]
 mod tests {
     use super::*;
 
@@ -803,7 +801,7 @@ mod tests {
     /// normals (the angle at the edge shared by faces `i` and `j` is
     /// `π − ∠(n_i, n_j)`): independent of the crate's formula.
     fn min_dihedral_by_normals(c: &[DVec3; 4]) -> f64 {
-        let normals = crate::mesh::OUTWARD_FACES.map(|f| {
+        let normals = crate::geometry::OUTWARD_FACES.map(|f| {
             let n = (c[f[1]] - c[f[0]]).cross(c[f[2]] - c[f[0]]);
             n.normalize() * volume6(c).signum()
         });
@@ -876,7 +874,7 @@ mod tests {
         Ok((below, checked))
     }
 
-    use super::splitmix::Random;
+    use test_support::SplitMix64 as Random;
 
     /// Points and directions for the surveys.
     trait Draw {
@@ -886,12 +884,12 @@ mod tests {
 
     impl Draw for Random {
         fn in_box(&mut self, lo: DVec3, hi: DVec3) -> DVec3 {
-            lo + (hi - lo) * DVec3::new(self.next(), self.next(), self.next())
+            lo + (hi - lo) * DVec3::new(self.f64(), self.f64(), self.f64())
         }
 
         fn direction(&mut self) -> DVec3 {
             loop {
-                let v = DVec3::new(self.next(), self.next(), self.next()) * 2.0 - 1.0;
+                let v = DVec3::new(self.f64(), self.f64(), self.f64()) * 2.0 - 1.0;
                 if v.length_squared() > 0.01 && v.length_squared() <= 1.0 {
                     return v.normalize();
                 }
@@ -912,7 +910,7 @@ mod tests {
         for k in 0..surfaces {
             let centre = rng.in_box(lo + (hi - lo) * 0.25, hi - (hi - lo) * 0.25);
             let n = rng.direction();
-            let r = (hi - lo).length() * (0.1 + 0.3 * rng.next());
+            let r = (hi - lo).length() * (0.1 + 0.3 * rng.f64());
             let plane = move |x: DVec3| (x - centre).dot(n);
             let sphere = move |x: DVec3| x.distance(centre) - r;
             let level: &(dyn Fn(DVec3) -> f64 + Sync) = if k % 3 == 2 { &sphere } else { &plane };
@@ -948,9 +946,9 @@ mod tests {
         let mut rng = Random(0xB0B0);
         let (mut enforced, mut loose) = ([0; 3], [0; 3]);
         for _ in 0..24 {
-            let (mut p, tets) = crate::kuhn::cube(5, 1.0);
+            let (mut p, tets) = crate::mesh::tests::cube(5, 1.0);
             for x in &mut p {
-                *x += (DVec3::new(rng.next(), rng.next(), rng.next()) - 0.5) * 0.12;
+                *x += (DVec3::new(rng.f64(), rng.f64(), rng.f64()) - 0.5) * 0.12;
             }
             let Ok(mesh) = TetMesh::new(&p, &tets) else {
                 continue;
@@ -965,7 +963,7 @@ mod tests {
                     total[k] += got[k];
                 }
             }
-            rng.next();
+            rng.f64();
         }
         eprintln!("enforced: {enforced:?}, stuffing's snap alone: {loose:?}");
         assert!(enforced[1] > 1000, "{enforced:?}");

@@ -4,13 +4,10 @@
 use tet_diffusion::glam::DVec3;
 use tet_diffusion::{Medium, Object, TetMesh};
 
-mod kuhn;
-
 /// An `n³` lattice of `[-1, 1]³`, each cube split into six tets around its
 /// main diagonal.
 pub(crate) fn cube(n: usize) -> (Vec<DVec3>, Vec<[u32; 4]>) {
-    let (p, tets) = kuhn::cube(n, 2.0);
-    (p.into_iter().map(|x| x - DVec3::ONE).collect(), tets)
+    tet_diffusion::kuhn_lattice(n, -DVec3::ONE, DVec3::ONE)
 }
 
 /// A ball of radius `r`: the cube lattice mapped radially,
@@ -215,7 +212,7 @@ pub(crate) fn clipped_volume(mesh: &TetMesh, point: DVec3, normal: DVec3) -> f64
 /// the normal points to) of `before` into `after`: every boundary vertex
 /// the cut made (not an old boundary vertex where it was) lies on the plane
 /// to `1e-9` of the bounding box; every tet has a dihedral angle of at
-/// least `cut::created_angle_bound(before's smallest)` (each tet the cut
+/// least `created_angle_bound(before's smallest)` (each tet the cut
 /// made is above its parent's bound, which is at least that); the cut face's normal is within
 /// 1° of the plane's at every vertex of it; the mesh is the one built from
 /// scratch from its positions and tets. Returns (the largest distance
@@ -280,7 +277,7 @@ pub(crate) fn check_exact_plane_cut(
             .to_degrees()
     };
     let (was, now) = (min_of(before), min_of(after));
-    let bound = tet_diffusion::cut::created_angle_bound(was);
+    let bound = tet_diffusion::created_angle_bound(was);
     assert!(
         now >= bound - 1e-9,
         "smallest dihedral {now}° (before {was}°, bound {bound}°)"
