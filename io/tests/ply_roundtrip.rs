@@ -1,42 +1,31 @@
 //! Property tests of the PLY reader and writer over random data: random
 //! counts, every scalar type, random float bit patterns (so that binary
 //! records often start with bytes that look like whitespace), ASCII and
-//! both binary byte orders. A small seeded generator keeps them
-//! deterministic without a dependency.
+//! both binary byte orders. test-support's seeded generator keeps them
+//! deterministic.
 
 use std::fmt::Write as _;
+use std::io::Write as _;
 use std::path::Path;
 
 use glam::{DVec3, Vec2, Vec3};
 use trilux_io::mesh::ply::{self, Format, PlyData};
 
-/// SplitMix64 (Steele, Lea & Flood 2014): enough for test data.
-struct Rng(u64);
+use test_support::SplitMix64 as Rng;
 
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
+/// Random floats whose bytes cover every value.
+trait Float {
+    fn float(&mut self) -> f32;
+}
 
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-
+impl Float for Rng {
     /// A finite f32 with a random mantissa and a binary exponent in
     /// `[-20, 15]`, either sign: every low byte occurs, 0x0a and 0x20
     /// included.
     fn float(&mut self) -> f32 {
-        let bits = self.next() as u32;
+        let bits = self.next_u64() as u32;
         let exponent = (127 - 20 + self.below(36) as u32) << 23;
         f32::from_bits((bits & 0x807F_FFFF) | exponent)
-    }
-
-    fn unit(&mut self) -> f32 {
-        (self.next() >> 40) as f32 / (1u64 << 24) as f32
     }
 }
 
@@ -83,12 +72,12 @@ impl Ty {
     /// A random value this type holds exactly.
     fn random(self, rng: &mut Rng) -> f64 {
         match self {
-            Ty::I8 => f64::from(rng.next() as i8),
-            Ty::U8 => f64::from(rng.next() as u8),
-            Ty::I16 => f64::from(rng.next() as i16),
-            Ty::U16 => f64::from(rng.next() as u16),
-            Ty::I32 => f64::from(rng.next() as i32),
-            Ty::U32 => f64::from(rng.next() as u32),
+            Ty::I8 => f64::from(rng.next_u64() as i8),
+            Ty::U8 => f64::from(rng.next_u64() as u8),
+            Ty::I16 => f64::from(rng.next_u64() as i16),
+            Ty::U16 => f64::from(rng.next_u64() as u16),
+            Ty::I32 => f64::from(rng.next_u64() as i32),
+            Ty::U32 => f64::from(rng.next_u64() as u32),
             Ty::F32 => f64::from(rng.float()),
             Ty::F64 => f64::from(rng.float()) * (1.0 + 2f64.powi(-40)),
         }
@@ -97,7 +86,7 @@ impl Ty {
     /// Encodes `v` (exactly representable) in `format`.
     fn encode(self, v: f64, format: Format, out: &mut Vec<u8>) {
         if format == Format::Ascii {
-            let _ = write!(Text(out), "{v} ");
+            let _ = write!(out, "{v} ");
             return;
         }
         let mut bytes: Vec<u8> = match self {
@@ -114,15 +103,6 @@ impl Ty {
             bytes.reverse();
         }
         out.extend_from_slice(&bytes);
-    }
-}
-
-struct Text<'a>(&'a mut Vec<u8>);
-
-impl std::fmt::Write for Text<'_> {
-    fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        self.0.extend_from_slice(s.as_bytes());
-        Ok(())
     }
 }
 
@@ -256,8 +236,11 @@ fn written_files_read_back_in_every_format() {
                     .map(|_| Vec3::new(rng.float(), rng.float(), rng.float()))
                     .collect()
             }),
-            colors: pick(&mut rng)
-                .then(|| (0..n).map(|_| (rng.next() as u32).to_le_bytes()).collect()),
+            colors: pick(&mut rng).then(|| {
+                (0..n)
+                    .map(|_| (rng.next_u64() as u32).to_le_bytes())
+                    .collect()
+            }),
             // Multiples of 2^-12 in [0, 1]: 1 - (1 - v) is exact for them.
             uvs: pick(&mut rng).then(|| {
                 (0..n)
@@ -267,7 +250,7 @@ fn written_files_read_back_in_every_format() {
                     })
                     .collect()
             }),
-            face_ids: pick(&mut rng).then(|| (0..n).map(|_| rng.next() as u32).collect()),
+            face_ids: pick(&mut rng).then(|| (0..n).map(|_| rng.next_u64() as u32).collect()),
             triangles: if pick(&mut rng) {
                 (0..rng.below(30))
                     .map(|_| [0, 1, 2].map(|_| rng.below(n as u64) as u32))
@@ -277,7 +260,7 @@ fn written_files_read_back_in_every_format() {
             },
             scalars: (0..rng.below(3))
                 .map(|k| {
-                    let column = (0..n).map(|_| rng.float() * rng.unit()).collect();
+                    let column = (0..n).map(|_| rng.float() * rng.f32()).collect();
                     (format!("quality_{k}"), column)
                 })
                 .collect(),

@@ -6,29 +6,22 @@
 //! (an `Err`, or a consistent mesh).
 
 use std::fmt::Write as _;
+use std::io::Write as _;
 
 use glam::{DVec3, Vec2};
 use trilux_io::mesh::ply;
 use trilux_io::tet::{TetMesh, gmsh};
 
-/// SplitMix64 (Steele, Lea & Flood 2014): enough for test data.
-struct Rng(u64);
+use test_support::SplitMix64 as Rng;
 
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
+/// A coordinate of a random mesh, uniform in `[-100, 100)`.
+trait Coordinate {
+    fn real(&mut self) -> f64;
+}
 
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-
+impl Coordinate for Rng {
     fn real(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64 * 200.0 - 100.0
+        self.f64() * 200.0 - 100.0
     }
 }
 
@@ -283,12 +276,12 @@ fn gmsh_41_binary_truncated_or_random_never_panics() {
     for _ in 0..3000 {
         let mut data = header.to_vec();
         let len = rng.below(200) as usize;
-        data.extend((0..len).map(|_| rng.next() as u8));
+        data.extend((0..len).map(|_| rng.next_u64() as u8));
         // Also random bytes in place of a valid file's bytes.
         let mut flipped = whole.clone();
         for _ in 0..1 + rng.below(4) {
             let at = rng.below(flipped.len() as u64) as usize;
-            flipped[at] = rng.next() as u8;
+            flipped[at] = rng.next_u64() as u8;
         }
         for bytes in [data, flipped] {
             if let Ok(mesh) = gmsh::from_bytes(&bytes, "r.msh") {
@@ -463,24 +456,15 @@ fn ply_strips_and_texcoords_random_bodies_never_panic() {
         let len = rng.below(120) as usize;
         if header.contains("ascii") {
             for _ in 0..len / 3 {
-                let _ = write!(AsciiBuf(&mut data), "{} ", rng.below(12) as i64 - 2);
+                let _ = write!(data, "{} ", rng.below(12) as i64 - 2);
             }
         } else {
-            data.extend((0..len).map(|_| rng.next() as u8));
+            data.extend((0..len).map(|_| rng.next_u64() as u8));
         }
         if let Ok(ply) = ply::from_bytes(&data, "r.ply") {
             let n = ply.positions.len();
             assert!(ply.triangles.iter().flatten().all(|&i| (i as usize) < n));
             assert!(ply.uvs.as_ref().is_none_or(|u| u.len() == n));
         }
-    }
-}
-
-struct AsciiBuf<'a>(&'a mut Vec<u8>);
-
-impl std::fmt::Write for AsciiBuf<'_> {
-    fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        self.0.extend_from_slice(s.as_bytes());
-        Ok(())
     }
 }
