@@ -15,12 +15,11 @@
 //! than 1 dB more (tested: ≥ 38 dB for Spot in memory, ≥ 36 dB through
 //! an 8-bit PNG).
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-use glam::{DVec2, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use mesh_colors::atlas::Atlas;
-use mesh_colors::{MeshColors, Texture, Topology, lattice_points};
+use mesh_colors::{MeshColors, Texture, Topology};
 use trilux_io::image::Image;
 use trilux_io::mesh::{Material, Object, TriMesh};
 
@@ -78,7 +77,8 @@ pub fn colors_wrap(wrap: trilux_io::mesh::Wrap) -> mesh_colors::Wrap {
 /// live on the connectivity of the surface itself. Triangle `f` here is
 /// triangle `f` of the `TriMesh`.
 ///
-/// Built by [`ColorMesh::new`]: vertices with equal positions are welded
+/// Built by [`ColorMesh::new`] ([`mesh_colors::convert::weld_manifold`]):
+/// vertices with equal positions are welded
 /// and unused vertices dropped; a triangle that would repeat a vertex
 /// after welding, or be the third on an edge (which mesh colours cannot
 /// colour consistently), keeps vertices of its own (counted in
@@ -120,47 +120,7 @@ impl ColorMesh {
                 "triangle {t} references a vertex beyond the {n} the mesh has"
             )));
         }
-        let (welded, faces, _) = mesh_colors::weld(&mesh.positions, &mesh.indices);
-        let mut compact = vec![u32::MAX; welded.len()];
-        let mut positions = Vec::new();
-        let mut edges: HashMap<(u32, u32), u8> = HashMap::with_capacity(faces.len() * 3 / 2);
-        let mut detached = 0;
-        let mut out = Vec::with_capacity(faces.len());
-        for face in &faces {
-            let degenerate = face[0] == face[1] || face[1] == face[2] || face[2] == face[0];
-            let full = |edges: &HashMap<(u32, u32), u8>| {
-                (0..3).any(|k| {
-                    let (a, b) = (
-                        compact[face[k] as usize],
-                        compact[face[(k + 1) % 3] as usize],
-                    );
-                    a != u32::MAX
-                        && b != u32::MAX
-                        && edges.get(&(a.min(b), a.max(b))).is_some_and(|&c| c >= 2)
-                })
-            };
-            if degenerate || full(&edges) {
-                // Vertices of its own: a small island, coloured alone.
-                let base = positions.len() as u32;
-                positions.extend(face.map(|v| welded[v as usize]));
-                out.push([base, base + 1, base + 2]);
-                detached += 1;
-                continue;
-            }
-            let tri = face.map(|v| {
-                let slot = &mut compact[v as usize];
-                if *slot == u32::MAX {
-                    *slot = positions.len() as u32;
-                    positions.push(welded[v as usize]);
-                }
-                *slot
-            });
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-            out.push(tri);
-        }
+        let welded = mesh_colors::convert::weld_manifold(&mesh.positions, &mesh.indices)?;
         let corners = |attr: &[Vec2]| {
             mesh.indices
                 .iter()
@@ -168,8 +128,8 @@ impl ColorMesh {
                 .collect()
         };
         Ok(Self {
-            positions,
-            faces: out,
+            positions: welded.positions,
+            faces: welded.faces,
             corner_uvs: mesh.uvs.as_deref().map(corners),
             corner_normals: mesh.normals.as_deref().map(|n| {
                 mesh.indices
@@ -177,7 +137,7 @@ impl ColorMesh {
                     .map(|t| t.map(|v| n[v as usize]))
                     .collect()
             }),
-            detached,
+            detached: welded.detached,
             origin: mesh.origin,
         })
     }
@@ -216,35 +176,10 @@ impl ColorMesh {
     }
 }
 
-/// How to convert a textured mesh to mesh colours.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ConvertOptions {
-    /// Samples per covered texel to aim for (1: the texture's density).
-    pub density: f64,
-    /// The highest face level (`R ≤ 2^max_level`, at most
-    /// [`mesh_colors::MAX_LEVEL`]).
-    pub max_level: u8,
-    /// At most this many samples; `None`: the texel count of the textures.
-    pub max_samples: Option<usize>,
-}
-
-impl Default for ConvertOptions {
-    fn default() -> Self {
-        Self {
-            density: 1.0,
-            max_level: 8,
-            max_samples: None,
-        }
-    }
-}
-
-/// What colours a triangle: a texture (index into the converted textures)
-/// or a flat colour.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Source {
-    Texture(usize),
-    Flat([f32; 3]),
-}
+/// How to convert a textured mesh to mesh colours: mesh-colors' own
+/// options (`max_samples: None` is the texel count of all the textures).
+pub use mesh_colors::convert::Options as ConvertOptions;
+use mesh_colors::convert::Source;
 
 /// The textures of `mesh`'s materials (decoded by the reader, or read from
 /// the material's file), and per triangle what colours it. `texture`
@@ -374,9 +309,9 @@ pub fn psnr(
 
 /// Converts a textured mesh to linear-RGB mesh colours: welds it
 /// ([`ColorMesh`]), gives each face a resolution from the texels its UVs
-/// cover ([`mesh_colors::convert::choose_levels`], within the budget), and
-/// fills every sample with the bilinear texture value at its UV, averaged
-/// over its distinct UVs where it lies on a seam. Each triangle reads its
+/// cover, and fills every sample with the bilinear texture value at its UV,
+/// averaged over its distinct UVs where it lies on a seam
+/// ([`mesh_colors::convert::from_textures`]). Each triangle reads its
 /// material's texture (`texture` replaces them all); triangles whose
 /// material has none take its flat diffuse colour.
 ///
@@ -407,117 +342,14 @@ pub fn to_mesh_colors(
     let SurfaceTexture {
         textures, sources, ..
     } = SurfaceTexture::new(mesh, texture)?;
-    let topology = surface.topology()?;
-    // Each face's footprint in its own texture's texels: scale its UVs so
-    // that a 1×1 reference texture sees the same texel area.
-    let scale: Vec<f32> = textures
-        .iter()
-        .map(|t| ((t.width() * t.height()) as f32).sqrt())
-        .collect();
-    let scaled: Vec<[Vec2; 3]> = corner_uvs
-        .iter()
-        .zip(&sources)
-        .map(|(uv, s)| match s {
-            Source::Texture(t) => uv.map(|p| p * scale[*t]),
-            Source::Flat(_) => [Vec2::ZERO; 3],
-        })
-        .collect();
-    let reference = Texture::new(1, 1, 1, vec![0.0])?;
-    let budget = options
-        .max_samples
-        .unwrap_or_else(|| textures.iter().map(|t| t.width() * t.height()).sum());
-    let levels = mesh_colors::convert::choose_levels(
-        &topology,
-        &scaled,
-        &reference,
-        &mesh_colors::convert::Options {
-            density: options.density,
-            max_level: options.max_level,
-            max_samples: Some(budget),
-        },
+    let colors = mesh_colors::convert::from_textures(
+        surface.topology()?,
+        corner_uvs,
+        &textures,
+        &sources,
+        options,
     )?;
-    let resolutions: Vec<u32> = levels.iter().map(|&n| 1u32 << n).collect();
-    let mut colors = MeshColors::new(topology, &resolutions, 3)?;
-    fill(&mut colors, corner_uvs, &textures, &sources);
     Ok((surface, colors))
-}
-
-/// Every sample the bilinear value of its face's texture at its UV (or the
-/// face's flat colour), averaged over its distinct (texture, UV) pairs.
-fn fill(
-    colors: &mut MeshColors,
-    corner_uvs: &[[Vec2; 3]],
-    textures: &[Texture],
-    sources: &[Source],
-) {
-    use rayon::prelude::*;
-    const FLAT: u32 = u32::MAX;
-    // (sample, texture or FLAT, u bits, v bits; for FLAT: the face).
-    let mut entries: Vec<(usize, u32, u32, u32)> =
-        Vec::with_capacity(colors.sample_count() * 3 / 2);
-    for (f, uv) in corner_uvs.iter().enumerate() {
-        let Some(r) = colors.face_resolution(f) else {
-            continue;
-        };
-        let rf = f64::from(r);
-        for a in lattice_points(r) {
-            let Some(i) = colors.lattice_index(f, a) else {
-                continue;
-            };
-            match sources[f] {
-                Source::Texture(t) => {
-                    let p = (0..3).fold(DVec2::ZERO, |s, k| {
-                        s + f64::from(a[k]) / rf * uv[k].as_dvec2()
-                    });
-                    entries.push((i, t as u32, (p.x as f32).to_bits(), (p.y as f32).to_bits()));
-                }
-                Source::Flat(_) => entries.push((i, FLAT, f as u32, 0)),
-            }
-        }
-    }
-    entries.par_sort_unstable();
-    entries.dedup_by(|a, b| {
-        // Flat entries of one sample from several faces of one colour
-        // count once, like equal UVs.
-        a.0 == b.0
-            && a.1 == b.1
-            && (a.1 == FLAT && sources[a.2 as usize] == sources[b.2 as usize]
-                || a.2 == b.2 && a.3 == b.3)
-    });
-    let values: Vec<[f32; 3]> = entries
-        .par_iter()
-        .map(|&(_, t, u, v)| {
-            if t == FLAT {
-                match sources[u as usize] {
-                    Source::Flat(c) => c,
-                    Source::Texture(_) => [0.0; 3],
-                }
-            } else {
-                let mut out = [0.0f32; 3];
-                textures[t as usize].bilinear([f32::from_bits(u), f32::from_bits(v)], &mut out);
-                out
-            }
-        })
-        .collect();
-    let mut start = 0;
-    while start < entries.len() {
-        let i = entries[start].0;
-        let mut end = start;
-        let mut sum = [0.0f64; 3];
-        while end < entries.len() && entries[end].0 == i {
-            for c in 0..3 {
-                sum[c] += f64::from(values[end][c]);
-            }
-            end += 1;
-        }
-        let n = (end - start) as f64;
-        if let Some(sample) = colors.sample_mut(i) {
-            for (o, s) in sample.iter_mut().zip(sum) {
-                *o = (s / n) as f32;
-            }
-        }
-        start = end;
-    }
 }
 
 /// A baked atlas as a mesh and an image to write: one vertex per triangle

@@ -11,7 +11,7 @@
 //! UVs (it lies on a UV seam) takes the mean over its distinct UVs, which
 //! removes the seam.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
 use crate::structure::{
     MeshColors, lattice_points, layout_sample_count, samples_per_edge, samples_per_face,
@@ -219,15 +219,25 @@ pub fn fill(mc: &mut MeshColors, corner_uvs: &[[Vec2; 3]], texture: &Texture) ->
     }
     entries.sort_unstable();
     entries.dedup();
-    let c = mc.channels();
     let values = lookups(&entries, texture);
+    average(mc, entries.iter().map(|e| e.0), &values);
+    Ok(())
+}
+
+/// Sets every sample to the mean of its values: `samples` gives, in
+/// ascending order, the sample of each value (`channels` numbers each in
+/// `values`); a sample seen several times (on a seam) takes their mean,
+/// summed in order in `f64`.
+fn average(mc: &mut MeshColors, samples: impl Iterator<Item = usize>, values: &[f32]) {
+    let c = mc.channels();
+    let samples: Vec<usize> = samples.collect();
     let mut sum = vec![0.0f64; c];
     let mut start = 0;
-    while start < entries.len() {
-        let i = entries[start].0;
+    while start < samples.len() {
+        let i = samples[start];
         let mut end = start;
         sum.fill(0.0);
-        while end < entries.len() && entries[end].0 == i {
+        while end < samples.len() && samples[end] == i {
             for (s, &x) in sum.iter_mut().zip(&values[end * c..(end + 1) * c]) {
                 *s += f64::from(x);
             }
@@ -239,7 +249,266 @@ pub fn fill(mc: &mut MeshColors, corner_uvs: &[[Vec2; 3]], texture: &Texture) ->
         }
         start = end;
     }
+}
+
+/// What colours one face in [`from_textures`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Source {
+    /// Texture `i` of the list, read bilinearly at the face's UVs.
+    Texture(usize),
+    /// One linear RGB colour (a material without a texture).
+    Flat([f32; 3]),
+}
+
+/// Converts a mesh whose faces read different RGB textures (one per
+/// material), or flat colours, to 3-channel mesh colours.
+/// `sources[f]` says what colours face `f`, `corner_uvs[f]` its UVs (unused
+/// for a flat face).
+///
+/// Each face's resolution comes from its footprint in its own texture's
+/// texels ([`choose_levels`] on UVs scaled by `√(width · height)` of that
+/// texture; flat faces get the coarsest level), within
+/// `options.max_samples`, by default the texel count of all the textures.
+/// Every sample is the bilinear value of its face's texture at its UV (or
+/// the face's flat colour), averaged over its distinct (texture, UV) pairs,
+/// so that a sample on a seam between materials takes both.
+///
+/// # Errors
+/// [`Error::ChannelMismatch`] for a texture that is not RGB or a count of
+/// sources or UVs other than one per face, [`Error::MissingTexture`],
+/// and those of [`choose_levels`].
+pub fn from_textures(
+    topology: Topology,
+    corner_uvs: &[[Vec2; 3]],
+    textures: &[Texture],
+    sources: &[Source],
+    options: &Options,
+) -> Result<MeshColors, Error> {
+    check_sources(topology.faces().len(), textures, sources)?;
+    // Each face's footprint in its own texture's texels: scale its UVs so
+    // that a 1×1 reference texture sees the same texel area.
+    let scale: Vec<f32> = textures
+        .iter()
+        .map(|t| ((t.width() * t.height()) as f32).sqrt())
+        .collect();
+    let scaled: Vec<[Vec2; 3]> = corner_uvs
+        .iter()
+        .zip(sources)
+        .map(|(uv, s)| match s {
+            Source::Texture(t) => uv.map(|p| p * scale[*t]),
+            Source::Flat(_) => [Vec2::ZERO; 3],
+        })
+        .collect();
+    let reference = Texture::new(1, 1, 1, vec![0.0])?;
+    let budget = options
+        .max_samples
+        .unwrap_or_else(|| textures.iter().map(|t| t.width() * t.height()).sum());
+    let levels = choose_levels(
+        &topology,
+        &scaled,
+        &reference,
+        &Options {
+            max_samples: Some(budget),
+            ..*options
+        },
+    )?;
+    let resolutions: Vec<u32> = levels.iter().map(|&n| 1u32 << n).collect();
+    let mut colors = MeshColors::new(topology, &resolutions, 3)?;
+    fill_sources(&mut colors, corner_uvs, textures, sources);
+    Ok(colors)
+}
+
+/// One source per face, naming RGB textures of the list.
+fn check_sources(faces: usize, textures: &[Texture], sources: &[Source]) -> Result<(), Error> {
+    if sources.len() != faces {
+        return Err(Error::ChannelMismatch {
+            what: "face sources (one per face)",
+            expected: faces,
+            got: sources.len(),
+        });
+    }
+    if let Some(t) = textures.iter().find(|t| t.channels() != 3) {
+        return Err(Error::ChannelMismatch {
+            what: "texture channels (RGB)",
+            expected: 3,
+            got: t.channels(),
+        });
+    }
+    for (face, s) in sources.iter().enumerate() {
+        if let Source::Texture(texture) = *s
+            && texture >= textures.len()
+        {
+            return Err(Error::MissingTexture {
+                face,
+                texture,
+                count: textures.len(),
+            });
+        }
+    }
     Ok(())
+}
+
+/// [`from_textures`]'s fill: every sample the bilinear value of its face's
+/// texture at its UV (or the face's flat colour), averaged over its
+/// distinct (texture, UV) pairs. The sources are checked.
+fn fill_sources(
+    colors: &mut MeshColors,
+    corner_uvs: &[[Vec2; 3]],
+    textures: &[Texture],
+    sources: &[Source],
+) {
+    const FLAT: u32 = u32::MAX;
+    // (sample, texture or FLAT, u bits, v bits; for FLAT: the face).
+    let mut entries: Vec<(usize, u32, u32, u32)> =
+        Vec::with_capacity(colors.sample_count() * 3 / 2);
+    for (f, uv) in corner_uvs.iter().enumerate() {
+        let Some(r) = colors.face_resolution(f) else {
+            continue;
+        };
+        let rf = f64::from(r);
+        for a in lattice_points(r) {
+            let Some(i) = colors.lattice_index(f, a) else {
+                continue;
+            };
+            match sources[f] {
+                Source::Texture(t) => {
+                    let p = (0..3).fold(glam::DVec2::ZERO, |s, k| {
+                        s + f64::from(a[k]) / rf * uv[k].as_dvec2()
+                    });
+                    entries.push((i, t as u32, (p.x as f32).to_bits(), (p.y as f32).to_bits()));
+                }
+                Source::Flat(_) => entries.push((i, FLAT, f as u32, 0)),
+            }
+        }
+    }
+    // Equal entries are identical, so the unstable sort is deterministic.
+    #[cfg(feature = "rayon")]
+    rayon::slice::ParallelSliceMut::par_sort_unstable(entries.as_mut_slice());
+    #[cfg(not(feature = "rayon"))]
+    entries.sort_unstable();
+    entries.dedup_by(|a, b| {
+        // Flat entries of one sample from several faces of one colour
+        // count once, like equal UVs.
+        a.0 == b.0
+            && a.1 == b.1
+            && (a.1 == FLAT && sources[a.2 as usize] == sources[b.2 as usize]
+                || a.2 == b.2 && a.3 == b.3)
+    });
+    let value = |&(_, t, u, v): &(usize, u32, u32, u32)| -> [f32; 3] {
+        if t == FLAT {
+            match sources[u as usize] {
+                Source::Flat(c) => c,
+                Source::Texture(_) => [0.0; 3],
+            }
+        } else {
+            let mut out = [0.0f32; 3];
+            textures[t as usize].bilinear([f32::from_bits(u), f32::from_bits(v)], &mut out);
+            out
+        }
+    };
+    #[cfg(feature = "rayon")]
+    let values: Vec<[f32; 3]> = {
+        use rayon::prelude::*;
+        entries.par_iter().map(value).collect()
+    };
+    #[cfg(not(feature = "rayon"))]
+    let values: Vec<[f32; 3]> = entries.iter().map(value).collect();
+    average(colors, entries.iter().map(|e| e.0), values.as_flattened());
+}
+
+/// A mesh welded for mesh colours by [`weld_manifold`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Welded {
+    /// The positions, welded and used ones only, in order of first use.
+    pub positions: Vec<Vec3>,
+    /// Face `f` of the input over them.
+    pub faces: Vec<[u32; 3]>,
+    /// How many faces keep vertices of their own.
+    pub detached: usize,
+}
+
+/// Welds a triangle soup for mesh colours: readers split a vertex
+/// wherever its UV or normal changes (a seam), while mesh colours live on
+/// the connectivity of the surface itself. Vertices with equal positions
+/// are welded ([`weld`](crate::weld)) and unused ones dropped; a face that
+/// would repeat a vertex after welding, or be the third on an edge (which
+/// mesh colours cannot colour consistently), keeps vertices of its own
+/// (counted in [`Welded::detached`]), so the result always makes a
+/// [`Topology`]. Deterministic: mesh colours made for a mesh fit the same
+/// mesh read again.
+///
+/// # Errors
+/// [`Error::MissingVertex`] for a face naming a vertex beyond `positions`.
+///
+/// # Example
+/// ```
+/// use mesh_colors::{Topology, convert::weld_manifold, glam::Vec3};
+/// // Two triangles sharing an edge, its vertices split (a UV seam), and a
+/// // flat one.
+/// let p = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X, Vec3::Y, Vec3::ONE];
+/// let w = weld_manifold(&p, &[[0, 1, 2], [3, 5, 4], [0, 0, 1]])?;
+/// assert_eq!((w.positions.len(), w.detached), (7, 1));
+/// assert_eq!(Topology::new(w.positions.len(), &w.faces)?.faces().len(), 3);
+/// # Ok::<(), mesh_colors::Error>(())
+/// ```
+pub fn weld_manifold(positions: &[Vec3], faces: &[[u32; 3]]) -> Result<Welded, Error> {
+    use std::collections::HashMap;
+    let count = positions.len();
+    for (face, tri) in faces.iter().enumerate() {
+        if let Some(&vertex) = tri.iter().find(|&&v| v as usize >= count) {
+            return Err(Error::MissingVertex {
+                face,
+                vertex,
+                count,
+            });
+        }
+    }
+    let (welded, faces, _) = crate::weld(positions, faces);
+    let mut compact = vec![u32::MAX; welded.len()];
+    let mut positions = Vec::new();
+    let mut edges: HashMap<(u32, u32), u8> = HashMap::with_capacity(faces.len() * 3 / 2);
+    let mut detached = 0;
+    let mut out = Vec::with_capacity(faces.len());
+    for face in &faces {
+        let degenerate = face[0] == face[1] || face[1] == face[2] || face[2] == face[0];
+        let full = |edges: &HashMap<(u32, u32), u8>| {
+            (0..3).any(|k| {
+                let (a, b) = (
+                    compact[face[k] as usize],
+                    compact[face[(k + 1) % 3] as usize],
+                );
+                a != u32::MAX
+                    && b != u32::MAX
+                    && edges.get(&(a.min(b), a.max(b))).is_some_and(|&c| c >= 2)
+            })
+        };
+        if degenerate || full(&edges) {
+            // Vertices of its own: a small island, coloured alone.
+            let base = positions.len() as u32;
+            positions.extend(face.map(|v| welded[v as usize]));
+            out.push([base, base + 1, base + 2]);
+            detached += 1;
+            continue;
+        }
+        let tri = face.map(|v| {
+            let slot = &mut compact[v as usize];
+            if *slot == u32::MAX {
+                *slot = positions.len() as u32;
+                positions.push(welded[v as usize]);
+            }
+            *slot
+        });
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+        out.push(tri);
+    }
+    Ok(Welded {
+        positions,
+        faces: out,
+        detached,
+    })
 }
 
 /// The bilinear texture value at each entry's UV (on all threads with the

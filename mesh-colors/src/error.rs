@@ -94,6 +94,17 @@ pub enum Error {
         /// Values given.
         got: usize,
     },
+    /// A face of a multi-texture conversion names a texture that is not
+    /// in the list.
+    #[error("face {face} names texture {texture}, but there are only {count} textures")]
+    MissingTexture {
+        /// The face.
+        face: usize,
+        /// The texture index it names.
+        texture: usize,
+        /// The number of textures.
+        count: usize,
+    },
     /// A non-finite UV or position.
     #[error("{what} {index} is not finite (NaN or infinite)")]
     NonFinite {

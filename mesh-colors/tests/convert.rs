@@ -182,3 +182,114 @@ fn the_sample_budget_is_kept_and_used() {
         );
     }
 }
+
+/// The seam test's two UV islands over one texture: `from_textures` with
+/// that texture for both faces gives `from_texture`'s resolutions and
+/// values; with face 1 flat blue instead, face 0 stays red inside and the
+/// shared edge takes the mean of red and blue.
+#[test]
+fn several_textures_convert_like_one_and_flat_faces_join_at_the_seam() {
+    let (w, h) = (64, 32);
+    let red = [Texture::new(w, h, 3, [1.0, 0.0, 0.0].repeat(w * h)).unwrap()];
+    let topology = || Topology::new(4, &[[0, 1, 2], [2, 1, 3]]).unwrap();
+    let uvs = [
+        [
+            Vec2::new(0.1, 0.1),
+            Vec2::new(0.4, 0.1),
+            Vec2::new(0.1, 0.9),
+        ],
+        [
+            Vec2::new(0.6, 0.9),
+            Vec2::new(0.9, 0.1),
+            Vec2::new(0.9, 0.9),
+        ],
+    ];
+    let options = convert::Options {
+        max_samples: Some(10_000),
+        ..convert::Options::default()
+    };
+    let one = convert::from_texture(topology(), &uvs, &red[0], &options).unwrap();
+    let both = [convert::Source::Texture(0); 2];
+    let many = convert::from_textures(topology(), &uvs, &red, &both, &options).unwrap();
+    assert_eq!(one.sample_count(), many.sample_count());
+    for f in 0..2 {
+        assert_eq!(one.face_resolution(f), many.face_resolution(f));
+    }
+    for i in 0..one.sample_count() {
+        assert_eq!(one.sample(i), many.sample(i), "sample {i}");
+    }
+
+    let sources = [
+        convert::Source::Texture(0),
+        convert::Source::Flat([0.0, 0.0, 1.0]),
+    ];
+    let mc = convert::from_textures(topology(), &uvs, &red, &sources, &options).unwrap();
+    let mut c = [0.0f32; 3];
+    mc.linear(0, [0.6, 0.2, 0.2], &mut c).unwrap();
+    assert!((c[0] - 1.0).abs() < 1e-6 && c[2].abs() < 1e-6, "{c:?}");
+    mc.linear(1, [0.2, 0.2, 0.6], &mut c).unwrap();
+    assert!(c[0] < 0.5 && c[2] > 0.5, "{c:?}");
+    mc.linear(0, [0.0, 0.5, 0.5], &mut c).unwrap();
+    assert!(
+        (c[0] - 0.5).abs() < 1e-6 && (c[2] - 0.5).abs() < 1e-6,
+        "{c:?}"
+    );
+
+    // Bad sources are errors naming what is wrong.
+    let missing = [convert::Source::Texture(0), convert::Source::Texture(3)];
+    assert_eq!(
+        convert::from_textures(topology(), &uvs, &red, &missing, &options).unwrap_err(),
+        mesh_colors::Error::MissingTexture {
+            face: 1,
+            texture: 3,
+            count: 1
+        }
+    );
+    assert!(matches!(
+        convert::from_textures(topology(), &uvs, &red, &both[..1], &options),
+        Err(mesh_colors::Error::ChannelMismatch { .. })
+    ));
+    let grey = Texture::new(2, 2, 1, vec![0.5; 4]).unwrap();
+    assert!(matches!(
+        convert::from_textures(topology(), &uvs, &[grey], &both, &options),
+        Err(mesh_colors::Error::ChannelMismatch {
+            expected: 3,
+            got: 1,
+            ..
+        })
+    ));
+}
+
+/// Three faces on one edge: the third keeps vertices of its own, and the
+/// weld always gives a topology; a face naming a missing vertex is an
+/// error.
+#[test]
+fn the_manifold_weld_detaches_what_mesh_colours_cannot_share() {
+    use glam::Vec3;
+    let p = [
+        Vec3::ZERO,
+        Vec3::X,
+        Vec3::Y,
+        Vec3::Z,
+        Vec3::NEG_Y,
+        // A copy of vertex 1 (a seam): welded.
+        Vec3::X,
+    ];
+    let faces = [[0, 1, 2], [5, 0, 3], [1, 0, 4], [0, 0, 2]];
+    let w = convert::weld_manifold(&p, &faces).unwrap();
+    // Faces 0 and 1 share the welded edge (0, 1); face 2 is its third
+    // face and face 3 is degenerate: both detached.
+    assert_eq!(w.detached, 2);
+    assert_eq!(w.faces.len(), 4);
+    assert_eq!(w.positions.len(), 4 + 3 + 3);
+    assert_eq!(w.faces[1], [1, 0, 3]);
+    assert!(Topology::new(w.positions.len(), &w.faces).is_ok());
+    assert_eq!(
+        convert::weld_manifold(&p, &[[0, 1, 9]]).unwrap_err(),
+        mesh_colors::Error::MissingVertex {
+            face: 0,
+            vertex: 9,
+            count: 6
+        }
+    );
+}
