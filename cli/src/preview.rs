@@ -88,6 +88,18 @@ pub struct Fragment {
     pub to_eye: Vec3,
 }
 
+/// A triangle projected to the supersampled screen: its corners, their
+/// [`to_screen`] (position, depth, `1/w`), its doubled signed area on
+/// screen and the samples' bounding box.
+#[derive(Debug, Clone, Copy)]
+struct Projected {
+    p: [Vec3; 3],
+    s: [(Vec2, f32, f32); 3],
+    area: f32,
+    lo: Vec2,
+    hi: Vec2,
+}
+
 /// A picture being drawn: colour and depth at `supersample²` samples per
 /// output pixel.
 #[derive(Debug, Clone)]
@@ -148,84 +160,103 @@ impl Renderer {
         faces: &[[u32; 3]],
         shade: impl Fn(&Fragment) -> [f32; 3],
     ) {
+        for (f, tri) in faces.iter().enumerate() {
+            if let Some(t) = self.project(positions, tri) {
+                self.raster(f as u32, &t, &shade);
+            }
+        }
+    }
+
+    /// Triangle `tri` on the supersampled screen; `None` when a corner is
+    /// missing or behind the camera, the triangle is flat on screen, or it
+    /// covers no sample.
+    fn project(&self, positions: &[Vec3], tri: &[u32; 3]) -> Option<Projected> {
+        let (wf, hf) = (
+            (self.width * self.ss) as f32,
+            (self.height * self.ss) as f32,
+        );
+        let p = tri
+            .iter()
+            .map(|&v| positions.get(v as usize).copied())
+            .collect::<Option<Vec<Vec3>>>()?;
+        let p = [p[0], p[1], p[2]];
+        let clip = [0, 1, 2].map(|k| self.view_projection * p[k].extend(1.0));
+        if clip
+            .iter()
+            .any(|c| c.w.is_nan() || c.w <= 0.0 || !c.is_finite())
+        {
+            return None;
+        }
+        let s = clip.map(|c| to_screen(c, wf, hf));
+        let (a, b, c) = (s[0].0, s[1].0, s[2].0);
+        let area = (b - a).perp_dot(c - a);
+        if area.abs() < 1e-12 || !area.is_finite() {
+            return None;
+        }
+        let lo = a.min(b).min(c).max(Vec2::ZERO);
+        let hi = a.max(b).max(c).min(Vec2::new(wf - 1.0, hf - 1.0));
+        if lo.x > hi.x || lo.y > hi.y {
+            return None;
+        }
+        Some(Projected { p, s, area, lo, hi })
+    }
+
+    /// Fills the samples of a projected triangle (face `f`) nearer than
+    /// what is drawn, with `shade`.
+    fn raster(&mut self, f: u32, t: &Projected, shade: &impl Fn(&Fragment) -> [f32; 3]) {
         let (w, h) = (self.width * self.ss, self.height * self.ss);
         let (wf, hf) = (w as f32, h as f32);
         let scale = self.ss as f32;
-        for (f, tri) in faces.iter().enumerate() {
-            let Some(p) = tri
-                .iter()
-                .map(|&v| positions.get(v as usize).copied())
-                .collect::<Option<Vec<Vec3>>>()
-            else {
-                continue;
-            };
-            let clip = [0, 1, 2].map(|k| self.view_projection * p[k].extend(1.0));
-            if clip
-                .iter()
-                .any(|c| c.w.is_nan() || c.w <= 0.0 || !c.is_finite())
-            {
-                continue;
-            }
-            let s = clip.map(|c| to_screen(c, wf, hf));
-            let (a, b, c) = (s[0].0, s[1].0, s[2].0);
-            let area = (b - a).perp_dot(c - a);
-            if area.abs() < 1e-12 || !area.is_finite() {
-                continue;
-            }
-            let lo = a.min(b).min(c).max(Vec2::ZERO);
-            let hi = a.max(b).max(c).min(Vec2::new(wf - 1.0, hf - 1.0));
-            if lo.x > hi.x || lo.y > hi.y {
-                continue;
-            }
-            let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
-            // Screen-space (affine) barycentrics of a screen point.
-            let affine = |q: Vec2| {
-                [
-                    (c - b).perp_dot(q - b) / area,
-                    (a - c).perp_dot(q - c) / area,
-                    (b - a).perp_dot(q - a) / area,
-                ]
-            };
-            // Perspective-correct barycentrics from the affine ones.
-            let correct = |l: [f32; 3]| {
-                let pw = [l[0] * s[0].2, l[1] * s[1].2, l[2] * s[2].2];
-                let sum = pw[0] + pw[1] + pw[2];
-                pw.map(|x| x / sum)
-            };
-            for y in lo.y.floor() as u32..=hi.y.ceil().min(hf - 1.0) as u32 {
-                for x in lo.x.floor() as u32..=hi.x.ceil().min(wf - 1.0) as u32 {
-                    let q = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                    let l = affine(q);
-                    if l.iter().any(|&x| x < -1e-6) {
-                        continue;
-                    }
-                    let z = l[0] * s[0].1 + l[1] * s[1].1 + l[2] * s[2].1;
-                    let i = (y * w + x) as usize;
-                    if z.is_nan() || z >= self.depth[i] || z < -1.0 {
-                        continue;
-                    }
-                    self.depth[i] = z;
-                    let bc = correct(l);
-                    let position = p[0] * bc[0] + p[1] * bc[1] + p[2] * bc[2];
-                    let to_eye = (self.camera.eye - position).normalize_or(Vec3::Z);
-                    let bx = correct(affine(q + Vec2::X));
-                    let by = correct(affine(q + Vec2::Y));
-                    let fragment = Fragment {
-                        face: f as u32,
-                        barycentric: bc,
-                        db_dx: [0, 1, 2].map(|k| (bx[k] - bc[k]) * scale),
-                        db_dy: [0, 1, 2].map(|k| (by[k] - bc[k]) * scale),
-                        position,
-                        normal: if normal.dot(to_eye) < 0.0 {
-                            -normal
-                        } else {
-                            normal
-                        },
-                        to_eye,
-                    };
-                    let rgb = shade(&fragment);
-                    self.color[i] = [rgb[0], rgb[1], rgb[2], 1.0];
+        let Projected { p, s, area, lo, hi } = *t;
+        let (a, b, c) = (s[0].0, s[1].0, s[2].0);
+        let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero();
+        // Screen-space (affine) barycentrics of a screen point.
+        let affine = |q: Vec2| {
+            [
+                (c - b).perp_dot(q - b) / area,
+                (a - c).perp_dot(q - c) / area,
+                (b - a).perp_dot(q - a) / area,
+            ]
+        };
+        // Perspective-correct barycentrics from the affine ones.
+        let correct = |l: [f32; 3]| {
+            let pw = [l[0] * s[0].2, l[1] * s[1].2, l[2] * s[2].2];
+            let sum = pw[0] + pw[1] + pw[2];
+            pw.map(|x| x / sum)
+        };
+        for y in lo.y.floor() as u32..=hi.y.ceil().min(hf - 1.0) as u32 {
+            for x in lo.x.floor() as u32..=hi.x.ceil().min(wf - 1.0) as u32 {
+                let q = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let l = affine(q);
+                if l.iter().any(|&x| x < -1e-6) {
+                    continue;
                 }
+                let z = l[0] * s[0].1 + l[1] * s[1].1 + l[2] * s[2].1;
+                let i = (y * w + x) as usize;
+                if z.is_nan() || z >= self.depth[i] || z < -1.0 {
+                    continue;
+                }
+                self.depth[i] = z;
+                let bc = correct(l);
+                let position = p[0] * bc[0] + p[1] * bc[1] + p[2] * bc[2];
+                let to_eye = (self.camera.eye - position).normalize_or(Vec3::Z);
+                let bx = correct(affine(q + Vec2::X));
+                let by = correct(affine(q + Vec2::Y));
+                let fragment = Fragment {
+                    face: f,
+                    barycentric: bc,
+                    db_dx: [0, 1, 2].map(|k| (bx[k] - bc[k]) * scale),
+                    db_dy: [0, 1, 2].map(|k| (by[k] - bc[k]) * scale),
+                    position,
+                    normal: if normal.dot(to_eye) < 0.0 {
+                        -normal
+                    } else {
+                        normal
+                    },
+                    to_eye,
+                };
+                let rgb = shade(&fragment);
+                self.color[i] = [rgb[0], rgb[1], rgb[2], 1.0];
             }
         }
     }

@@ -257,27 +257,7 @@ pub fn render(
                 + normals[t[2] as usize] * b[2])
                 .normalize_or(f.normal);
             let mut c = fragment_radiance(j, n, f.to_eye, eta);
-            for light in lights {
-                let (l, rgb) = match light {
-                    Light::Directional {
-                        to_light,
-                        irradiance,
-                    } => (to_light.as_vec3().normalize_or_zero(), *irradiance),
-                    Light::Point {
-                        position,
-                        intensity,
-                    } => (
-                        (position.as_vec3() - f.position).normalize_or_zero(),
-                        *intensity,
-                    ),
-                    Light::Environment(_) => continue,
-                };
-                let h = (l + f.to_eye).normalize_or_zero();
-                let spec = 0.04 * n.dot(h).max(0.0).powf(80.0) * f32::from(n.dot(l) > 0.0) * scale;
-                for (x, c) in c.iter_mut().zip(rgb) {
-                    *x += spec * c as f32;
-                }
-            }
+            add_specular(&mut c, lights, n, f, scale);
             c
         });
     }
@@ -285,6 +265,38 @@ pub fn render(
         image: r.image(),
         coverage: r.coverage(),
         background: r.background(),
+    }
+}
+
+/// Adds the Blinn–Phong highlight of the directional and point lights at
+/// fragment `f` (shading normal `n`; `scale` = 1/4π) to `c`.
+fn add_specular(
+    c: &mut [f32; 3],
+    lights: &[Light],
+    n: Vec3,
+    f: &crate::preview::Fragment,
+    scale: f32,
+) {
+    for light in lights {
+        let (l, rgb) = match light {
+            Light::Directional {
+                to_light,
+                irradiance,
+            } => (to_light.as_vec3().normalize_or_zero(), *irradiance),
+            Light::Point {
+                position,
+                intensity,
+            } => (
+                (position.as_vec3() - f.position).normalize_or_zero(),
+                *intensity,
+            ),
+            Light::Environment(_) => continue,
+        };
+        let h = (l + f.to_eye).normalize_or_zero();
+        let spec = 0.04 * n.dot(h).max(0.0).powf(80.0) * f32::from(n.dot(l) > 0.0) * scale;
+        for (x, c) in c.iter_mut().zip(rgb) {
+            *x += spec * c as f32;
+        }
     }
 }
 

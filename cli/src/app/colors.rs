@@ -89,22 +89,7 @@ pub(crate) fn run(context: &mut Context, command: Command) -> Result<()> {
 }
 
 fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
-    if !args.max_res.is_power_of_two() || args.max_res > 1 << mesh_colors::MAX_LEVEL {
-        return Err(arg_error(
-            format!("--max-res {}", args.max_res),
-            format!(
-                "the face resolution must be a power of two from 1 to {}",
-                1 << mesh_colors::MAX_LEVEL
-            ),
-        ));
-    }
-    if args.budget == Some(0) {
-        return Err(arg_error("--budget 0", "at least one sample is needed"));
-    }
-    super::check_output(context, &args.output, &["meshcolors"])?;
-    if let Some(p) = &args.preview {
-        super::check_output(context, p, &["png", "exr"])?;
-    }
+    check_convert(context, &args)?;
     let mesh = super::read_mesh(context, &args.mesh)?;
     if mesh.uvs.is_none() {
         return Err(file_error(
@@ -141,6 +126,39 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
         });
         super::write_image(context, p, &image)?;
     }
+    let (text, json) = convert_summary(context, &args, (&surface, &colors), psnr);
+    context.report(&text, json);
+    Ok(())
+}
+
+/// The arguments' own checks, before any file is read.
+fn check_convert(context: &Context, args: &ConvertArgs) -> Result<()> {
+    if !args.max_res.is_power_of_two() || args.max_res > 1 << mesh_colors::MAX_LEVEL {
+        return Err(arg_error(
+            format!("--max-res {}", args.max_res),
+            format!(
+                "the face resolution must be a power of two from 1 to {}",
+                1 << mesh_colors::MAX_LEVEL
+            ),
+        ));
+    }
+    if args.budget == Some(0) {
+        return Err(arg_error("--budget 0", "at least one sample is needed"));
+    }
+    super::check_output(context, &args.output, &["meshcolors"])?;
+    if let Some(p) = &args.preview {
+        super::check_output(context, p, &["png", "exr"])?;
+    }
+    Ok(())
+}
+
+/// What `colors convert` reports: counts, resolutions, welding, PSNR.
+fn convert_summary(
+    context: &Context,
+    args: &ConvertArgs,
+    (surface, colors): (&trilux::ColorMesh, &mesh_colors::MeshColors),
+    psnr: f64,
+) -> (String, serde_json::Value) {
     let (lo, hi) = (0..colors.face_count())
         .filter_map(|f| colors.face_resolution(f))
         .fold((u32::MAX, 0), |(a, b), r| (a.min(r), b.max(r)));
@@ -171,8 +189,7 @@ fn convert(context: &mut Context, args: ConvertArgs) -> Result<()> {
         "output": super::shown(&args.output),
         "seconds": context.timings_json(),
     });
-    context.report(&text, json);
-    Ok(())
+    (text, json)
 }
 
 fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {

@@ -132,32 +132,14 @@ fn describe_mesh(
         used,
         shape.welded_vertices
     );
+    let closed = !faceless && shape.boundary_edges == 0 && shape.non_manifold_edges == 0;
     if faceless {
         let _ = writeln!(
             text,
             "  triangles: 0 — no faces (an empty file or points only), so no surface"
         );
     } else {
-        let _ = writeln!(text, "  triangles: {}", mesh.indices.len());
-        let _ = writeln!(text, "  bounds: {lo} .. {hi} (size {})", hi - lo);
-        let _ = writeln!(
-            text,
-            "  diagonal: {diagonal} — units look like {}",
-            trilux::mesh::unit_guess(diagonal as f32)
-        );
-        let _ = writeln!(text, "  area: {area:.6}");
-    }
-    let closed = !faceless && shape.boundary_edges == 0 && shape.non_manifold_edges == 0;
-    if !faceless {
-        let _ = writeln!(
-            text,
-            "  parts: {}, holes: {} ({} boundary edges), non-manifold edges: {}{}",
-            shape.parts,
-            shape.holes,
-            shape.boundary_edges,
-            shape.non_manifold_edges,
-            if closed { " — closed" } else { "" }
-        );
+        describe_surface(&mut text, mesh, &shape, (lo, hi), (area, closed));
     }
     let _ = writeln!(
         text,
@@ -190,6 +172,35 @@ fn describe_mesh(
     });
     add_warnings(&mut text, &mut json, &mesh.warnings);
     (text, json)
+}
+
+/// The lines of a mesh with faces: triangles, bounds, size, area, parts,
+/// holes and edges (`closed`: no boundary or non-manifold edge).
+fn describe_surface(
+    text: &mut String,
+    mesh: &trilux_io::mesh::TriMesh,
+    shape: &trilux::mesh::Shape,
+    (lo, hi): (glam::DVec3, glam::DVec3),
+    (area, closed): (f64, bool),
+) {
+    let diagonal = (hi - lo).length();
+    let _ = writeln!(text, "  triangles: {}", mesh.indices.len());
+    let _ = writeln!(text, "  bounds: {lo} .. {hi} (size {})", hi - lo);
+    let _ = writeln!(
+        text,
+        "  diagonal: {diagonal} — units look like {}",
+        trilux::mesh::unit_guess(diagonal as f32)
+    );
+    let _ = writeln!(text, "  area: {area:.6}");
+    let _ = writeln!(
+        text,
+        "  parts: {}, holes: {} ({} boundary edges), non-manifold edges: {}{}",
+        shape.parts,
+        shape.holes,
+        shape.boundary_edges,
+        shape.non_manifold_edges,
+        if closed { " — closed" } else { "" }
+    );
 }
 
 /// How many vertices the triangles use.

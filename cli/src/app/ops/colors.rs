@@ -40,18 +40,26 @@ pub(crate) fn convert_mesh(
     })?;
     let source = SurfaceTexture::new(mesh, texture)?;
     let points = surface_points(mesh, 200_000, 1)?;
-    let psnr = context.step("measuring PSNR", || {
-        trilux::colors::psnr(
-            &points,
-            |f, b| source.color(f, b),
-            |f, b| {
-                let mut out = [0.0f32; 3];
-                let _ = colors.linear(f as usize, b, &mut out);
-                out
-            },
-        )
-    });
+    let psnr = context.step("measuring PSNR", || psnr_against(&points, &source, &colors));
     Ok((surface, colors, psnr))
+}
+
+/// The PSNR of mesh colours (linear filter) against the surface texture
+/// they were converted from, at `points` (`(face, barycentrics)`).
+pub(crate) fn psnr_against(
+    points: &[(u32, [f32; 3])],
+    source: &SurfaceTexture,
+    colors: &MeshColors,
+) -> f64 {
+    trilux::colors::psnr(
+        points,
+        |f, b| source.color(f, b),
+        |f, b| {
+            let mut out = [0.0f32; 3];
+            let _ = colors.linear(f as usize, b, &mut out);
+            out
+        },
+    )
 }
 
 /// Loads mesh colours and checks they belong to the mesh (read from

@@ -41,8 +41,8 @@ pub(crate) fn line_plot(
     context: &Context,
     path: &Path,
     title: &str,
-    (x_label, y_label): (&str, &str),
-    (log_x, log_y): (bool, bool),
+    labels: (&str, &str),
+    log: (bool, bool),
     series: &[Series],
 ) -> Result<bool> {
     let Some(font) = font() else {
@@ -50,30 +50,82 @@ pub(crate) fn line_plot(
     };
     let (w, h) = (800u32, 520u32);
     let mut buffer = vec![0u8; (w * h * 3) as usize];
-    let all: Vec<(f64, f64)> = series
-        .iter()
-        .flat_map(|s| s.points.iter().copied())
-        .collect();
-    let range = |v: Vec<f64>, log: bool| {
-        let v: Vec<f64> = v
-            .into_iter()
-            .filter(|x| x.is_finite() && (!log || *x > 0.0))
-            .collect();
-        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        if !(lo.is_finite() && hi.is_finite()) {
-            (1.0, 10.0)
-        } else if log {
-            (lo / 1.5, hi * 1.5)
-        } else {
-            let pad = ((hi - lo) * 0.08).max(1e-9);
-            (lo - pad, hi + pad)
-        }
+    let chart = Chart {
+        font,
+        title,
+        labels,
+        log,
     };
-    let xr = range(all.iter().map(|p| p.0).collect(), log_x);
-    let yr = range(all.iter().map(|p| p.1).collect(), log_y);
-    let mut draw = || -> std::result::Result<(), Box<dyn std::error::Error>> {
-        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+    chart
+        .draw(&mut buffer, (w, h), series)
+        .map_err(|e| invalid(format!("{}: drawing the plot failed: {e}", path.display())))?;
+    let srgb = trilux_io::image::srgb_to_linear;
+    let image = trilux_io::image::Image {
+        width: w,
+        height: h,
+        pixels: buffer
+            .chunks_exact(3)
+            .map(|p| {
+                [
+                    srgb(f32::from(p[0]) / 255.0),
+                    srgb(f32::from(p[1]) / 255.0),
+                    srgb(f32::from(p[2]) / 255.0),
+                    1.0,
+                ]
+            })
+            .collect(),
+    };
+    crate::app::write_image(context, path, &image)?;
+    Ok(true)
+}
+
+/// The range of one axis over the finite (and, on a log axis, positive)
+/// values, padded; `(1, 10)` when there is none.
+fn axis_range(v: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let v: Vec<f64> = v.filter(|x| x.is_finite() && (!log || *x > 0.0)).collect();
+    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        (1.0, 10.0)
+    } else if log {
+        (lo / 1.5, hi * 1.5)
+    } else {
+        let pad = ((hi - lo) * 0.08).max(1e-9);
+        (lo - pad, hi + pad)
+    }
+}
+
+/// What a plot looks like: its font, title, axis labels and scales.
+struct Chart<'a> {
+    font: &'static str,
+    title: &'a str,
+    labels: (&'a str, &'a str),
+    log: (bool, bool),
+}
+
+impl Chart<'_> {
+    /// Draws `series` into `buffer` (RGB8, `w × h`).
+    fn draw(
+        &self,
+        buffer: &mut [u8],
+        (w, h): (u32, u32),
+        series: &[Series],
+    ) -> std::result::Result<(), Box<dyn std::error::Error>> {
+        let Self {
+            font,
+            title,
+            labels: (x_label, y_label),
+            log: (log_x, log_y),
+        } = *self;
+        let xr = axis_range(
+            series.iter().flat_map(|s| s.points.iter().map(|p| p.0)),
+            log_x,
+        );
+        let yr = axis_range(
+            series.iter().flat_map(|s| s.points.iter().map(|p| p.1)),
+            log_y,
+        );
+        let root = BitMapBackend::with_buffer(buffer, (w, h)).into_drawing_area();
         root.fill(&WHITE)?;
         let mut builder = ChartBuilder::on(&root);
         let chart = builder
@@ -119,24 +171,5 @@ pub(crate) fn line_plot(
         }
         root.present()?;
         Ok(())
-    };
-    draw().map_err(|e| invalid(format!("{}: drawing the plot failed: {e}", path.display())))?;
-    let srgb = trilux_io::image::srgb_to_linear;
-    let image = trilux_io::image::Image {
-        width: w,
-        height: h,
-        pixels: buffer
-            .chunks_exact(3)
-            .map(|p| {
-                [
-                    srgb(f32::from(p[0]) / 255.0),
-                    srgb(f32::from(p[1]) / 255.0),
-                    srgb(f32::from(p[2]) / 255.0),
-                    1.0,
-                ]
-            })
-            .collect(),
-    };
-    crate::app::write_image(context, path, &image)?;
-    Ok(true)
+    }
 }
