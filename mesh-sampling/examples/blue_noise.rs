@@ -1,8 +1,10 @@
-//! Blue-noise points on the data meshes by weighted sample elimination,
-//! beside Open3D's `sample_points_poisson_disk` timed in the same run.
+//! Blue-noise points on the data meshes by weighted sample elimination
+//! (`trilux`) and by the dense packing (`trilux-dense`: elimination of 14
+//! candidates per point, then farthest-point relocation), beside Open3D's
+//! `sample_points_poisson_disk` timed in the same run.
 //!
 //! ```sh
-//! TRILUX_DATA=../shared/data cargo run --release -p mesh-sampling --example blue_noise -- [--json] [--no-peers] [--n 10000,100000]
+//! TRILUX_DATA=../shared/data cargo run --release -p mesh-sampling --example blue_noise -- [--json] [--no-peers] [--n 10000,100000] [--mesh spot] [--packing elimination,dense]
 //! ```
 //!
 //! For each of the Stanford bunny, spot and fandisk, at N = 10⁴, 10⁵ and
@@ -24,7 +26,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 use mesh_sampling::{
-    BlueNoiseOptions, BlueNoiseTarget, Density, DensitySampler, MeshRef, SurfaceArea,
+    BlueNoiseOptions, BlueNoiseTarget, Density, DensitySampler, MeshRef, Packing, SurfaceArea,
     SurfaceSampler, UniformSampler, blue_noise, relative_radius, relative_radius_with_density,
 };
 
@@ -35,6 +37,7 @@ struct Args {
     peers: bool,
     counts: Vec<usize>,
     meshes: Vec<String>,
+    packings: Vec<Packing>,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -43,6 +46,7 @@ fn parse_args() -> Result<Args, String> {
         peers: true,
         counts: vec![10_000, 100_000, 1_000_000],
         meshes: MESHES.iter().map(ToString::to_string).collect(),
+        packings: vec![Packing::Elimination, Packing::Dense],
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -68,9 +72,24 @@ fn parse_args() -> Result<Args, String> {
                     .ok_or("--mesh needs a comma-separated list of mesh names")?;
                 args.meshes = list.split(',').map(|s| s.trim().to_string()).collect();
             }
+            "--packing" => {
+                let list = it
+                    .next()
+                    .ok_or("--packing needs a comma-separated list of elimination, dense")?;
+                args.packings = list
+                    .split(',')
+                    .map(|s| match s.trim() {
+                        "elimination" => Ok(Packing::Elimination),
+                        "dense" => Ok(Packing::Dense),
+                        other => Err(format!(
+                            "--packing: '{other}' is not a packing (elimination or dense)"
+                        )),
+                    })
+                    .collect::<Result<_, _>>()?;
+            }
             other => {
                 return Err(format!(
-                    "unknown argument '{other}' (try --json, --no-peers, --n, --mesh)"
+                    "unknown argument '{other}' (try --json, --no-peers, --n, --mesh, --packing)"
                 ));
             }
         }
@@ -174,15 +193,15 @@ fn ours<S: SurfaceSampler + SurfaceArea>(
     sampler: &S,
     n: usize,
     threads: usize,
+    options: &BlueNoiseOptions,
 ) -> Result<(f64, f64), String> {
-    let options = BlueNoiseOptions::default();
     let runs = if n >= 1_000_000 { 1 } else { 3 };
     let mut times = Vec::new();
     let mut points = Vec::new();
     for seed in 0..runs {
         let start = Instant::now();
         points = pool(threads)?
-            .install(|| blue_noise(sampler, BlueNoiseTarget::Count(n), seed as u64, &options))
+            .install(|| blue_noise(sampler, BlueNoiseTarget::Count(n), seed as u64, options))
             .map_err(|e| e.to_string())?;
         times.push(start.elapsed().as_secs_f64() * 1e3);
     }
@@ -258,30 +277,30 @@ fn run() -> Result<(), String> {
         let noisy = DensitySampler::new(mesh_ref, Density::PerVertex(&weights))
             .map_err(|e| e.to_string())?;
         for &n in &args.counts {
-            for threads in [1, 2] {
-                eprintln!("{name}, N = {n}, {threads} thread(s)…");
-                let (ms, rho) = ours(&uniform, n, threads)?;
-                rows.push(Row {
-                    mesh: name,
-                    density: "uniform",
-                    n,
-                    tool: "trilux".into(),
-                    threads,
-                    ms,
-                    rho,
-                    candidates: 5 * n,
-                });
-                let (ms, rho) = ours(&noisy, n, threads)?;
-                rows.push(Row {
-                    mesh: name,
-                    density: "perlin",
-                    n,
-                    tool: "trilux".into(),
-                    threads,
-                    ms,
-                    rho,
-                    candidates: 5 * n,
-                });
+            for &packing in &args.packings {
+                let (tool, options) = match packing {
+                    Packing::Elimination => ("trilux", BlueNoiseOptions::default()),
+                    Packing::Dense => ("trilux-dense", BlueNoiseOptions::dense()),
+                };
+                let candidates = (options.candidate_factor * n as f64).ceil() as usize;
+                for threads in [1, 2] {
+                    eprintln!("{name}, N = {n}, {tool}, {threads} thread(s)…");
+                    for (density, row) in [
+                        ("uniform", ours(&uniform, n, threads, &options)?),
+                        ("perlin", ours(&noisy, n, threads, &options)?),
+                    ] {
+                        rows.push(Row {
+                            mesh: name,
+                            density,
+                            n,
+                            tool: tool.into(),
+                            threads,
+                            ms: row.0,
+                            rho: row.1,
+                            candidates,
+                        });
+                    }
+                }
             }
         }
         if args.peers {

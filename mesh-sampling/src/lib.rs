@@ -102,7 +102,7 @@ mod uniform;
 pub use batch::SurfaceSampler;
 #[cfg(feature = "blue-noise")]
 pub use blue_noise::{
-    BlueNoiseOptions, BlueNoiseTarget, SurfaceArea, blue_noise, max_poisson_radius,
+    BlueNoiseOptions, BlueNoiseTarget, Packing, SurfaceArea, blue_noise, max_poisson_radius,
     nearest_neighbour_distances, relative_radius, relative_radius_with_density,
 };
 pub use density::{

@@ -100,6 +100,28 @@ fn blue_noise_points_are_pinned() {
     assert_pinned("blue noise", &summary(&points[..4]), &BLUE_NOISE);
 }
 
+/// The dense packing's output (sorted by candidate, as elimination's):
+/// pinned so that a change of the relocation is a conscious one.
+#[cfg(feature = "blue-noise")]
+#[test]
+fn dense_blue_noise_points_are_pinned() {
+    use mesh_sampling::{BlueNoiseOptions, BlueNoiseTarget, blue_noise};
+    let (positions, _, indices) = grid();
+    let sampler = UniformSampler::new(MeshRef::new(&positions, &indices)).unwrap();
+    let points = blue_noise(
+        &sampler,
+        BlueNoiseTarget::Count(200),
+        2026,
+        &BlueNoiseOptions::dense(),
+    )
+    .unwrap();
+    assert_pinned(
+        "dense blue noise",
+        &summary(&points[..4]),
+        &DENSE_BLUE_NOISE,
+    );
+}
+
 const UNIFORM: [(u32, [f32; 3]); 4] = [
     (24, [0.8187891, 0.048960943, 0.13224994]),
     (26, [0.11395139, 0.4261354, 0.4599132]),
@@ -124,4 +146,11 @@ const BLUE_NOISE: [(u32, [f32; 3]); 4] = [
     (0, [0.23901673, 0.29438075, 0.46660253]),
     (0, [0.34885493, 0.63759553, 0.013549532]),
     (0, [0.043647766, 0.9136988, 0.042653415]),
+];
+#[cfg(feature = "blue-noise")]
+const DENSE_BLUE_NOISE: [(u32, [f32; 3]); 4] = [
+    (0, [0.7613868, 0.07127379, 0.1673394]),
+    (0, [0.59494233, 0.35446066, 0.050596997]),
+    (0, [0.1939455, 0.38904005, 0.41701448]),
+    (0, [0.019508267, 0.9622606, 0.018231118]),
 ];

@@ -132,17 +132,17 @@ pub(crate) struct Eliminated {
     pub(crate) removed: Vec<u32>,
 }
 
-/// Eliminates candidates at `points` (disk radii `radii`) until `target`
-/// are left. Deterministic: the lists are built in fixed chunks and the
+/// Eliminates candidates at `points` (disk radii `radii`; `tree` is the
+/// k-d tree over `points`) until `target` are left. Deterministic: the lists are built in fixed chunks and the
 /// heap breaks ties by index.
 pub(crate) fn eliminate(
+    tree: &Tree,
     points: &[[f32; 3]],
     radii: &[f32],
     target: usize,
     weights: Weights,
 ) -> Eliminated {
-    let tree = Tree::new_from_slice(points);
-    let lists = Neighbours::build(&tree, points, radii, weights);
+    let lists = Neighbours::build(tree, points, radii, weights);
     debug_assert_eq!(lists.len(), points.len());
     // Each candidate's total weight, summed in candidate order.
     let mut total = vec![0.0f64; points.len()];
@@ -288,10 +288,11 @@ mod tests {
             alpha: 8.0,
             min_ratio: 0.0,
         };
-        let e = eliminate(&points, &radii, 3, w);
+        let tree = Tree::new_from_slice(&points);
+        let e = eliminate(&tree, &points, &radii, 3, w);
         assert_eq!(e.removed, vec![1]);
         assert_eq!(e.survivors, vec![0, 2, 3]);
-        let e = eliminate(&points, &radii, 2, w);
+        let e = eliminate(&tree, &points, &radii, 2, w);
         assert_eq!(e.survivors.len(), 2);
         assert!(e.survivors.contains(&3));
     }

@@ -16,7 +16,12 @@
 //!    Sec. 4.1 (`d̂ = max(d, 2 r_min)`, `r_min = r β (1 − (N/M)^γ)`,
 //!    `β = 0.65`, `γ = 1.5`), using Euclidean 3D distance, and remove the
 //!    heaviest candidate (an indexed max-heap) until `N` are left.
-//! 4. Optionally order the output progressively (Sec. 5): the survivors are
+//! 4. With [`Packing::Dense`], move the worst-spaced survivors into the
+//!    largest holes of the candidate pool (farthest-point relocation, a
+//!    greedy form of Schlömer, Heck & Deussen 2011's farthest-point
+//!    optimisation on the candidates), which raises the relative radius ρ
+//!    from about 0.69 to 0.75 and more.
+//! 5. Optionally order the output progressively (Sec. 5): the survivors are
 //!    eliminated again to `N/2`, `N/4`, …, and each prefix of length
 //!    `N/2^j` is itself a blue-noise set.
 //!
@@ -27,6 +32,7 @@
 
 mod elimination;
 mod heap;
+mod relocation;
 mod spacing;
 
 pub use spacing::{
@@ -35,7 +41,8 @@ pub use spacing::{
 
 use crate::{DensitySampler, Error, SurfacePoint, SurfaceSampler, UniformSampler};
 use discrete_sampling::DiscreteSampler;
-use elimination::{Weights, eliminate};
+use elimination::{Tree, Weights, eliminate};
+use relocation::relocate;
 
 /// How many points to keep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,11 +57,47 @@ pub enum BlueNoiseTarget {
     Radius(f64),
 }
 
-/// Parameters of [`blue_noise`]; the defaults are Yuksel 2015's.
+/// How tightly [`blue_noise`] packs its points.
+///
+/// ρ is the relative radius of Lagae & Dutré 2008 ([`relative_radius`]:
+/// half the smallest distance between two points over the radius of a
+/// hexagonal packing of as many disks; 1 for the hexagonal lattice, about
+/// 0.01 for independent points), measured on the data meshes at
+/// N = 10⁵ with Euclidean 3D distances. MeshLab's and point-cloud-utils'
+/// Poisson-disk sampling (Corsini et al. 2012) reach 0.75–0.77.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Packing {
+    /// Weighted sample elimination alone (Yuksel 2015): ρ ≈ 0.69 with the
+    /// paper's 5 candidates per point. Keeps the paper's progressive order
+    /// and is the fastest.
+    #[default]
+    Elimination,
+    /// Elimination followed by farthest-point relocation (a greedy form of
+    /// Schlömer, Heck & Deussen 2011, "Farthest-Point Optimized Point Sets
+    /// with Maximized Minimum Distance", restricted to the candidates): the
+    /// point with the smallest spacing moves to the unused candidate
+    /// farthest from every kept point while that raises the smallest
+    /// spacing. ρ ≈ 0.76 on the data meshes (uniform and with a density)
+    /// with [`BlueNoiseOptions::dense`]'s 14 candidates per point (0.755
+    /// with 12, 0.765 with 15), about 3× the time of elimination at 5.
+    /// Every output point is still one of the sampler's candidates; with
+    /// `progressive`, the dense set is ordered by eliminating it to `N/2`,
+    /// `N/4`, … (the prefixes have elimination's spacing, the whole set the
+    /// dense one).
+    Dense,
+}
+
+/// Parameters of [`blue_noise`]; the defaults are Yuksel 2015's
+/// ([`Packing::Elimination`]); [`BlueNoiseOptions::dense`] gives the
+/// denser packing.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BlueNoiseOptions {
-    /// Candidates drawn per output point (≥ 1; the paper uses 5).
+    /// Candidates drawn per output point (≥ 1; the paper uses 5, the dense
+    /// packing 14): more candidates give a denser packing, at a cost
+    /// roughly proportional to their square.
     pub candidate_factor: f64,
+    /// Elimination alone, or followed by farthest-point relocation.
+    pub packing: Packing,
     /// Order the output so that every prefix of length `N / 2^j` is
     /// itself well spread (Sec. 5). Costs about twice the time.
     pub progressive: bool,
@@ -74,11 +117,28 @@ impl Default for BlueNoiseOptions {
     fn default() -> Self {
         Self {
             candidate_factor: 5.0,
+            packing: Packing::Elimination,
             progressive: false,
             alpha: 8.0,
             beta: 0.65,
             gamma: 1.5,
             max_memory_bytes: 2 << 30,
+        }
+    }
+}
+
+impl BlueNoiseOptions {
+    /// Candidates per point of [`BlueNoiseOptions::dense`].
+    pub const DENSE_CANDIDATE_FACTOR: f64 = 14.0;
+
+    /// The dense packing ([`Packing::Dense`]) with
+    /// [`DENSE_CANDIDATE_FACTOR`](Self::DENSE_CANDIDATE_FACTOR) candidates
+    /// per point, the other options at their defaults.
+    pub fn dense() -> Self {
+        Self {
+            candidate_factor: Self::DENSE_CANDIDATE_FACTOR,
+            packing: Packing::Dense,
+            ..Self::default()
         }
     }
 }
@@ -107,9 +167,14 @@ impl<S: DiscreteSampler + Sync> SurfaceArea for DensitySampler<'_, S> {
 /// heap's key and slots, and about 24 neighbour-list entries of 8 bytes
 /// (a disk of radius `2 r` holds `4π / (2√3) · M/N ≈ 3.6 · factor`
 /// candidates on average).
-fn bytes_per_candidate(factor: f64) -> f64 {
+/// The dense packing adds a flag, a spacing and a hole-heap entry.
+fn bytes_per_candidate(factor: f64, packing: Packing) -> f64 {
     let point = size_of::<SurfacePoint>() + 12 + 4 + 8 + 8;
-    point as f64 + 8.0 * (2.0 + 3.7 * factor)
+    let dense = match packing {
+        Packing::Elimination => 0,
+        Packing::Dense => 1 + 8 + 16,
+    };
+    (point + dense) as f64 + 8.0 * (2.0 + 3.7 * factor)
 }
 
 /// `n` points (or as many as [`BlueNoiseTarget::Radius`] implies) spread
@@ -158,7 +223,7 @@ pub fn blue_noise<S: SurfaceSampler + SurfaceArea>(
     let area = sampler.surface_area();
     let n = target_count(target, area)?;
     let m_f = (n as f64 * options.candidate_factor).ceil();
-    let bytes = m_f * bytes_per_candidate(options.candidate_factor);
+    let bytes = m_f * bytes_per_candidate(options.candidate_factor, options.packing);
     if m_f >= f64::from(u32::MAX) || bytes > options.max_memory_bytes as f64 {
         return Err(Error::InvalidOption(format!(
             "blue noise: {n} points from {m_f:.0} candidates need about {:.1} MB, more than \
@@ -269,8 +334,13 @@ fn target_count(target: BlueNoiseTarget, area: f64) -> Result<usize, Error> {
 fn select(candidates: &[SurfacePoint], n: usize, options: &BlueNoiseOptions) -> Vec<u32> {
     let positions: Vec<[f32; 3]> = candidates.iter().map(|p| p.position.to_array()).collect();
     let pdf: Vec<f64> = candidates.iter().map(|p| f64::from(p.pdf)).collect();
-    let first = stage(&positions, &pdf, n, options);
-    let mut kept = first.survivors;
+    let tree = Tree::new_from_slice(&positions);
+    let radii = radii(&pdf, n);
+    let mut kept = stage_in(&tree, &positions, &radii, n, options).survivors;
+    if options.packing == Packing::Dense {
+        kept = relocate(&tree, &positions, &radii, &kept);
+    }
+    drop(tree);
     if !options.progressive {
         return kept;
     }
@@ -299,14 +369,24 @@ fn stage(
     n: usize,
     options: &BlueNoiseOptions,
 ) -> elimination::Eliminated {
-    let m = positions.len();
-    let radii = radii(pdf, n);
-    let ratio = n as f64 / m as f64;
+    let tree = Tree::new_from_slice(positions);
+    stage_in(&tree, positions, &radii(pdf, n), n, options)
+}
+
+/// [`stage`] with the k-d tree and the radii at hand.
+fn stage_in(
+    tree: &Tree,
+    positions: &[[f32; 3]],
+    radii: &[f32],
+    n: usize,
+    options: &BlueNoiseOptions,
+) -> elimination::Eliminated {
+    let ratio = n as f64 / positions.len() as f64;
     let weights = Weights {
         alpha: options.alpha,
         min_ratio: options.beta * (1.0 - ratio.powf(options.gamma)),
     };
-    eliminate(positions, &radii, n, weights)
+    eliminate(tree, positions, radii, n, weights)
 }
 
 /// `r_k = √(1 / (2√3 n p_k))`, with densities below 1/64 of the mean
@@ -373,9 +453,42 @@ mod tests {
             alpha: 8.0,
             min_ratio: 0.65 * (1.0 - 0.2f64.powf(1.5)),
         };
-        let wrong = chi_square(&eliminate(&positions, &uniform, n, weights).survivors);
+        let tree = Tree::new_from_slice(&positions);
+        let plain = eliminate(&tree, &positions, &uniform, n, weights).survivors;
+        let wrong = chi_square(&plain);
         assert!(right < 16.27, "right: χ² = {right}");
         assert!(wrong > 16.27 * 10.0, "wrong: χ² = {wrong}");
+        // The same for the dense packing: its own radii keep the density,
+        // relocation with one radius for all flattens it.
+        let dense = BlueNoiseOptions::dense();
+        let candidates = sampler.sample_n(3, 14 * n).unwrap();
+        let right = chi_square_of(&candidates, &select(&candidates, n, &dense), n);
+        let positions: Vec<[f32; 3]> = candidates.iter().map(|p| p.position.to_array()).collect();
+        let tree = Tree::new_from_slice(&positions);
+        let uniform = vec![max_poisson_radius(1.0, n) as f32; positions.len()];
+        let weights = Weights {
+            alpha: 8.0,
+            min_ratio: 0.65 * (1.0 - (1.0f64 / 14.0).powf(1.5)),
+        };
+        let plain = eliminate(&tree, &positions, &uniform, n, weights).survivors;
+        let relocated = relocation::relocate(&tree, &positions, &uniform, &plain);
+        let wrong = chi_square_of(&candidates, &relocated, n);
+        assert!(right < 16.27, "dense right: χ² = {right}");
+        assert!(wrong > 16.27 * 10.0, "dense wrong: χ² = {wrong}");
+    }
+
+    /// χ² of the quadrant counts of `kept` against the checkerboard's
+    /// masses 0.1, 0.4, 0.4, 0.1.
+    fn chi_square_of(candidates: &[SurfacePoint], kept: &[u32], n: usize) -> f64 {
+        let mut counts = [0.0f64; 4];
+        for &k in kept {
+            let uv = candidates[k as usize].uv.unwrap();
+            counts[usize::from(uv.x >= 0.5) + 2 * usize::from(uv.y >= 0.5)] += 1.0;
+        }
+        let expected = [0.1, 0.4, 0.4, 0.1].map(|p| p * n as f64);
+        (0..4)
+            .map(|q| (counts[q] - expected[q]).powi(2) / expected[q])
+            .sum::<f64>()
     }
 
     #[test]
