@@ -1,5 +1,6 @@
-//! A tet mesh built in code: the Kuhn-subdivided box lattice, conforming
-//! and well shaped, for tests, examples and built-in objects.
+//! Tet meshes built in code: the Kuhn-subdivided box lattice, conforming
+//! and well shaped, and the ball mapped from it, for tests, examples and
+//! built-in objects.
 
 use glam::DVec3;
 
@@ -66,5 +67,36 @@ pub fn kuhn_lattice(n: usize, min: DVec3, max: DVec3) -> (Vec<DVec3>, Vec<[u32; 
             }
         }
     }
+    (positions, tets)
+}
+
+/// A ball of `radius` around the origin: the [`kuhn_lattice`] of
+/// `[-1, 1]³` mapped radially, `x ← radius · x ‖x‖∞ / ‖x‖₂`, so that its
+/// boundary vertices lie on the sphere and every tet stays positively
+/// oriented (after [`TetMesh::new`](crate::TetMesh::new)'s re-orientation).
+///
+/// # Example
+/// ```
+/// use tet_diffusion::{kuhn_ball, TetMesh};
+/// let (p, t) = kuhn_ball(6, 2.0);
+/// let ball = TetMesh::new(&p, &t)?;
+/// for &v in ball.boundary_vertices() {
+///     assert!((ball.positions()[v as usize].length() - 2.0).abs() < 1e-12);
+/// }
+/// # Ok::<(), tet_diffusion::Error>(())
+/// ```
+pub fn kuhn_ball(n: usize, radius: f64) -> (Vec<DVec3>, Vec<[u32; 4]>) {
+    let (lattice, tets) = kuhn_lattice(n, -DVec3::ONE, DVec3::ONE);
+    let positions = lattice
+        .into_iter()
+        .map(|x| {
+            let l = x.length();
+            if l == 0.0 {
+                x
+            } else {
+                x * (radius * x.abs().max_element() / l)
+            }
+        })
+        .collect();
     (positions, tets)
 }

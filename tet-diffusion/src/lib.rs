@@ -92,7 +92,7 @@ pub use cut::{
 };
 pub use error::Error;
 pub use fem::{Integration, P1Matrices};
-pub use lattice::kuhn_lattice;
+pub use lattice::{kuhn_ball, kuhn_lattice};
 pub use light::{Environment, Light};
 pub use medium::{MEASURED, Medium, Noise, ResolutionWarning};
 pub use mesh::{NONE, TetMesh};

@@ -3,7 +3,7 @@
 //! invisible from outside, lit through, and revealed by the first cut.
 
 use tet_diffusion::glam::DVec3;
-use tet_diffusion::{Error, Medium, Object, TetMesh, kuhn_lattice};
+use tet_diffusion::{Error, Medium, Object, TetMesh, kuhn_ball};
 
 /// Radius of the ball, mm (the mesh's unit).
 pub const RADIUS: f64 = 20.0;
@@ -13,18 +13,7 @@ pub const RADIUS: f64 = 20.0;
 /// (`x ← R x ‖x‖∞ / ‖x‖₂`) so that the boundary vertices lie on the sphere
 /// and every tet stays positively oriented.
 pub fn ball(n: usize) -> Result<TetMesh, Error> {
-    let (lattice, tets) = kuhn_lattice(n, -DVec3::ONE, DVec3::ONE);
-    let positions: Vec<DVec3> = lattice
-        .into_iter()
-        .map(|c| {
-            let l = c.length();
-            if l == 0.0 {
-                c
-            } else {
-                c * (RADIUS * c.abs().max_element() / l)
-            }
-        })
-        .collect();
+    let (positions, tets) = kuhn_ball(n, RADIUS);
     TetMesh::new(&positions, &tets)
 }
 

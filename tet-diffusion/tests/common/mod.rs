@@ -13,18 +13,7 @@ pub(crate) fn cube(n: usize) -> (Vec<DVec3>, Vec<[u32; 4]>) {
 /// A ball of radius `r`: the cube lattice mapped radially,
 /// `x ← r x ‖x‖∞ / ‖x‖₂`, so that the boundary vertices lie on the sphere.
 pub(crate) fn ball(n: usize, r: f64) -> TetMesh {
-    let (p, t) = cube(n);
-    let p: Vec<DVec3> = p
-        .into_iter()
-        .map(|x| {
-            let l = x.length();
-            if l == 0.0 {
-                x
-            } else {
-                x * (r * x.abs().max_element() / l)
-            }
-        })
-        .collect();
+    let (p, t) = tet_diffusion::kuhn_ball(n, r);
     TetMesh::new(&p, &t).unwrap()
 }
 
