@@ -74,10 +74,8 @@ pub fn write_atomic_files(
     write: impl FnOnce(&Path) -> Result<()>,
 ) -> Result<Vec<PathBuf>> {
     check_new(path, force)?;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    let parent = path.parent().filter(|d| !d.as_os_str().is_empty());
+    let dir = parent.unwrap_or(Path::new("."));
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -93,7 +91,12 @@ pub fn write_atomic_files(
         let mut files = Vec::new();
         for entry in std::fs::read_dir(&tmp).map_err(file_error(&tmp))? {
             let entry = entry.map_err(file_error(&tmp))?;
-            let target = dir.join(entry.file_name());
+            // Beside `path` as it was given: `out.obj` → `out.mtl`, not
+            // `./out.mtl`.
+            let target = match parent {
+                Some(d) => d.join(entry.file_name()),
+                None => PathBuf::from(entry.file_name()),
+            };
             check_new(&target, force)?;
             files.push((entry.path(), target));
         }

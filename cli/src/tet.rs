@@ -323,11 +323,6 @@ pub fn fragment_radiance(flux: [f32; 3], normal: Vec3, to_eye: Vec3, eta: f64) -
     flux.map(|j| j * f)
 }
 
-/// Rec. 709 luminance of linear RGB.
-fn luminance(p: [f32; 4]) -> f32 {
-    0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
-}
-
 /// The exposure's white: the 99th-percentile luminance of the pixels the
 /// objects cover fully (of those they cover at all when none is fully
 /// covered; 1 when nothing is covered). The background never counts, so a
@@ -340,7 +335,7 @@ pub fn exposure_white(picture: &Picture) -> f32 {
             .iter()
             .zip(&picture.coverage)
             .filter(|&(_, &c)| if full { c >= 1.0 } else { c > 0.0 })
-            .map(|(p, _)| luminance(*p))
+            .map(|(p, _)| trilux_io::image::luminance([p[0], p[1], p[2]]))
             .filter(|l| *l > 0.0)
             .collect();
         lum.sort_by(f32::total_cmp);

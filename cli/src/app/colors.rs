@@ -7,7 +7,10 @@ use super::ops::colors::{Filter, convert_mesh, load_for, render_colors, render_c
 use super::{Context, Result, arg_error, file_cause, file_error};
 
 #[derive(Debug, clap::Subcommand)]
-#[command(about = "Mesh colours: convert a textured mesh, bake an atlas, render")]
+#[command(
+    about = "Mesh colours: convert a textured mesh, bake an atlas, render",
+    after_help = "Example:\n  trilux colors convert ../shared/data/meshes/spot.obj \\\n      --texture ../shared/data/textures/spot_texture.png -o spot.meshcolors\n  trilux colors render ../shared/data/meshes/spot.obj spot.meshcolors --filter mip -o spot.png"
+)]
 pub(crate) enum Command {
     Convert(ConvertArgs),
     Bake(BakeArgs),
@@ -195,7 +198,7 @@ fn convert_summary(
 fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
     let ext = super::extension(&args.output);
     if ext == "gltf" || ext == "glb" {
-        return Err(file_error(
+        return Err(super::output_error(
             &args.output,
             "trilux-io writes no glTF yet (write .obj, with .mtl and .png beside it)",
         ));

@@ -391,8 +391,12 @@ fn translucent(d: &Demo<'_>, i: &Inputs) -> Pipeline {
     let r = &stuffed.report;
     Ok((
         format!(
-            "blob stuffed into {} tetrahedra (dihedral {:.1}°..{:.1}°), cut open, marble diffusion solved ({} levels)",
-            r.tets, r.min_dihedral_deg, r.max_dihedral_deg, report.levels
+            "blob stuffed into {} tetrahedra (dihedral {:.1}°..{:.1}°), cut open, marble diffusion solved ({} level{})",
+            r.tets,
+            r.min_dihedral_deg,
+            r.max_dihedral_deg,
+            report.levels,
+            if report.levels == 1 { "" } else { "s" }
         ),
         files,
     ))

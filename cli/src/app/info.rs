@@ -184,11 +184,36 @@ fn describe_surface(
     (area, closed): (f64, bool),
 ) {
     let diagonal = (hi - lo).length();
+    // For people, at the precision the file's positions have (f32), not
+    // 17 digits of their f64 sum; a mesh the reader shifted to keep
+    // precision (`origin`) shows its f64 values.
+    let far = mesh.origin != glam::DVec3::ZERO;
+    let point = |p: glam::DVec3| {
+        if far {
+            p.to_string()
+        } else {
+            p.as_vec3().to_string()
+        }
+    };
+    let length = |x: f64| {
+        if far {
+            x.to_string()
+        } else {
+            (x as f32).to_string()
+        }
+    };
     let _ = writeln!(text, "  triangles: {}", mesh.indices.len());
-    let _ = writeln!(text, "  bounds: {lo} .. {hi} (size {})", hi - lo);
     let _ = writeln!(
         text,
-        "  diagonal: {diagonal} — units look like {}",
+        "  bounds: {} .. {} (size {})",
+        point(lo),
+        point(hi),
+        point(hi - lo)
+    );
+    let _ = writeln!(
+        text,
+        "  diagonal: {} — units look like {}",
+        length(diagonal),
         trilux::mesh::unit_guess(diagonal as f32)
     );
     let _ = writeln!(text, "  area: {area:.6}");

@@ -54,6 +54,13 @@ pub(crate) fn arg_error(argument: impl Display, problem: impl Display) -> Error 
     placed(argument, true, usage(problem.to_string()))
 }
 
+/// An output path the command cannot write, such as an unknown extension:
+/// `PATH: problem`, a usage error (exit code 2) since the path is an
+/// argument as typed.
+pub(crate) fn output_error(path: &Path, problem: impl Display) -> Error {
+    placed(path.display(), true, usage(problem.to_string()))
+}
+
 /// A library's error `e` about a file: `PATH: e` with `e` kept as the
 /// source (its own causes follow it in the printed chain).
 pub(crate) fn file_cause(path: &Path, e: impl std::error::Error + Send + Sync + 'static) -> Error {
@@ -213,7 +220,7 @@ pub(crate) fn round(x: f64, digits: i32) -> f64 {
 /// JSON object on stdout, `{"error": "...", "exit_code": N}`, where a
 /// success's result would have gone.
 pub(crate) fn run() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match parse() {
         Ok(cli) => cli,
         Err(e) => return parse_failure(&e),
     };
@@ -246,6 +253,24 @@ pub(crate) fn run() -> ExitCode {
             ExitCode::from(code)
         }
     }
+}
+
+/// The command line as [`Cli`]. `info` writes nothing, so its help does
+/// not list the global `--force`: it has a hidden `--force` of its own,
+/// which the global one then leaves alone (given, it is accepted and has
+/// nothing to overwrite).
+fn parse() -> std::result::Result<Cli, clap::Error> {
+    use clap::{Arg, ArgAction, CommandFactory, FromArgMatches};
+    let mut command = Cli::command().mut_subcommand("info", |info| {
+        info.arg(
+            Arg::new("force")
+                .long("force")
+                .action(ArgAction::SetTrue)
+                .hide(true),
+        )
+    });
+    let matches = command.try_get_matches_from_mut(std::env::args_os())?;
+    Cli::from_arg_matches(&matches).map_err(|e| e.format(&mut command))
 }
 
 /// A failure as the one JSON object `--json` promises on stdout.
@@ -353,7 +378,7 @@ pub(crate) fn write_image(
             image,
             trilux_io::image::ExrPrecision::F32,
         )?),
-        _ => Err(file_error(
+        _ => Err(output_error(
             path,
             format!("unknown image extension {ext:?} (write .png or .exr)"),
         )),
@@ -373,7 +398,7 @@ pub(crate) fn extension(path: &Path) -> String {
 pub(crate) fn check_output(context: &Context, path: &Path, allowed: &[&str]) -> Result<()> {
     let ext = extension(path);
     if !allowed.contains(&ext.as_str()) {
-        return Err(file_error(
+        return Err(output_error(
             path,
             format!(
                 "unknown output extension {ext:?} (expected {})",
