@@ -163,6 +163,117 @@ impl<'m> VCycle<'m> {
         }
     }
 
+    /// The same hierarchy (the coarsening and the prolongations `P` are
+    /// kept) with its operators recomputed for `m`, a matrix of the same
+    /// size whose values moved (painted materials): the Galerkin products
+    /// `Pᵀ M P`, the smoothers' diagonals and the coarsest factorisation.
+    /// Much cheaper than [`new`](Self::new) (no coarsening, no graphs),
+    /// and it restores the convergence of a fresh V-cycle where the kept
+    /// one slows down. With the matrix the V-cycle was built from, the
+    /// operators are bit for bit those of [`new`](Self::new).
+    ///
+    /// # Errors
+    /// [`Error::DimensionMismatch`] for a matrix of another size;
+    /// those of [`new`](Self::new) for `m` itself.
+    pub fn refreshed(&self, m: &CsMat<f64>) -> Result<VCycle<'static>, Error> {
+        let n = check_square(m)?;
+        if n != self.fine.rows() {
+            return Err(Error::DimensionMismatch {
+                what: "the refreshed matrix's rows",
+                expected: self.fine.rows(),
+                found: n,
+            });
+        }
+        check_symmetric(m)?;
+        let damping = self.options.damping;
+        let fine_inverse_diagonal = damped_inverse_diagonal(m, damping)?;
+        let mut levels: Vec<Level> = Vec::with_capacity(self.levels.len());
+        for step in &self.hierarchy.steps {
+            let finer = levels.last().map_or(m, |l| &l.matrix);
+            let matrix = galerkin(finer, step);
+            let inverse_diagonal = damped_inverse_diagonal(&matrix, damping)?;
+            levels.push(Level {
+                matrix,
+                inverse_diagonal,
+            });
+        }
+        let last = levels.last().map_or(m, |l| &l.matrix);
+        let coarsest = if last.rows() <= DENSE_LIMIT {
+            Some(Cholesky::new(last)?)
+        } else {
+            None
+        };
+        Ok(VCycle {
+            fine: Cow::Owned(m.clone()),
+            fine_inverse_diagonal,
+            levels,
+            restrict: self.restrict.clone(),
+            coarsest,
+            options: self.options,
+            hierarchy: self.hierarchy.clone(),
+            work: std::sync::Mutex::new(None),
+        })
+    }
+
+    /// How far `m`'s diagonal moved from that of the matrix the V-cycle
+    /// was built for: the mean over rows of `min(1, |mᵢᵢ − aᵢᵢ| / aᵢᵢ)`
+    /// (0 for the same diagonal, 1 when every row changed by 100% or
+    /// more). A cheap proxy for how much the kept V-cycle has lost as a
+    /// preconditioner of `m`, to decide when to [`refresh`](Self::refreshed)
+    /// it. A matrix of another size gives 1.
+    pub fn diagonal_drift(&self, m: &CsMat<f64>) -> f64 {
+        let n = self.fine.rows();
+        if m.rows() != n || m.cols() != n || n == 0 {
+            return 1.0;
+        }
+        let now = crate::matrix::diagonal(m);
+        let built = crate::matrix::diagonal(&self.fine);
+        let sum: f64 = now
+            .par_chunks(CHUNK)
+            .zip(built.par_chunks(CHUNK))
+            .map(|(d, a)| {
+                d.iter()
+                    .zip(a)
+                    .map(|(&d, &a)| ((d - a) / a).abs().min(1.0))
+                    .sum::<f64>()
+            })
+            .collect::<Vec<f64>>()
+            .iter()
+            .sum();
+        sum / n as f64
+    }
+
+    /// Bytes of the operators, the prolongations and the hierarchy's
+    /// index arrays (the matrix copy included), to budget kept copies.
+    pub fn memory_bytes(&self) -> usize {
+        let csr = |m: &CsMat<f64>| m.nnz() * 12 + (m.rows() + 1) * 8;
+        let levels: usize = self
+            .levels
+            .iter()
+            .map(|l| csr(&l.matrix) + 8 * l.inverse_diagonal.len())
+            .sum();
+        let steps: usize = self
+            .hierarchy
+            .steps
+            .iter()
+            .map(|s| 2 * csr(&s.interpolation) + 4 * (s.kept.len() + s.coarse_index.len()))
+            .sum();
+        let graphs: usize = self
+            .hierarchy
+            .graphs
+            .iter()
+            .map(|g| 4 * (g.len() + 2 * g.edges()))
+            .sum();
+        let dense = self.coarsest.as_ref().map_or(0, |_| {
+            let r = self
+                .levels
+                .last()
+                .map_or(self.fine.rows(), |l| l.matrix.rows());
+            8 * r * r
+        });
+        csr(&self.fine) + 8 * self.fine_inverse_diagonal.len() + levels + steps + graphs + dense
+    }
+
     /// Unknowns of the matrix it was built from.
     pub fn rows(&self) -> usize {
         self.fine.rows()
