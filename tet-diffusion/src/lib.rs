@@ -96,10 +96,10 @@ pub use lattice::{kuhn_ball, kuhn_lattice};
 pub use light::{Environment, Light};
 pub use medium::{MEASURED, Medium, Noise, ResolutionWarning};
 pub use mesh::{NONE, TetMesh};
-pub use object::{Budget, Method, Object, SolveReport, SolverSettings};
+pub use object::{Budget, Method, Object, REFRESH_DRIFT, SolveReport, SolverSettings};
 pub use paint::{PaintReport, Stroke};
 pub use quality::{POOR_DIHEDRAL_DEGREES, Quality};
-pub use session::{Applied, Edit, Log, Logged, Session, SessionOptions};
+pub use session::{Applied, Edit, Log, Logged, Session, SessionOptions, UndoMemory};
 
 /// The old path of [`MEASURED`], kept (hidden) until the Python package's
 /// `media()` takes it from the root.

@@ -78,6 +78,10 @@ pub struct SolveReport {
     /// Whether this solve built the hierarchy (the first solve after the
     /// mesh changed, or after a change of method).
     pub hierarchy_built: bool,
+    /// Whether this solve refreshed the kept hierarchy's coarse operators
+    /// (the matrix's diagonal had drifted past [`REFRESH_DRIFT`] from the
+    /// one they were made for).
+    pub hierarchy_refreshed: bool,
     /// Whether the [`Budget`]'s deadline or cancel flag stopped it.
     pub interrupted: bool,
 }
@@ -93,6 +97,16 @@ pub struct Budget<'a> {
     /// Stop as soon as this is set (checked after every iteration).
     pub cancel: Option<&'a AtomicBool>,
 }
+
+/// The kept V-cycles' coarse operators are recomputed for the current
+/// matrices (Galerkin products on the kept prolongations,
+/// [`multires::VCycle::refreshed`]) before a solve when the matrices'
+/// diagonal has moved this far from theirs
+/// ([`multires::VCycle::diagonal_drift`]: the mean relative change per
+/// row, capped at 1). Paint changes few rows, so a stroke rarely reaches
+/// it; painting a third of the object with a very different medium does,
+/// where the stale operators would triple the iterations.
+pub const REFRESH_DRIFT: f64 = 0.05;
 
 /// The solver state kept across solves while the mesh stays the same.
 #[derive(Debug)]
@@ -169,6 +183,10 @@ pub struct Object {
     /// clones (it is only read).
     pub(crate) kept: Option<Arc<Kept>>,
     pub(crate) hierarchy_builds: usize,
+    pub(crate) hierarchy_refreshes: usize,
+    /// Whether the matrices' values changed since the kept hierarchy's
+    /// drift was last checked.
+    pub(crate) values_changed: bool,
 }
 
 impl Object {
@@ -269,6 +287,8 @@ impl Object {
             assembly_ms: 0.0,
             kept: None,
             hierarchy_builds: 0,
+            hierarchy_refreshes: 0,
+            values_changed: false,
         };
         object.rebuild();
         Ok(object)
@@ -519,6 +539,7 @@ impl Object {
     /// rebuilding the mesh) and returns the time it took, ms.
     pub fn reassemble(&mut self) -> f64 {
         let start = Instant::now();
+        self.values_changed = true;
         // Free the old arrays first: they are not read, and keeping them
         // while the new ones are built would double the peak memory.
         self.matrices = std::array::from_fn(|_| CsMat::zero((0, 0)));
@@ -588,6 +609,7 @@ impl Object {
     /// Re-assembles the matrices from the media, keeping the geometry.
     fn reassemble_values(&mut self) {
         let start = Instant::now();
+        self.values_changed = true;
         self.coefficients = self.coefficients_of_media();
         self.matrices = assembly::assemble(
             &self.mesh,
@@ -676,6 +698,14 @@ impl Object {
         if let Some(t) = built {
             hierarchy_ms = t;
         }
+        let refreshed = if built.is_none() {
+            self.refresh_kept()?
+        } else {
+            None
+        };
+        if let Some(t) = refreshed {
+            hierarchy_ms = t;
+        }
         let kept = self
             .kept
             .clone()
@@ -746,6 +776,7 @@ impl Object {
             hierarchy_ms,
             solve_ms,
             hierarchy_built: built.is_some(),
+            hierarchy_refreshed: refreshed.is_some(),
             interrupted,
         })
     }
@@ -793,7 +824,60 @@ impl Object {
             solver,
         }));
         self.hierarchy_builds += 1;
+        self.values_changed = false;
         Ok(Some(ms(t)))
+    }
+
+    /// Recomputes the kept V-cycles' operators for the current matrices
+    /// when their diagonal drifted past [`REFRESH_DRIFT`]; returns the
+    /// time (ms) when it did.
+    fn refresh_kept(&mut self) -> Result<Option<f64>, Error> {
+        if !std::mem::take(&mut self.values_changed) {
+            return Ok(None);
+        }
+        let Some(kept) = &self.kept else {
+            return Ok(None);
+        };
+        let KeptSolver::VCycles(v) = &kept.solver else {
+            return Ok(None);
+        };
+        let channel = |k: usize| if v.len() == 3 { k } else { 1 };
+        let drift = v
+            .iter()
+            .enumerate()
+            .map(|(k, v)| v.diagonal_drift(&self.matrices[channel(k)]))
+            .fold(0.0f64, f64::max);
+        if drift <= REFRESH_DRIFT {
+            return Ok(None);
+        }
+        let t = Instant::now();
+        let mut fresh = Vec::with_capacity(v.len());
+        for (k, v) in v.iter().enumerate() {
+            fresh.push(v.refreshed(&self.matrices[channel(k)])?);
+        }
+        self.kept = Some(Arc::new(Kept {
+            method: kept.method,
+            share_hierarchy: kept.share_hierarchy,
+            solver: KeptSolver::VCycles(fresh),
+        }));
+        self.hierarchy_refreshes += 1;
+        Ok(Some(ms(t)))
+    }
+
+    /// How many times the kept hierarchy's coarse operators were
+    /// recomputed for drifted matrices (see [`REFRESH_DRIFT`]).
+    pub fn hierarchy_refreshes(&self) -> usize {
+        self.hierarchy_refreshes
+    }
+
+    /// Bytes of the kept solver state (see
+    /// [`multires::VCycle::memory_bytes`]; 0 for Jacobi and the cascade,
+    /// whose size is not counted).
+    pub(crate) fn kept_bytes(kept: &Option<Arc<Kept>>) -> usize {
+        match kept.as_deref().map(|k| &k.solver) {
+            Some(KeptSolver::VCycles(v)) => v.iter().map(VCycle::memory_bytes).sum(),
+            _ => 0,
+        }
     }
 
     /// How many times this object (and the objects it was cloned from)

@@ -117,6 +117,7 @@ impl Object {
         }
         rows.sort_unstable();
         rows.dedup();
+        self.values_changed |= !rows.is_empty();
         let a = self.boundary_factor();
         reassemble_rows(
             &self.mesh,

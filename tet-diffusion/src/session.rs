@@ -19,21 +19,34 @@
 //!   recombine build a new one.
 //! - Undo keeps small deltas: a paint keeps the changed tets' previous
 //!   media (their rows are re-assembled from them, exactly), a light
-//!   change the previous lights, a move the previous offset, and each of
-//!   them the `φ` before it (`3 × 8` bytes per vertex) so that undo
-//!   restores `φ` bit for bit without a solve. Cut, fracture and
-//!   recombine keep a checkpoint (the pieces before). The deltas share a
-//!   budget ([`SessionOptions::undo_budget_bytes`]): past it, the oldest
-//!   `φ` copies are dropped first (undoing those edits then re-solves, to
-//!   the tolerance rather than bit for bit), then the oldest entries.
+//!   change the previous lights, a move the previous offset, and an edit
+//!   whose solve refreshed the kept hierarchy the hierarchy before. Cut,
+//!   fracture and recombine keep a checkpoint (the pieces before).
+//! - `φ` is restored bit for bit, but not copied for every edit (a copy is
+//!   `3 × 8` bytes per vertex, 1.5–2% of the object): the newest applied
+//!   edit and every [`SessionOptions::phi_interval`]-th edit (an
+//!   *anchor*; also the first edit and the first after a cut) keep the
+//!   `φ` before them. Undoing another edit recomputes its `φ` from the
+//!   nearest anchor before it: `φ` after each edit is a deterministic
+//!   function of the `φ` before it and the edit (the same solves, the
+//!   same hierarchy), so re-doing the edits in between gives the same
+//!   bits. The `φ` passed on the way are kept until the next new edit,
+//!   so undoing step by step recomputes once per anchor interval. Redo
+//!   re-does the edit and its solves (the same bits again).
+//! - The deltas share a budget ([`SessionOptions::undo_budget_bytes`]):
+//!   past it, the oldest entries (up to the next anchor) leave the undo
+//!   history (they stay in the log). [`Session::undo_memory`] reports
+//!   the undo bytes against the object's.
 
 use std::collections::VecDeque;
+use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use glam::{DAffine3, DVec3};
 
 use crate::error::finite_vec;
+use crate::object::Kept;
 use crate::{Budget, Cut, Error, Light, Medium, Object, SolveReport, Stroke};
 
 /// One edit of a session. Points and directions are in the display frame
@@ -174,16 +187,41 @@ pub struct SessionOptions {
     pub cut_method: crate::CutMethod,
     /// Bytes the undo deltas may hold together.
     pub undo_budget_bytes: usize,
+    /// Every how many edits (since the start or the last cut) an edit
+    /// keeps a copy of `φ` before it (an anchor, see the [module
+    /// docs](self)): undoing the edits in between re-does at most this
+    /// many minus one edits' solves. At least 1 (1: every edit keeps its
+    /// copy, no undo re-solves).
+    pub phi_interval: usize,
 }
 
 impl Default for SessionOptions {
-    /// 10⁻², exact cuts, 512 MiB of undo.
+    /// 10⁻², exact cuts, 512 MiB of undo, a `φ` anchor every 8 edits.
     fn default() -> Self {
         Self {
             coarse_tolerance: 1e-2,
             cut_method: crate::CutMethod::Exact,
             undo_budget_bytes: 512 << 20,
+            phi_interval: 8,
         }
+    }
+}
+
+/// What the undo history holds, against the object it undoes
+/// ([`Session::undo_memory`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct UndoMemory {
+    /// Bytes of the undo and redo deltas (media, lights, offsets, `φ`
+    /// copies, replaced hierarchies, checkpoints).
+    pub undo_bytes: usize,
+    /// Bytes of the pieces now ([`Object::memory_bytes`]).
+    pub object_bytes: usize,
+}
+
+impl UndoMemory {
+    /// `undo_bytes / object_bytes`.
+    pub fn fraction(&self) -> f64 {
+        self.undo_bytes as f64 / self.object_bytes.max(1) as f64
     }
 }
 
@@ -199,9 +237,14 @@ enum Delta {
         lights: Option<Vec<Vec<Light>>>,
         /// The offsets before, for a move.
         offsets: Option<Vec<DVec3>>,
-        /// `φ` of each piece in the other state, unless dropped for the
-        /// budget.
+        /// `φ` of each piece before the edit, for an anchor, the newest
+        /// applied edit, and those an undo recomputed (until the next new
+        /// edit); `None` otherwise and while the edit is undone.
         phi: Option<Vec<[Vec<f64>; 3]>>,
+        /// The pieces whose hierarchy the edit's solve refreshed, each
+        /// with its hierarchy in the other state (before the edit while it
+        /// is applied, after it while it is undone).
+        kept: Vec<(usize, Option<Arc<Kept>>)>,
     },
     /// Cut, fracture, recombine: the pieces and offsets in the other
     /// state.
@@ -212,7 +255,11 @@ impl Delta {
     fn bytes(&self) -> usize {
         match self {
             Delta::Values {
-                media, lights, phi, ..
+                media,
+                lights,
+                phi,
+                kept,
+                ..
             } => {
                 let m: usize = media
                     .iter()
@@ -223,10 +270,9 @@ impl Delta {
                         .map(|v| v.len() * std::mem::size_of::<Light>())
                         .sum()
                 });
-                let p: usize = phi
-                    .as_ref()
-                    .map_or(0, |p| p.iter().map(|c| 3 * 8 * c[0].len()).sum());
-                m + l + p
+                let p: usize = phi.as_ref().map_or(0, |p| phi_bytes(p));
+                let k: usize = kept.iter().map(|(_, k)| Object::kept_bytes(k)).sum();
+                m + l + p + k
             }
             Delta::Checkpoint(pieces, _) => pieces.iter().map(Object::memory_bytes).sum(),
         }
@@ -237,6 +283,23 @@ impl Delta {
 struct Entry {
     logged: Logged,
     delta: Delta,
+    /// Whether it keeps the `φ` before it while applied (see the module
+    /// docs).
+    anchor: bool,
+}
+
+impl Entry {
+    fn phi(&self) -> Option<&Vec<[Vec<f64>; 3]>> {
+        match &self.delta {
+            Delta::Values { phi, .. } => phi.as_ref(),
+            Delta::Checkpoint(..) => None,
+        }
+    }
+}
+
+/// Bytes of `φ` copies.
+fn phi_bytes(phi: &[[Vec<f64>; 3]]) -> usize {
+    phi.iter().map(|c| 3 * 8 * c[0].len()).sum()
 }
 
 /// What [`Session::apply_pending`] or [`Session::refine`] did.
@@ -366,16 +429,20 @@ impl Session {
         let start = Instant::now();
         let (delta, touched) = self.perform(&edit)?;
         self.history.truncate(self.cursor);
+        let k = self.history.len();
+        let anchor = self.is_anchor(k);
         self.history.push(Entry {
             logged: Logged {
                 edit: edit.clone(),
                 refined: false,
             },
             delta,
+            anchor,
         });
-        self.cursor = self.history.len();
-        let solves = self.solve_coarse(&touched)?;
+        self.cursor = k + 1;
+        let solves = self.solve_recording_kept(k, &touched)?;
         self.unrefined = true;
+        self.thin_phi();
         self.enforce_budget();
         Ok(Applied {
             topology_changed: edit.changes_topology(),
@@ -402,31 +469,7 @@ impl Session {
         };
         let phi_now = |s: &Self| Some(s.pieces.iter().map(phi_of).collect::<Vec<_>>());
         match edit {
-            Edit::Paint(dabs) => {
-                let phi = phi_now(self);
-                let mut media = vec![Vec::new(); n];
-                let mut touched = Vec::new();
-                for (p, piece) in self.pieces.iter_mut().enumerate() {
-                    for dab in dabs {
-                        let local = Stroke {
-                            points: dab.points.iter().map(|&x| x - self.offsets[p]).collect(),
-                            ..dab.clone()
-                        };
-                        let (report, previous) = piece.paint_recorded(&local)?;
-                        media[p].extend(previous);
-                        if report.tets > 0 && !touched.contains(&p) {
-                            touched.push(p);
-                        }
-                    }
-                }
-                let delta = Delta::Values {
-                    media,
-                    lights: None,
-                    offsets: None,
-                    phi,
-                };
-                Ok((delta, touched))
-            }
+            Edit::Paint(dabs) => self.perform_paint(dabs),
             Edit::Material(m) => {
                 let phi = phi_now(self);
                 let mut media = Vec::with_capacity(n);
@@ -438,6 +481,7 @@ impl Session {
                     lights: None,
                     offsets: None,
                     phi,
+                    kept: Vec::new(),
                 };
                 Ok((delta, (0..n).collect()))
             }
@@ -452,6 +496,7 @@ impl Session {
                     lights: Some(before),
                     offsets: None,
                     phi,
+                    kept: Vec::new(),
                 };
                 Ok((delta, (0..n).collect()))
             }
@@ -471,45 +516,11 @@ impl Session {
                     lights: None,
                     offsets: Some(before),
                     phi,
+                    kept: Vec::new(),
                 };
                 Ok((delta, vec![*piece]))
             }
-            Edit::Cut(cut) => {
-                let before = (self.pieces.clone(), self.offsets.clone());
-                let mut pieces = Vec::new();
-                let mut offsets = Vec::new();
-                let mut touched = Vec::new();
-                let mut removed_all = 0;
-                for (piece, offset) in self.pieces.iter().zip(&self.offsets) {
-                    let local = cut_in(cut, *offset);
-                    let reached = piece
-                        .mesh()
-                        .positions()
-                        .iter()
-                        .any(|&x| local.side(x) > 0.0);
-                    if !reached {
-                        pieces.push(piece.clone());
-                        offsets.push(*offset);
-                        continue;
-                    }
-                    let mut piece = piece.clone();
-                    match piece.cut(&local, self.options.cut_method) {
-                        Ok(_) => {
-                            touched.push(pieces.len());
-                            pieces.push(piece);
-                            offsets.push(*offset);
-                        }
-                        Err(Error::CutRemovesEverything { tets }) => removed_all += tets,
-                        Err(e) => return Err(e),
-                    }
-                }
-                if pieces.is_empty() {
-                    return Err(Error::CutRemovesEverything { tets: removed_all });
-                }
-                self.pieces = pieces;
-                self.offsets = offsets;
-                Ok((Delta::Checkpoint(before.0, before.1), touched))
-            }
+            Edit::Cut(cut) => self.perform_cut(cut),
             Edit::Fracture {
                 piece,
                 point,
@@ -543,6 +554,134 @@ impl Session {
                 Ok((Delta::Checkpoint(before.0, before.1), vec![lo]))
             }
         }
+    }
+
+    /// [`perform`](Self::perform) of a paint edit.
+    fn perform_paint(&mut self, dabs: &[Stroke]) -> Result<(Delta, Vec<usize>), Error> {
+        let n = self.pieces.len();
+        let phi = Some(self.pieces.iter().map(phi_of).collect::<Vec<_>>());
+        let mut media = vec![Vec::new(); n];
+        let mut touched = Vec::new();
+        for (p, piece) in self.pieces.iter_mut().enumerate() {
+            for dab in dabs {
+                let local = Stroke {
+                    points: dab.points.iter().map(|&x| x - self.offsets[p]).collect(),
+                    ..dab.clone()
+                };
+                let (report, previous) = piece.paint_recorded(&local)?;
+                media[p].extend(previous);
+                if report.tets > 0 && !touched.contains(&p) {
+                    touched.push(p);
+                }
+            }
+        }
+        let delta = Delta::Values {
+            media,
+            lights: None,
+            offsets: None,
+            phi,
+            kept: Vec::new(),
+        };
+        Ok((delta, touched))
+    }
+
+    /// [`perform`](Self::perform) of a cut.
+    fn perform_cut(&mut self, cut: &Cut) -> Result<(Delta, Vec<usize>), Error> {
+        let before = (self.pieces.clone(), self.offsets.clone());
+        let mut pieces = Vec::new();
+        let mut offsets = Vec::new();
+        let mut touched = Vec::new();
+        let mut removed_all = 0;
+        for (piece, offset) in self.pieces.iter().zip(&self.offsets) {
+            let local = cut_in(cut, *offset);
+            let reached = piece
+                .mesh()
+                .positions()
+                .iter()
+                .any(|&x| local.side(x) > 0.0);
+            if !reached {
+                pieces.push(piece.clone());
+                offsets.push(*offset);
+                continue;
+            }
+            let mut piece = piece.clone();
+            match piece.cut(&local, self.options.cut_method) {
+                Ok(_) => {
+                    touched.push(pieces.len());
+                    pieces.push(piece);
+                    offsets.push(*offset);
+                }
+                Err(Error::CutRemovesEverything { tets }) => removed_all += tets,
+                Err(e) => return Err(e),
+            }
+        }
+        if pieces.is_empty() {
+            return Err(Error::CutRemovesEverything { tets: removed_all });
+        }
+        self.pieces = pieces;
+        self.offsets = offsets;
+        Ok((Delta::Checkpoint(before.0, before.1), touched))
+    }
+
+    /// Whether an edit applied at history index `k` is an anchor: the
+    /// first, the first after a checkpoint, or `phi_interval` after the
+    /// previous anchor.
+    fn is_anchor(&self, k: usize) -> bool {
+        let interval = self.options.phi_interval.max(1);
+        let mut back = 0;
+        for e in self.history[..k].iter().rev() {
+            if matches!(e.delta, Delta::Checkpoint(..)) {
+                break;
+            }
+            back += 1;
+            if e.anchor {
+                return back >= interval;
+            }
+        }
+        true
+    }
+
+    /// Drops the `φ` copies of the applied edits that are neither anchors
+    /// nor the newest.
+    fn thin_phi(&mut self) {
+        let newest = self.cursor.checked_sub(1);
+        for (k, e) in self.history.iter_mut().enumerate() {
+            if !e.anchor
+                && Some(k) != newest
+                && let Delta::Values { phi, .. } = &mut e.delta
+            {
+                *phi = None;
+            }
+        }
+    }
+
+    /// The coarse solve of the pieces `touched` by history entry `k`,
+    /// recording in its delta the hierarchies the solve replaced.
+    fn solve_recording_kept(
+        &mut self,
+        k: usize,
+        touched: &[usize],
+    ) -> Result<Vec<SolveReport>, Error> {
+        let before: Vec<Option<Arc<Kept>>> = touched
+            .iter()
+            .map(|&p| self.pieces[p].kept.clone())
+            .collect();
+        let solves = self.solve_coarse(touched);
+        if let Delta::Values { kept, .. } = &mut self.history[k].delta {
+            for (&p, old) in touched.iter().zip(before) {
+                let same = match (&old, &self.pieces[p].kept) {
+                    (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                    (None, None) => true,
+                    _ => false,
+                };
+                // A first build (after a topology change) is not undone:
+                // only a refresh of a kept hierarchy is.
+                if !same && old.is_some() {
+                    kept.push((p, old));
+                }
+            }
+        }
+        solves
     }
 
     /// Gives piece `p` `lights` (display frame).
@@ -596,6 +735,22 @@ impl Session {
         if !self.unrefined {
             return Ok((Vec::new(), true));
         }
+        let (reports, finished) = self.solve_full(cancel)?;
+        if !finished {
+            return Ok((reports, false));
+        }
+        self.unrefined = false;
+        match self.cursor.checked_sub(1) {
+            Some(i) => self.history[i].logged.refined = true,
+            None if self.settled.edits.is_empty() => self.settled.refined_initially = true,
+            None => {}
+        }
+        Ok((reports, true))
+    }
+
+    /// Solves every piece to its full tolerance unless `cancel` stops it
+    /// (then `φ` is put back, and the result says it did not finish).
+    fn solve_full(&mut self, cancel: &AtomicBool) -> Result<(Vec<SolveReport>, bool), Error> {
         let saved: Vec<[Vec<f64>; 3]> = self.pieces.iter().map(phi_of).collect();
         let budget = Budget {
             cancel: Some(cancel),
@@ -614,12 +769,6 @@ impl Session {
                     return Err(e);
                 }
             }
-        }
-        self.unrefined = false;
-        match self.cursor.checked_sub(1) {
-            Some(i) => self.history[i].logged.refined = true,
-            None if self.settled.edits.is_empty() => self.settled.refined_initially = true,
-            None => {}
         }
         Ok((reports, true))
     }
@@ -701,132 +850,196 @@ impl Session {
         self.cursor < self.history.len()
     }
 
-    /// Undoes the last applied edit: media, lights, offsets, pieces and `φ`
-    /// as they were before it (φ bit for bit while its copy is within the
-    /// budget, else re-solved). Waiting edits are dropped. Returns the
-    /// edit undone, or `None` when there is none.
+    /// Undoes the last applied edit: media, lights, offsets, pieces,
+    /// hierarchy and `φ` bit for bit as they were before it (`φ` from its
+    /// copy, or recomputed from the nearest anchor: see the [module
+    /// docs](self)). Waiting edits are dropped. Returns the edit undone, or
+    /// `None` when there is none.
     ///
     /// # Errors
-    /// Those of a re-solve (only when `φ`'s copy was dropped).
+    /// Those of re-doing the edits since the anchor (which succeeded
+    /// before, so none in practice).
     pub fn undo(&mut self) -> Result<Option<Edit>, Error> {
         self.pending.clear();
         let Some(i) = self.cursor.checked_sub(1) else {
             return Ok(None);
         };
-        let mut entry = self.history[i].clone();
-        let resolve = self.swap_back(&mut entry.delta, &entry.logged.edit)?;
-        self.history[i].delta = entry.delta;
-        self.cursor = i;
         self.unrefined = false;
-        if resolve {
-            self.refine_after_swap()?;
+        if let Delta::Checkpoint(..) = self.history[i].delta {
+            self.swap_checkpoint(i);
+            self.cursor = i;
+            return Ok(Some(self.history[i].logged.edit.clone()));
         }
-        Ok(Some(entry.logged.edit))
+        self.swap_values_back(i)?;
+        self.cursor = i;
+        if let Some(phi) = self.take_phi(i) {
+            self.restore_phi(phi);
+        } else {
+            self.recompute_phi_before(i)?;
+        }
+        Ok(Some(self.history[i].logged.edit.clone()))
     }
 
-    /// Redoes the last undone edit (the same media, lights and `φ` as when
-    /// it was first applied). Returns it, or `None` when there is none.
+    /// Redoes the last undone edit (the same media, lights, hierarchy and
+    /// `φ` as when it was first applied: the edit and its solves again).
+    /// Returns it, or `None` when there is none.
     ///
     /// # Errors
-    /// Those of the edit (which succeeded before, so none in practice) or
-    /// of a re-solve.
+    /// Those of the edit and its solves (which succeeded before, so none
+    /// in practice).
     pub fn redo(&mut self) -> Result<Option<Edit>, Error> {
         self.pending.clear();
         if self.cursor >= self.history.len() {
             return Ok(None);
         }
         let i = self.cursor;
-        let edit = self.history[i].logged.edit.clone();
-        let resolve = match &mut self.history[i].delta {
-            Delta::Checkpoint(..) => {
-                let mut delta = self.history[i].delta.clone();
-                self.swap_back(&mut delta, &edit)?;
-                self.history[i].delta = delta;
-                false
-            }
-            Delta::Values { phi, .. } => {
-                let after = phi.take();
-                let (delta, _) = self.perform(&edit)?;
-                let resolve = after.is_none();
-                if let Some(after) = after {
-                    self.restore_phi(after);
-                }
-                self.history[i].delta = delta;
-                resolve
-            }
-        };
-        self.cursor = i + 1;
         self.unrefined = false;
-        if resolve {
-            self.refine_after_swap()?;
+        if let Delta::Checkpoint(..) = self.history[i].delta {
+            self.swap_checkpoint(i);
+        } else {
+            let phi = self.pieces.iter().map(phi_of).collect();
+            self.reapply(i)?;
+            if let Delta::Values { phi: slot, .. } = &mut self.history[i].delta {
+                *slot = Some(phi);
+            }
         }
-        Ok(Some(edit))
+        self.cursor = i + 1;
+        self.thin_phi();
+        Ok(Some(self.history[i].logged.edit.clone()))
     }
 
-    fn refine_after_swap(&mut self) -> Result<(), Error> {
-        for p in &mut self.pieces {
-            p.solve()?;
+    fn take_phi(&mut self, i: usize) -> Option<Vec<[Vec<f64>; 3]>> {
+        match &mut self.history[i].delta {
+            Delta::Values { phi, .. } => phi.take(),
+            Delta::Checkpoint(..) => None,
+        }
+    }
+
+    /// With the values of entries `i..` undone and `φ` still that after
+    /// entry `i`, recomputes `φ` before entry `i`: back to the nearest
+    /// earlier entry holding its `φ` (an anchor), then its edits and
+    /// solves again, keeping the `φ` met on the way for the next undo.
+    fn recompute_phi_before(&mut self, i: usize) -> Result<(), Error> {
+        let lost = || Error::BadArgument {
+            what: "the undo history".into(),
+            value: i as f64,
+            need: "an edit without its φ has an anchor before it",
+        };
+        let j = (0..i)
+            .rev()
+            .find(|&j| self.history[j].phi().is_some())
+            .ok_or_else(lost)?;
+        if self.history[j..i]
+            .iter()
+            .any(|e| matches!(e.delta, Delta::Checkpoint(..)))
+        {
+            return Err(lost());
+        }
+        for m in (j..i).rev() {
+            self.swap_values_back(m)?;
+        }
+        let phi = self.history[j].phi().cloned().ok_or_else(lost)?;
+        self.restore_phi(phi);
+        for m in j..i {
+            if m > j {
+                let phi = self.pieces.iter().map(phi_of).collect();
+                if let Delta::Values { phi: slot, .. } = &mut self.history[m].delta {
+                    *slot = Some(phi);
+                }
+            }
+            self.reapply(m)?;
         }
         Ok(())
     }
 
-    /// Puts the state in `delta` back and leaves the current one in it
-    /// (for the opposite move). Returns whether `φ` must be re-solved.
-    fn swap_back(&mut self, delta: &mut Delta, edit: &Edit) -> Result<bool, Error> {
-        match delta {
-            Delta::Checkpoint(pieces, offsets) => {
-                std::mem::swap(&mut self.pieces, pieces);
-                std::mem::swap(&mut self.offsets, offsets);
-                Ok(false)
-            }
-            Delta::Values {
-                media,
-                lights,
-                offsets,
-                phi,
-            } => {
-                for (piece, previous) in self.pieces.iter_mut().zip(media.iter()) {
-                    if matches!(edit, Edit::Material(_)) {
-                        piece.restore_all_media(previous);
-                    } else {
-                        piece.restore_media(previous);
-                    }
-                }
-                if let Some(before) = offsets.take() {
-                    for (p, &o) in before.iter().enumerate() {
-                        if o != self.offsets[p] {
-                            let display: Vec<Light> = self.pieces[p]
-                                .lights()
-                                .iter()
-                                .map(|l| shift(l, self.offsets[p]))
-                                .collect();
-                            self.offsets[p] = o;
-                            self.pieces[p].set_transform(DAffine3::from_translation(o));
-                            self.set_piece_lights(p, &display)?;
-                        }
-                    }
-                }
-                if let Some(before) = lights.take() {
-                    for (p, l) in before.into_iter().enumerate() {
-                        let piece = &mut self.pieces[p];
-                        piece.clear_lights();
-                        for l in l {
-                            piece.add_light(l)?;
-                        }
-                    }
-                }
-                let now: Vec<[Vec<f64>; 3]> = self.pieces.iter().map(phi_of).collect();
-                let resolve = match phi.take() {
-                    Some(before) => {
-                        self.restore_phi(before);
-                        false
-                    }
-                    None => true,
-                };
-                *phi = Some(now);
-                Ok(resolve)
+    /// Does history entry `i` (a values edit, undone) again with the
+    /// solves it had: the coarse one with the hierarchy it used, and the
+    /// refinement if it was refined. Its delta becomes the new one (the
+    /// `φ` slot keeps what it held).
+    fn reapply(&mut self, i: usize) -> Result<(), Error> {
+        let edit = self.history[i].logged.edit.clone();
+        let refined = self.history[i].logged.refined;
+        let (mut delta, touched) = self.perform(&edit)?;
+        let (swapped, held) = match &mut self.history[i].delta {
+            Delta::Values { kept, phi, .. } => (std::mem::take(kept), phi.take()),
+            Delta::Checkpoint(..) => (Vec::new(), None),
+        };
+        let mut replaced = Vec::with_capacity(swapped.len());
+        for (p, mut k) in swapped {
+            std::mem::swap(&mut self.pieces[p].kept, &mut k);
+            replaced.push((p, k));
+        }
+        if let Delta::Values { phi, kept, .. } = &mut delta {
+            *phi = held;
+            *kept = replaced;
+        }
+        self.history[i].delta = delta;
+        self.solve_coarse(&touched)?;
+        if refined {
+            let never = AtomicBool::new(false);
+            self.solve_full(&never)?;
+        }
+        Ok(())
+    }
+
+    fn swap_checkpoint(&mut self, i: usize) {
+        if let Delta::Checkpoint(pieces, offsets) = &mut self.history[i].delta {
+            std::mem::swap(&mut self.pieces, pieces);
+            std::mem::swap(&mut self.offsets, offsets);
+        }
+    }
+
+    /// Puts back the media, lights, offsets and hierarchies entry `i`
+    /// (a values edit) changed; `φ` is left alone. The delta then holds
+    /// the hierarchies of the undone state (for redo); the rest of it is
+    /// re-made by redo.
+    fn swap_values_back(&mut self, i: usize) -> Result<(), Error> {
+        let is_material = matches!(self.history[i].logged.edit, Edit::Material(_));
+        let Delta::Values {
+            media,
+            lights,
+            offsets,
+            kept,
+            ..
+        } = &mut self.history[i].delta
+        else {
+            return Ok(());
+        };
+        let (media, lights, offsets) = (std::mem::take(media), lights.take(), offsets.take());
+        for (p, k) in kept.iter_mut() {
+            std::mem::swap(&mut self.pieces[*p].kept, k);
+        }
+        for (piece, previous) in self.pieces.iter_mut().zip(media.iter()) {
+            if is_material {
+                piece.restore_all_media(previous);
+            } else {
+                piece.restore_media(previous);
             }
         }
+        if let Some(before) = offsets {
+            for (p, &o) in before.iter().enumerate() {
+                if o != self.offsets[p] {
+                    let display: Vec<Light> = self.pieces[p]
+                        .lights()
+                        .iter()
+                        .map(|l| shift(l, self.offsets[p]))
+                        .collect();
+                    self.offsets[p] = o;
+                    self.pieces[p].set_transform(DAffine3::from_translation(o));
+                    self.set_piece_lights(p, &display)?;
+                }
+            }
+        }
+        if let Some(before) = lights {
+            for (p, l) in before.into_iter().enumerate() {
+                let piece = &mut self.pieces[p];
+                piece.clear_lights();
+                for l in l {
+                    piece.add_light(l)?;
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Bytes the undo and redo deltas hold.
@@ -834,26 +1047,44 @@ impl Session {
         self.history.iter().map(|e| e.delta.bytes()).sum()
     }
 
-    /// Drops the oldest `φ` copies, then the oldest entries, until the
-    /// deltas fit the budget (the newest entry is always kept).
+    /// The undo history's bytes against the object's (the figure the
+    /// memory budget of undo is stated in).
+    pub fn undo_memory(&self) -> UndoMemory {
+        UndoMemory {
+            undo_bytes: self.undo_bytes(),
+            object_bytes: self.pieces.iter().map(Object::memory_bytes).sum(),
+        }
+    }
+
+    /// Drops the oldest entries (with the entries after them that need
+    /// their anchor) until the deltas fit the budget; the newest entry is
+    /// always kept.
     fn enforce_budget(&mut self) {
         let budget = self.options.undo_budget_bytes;
         let mut total = self.undo_bytes();
-        let mut k = 0;
-        while total > budget && k + 1 < self.cursor {
-            if let Delta::Values { phi, .. } = &mut self.history[k].delta
-                && let Some(p) = phi.take()
-            {
-                total -= p.iter().map(|c| 3 * 8 * c[0].len()).sum::<usize>();
-            }
-            k += 1;
-        }
         while total > budget && self.cursor > 1 {
-            let e = self.history.remove(0);
-            total -= e.delta.bytes();
-            self.settled.edits.push(e.logged);
-            self.cursor -= 1;
+            self.drop_oldest(&mut total);
+            while self.cursor > 1
+                && matches!(self.history[0].delta, Delta::Values { .. })
+                && self.history[0].phi().is_none()
+            {
+                self.drop_oldest(&mut total);
+            }
         }
+        // The oldest entry holds its φ (the loop above dropped those that
+        // did not): it stays an anchor from now on.
+        if let Some(e) = self.history.first_mut()
+            && e.phi().is_some()
+        {
+            e.anchor = true;
+        }
+    }
+
+    fn drop_oldest(&mut self, total: &mut usize) {
+        let e = self.history.remove(0);
+        *total -= e.delta.bytes();
+        self.settled.edits.push(e.logged);
+        self.cursor -= 1;
     }
 }
 
