@@ -127,7 +127,23 @@ async fn the_page_cuts_paints_relights_undoes_and_redoes_in_chromium() {
     assert_eq!(step("undo")["history"]["redo"].as_array().unwrap().len(), 2);
     assert_eq!(done("redo").len(), lit.len() - 1);
     assert_eq!(v["help_visible"], true);
-    for s in ["load", "cut", "paint", "light", "undo", "redo"] {
+    // Exposure from the covered pixels (as the CLI's PNGs), not the
+    // surface vertices: measured, with part of the drawing covered.
+    assert_eq!(load["white_from"], "pixels", "{load}");
+    assert!(load["covered"].as_u64().unwrap() > 100, "{load}");
+    assert!(load["white"].as_f64().unwrap() > 0.0);
+    // The environment map loaded from the page lights the object: in the
+    // lights and the history, and the picture changed.
+    let env = step("env");
+    assert!(
+        env["environment"]
+            .as_str()
+            .is_some_and(|f| f.starts_with("env-") && f.ends_with(".hdr")),
+        "{env}"
+    );
+    assert_eq!(done("env").last().map(String::as_str), Some("lights"));
+    assert_ne!(env["mean"], step("redo")["mean"]);
+    for s in ["load", "cut", "paint", "light", "undo", "redo", "env"] {
         assert_eq!(step(s)["errors"], 0, "{s}: {v:#}");
     }
 }

@@ -15,6 +15,7 @@ use tokio::io::{AsyncReadExt, AsyncWriteExt};
 use tokio_tungstenite::tungstenite::client::IntoClientRequest;
 use tokio_tungstenite::tungstenite::{self, Message};
 use trilux::view::protocol::{self, ExportKind};
+use trilux::view::session_file;
 use trilux::view::{Exporter, Options, Running, builtin};
 
 type Socket =
@@ -478,12 +479,35 @@ async fn bad_messages_get_an_error_naming_the_field_and_keep_the_session() {
     )
     .await;
     until(&mut s, "probe", &mut seen).await;
-    // A message over the size limit closes this connection only.
+    // A text message over the size limit gets an error; the connection
+    // stays.
     let huge = format!(
         r#"{{"seq": 1, "op": "hello", "pad": "{}"}}"#,
         "x".repeat(200_000)
     );
-    let _ = send_raw(&mut s, huge).await;
+    send_raw(&mut s, huge).await.unwrap();
+    let e = until(&mut s, "error", &mut seen).await;
+    assert_eq!(e["field"], "(message)", "{e}");
+    // Uploads: a wrong header and a file that is no image are errors
+    // naming the upload; one over the upload limit closes this
+    // connection only.
+    s.send(Message::Binary(b"TLXF\x01\x01".to_vec().into()))
+        .await
+        .unwrap();
+    let e = until(&mut s, "error", &mut seen).await;
+    assert_eq!(e["field"], "(upload)", "{e}");
+    let mut not_hdr = protocol::upload_header(77).to_vec();
+    not_hdr.extend_from_slice(b"#?RADIANCE\nnonsense");
+    s.send(Message::Binary(not_hdr.into())).await.unwrap();
+    let e = until(&mut s, "error", &mut seen).await;
+    assert_eq!(
+        (e["field"].as_str(), e["seq"].as_u64()),
+        (Some("(upload)"), Some(77)),
+        "{e}"
+    );
+    let mut big = protocol::upload_header(78).to_vec();
+    big.resize(protocol::MAX_UPLOAD + 1, 0);
+    let _ = s.send(Message::Binary(big.into())).await;
     let closed = tokio::time::timeout(Duration::from_secs(60), async {
         loop {
             match s.next().await {
@@ -544,5 +568,90 @@ async fn a_dropped_connection_keeps_the_session_and_floods_are_limited() {
         }
     }
     assert!(rated);
+    r.stop().await.unwrap();
+}
+
+/// A tiny Radiance `.hdr`: 4 × 2 flat RGBE pixels, a bright top row.
+fn tiny_hdr() -> Vec<u8> {
+    let mut f = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n".to_vec();
+    for row in 0..2 {
+        for _ in 0..4 {
+            // RGBE: 1.0 is (128, 128, 128, 129); the top row 8× brighter.
+            let e = if row == 0 { 132 } else { 129 };
+            f.extend_from_slice(&[128, 128, 128, e]);
+        }
+    }
+    f
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn an_uploaded_environment_map_lights_the_object_and_is_saved_with_the_session() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = server(dir.path()).await;
+    let mut s = connect(&r).await;
+    let mut seen = Seen::default();
+    until(&mut s, "status", &mut seen).await;
+    let status_of = async |s: &mut Socket, seen: &mut Seen, seq: u64| loop {
+        let st = until(s, "status", seen).await;
+        let errors: Vec<&Value> = seen.texts.iter().filter(|t| t["type"] == "error").collect();
+        assert!(errors.is_empty(), "{errors:?}");
+        if st["seqs"].as_array().unwrap().contains(&json!(seq)) {
+            break st;
+        }
+    };
+    let mut upload = protocol::upload_header(5).to_vec();
+    upload.extend_from_slice(&tiny_hdr());
+    s.send(Message::Binary(upload.into())).await.unwrap();
+    let st = status_of(&mut s, &mut seen, 5).await;
+    assert_eq!(st["edit"], "lights");
+    let kinds = |st: &Value| -> Vec<String> {
+        st["lights"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|l| l["kind"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(kinds(&st), ["dir", "env"]);
+    let file = st["lights"][1]["file"].as_str().unwrap().to_string();
+    assert!(file.starts_with("env-") && file.ends_with(".hdr"), "{file}");
+    assert_eq!(std::fs::read(dir.path().join(&file)).unwrap(), tiny_hdr());
+    // The page's light drag replaces the directional light; the map stays.
+    send(
+        &mut s,
+        json!({"seq": 6, "op": "lights", "lights": [{"kind": "dir", "dir": [0, 0, 1]}]}),
+    )
+    .await;
+    let st = status_of(&mut s, &mut seen, 6).await;
+    assert_eq!(kinds(&st), ["dir", "env"]);
+    // Saved in the session file by its file name, and read back from it.
+    send(
+        &mut s,
+        json!({"seq": 7, "op": "export", "kind": "session", "name": "env.json"}),
+    )
+    .await;
+    until(&mut s, "export", &mut seen).await;
+    let text = std::fs::read_to_string(dir.path().join("env.json")).unwrap();
+    assert!(text.contains(&file), "{text}");
+    let (_, log, envs) = session_file::from_json_in(&text, Some(dir.path())).unwrap();
+    assert_eq!(envs.len(), 1);
+    assert!(matches!(&log.edits[0].edit, tet_diffusion::Edit::Lights(l)
+        if matches!(l[1], Light::Environment(_))));
+    // Without the map's file the session file names the entry.
+    std::fs::remove_file(dir.path().join(&file)).unwrap();
+    let e = session_file::from_json_in(&text, Some(dir.path())).unwrap_err();
+    assert!(
+        e.contains("edits[0].lights[1].file") && e.contains(&file),
+        "{e}"
+    );
+    // An empty upload removes the map; undo brings it back.
+    s.send(Message::Binary(protocol::upload_header(8).to_vec().into()))
+        .await
+        .unwrap();
+    let st = status_of(&mut s, &mut seen, 8).await;
+    assert_eq!(kinds(&st), ["dir"]);
+    send(&mut s, json!({"seq": 9, "op": "undo"})).await;
+    let st = status_of(&mut s, &mut seen, 9).await;
+    assert_eq!(kinds(&st), ["dir", "env"]);
     r.stop().await.unwrap();
 }

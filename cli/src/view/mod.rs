@@ -87,6 +87,9 @@ pub struct Options {
     pub export_dir: PathBuf,
     /// The session's options.
     pub session: SessionOptions,
+    /// The environment maps a replayed log uses, with their files (from
+    /// [`session_file::from_json_in`]).
+    pub environments: session_file::EnvFiles,
 }
 
 impl Default for Options {
@@ -97,6 +100,7 @@ impl Default for Options {
             token: None,
             export_dir: PathBuf::from("."),
             session: SessionOptions::default(),
+            environments: Vec::new(),
         }
     }
 }
@@ -212,6 +216,7 @@ pub async fn start(
         export_dir: options.export_dir.clone(),
         source,
         white,
+        envs: options.environments.clone(),
     };
     std::thread::Builder::new()
         .name("trilux-view-session".into())
@@ -406,8 +411,10 @@ async fn websocket(
     if !headers.contains_key(header::ORIGIN) {
         return (StatusCode::FORBIDDEN, "missing Origin").into_response();
     }
-    ws.max_message_size(MAX_MESSAGE)
-        .max_frame_size(MAX_MESSAGE)
+    // Uploads (environment maps) are the only large messages; text is
+    // held to MAX_MESSAGE below.
+    ws.max_message_size(protocol::MAX_UPLOAD)
+        .max_frame_size(protocol::MAX_UPLOAD)
         .on_upgrade(move |socket| client(socket, s))
 }
 
@@ -471,11 +478,28 @@ async fn client(mut socket: WebSocket, s: Shared) {
             incoming = socket.recv() => {
                 let Some(Ok(message)) = incoming else { return };
                 let text = match message {
+                    Message::Text(t) if t.len() > MAX_MESSAGE => {
+                        let problem = format!("{} bytes: a text message may have at most {MAX_MESSAGE}", t.len());
+                        if socket.send(error_text(None, "(message)", &problem)).await.is_err() {
+                            return;
+                        }
+                        continue;
+                    }
                     Message::Text(t) => t,
                     Message::Close(_) => return,
                     Message::Ping(_) | Message::Pong(_) => continue,
-                    Message::Binary(_) => {
-                        if socket.send(error_text(None, "(message)", "binary messages are not accepted; send JSON text")).await.is_err() {
+                    Message::Binary(b) => {
+                        let sent = match protocol::parse_upload(&b) {
+                            Ok((seq, request)) => {
+                                s.cancel.store(true, Ordering::SeqCst);
+                                if s.requests.send((seq, request)).is_err() {
+                                    return;
+                                }
+                                Ok(())
+                            }
+                            Err(bad) => socket.send(error_text(None, &bad.field, &bad.problem)).await,
+                        };
+                        if sent.is_err() {
                             return;
                         }
                         continue;

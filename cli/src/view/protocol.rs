@@ -5,7 +5,11 @@
 //! echoed in every answer to it. Ops: `paint`, `lights`, `material`,
 //! `cut`, `fracture`, `move`, `recombine`, `undo`, `redo`, `probe`,
 //! `export`, `hello` (see [`parse`]). Points are in the display frame,
-//! mesh units.
+//! mesh units. One binary message uploads an environment map
+//! ([`parse_upload`]): a 16-byte header — magic `TLXU`, version 1, kind 1
+//! (environment), two zero bytes, the `seq` as u64 — then the Radiance
+//! `.hdr` file's bytes, at most [`MAX_UPLOAD`]; no bytes remove the map.
+//! A `lights` edit keeps the environment map loaded.
 //!
 //! **Down**: JSON text messages (`status`, `error`, `probe`, `export`,
 //! `hello`) and binary frames: a fixed 16-byte header, then raw
@@ -50,6 +54,13 @@ pub const LAST: u8 = 2;
 pub const MAX_POINTS: usize = 4096;
 /// Most lights.
 pub const MAX_LIGHTS: usize = 16;
+/// Magic of an upload (page → server binary message).
+pub const UPLOAD_MAGIC: &[u8; 4] = b"TLXU";
+/// Kind of an environment-map upload.
+pub const UPLOAD_ENVIRONMENT: u8 = 1;
+/// Largest upload (header included): a 4096 × 2048 RGBE map is 32 MiB
+/// uncompressed.
+pub const MAX_UPLOAD: usize = 40 << 20;
 
 /// A message from the page, parsed and checked.
 #[derive(Debug, Clone)]
@@ -83,6 +94,13 @@ pub enum Request {
     },
     /// The page (re)connected: send everything.
     Hello,
+    /// Light the object by this environment map (a Radiance `.hdr`
+    /// file's bytes, not yet decoded), in addition to the other lights;
+    /// empty: remove the environment map.
+    Environment {
+        /// The file's bytes.
+        hdr: Vec<u8>,
+    },
 }
 
 /// What an export writes.
@@ -215,6 +233,55 @@ pub fn medium(v: &Value, field: &str) -> Parsed<Medium> {
 /// The `seq` of a message, if it has a usable one (echoed in errors).
 pub fn seq_of(v: &Value) -> Option<u64> {
     v.get("seq").and_then(Value::as_u64)
+}
+
+/// Parses one binary message (an upload, see the [module docs](self)).
+///
+/// # Errors
+/// A [`BadField`] naming `(upload)`: too short, another magic, version or
+/// kind, or larger than [`MAX_UPLOAD`].
+pub fn parse_upload(bytes: &[u8]) -> Result<(u64, Request), BadField> {
+    let bad = |problem: String| BadField::new("(upload)", problem);
+    if bytes.len() > MAX_UPLOAD {
+        return Err(bad(format!(
+            "{} bytes: at most {MAX_UPLOAD} bytes may be uploaded",
+            bytes.len()
+        )));
+    }
+    if bytes.len() < HEADER || &bytes[..4] != UPLOAD_MAGIC {
+        return Err(bad(format!(
+            "expected a {HEADER}-byte header starting with {:?}",
+            std::str::from_utf8(UPLOAD_MAGIC).unwrap_or_default()
+        )));
+    }
+    if bytes[4] != VERSION {
+        return Err(bad(format!("version {}: expected {VERSION}", bytes[4])));
+    }
+    if bytes[5] != UPLOAD_ENVIRONMENT {
+        return Err(bad(format!(
+            "kind {}: expected {UPLOAD_ENVIRONMENT} (an environment map)",
+            bytes[5]
+        )));
+    }
+    let mut seq = [0u8; 8];
+    seq.copy_from_slice(&bytes[8..16]);
+    Ok((
+        u64::from_le_bytes(seq),
+        Request::Environment {
+            hdr: bytes[HEADER..].to_vec(),
+        },
+    ))
+}
+
+/// The header of an environment-map upload of `seq` (what the page
+/// writes before the file's bytes).
+pub fn upload_header(seq: u64) -> [u8; HEADER] {
+    let mut h = [0u8; HEADER];
+    h[..4].copy_from_slice(UPLOAD_MAGIC);
+    h[4] = VERSION;
+    h[5] = UPLOAD_ENVIRONMENT;
+    h[8..].copy_from_slice(&seq.to_le_bytes());
+    h
 }
 
 /// Parses one message.

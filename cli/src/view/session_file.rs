@@ -10,12 +10,26 @@
 //!  "edits": [{"refined": true, "op": "lights",
 //!             "lights": [{"kind": "dir", "dir": [0.3, 1, 0.6], "rgb": [1, 1, 1]}]}]}
 //! ```
+//!
+//! An environment-map light is saved as the name of its `.hdr` file
+//! (`{"kind": "env", "file": "env-….hdr", "samples": 256}`), which the
+//! server wrote beside the exports when the page uploaded it; a replay
+//! reads it from the session file's folder.
 
+use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use serde_json::{Value, json};
 use tet_diffusion::glam::DVec3;
-use tet_diffusion::{Cut, Edit, Light, Log, Logged, Medium, Stroke};
+use tet_diffusion::{Cut, Edit, Environment, Light, Log, Logged, Medium, Stroke};
+
+/// Environment maps and the `.hdr` file each was read from (a plain
+/// file name, beside the session file).
+pub type EnvFiles = Vec<(Arc<Environment>, String)>;
+
+/// Directions an uploaded or replayed environment map is reduced to.
+pub const ENV_SAMPLES: usize = 256;
 
 /// The `format` field.
 pub const FORMAT: &str = "trilux-session";
@@ -28,7 +42,7 @@ fn medium(m: &Medium) -> Value {
     json!({"sigma_a": m.sigma_a, "sigma_s_prime": m.sigma_s_prime})
 }
 
-fn light(l: &Light) -> Result<Value, String> {
+fn light(l: &Light, envs: &EnvFiles) -> Result<Value, String> {
     match l {
         Light::Directional {
             to_light,
@@ -38,22 +52,28 @@ fn light(l: &Light) -> Result<Value, String> {
             position,
             intensity,
         } => Ok(json!({"kind": "point", "pos": v3(*position), "rgb": intensity})),
-        Light::Environment(_) => Err("environment-map lights are not saved in sessions".into()),
+        Light::Environment(env) => envs
+            .iter()
+            .find(|(e, _)| Arc::ptr_eq(e, env))
+            .map(|(_, file)| json!({"kind": "env", "file": file, "samples": ENV_SAMPLES}))
+            .ok_or_else(|| {
+                "an environment-map light not loaded from a file cannot be saved".into()
+            }),
     }
 }
 
-/// One edit as JSON.
+/// One edit as JSON; `envs` names the environment maps' files.
 ///
 /// # Errors
-/// For an environment-map light, which the file cannot hold.
-pub fn encode(e: &Edit) -> Result<Value, String> {
+/// For an environment-map light not in `envs`.
+pub fn encode(e: &Edit, envs: &EnvFiles) -> Result<Value, String> {
     Ok(match e {
         Edit::Paint(dabs) => json!({"op": "paint", "dabs": dabs.iter().map(|d| json!({
             "points": d.points.iter().map(|&p| v3(p)).collect::<Vec<_>>(),
             "radius": d.radius, "strength": d.strength, "medium": medium(&d.medium),
         })).collect::<Vec<_>>()}),
         Edit::Lights(l) => {
-            json!({"op": "lights", "lights": l.iter().map(light).collect::<Result<Vec<_>, _>>()?})
+            json!({"op": "lights", "lights": l.iter().map(|l| light(l, envs)).collect::<Result<Vec<_>, _>>()?})
         }
         Edit::Material(m) => json!({"op": "material", "medium": medium(m)}),
         Edit::Cut(Cut::Plane { point, normal }) => {
@@ -123,75 +143,70 @@ fn points(v: &Value, at: &str) -> Result<Vec<DVec3>, String> {
 /// # Errors
 /// A message naming the field.
 pub fn decode(v: &Value, at: &str) -> Result<Edit, String> {
+    decode_in(v, at, &mut Maps::default())
+}
+
+/// Environment maps a decoding read (by file name), and the folder it
+/// reads them from.
+#[derive(Default)]
+struct Maps<'a> {
+    dir: Option<&'a Path>,
+    read: HashMap<String, Arc<Environment>>,
+}
+
+impl Maps<'_> {
+    fn get(&mut self, file: &str, at: &str) -> Result<Arc<Environment>, String> {
+        if let Some(e) = self.read.get(file) {
+            return Ok(e.clone());
+        }
+        let plain = !file.is_empty()
+            && !file.starts_with('.')
+            && !file.contains(['/', '\\'])
+            && file.ends_with(".hdr");
+        if !plain {
+            return Err(format!(
+                "{at}: expected a plain .hdr file name, not {file:?}"
+            ));
+        }
+        let dir = self
+            .dir
+            .ok_or_else(|| format!("{at}: environment maps are read beside a session file"))?;
+        let bytes = std::fs::read(dir.join(file)).map_err(|e| format!("{at}: {file}: {e}"))?;
+        let env = environment(&bytes, file).map_err(|e| format!("{at}: {e}"))?;
+        self.read.insert(file.to_string(), env.clone());
+        Ok(env)
+    }
+}
+
+/// An environment map from a Radiance `.hdr` file's bytes (`name` labels
+/// errors), reduced to [`ENV_SAMPLES`] directions.
+///
+/// # Errors
+/// A message saying what is wrong (not an image, a black map, …).
+pub fn environment(bytes: &[u8], name: &str) -> Result<Arc<Environment>, String> {
+    let image = trilux_io::image::decode(bytes, name, trilux_io::image::ReadOptions::default())
+        .map_err(|e| e.to_string())?;
+    let rgb: Vec<[f32; 3]> = image.pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    Environment::new(
+        &rgb,
+        image.width as usize,
+        image.height as usize,
+        ENV_SAMPLES,
+    )
+    .map(Arc::new)
+    .map_err(|e| format!("{name}: {e}"))
+}
+
+fn decode_in(v: &Value, at: &str, maps: &mut Maps<'_>) -> Result<Edit, String> {
     let op = field(v, "op", at)?.as_str().unwrap_or_default();
     Ok(match op {
-        "paint" => {
-            let dabs = field(v, "dabs", at)?
-                .as_array()
-                .ok_or_else(|| format!("{at}.dabs: expected an array"))?;
-            Edit::Paint(
-                dabs.iter()
-                    .enumerate()
-                    .map(|(k, d)| {
-                        let at = format!("{at}.dabs[{k}]");
-                        Ok(Stroke {
-                            points: points(field(d, "points", &at)?, &format!("{at}.points"))?,
-                            radius: num(field(d, "radius", &at)?, &format!("{at}.radius"))?,
-                            strength: num(field(d, "strength", &at)?, &format!("{at}.strength"))?,
-                            medium: decode_medium(
-                                field(d, "medium", &at)?,
-                                &format!("{at}.medium"),
-                            )?,
-                        })
-                    })
-                    .collect::<Result<_, String>>()?,
-            )
-        }
-        "lights" => {
-            let l = field(v, "lights", at)?
-                .as_array()
-                .ok_or_else(|| format!("{at}.lights: expected an array"))?;
-            Edit::Lights(
-                l.iter()
-                    .enumerate()
-                    .map(|(k, l)| {
-                        let at = format!("{at}.lights[{k}]");
-                        let color = rgb(field(l, "rgb", &at)?, &format!("{at}.rgb"))?;
-                        match field(l, "kind", &at)?.as_str() {
-                            Some("dir") => Ok(Light::Directional {
-                                to_light: vec3(field(l, "dir", &at)?, &format!("{at}.dir"))?,
-                                irradiance: color,
-                            }),
-                            Some("point") => Ok(Light::Point {
-                                position: vec3(field(l, "pos", &at)?, &format!("{at}.pos"))?,
-                                intensity: color,
-                            }),
-                            _ => Err(format!("{at}.kind: expected dir or point")),
-                        }
-                    })
-                    .collect::<Result<_, String>>()?,
-            )
-        }
+        "paint" => decode_paint(v, at)?,
+        "lights" => decode_lights(v, at, maps)?,
         "material" => Edit::Material(decode_medium(
             field(v, "medium", at)?,
             &format!("{at}.medium"),
         )?),
-        "cut" => {
-            if let Some(p) = v.get("plane") {
-                let at = format!("{at}.plane");
-                Edit::Cut(Cut::Plane {
-                    point: vec3(field(p, "point", &at)?, &format!("{at}.point"))?,
-                    normal: vec3(field(p, "normal", &at)?, &format!("{at}.normal"))?,
-                })
-            } else {
-                let s = field(v, "stroke", at)?;
-                let at = format!("{at}.stroke");
-                Edit::Cut(Cut::Stroke {
-                    points: points(field(s, "points", &at)?, &format!("{at}.points"))?,
-                    view: vec3(field(s, "view", &at)?, &format!("{at}.view"))?,
-                })
-            }
-        }
+        "cut" => decode_cut(v, at)?,
         "fracture" => Edit::Fracture {
             piece: index(v, "piece", at)?,
             point: vec3(field(v, "point", at)?, &format!("{at}.point"))?,
@@ -209,16 +224,85 @@ pub fn decode(v: &Value, at: &str) -> Result<Edit, String> {
     })
 }
 
+fn array<'a>(v: &'a Value, key: &str, at: &str) -> Result<&'a Vec<Value>, String> {
+    field(v, key, at)?
+        .as_array()
+        .ok_or_else(|| format!("{at}.{key}: expected an array"))
+}
+
+fn decode_paint(v: &Value, at: &str) -> Result<Edit, String> {
+    let dabs = array(v, "dabs", at)?
+        .iter()
+        .enumerate()
+        .map(|(k, d)| {
+            let at = format!("{at}.dabs[{k}]");
+            Ok(Stroke {
+                points: points(field(d, "points", &at)?, &format!("{at}.points"))?,
+                radius: num(field(d, "radius", &at)?, &format!("{at}.radius"))?,
+                strength: num(field(d, "strength", &at)?, &format!("{at}.strength"))?,
+                medium: decode_medium(field(d, "medium", &at)?, &format!("{at}.medium"))?,
+            })
+        })
+        .collect::<Result<_, String>>()?;
+    Ok(Edit::Paint(dabs))
+}
+
+fn decode_lights(v: &Value, at: &str, maps: &mut Maps<'_>) -> Result<Edit, String> {
+    let lights = array(v, "lights", at)?
+        .iter()
+        .enumerate()
+        .map(|(k, l)| {
+            let at = format!("{at}.lights[{k}]");
+            if field(l, "kind", &at)?.as_str() == Some("env") {
+                let file = field(l, "file", &at)?
+                    .as_str()
+                    .ok_or_else(|| format!("{at}.file: expected a file name"))?;
+                return Ok(Light::Environment(maps.get(file, &format!("{at}.file"))?));
+            }
+            let color = rgb(field(l, "rgb", &at)?, &format!("{at}.rgb"))?;
+            match field(l, "kind", &at)?.as_str() {
+                Some("dir") => Ok(Light::Directional {
+                    to_light: vec3(field(l, "dir", &at)?, &format!("{at}.dir"))?,
+                    irradiance: color,
+                }),
+                Some("point") => Ok(Light::Point {
+                    position: vec3(field(l, "pos", &at)?, &format!("{at}.pos"))?,
+                    intensity: color,
+                }),
+                _ => Err(format!("{at}.kind: expected dir, point or env")),
+            }
+        })
+        .collect::<Result<_, String>>()?;
+    Ok(Edit::Lights(lights))
+}
+
+fn decode_cut(v: &Value, at: &str) -> Result<Edit, String> {
+    Ok(Edit::Cut(if let Some(p) = v.get("plane") {
+        let at = format!("{at}.plane");
+        Cut::Plane {
+            point: vec3(field(p, "point", &at)?, &format!("{at}.point"))?,
+            normal: vec3(field(p, "normal", &at)?, &format!("{at}.normal"))?,
+        }
+    } else {
+        let s = field(v, "stroke", at)?;
+        let at = format!("{at}.stroke");
+        Cut::Stroke {
+            points: points(field(s, "points", &at)?, &format!("{at}.points"))?,
+            view: vec3(field(s, "view", &at)?, &format!("{at}.view"))?,
+        }
+    }))
+}
+
 /// The whole file as JSON.
 ///
 /// # Errors
 /// As [`encode`].
-pub fn to_json(source: &Value, log: &Log) -> Result<Value, String> {
+pub fn to_json(source: &Value, log: &Log, envs: &EnvFiles) -> Result<Value, String> {
     let edits = log
         .edits
         .iter()
         .map(|l| {
-            let mut v = encode(&l.edit)?;
+            let mut v = encode(&l.edit, envs)?;
             v["refined"] = json!(l.refined);
             Ok(v)
         })
@@ -229,11 +313,26 @@ pub fn to_json(source: &Value, log: &Log) -> Result<Value, String> {
     }))
 }
 
-/// The source and log of a session file's text.
+/// The source and log of a session file's text (without environment
+/// maps: see [`from_json_in`]).
 ///
 /// # Errors
 /// A message naming the field.
 pub fn from_json(text: &str) -> Result<(Value, Log), String> {
+    from_json_in(text, None).map(|(source, log, _)| (source, log))
+}
+
+/// The source, log and environment maps of a session file's text, the
+/// maps' `.hdr` files read from `dir` (the session file's folder).
+///
+/// # Errors
+/// A message naming the field (and the map's file when it cannot be
+/// read).
+pub fn from_json_in(text: &str, dir: Option<&Path>) -> Result<(Value, Log, EnvFiles), String> {
+    let mut maps = Maps {
+        dir,
+        read: HashMap::new(),
+    };
     let v: Value = serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
     if v.get("format").and_then(Value::as_str) != Some(FORMAT) {
         return Err(format!("format: expected \"{FORMAT}\""));
@@ -249,11 +348,12 @@ pub fn from_json(text: &str) -> Result<(Value, Log), String> {
         .map(|(k, e)| {
             let at = format!("edits[{k}]");
             Ok(Logged {
-                edit: decode(e, &at)?,
+                edit: decode_in(e, &at, &mut maps)?,
                 refined: e.get("refined").and_then(Value::as_bool).unwrap_or(true),
             })
         })
         .collect::<Result<Vec<_>, String>>()?;
+    let envs = maps.read.into_iter().map(|(file, e)| (e, file)).collect();
     Ok((
         v.get("source").cloned().unwrap_or(Value::Null),
         Log {
@@ -263,6 +363,7 @@ pub fn from_json(text: &str) -> Result<(Value, Log), String> {
                 .unwrap_or(true),
             edits,
         },
+        envs,
     ))
 }
 
@@ -270,8 +371,14 @@ pub fn from_json(text: &str) -> Result<(Value, Log), String> {
 ///
 /// # Errors
 /// A message saying what failed.
-pub fn write(path: &Path, source: &Value, log: &Log, overwrite: bool) -> Result<(), String> {
-    let v = to_json(source, log)?;
+pub fn write(
+    path: &Path,
+    source: &Value,
+    log: &Log,
+    envs: &EnvFiles,
+    overwrite: bool,
+) -> Result<(), String> {
+    let v = to_json(source, log, envs)?;
     crate::output::write_atomic(path, overwrite, |tmp| {
         std::fs::write(tmp, format!("{v:#}\n")).map_err(|source| crate::Error::File {
             path: tmp.to_path_buf(),

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use serde_json::{Value, json};
 use tet_diffusion::glam::DVec3;
-use tet_diffusion::{Applied, Session, SolveReport};
+use tet_diffusion::{Applied, Edit, Light, Session, SolveReport};
 use tokio::sync::broadcast;
 
 use super::protocol::{self, ExportKind, FINAL, LAST, RADIANCE, Request, SURFACE};
@@ -39,6 +39,8 @@ pub(crate) struct Worker {
     /// The exposure's white point, fixed at the start (a camera's
     /// exposure does not follow each edit).
     pub(crate) white: f64,
+    /// The environment maps loaded, with their files (for session files).
+    pub(crate) envs: session_file::EnvFiles,
 }
 
 /// Process CPU time, ms (Linux; 0 elsewhere).
@@ -119,7 +121,15 @@ impl Worker {
         let mut request = Some(first);
         while let Some((seq, r)) = request.take() {
             match r {
-                Request::Edit(edit) => {
+                Request::Edit(mut edit) => {
+                    // The page's lights are the directional and point ones:
+                    // the environment map loaded stays.
+                    if let Edit::Lights(l) = &mut edit
+                        && !l.iter().any(|l| matches!(l, Light::Environment(_)))
+                        && let Some(env) = self.environment_now()
+                    {
+                        l.push(Light::Environment(env));
+                    }
                     match self.session.push(edit) {
                         Ok(()) => seqs.push(seq),
                         Err(e) => self.error(seq, &field_of(&e), &e.to_string()),
@@ -207,6 +217,7 @@ impl Worker {
                 }
             }
             Request::Probe { piece, point } => self.probe(seq, piece, point),
+            Request::Environment { hdr } => self.environment(seq, &hdr),
             Request::Export {
                 kind,
                 name,
@@ -216,7 +227,8 @@ impl Worker {
             } => {
                 let path = self.export_dir.join(&name);
                 let result = if kind == ExportKind::Session {
-                    session_file::write(&path, &self.source, &self.session.log(), overwrite)
+                    let log = self.session.log();
+                    session_file::write(&path, &self.source, &log, &self.envs, overwrite)
                 } else {
                     self.exporter
                         .export(&self.session, kind, &path, size, view, overwrite)
@@ -237,6 +249,73 @@ impl Worker {
                 }
             }
         }
+    }
+
+    /// The environment map lighting the object now, if any.
+    fn environment_now(&self) -> Option<Arc<tet_diffusion::Environment>> {
+        self.session.pieces()[0]
+            .lights()
+            .into_iter()
+            .find_map(|l| match l {
+                Light::Environment(e) => Some(e),
+                _ => None,
+            })
+    }
+
+    /// Lights the object by the uploaded `.hdr` (kept beside the exports
+    /// under a name from its content, for session files), or without an
+    /// environment map when `hdr` is empty; the other lights stay.
+    fn environment(&mut self, seq: u64, hdr: &[u8]) {
+        let off = self.session.offsets()[0];
+        let mut lights: Vec<Light> = self.session.pieces()[0]
+            .lights()
+            .into_iter()
+            .filter_map(|l| match l {
+                Light::Environment(_) => None,
+                Light::Point {
+                    position,
+                    intensity,
+                } => Some(Light::Point {
+                    position: position + off,
+                    intensity,
+                }),
+                other => Some(other),
+            })
+            .collect();
+        if !hdr.is_empty() {
+            match self.load_environment(hdr) {
+                Ok(env) => lights.push(Light::Environment(env)),
+                Err(e) => return self.error(seq, "(upload)", &e),
+            }
+        }
+        match self.session.push(Edit::Lights(lights)) {
+            Ok(()) => self.apply(&[seq]),
+            Err(e) => self.error(seq, "(upload)", &e.to_string()),
+        }
+    }
+
+    fn load_environment(&mut self, hdr: &[u8]) -> Result<Arc<tet_diffusion::Environment>, String> {
+        // FNV-1a of the bytes: the same file gets the same name.
+        let hash = hdr.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+            (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+        });
+        let name = format!("env-{hash:016x}.hdr");
+        if let Some((e, _)) = self.envs.iter().find(|(_, f)| *f == name) {
+            return Ok(e.clone());
+        }
+        let env = session_file::environment(hdr, &name)?;
+        let path = self.export_dir.join(&name);
+        if !path.exists() {
+            crate::output::write_atomic(&path, false, |tmp| {
+                std::fs::write(tmp, hdr).map_err(|source| crate::Error::File {
+                    path: tmp.to_path_buf(),
+                    source,
+                })
+            })
+            .map_err(|e| e.to_string())?;
+        }
+        self.envs.push((env.clone(), name));
+        Ok(env)
     }
 
     fn probe(&self, seq: u64, piece: usize, point: DVec3) {
@@ -282,9 +361,10 @@ impl Worker {
             "eta": self.session.pieces()[0].eta(),
             "unit_mm": self.session.pieces()[0].length_unit_mm(),
             "white": self.white,
+            "max_upload": protocol::MAX_UPLOAD,
             "materials": tet_diffusion::MEASURED.iter().map(|m| m.0).collect::<Vec<_>>(),
             "bounds": [lo.to_array(), hi.to_array()],
-            "lights": lights_json(&self.session),
+            "lights": lights_json(&self.session, &self.envs),
             "source": self.source,
         })
         .to_string()
@@ -424,7 +504,7 @@ impl Worker {
             "undo_bytes": s.undo_bytes(),
             "object_bytes": s.pieces().iter().map(|o| o.memory_bytes()).sum::<usize>(),
             "hierarchy_builds": s.pieces().iter().map(|o| o.hierarchy_builds()).collect::<Vec<_>>(),
-            "lights": lights_json(s),
+            "lights": lights_json(s, &self.envs),
         })
         .to_string();
         self.latest_mut().status = Some(status.clone());
@@ -441,25 +521,29 @@ fn field_of(e: &tet_diffusion::Error) -> String {
     }
 }
 
-/// The lights of the first piece, display frame, as the page sends them.
-fn lights_json(s: &Session) -> Value {
+/// The lights of the first piece, display frame, as the page sends them
+/// (an environment map by its file).
+fn lights_json(s: &Session, envs: &session_file::EnvFiles) -> Value {
     let off = s.offsets()[0];
     Value::Array(
         s.pieces()[0]
             .lights()
             .iter()
-            .filter_map(|l| match l {
-                tet_diffusion::Light::Directional {
+            .map(|l| match l {
+                Light::Directional {
                     to_light,
                     irradiance,
-                } => Some(json!({"kind": "dir", "dir": to_light.to_array(), "rgb": irradiance})),
-                tet_diffusion::Light::Point {
+                } => json!({"kind": "dir", "dir": to_light.to_array(), "rgb": irradiance}),
+                Light::Point {
                     position,
                     intensity,
-                } => Some(
-                    json!({"kind": "point", "pos": (*position + off).to_array(), "rgb": intensity}),
-                ),
-                tet_diffusion::Light::Environment(_) => None,
+                } => {
+                    json!({"kind": "point", "pos": (*position + off).to_array(), "rgb": intensity})
+                }
+                Light::Environment(e) => {
+                    let file = envs.iter().find(|(x, _)| Arc::ptr_eq(x, e));
+                    json!({"kind": "env", "file": file.map(|(_, f)| f.as_str())})
+                }
             })
             .collect(),
     )

@@ -28,6 +28,8 @@ try {
     history: window.trilux.status && window.trilux.status.history, tets: window.trilux.status && window.trilux.status.tets,
     errors: window.trilux.errors.length, edit: window.trilux.status && window.trilux.status.edit,
     answered: window.trilux.answered.length,
+    white: window.trilux.white, white_from: window.trilux.whiteFrom, covered: window.trilux.covered,
+    environment: window.trilux.environment || null,
   }));
   // The mean colour of the canvas's centre and how much of it is lit.
   const pixels = () => page.evaluate(() => {
@@ -42,6 +44,8 @@ try {
     return { lit: lit / (w * h), mean: sum.map((s) => lit ? s / lit : 0) };
   });
   const waitEdit = async (name, before) => page.waitForFunction(([n, b]) => window.trilux.answered.length > b && window.trilux.answered[window.trilux.answered.length - 1] === n && window.trilux.pending.size === 0, [name, before], { timeout: 120000 });
+  // Auto exposure measures the covered pixels after the first frame.
+  await page.waitForFunction(() => window.trilux.whiteFrom === 'pixels', null, { timeout: 60000 });
   out.steps.load = { ...(await stats()), ...(await pixels()) };
   await page.screenshot({ path: dir + '/1-load.png' });
   // Orbit: drag in orbit mode; the picture changes, no server round trip.
@@ -81,6 +85,17 @@ try {
   await page.keyboard.press('Control+Shift+Z');
   await waitEdit('redo', s.answered);
   out.steps.redo = { ...(await stats()), ...(await pixels()) };
+  // Load an environment map (a tiny Radiance .hdr, bright above) through
+  // the file picker of the light panel.
+  const hdr = [...new TextEncoder().encode('#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n')];
+  for (let row = 0; row < 2; row++) for (let k = 0; k < 4; k++) hdr.push(128, 128, 128, row === 0 ? 134 : 129);
+  s = await stats();
+  await page.keyboard.press('l');
+  await page.setInputFiles('#envmap', { name: 'sky.hdr', mimeType: 'application/octet-stream', buffer: Buffer.from(hdr) });
+  await waitEdit('lights', s.answered);
+  await page.waitForFunction(() => window.trilux.environment !== null && window.trilux.environment !== undefined, null, { timeout: 60000 });
+  out.steps.env = { ...(await stats()), ...(await pixels()) };
+  await page.screenshot({ path: dir + '/5-environment.png' });
   // The help overlay.
   await page.keyboard.press('?');
   out.help_visible = await page.evaluate(() => !document.getElementById('helpbox').hidden);

@@ -10,6 +10,9 @@ const state = {
   mode: 'orbit', hello: null, status: null, camera: null, eta: 1.3, white: 1,
   lightDir: [0.4, 1, 0.7], pending: new Map(), errors: [], probes: [], exports: [],
   radianceFrames: 0, surfaceFrames: 0, answered: [], lastRadianceFinal: false, firstFrameAt: null,
+  // The exposure's white: the server's first estimate (surface vertices),
+  // then measured from the covered pixels as the CLI's PNGs are exposed.
+  whiteFrom: 'vertices', covered: 0, measureWanted: false,
 };
 window.trilux = state;
 
@@ -43,6 +46,9 @@ function onText(m) {
     renderer.dropPiecesFrom(m.pieces);
     showStatus(m);
     showHistory(m.history);
+    const env = (m.lights || []).find((l) => l.kind === 'env');
+    state.environment = env ? env.file : null;
+    $('envname').textContent = env ? `Environment: ${env.file}` : 'No environment map';
   } else if (m.type === 'error') {
     state.errors.push(m);
     if (m.seq != null) state.pending.delete(m.seq);
@@ -68,6 +74,8 @@ function onFrame(f) {
     if (renderer.setRadiance(f.piece, f.radiance)) {
       state.radianceFrames++;
       state.lastRadianceFinal = (f.flags & FINAL) !== 0;
+      // Re-expose on a settled result (not on every coarse frame of a drag).
+      if (state.firstFrameAt === null || state.lastRadianceFinal) state.measureWanted = true;
       if (state.firstFrameAt === null) state.firstFrameAt = performance.now();
     }
   }
@@ -99,14 +107,22 @@ setInterval(() => {
 function frame() {
   if (state.camera) {
     const ld = normalize(state.lightDir);
-    renderer.draw(state.camera, {
-      eta: state.eta, exposure: Math.pow(2, +$('ev').value) / state.white,
+    const opts = {
+      eta: state.eta, exposure: 1,
       lightDir: ld, lightRgb: [+$('intensity').value, +$('intensity').value, +$('intensity').value],
       specular: $('specular').checked,
-    });
+    };
+    if (state.measureWanted && $('autoexp').checked) {
+      const m = renderer.measureWhite(state.camera, opts);
+      if (m) { state.white = m.white; state.covered = m.covered; state.whiteFrom = 'pixels'; }
+    }
+    state.measureWanted = false;
+    opts.exposure = Math.pow(2, +$('ev').value) / state.white;
+    renderer.draw(state.camera, opts);
   }
   requestAnimationFrame(frame);
 }
+const reexpose = () => { state.measureWanted = true; };
 requestAnimationFrame(frame);
 
 // Modes.
@@ -214,6 +230,7 @@ canvas.addEventListener('pointerup', (e) => {
   if (pointers.size < 2) pinch = null;
   if (!drag) return;
   const d = drag; drag = null;
+  if (d.kind === 'orbit' || d.kind === 'pan' || d.kind === 'move') reexpose();
   if ((d.kind === 'cut' || d.kind === 'fracture') && d.points.length >= 2 && state.camera) {
     const [w, h] = size();
     const pts = d.points.map(([x, y]) => state.camera.onPlane(x, y, w, h));
@@ -231,7 +248,15 @@ canvas.addEventListener('pointerup', (e) => {
   if (d.kind === 'move' && d.piece != null && d.start) send('move', { piece: d.piece, offset: d.start });
   if (d.kind === 'paint') flushPaint();
 });
-canvas.addEventListener('wheel', (e) => { e.preventDefault(); state.camera && state.camera.zoom(Math.exp(e.deltaY * 0.001)); }, { passive: false });
+let wheelTimer = null;
+canvas.addEventListener('wheel', (e) => {
+  e.preventDefault();
+  if (state.camera) state.camera.zoom(Math.exp(e.deltaY * 0.001));
+  clearTimeout(wheelTimer); wheelTimer = setTimeout(reexpose, 200);
+}, { passive: false });
+window.addEventListener('resize', reexpose);
+$('autoexp').onchange = reexpose;
+$('specular').onchange = reexpose;
 
 // Paint: dabs spaced by σ/2 along the stroke, sent every 30 ms.
 let dabs = [], lastDab = null;
@@ -290,6 +315,21 @@ $('point').onchange = () => send('lights', { lights: lights() });
 $('intensity').onchange = () => send('lights', { lights: lights() });
 $('help').onclick = () => { $('helpbox').hidden = !$('helpbox').hidden; };
 
+// Environment maps: a Radiance .hdr from the file picker or dropped on the
+// view, uploaded as one binary message (the server's limit in hello).
+async function loadEnvironment(file) {
+  if (file && !/\.hdr$/i.test(file.name)) { $('status').textContent = `${file.name}: an environment map is a Radiance .hdr file`; return; }
+  const limit = state.hello ? state.hello.max_upload : 40 << 20;
+  if (file && file.size + 16 > limit) { $('status').textContent = `${file.name}: ${file.size} bytes; at most ${limit - 16} may be uploaded`; return; }
+  const bytes = file ? new Uint8Array(await file.arrayBuffer()) : new Uint8Array(0);
+  state.pending.set(conn.upload(bytes), performance.now());
+}
+state.loadEnvironment = loadEnvironment;
+$('envmap').onchange = (e) => { if (e.target.files[0]) loadEnvironment(e.target.files[0]); e.target.value = ''; };
+$('envclear').onclick = () => loadEnvironment(null);
+canvas.addEventListener('dragover', (e) => e.preventDefault());
+canvas.addEventListener('drop', (e) => { e.preventDefault(); const f = e.dataTransfer.files[0]; if (f) loadEnvironment(f); });
+
 function exportFile(kind, overwrite = false) {
   const ext = { png: 'png', exr: 'exr', vtu: 'vtu', tet: 'node', session: 'json' }[kind];
   const name = $('ename').value.replace(/[^A-Za-z0-9_.-]/g, '_').replace(/^\.+/, '') + '.' + ext;
@@ -308,7 +348,7 @@ window.addEventListener('keydown', (e) => {
   if (modes[k]) setMode(modes[k]);
   else if (e.key === '?') $('helpbox').hidden = !$('helpbox').hidden;
   else if (e.key === 'Escape') $('helpbox').hidden = true;
-  else if (k === 's') $('specular').checked = !$('specular').checked;
+  else if (k === 's') { $('specular').checked = !$('specular').checked; reexpose(); }
   else if (k === 'r') recombine();
   else if (k === 'e') exportFile('png');
   else if (e.key === '[') $('radius').value = +$('radius').value * 0.8;

@@ -3,6 +3,9 @@
 // Fresnel factor F_t(η, ω_o) / F_t(η, 0°) of Eq. 3 (so orbiting never
 // shows stale radiance), an optional Cook–Torrance specular term for the
 // directional light, exposure, and the sRGB encoding the CLI's PNGs use.
+// The exposure's white is measured as the CLI measures it for a PNG: the
+// 99th percentile of the luminance of the pixels the object covers (a
+// small offscreen pass writes each covered pixel's log-luminance).
 
 const VS = `#version 300 es
 in vec3 position; in vec3 normal; in vec3 radiance;
@@ -19,6 +22,7 @@ precision highp float;
 in vec3 vNormal; in vec3 vRadiance; in vec3 vWorld;
 uniform vec3 eye; uniform float eta; uniform float exposure;
 uniform vec3 lightDir; uniform vec3 lightRgb; uniform float specular; uniform float unitScale;
+uniform float measure;
 out vec4 color;
 float transmittance(float c) {
   c = clamp(c, 0.0, 1.0);
@@ -50,6 +54,16 @@ void main() {
       L += lightRgb * (d * g * f / (4.0 * nv)) * unitScale;
     }
   }
+  if (measure > 0.5) {
+    // log2 of the luminance in [-64, 64), 16 bits over red and green; alpha
+    // marks a covered pixel.
+    float lum = dot(L, vec3(0.2126, 0.7152, 0.0722));
+    if (lum <= 0.0) { color = vec4(0.0, 0.0, 1.0, 1.0); return; }
+    float v = clamp((log2(lum) + 64.0) / 128.0, 0.0, 1.0) * 65535.0;
+    float hi = floor(v / 256.0);
+    color = vec4(hi / 255.0, (v - hi * 256.0) / 255.0, 0.0, 1.0);
+    return;
+  }
   vec3 c = L * exposure;
   color = vec4(srgb(clamp(c.r, 0.0, 1.0)), srgb(clamp(c.g, 0.0, 1.0)), srgb(clamp(c.b, 0.0, 1.0)), 1.0);
 }`;
@@ -74,7 +88,7 @@ export class Renderer {
     if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p));
     this.program = p;
     this.loc = {};
-    for (const u of ['viewProj', 'offset', 'eye', 'eta', 'exposure', 'lightDir', 'lightRgb', 'specular', 'unitScale'])
+    for (const u of ['viewProj', 'offset', 'eye', 'eta', 'exposure', 'lightDir', 'lightRgb', 'specular', 'unitScale', 'measure'])
       this.loc[u] = gl.getUniformLocation(p, u);
     this.pieces = [];
     this.frames = 0;
@@ -127,12 +141,21 @@ export class Renderer {
     const c = gl.canvas;
     const w = Math.floor(c.clientWidth * devicePixelRatio), h = Math.floor(c.clientHeight * devicePixelRatio);
     if (c.width !== w || c.height !== h) { c.width = w; c.height = h; }
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, c.width, c.height);
     gl.clearColor(0.106, 0.11, 0.122, 1);
+    this.pass(camera, opts, c.width / c.height, 0);
+    this.frames++;
+  }
+
+  // One drawing of the pieces into the bound framebuffer (cleared first).
+  pass(camera, opts, aspect, measure) {
+    const gl = this.gl;
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
     gl.enable(gl.DEPTH_TEST);
     gl.useProgram(this.program);
-    gl.uniformMatrix4fv(this.loc.viewProj, false, camera.viewProj(c.width / c.height));
+    gl.uniform1f(this.loc.measure, measure);
+    gl.uniformMatrix4fv(this.loc.viewProj, false, camera.viewProj(aspect));
     gl.uniform3fv(this.loc.eye, camera.eye());
     gl.uniform1f(this.loc.eta, opts.eta);
     gl.uniform1f(this.loc.exposure, opts.exposure);
@@ -147,7 +170,50 @@ export class Renderer {
       gl.drawElements(gl.TRIANGLES, p.count, gl.UNSIGNED_INT, 0);
     }
     gl.bindVertexArray(null);
-    this.frames++;
+  }
+
+  // The exposure's white as the CLI's PNGs have it: the 99th percentile of
+  // the luminance of the pixels the object covers (background excluded),
+  // from a drawing at most 256 pixels wide with the canvas's aspect.
+  // `opts` as for draw (exposure unused). Returns null when nothing is
+  // covered.
+  measureWhite(camera, opts) {
+    const gl = this.gl;
+    const c = gl.canvas;
+    const aspect = c.width / Math.max(c.height, 1);
+    const w = Math.max(16, Math.min(256, c.width)), h = Math.max(16, Math.round(w / aspect));
+    if (!this.fbo || this.fbo.w !== w || this.fbo.h !== h) {
+      if (this.fbo) { gl.deleteFramebuffer(this.fbo.fb); gl.deleteTexture(this.fbo.tex); gl.deleteRenderbuffer(this.fbo.depth); }
+      const tex = gl.createTexture();
+      gl.bindTexture(gl.TEXTURE_2D, tex);
+      gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, w, h);
+      const depth = gl.createRenderbuffer();
+      gl.bindRenderbuffer(gl.RENDERBUFFER, depth);
+      gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, w, h);
+      const fb = gl.createFramebuffer();
+      gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
+      gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, depth);
+      this.fbo = { fb, tex, depth, w, h, pixels: new Uint8Array(w * h * 4) };
+    }
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.fbo.fb);
+    gl.viewport(0, 0, w, h);
+    gl.clearColor(0, 0, 0, 0);
+    this.pass(camera, opts, aspect, 1);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, this.fbo.pixels);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    const px = this.fbo.pixels, lum = [];
+    let covered = 0;
+    for (let i = 0; i < px.length; i += 4) {
+      if (px[i + 3] < 128) continue;
+      covered++;
+      if (px[i + 2] > 128) continue; // covered, luminance 0
+      const v = (px[i] * 256 + px[i + 1]) / 65535;
+      lum.push(Math.pow(2, v * 128 - 64));
+    }
+    if (!covered) return null;
+    lum.sort((a, b) => a - b);
+    return { white: lum.length ? Math.max(lum[Math.floor(lum.length * 0.99)], 1e-12) : 1, covered };
   }
 
   // The nearest surface hit of a ray (origin o, direction d): {piece, point, t}.
@@ -176,20 +242,5 @@ export class Renderer {
       }
     });
     return best;
-  }
-
-  // Luminance 99th percentile of the vertex radiance (the exposure's white).
-  white() {
-    const lum = [];
-    for (const p of this.pieces) {
-      if (!p) continue;
-      const r = p.radiance;
-      for (let i = 0; i < r.length; i += 3) {
-        const l = 0.2126 * r[i] + 0.7152 * r[i + 1] + 0.0722 * r[i + 2];
-        if (l > 0) lum.push(l);
-      }
-    }
-    lum.sort((a, b) => a - b);
-    return lum.length ? Math.max(lum[Math.floor(lum.length * 0.99)], 1e-12) : 1;
   }
 }

@@ -1,4 +1,5 @@
-// The WebSocket to the server: JSON edits with a sequence number up,
+// The WebSocket to the server: JSON edits with a sequence number up (and
+// environment maps as binary uploads),
 // JSON status and binary frames (16-byte header, little-endian arrays)
 // down. It reconnects after a drop; the server kept the session.
 
@@ -39,6 +40,17 @@ export class Connection {
   send(op, fields = {}) {
     const seq = ++this.seq;
     if (this.ws.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify({ seq, op, ...fields }));
+    return seq;
+  }
+  // An environment-map upload: the 16-byte header (TLXU, version 1, kind
+  // 1, the seq as u64) and the .hdr file's bytes (none: remove the map).
+  upload(bytes) {
+    const seq = ++this.seq;
+    const m = new Uint8Array(16 + bytes.length);
+    m.set([0x54, 0x4c, 0x58, 0x55, 1, 1, 0, 0]);
+    new DataView(m.buffer).setBigUint64(8, BigInt(seq), true);
+    m.set(bytes, 16);
+    if (this.ws.readyState === WebSocket.OPEN) this.ws.send(m);
     return seq;
   }
 }
