@@ -15,12 +15,21 @@ use super::{Context, Result, arg_cause, file_cause};
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Solve TransCut's diffusion on a tetrahedral mesh (or a surface, tetrahedralized first) and render it",
-    after_help = "Example:\n  trilux diffuse ../shared/data/tets/bunny_500k.msh --material marble \\\n      --light dir:0.3,1,0.6 --cut plane:0,0,1,0.01 -o bunny_marble.png\n\nPainting: the ears (the side y > 0.15) in skin, and a ball of ketchup:\n  trilux diffuse ../shared/data/tets/bunny_50k.node --material marble \\\n      --paint plane:0,1,0,0.15:skin1 --paint 0.03,0.08,0.03:0.01:ketchup -o bunny_painted.png\n\nMaterials: apple chicken1 chicken2 cream ketchup marble potato skimmilk skin1 skin2\nspectralon wholemilk, or noise:A,B (fractal noise between two of them)."
+    after_help = "Example:\n  trilux diffuse ../shared/data/tets/bunny_500k.msh --material marble \\\n      --light dir:0.3,1,0.6 --cut plane:0,0,1,0.01 -o bunny_marble.png\n\nPainting: the ears (the side y > 0.15) in skin, and a ball of ketchup:\n  trilux diffuse ../shared/data/tets/bunny_50k.node --material marble \\\n      --paint plane:0,1,0,0.15:skin1 --paint 0.03,0.08,0.03:0.01:ketchup -o bunny_painted.png\n\nMaterials: apple chicken1 chicken2 cream ketchup marble potato skimmilk skin1 skin2\nspectralon wholemilk, or noise:A,B (fractal noise between two of them).\n\nA session of `trilux view` (saved from its page), rendered as the page exports it:\n  trilux diffuse --session session.json --view 0.5,1,2 -o session.png"
 )]
 pub(crate) struct Args {
     /// A tetrahedral mesh (.node, .ele, .msh, .mesh) or a closed surface
     /// (.obj, .gltf, .glb, .ply), which is tetrahedralized first.
-    pub(crate) input: PathBuf,
+    #[arg(required_unless_present = "session")]
+    pub(crate) input: Option<PathBuf>,
+    /// Replay a session file of `trilux view` instead (its object and
+    /// edits, exactly as `trilux view --replay` does, refined as the page
+    /// refines when idle); the picture is the page's export of it.
+    #[cfg(feature = "view")]
+    #[arg(long, value_name = "SESSION.json", conflicts_with_all = [
+        "input", "material", "unit_mm", "light", "envmap", "cut", "relax_cut", "paint", "fracture",
+    ])]
+    pub(crate) session: Option<PathBuf>,
     /// A measured material (Jensen et al. 2001) or noise:A,B.
     #[arg(long, default_value = "marble", value_parser = Material::parse)]
     pub(crate) material: Material,
@@ -103,10 +112,21 @@ struct Solved {
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
-    check(context, &args)?;
-    let (positions, tets, dropped) = read_volume(context, &args.input, false)?;
-    let mesh =
-        tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_cause(&args.input, e))?;
+    #[cfg(feature = "view")]
+    if let Some(path) = &args.session {
+        return run_session(context, &args, path);
+    }
+    let input = args
+        .input
+        .as_deref()
+        .ok_or_else(|| super::usage("a MESH (or --session) is required"))?;
+    check_outputs(context, &args)?;
+    if let Some(path) = &args.envmap {
+        super::check_input(path)?;
+    }
+    check_volume(input, "diffuse", false)?;
+    let (positions, tets, dropped) = read_volume(context, input, false)?;
+    let mesh = tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_cause(input, e))?;
     let diagonal = diagonal(&positions);
     let unit_mm = unit_mm(args.unit_mm, diagonal);
     let mut media = args
@@ -128,8 +148,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     }
     let mut object = context
         .step("assembling", || Object::new(mesh, unit_mm, media, 1.3))
-        .map_err(|e| file_cause(&args.input, e))?;
-    let lights = light(context, &args, &mut object)?;
+        .map_err(|e| file_cause(input, e))?;
+    let lights = light(context, &args, input, &mut object)?;
     for (spec, count) in args.paint.iter().zip(&mut painted) {
         if let Paint::Ball(stroke) = &spec.paint {
             *count = object
@@ -144,7 +164,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     for o in &mut objects {
         let report = context
             .step("solving", || o.solve())
-            .map_err(|e| file_cause(&args.input, super::placed("the solve failed", false, e)))?;
+            .map_err(|e| file_cause(input, super::placed("the solve failed", false, e)))?;
         levels.get_or_insert(report.levels);
     }
     let solved = Solved {
@@ -156,12 +176,53 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         dropped,
     };
     write(context, &args, &solved)?;
-    report(context, &args, &solved);
+    report(context, &args, input, &solved);
     Ok(())
 }
 
-/// The outputs' names and the environment map, before any long step.
-fn check(context: &Context, args: &Args) -> Result<()> {
+/// `--session`: the view's session replayed, and its picture (and EXR,
+/// VTU) written as the page's exports write them — byte for byte.
+#[cfg(feature = "view")]
+fn run_session(context: &mut Context, args: &Args, path: &Path) -> Result<()> {
+    check_outputs(context, args)?;
+    super::check_input(path)?;
+    let session = super::view::replayed(context, path)?;
+    let (size, view) = (args.picture.size, args.picture.direction());
+    let force = context.force;
+    context.step("rendering", || {
+        super::view::write_picture(&session, true, &args.output, size, view, force)
+    })?;
+    if let Some(p) = &args.exr {
+        super::view::write_picture(&session, false, p, size, view, force)?;
+    }
+    if let Some(p) = &args.vtu {
+        super::view::write_vtu(&session, p, force)?;
+    }
+    let pieces = session.pieces();
+    let tets: usize = pieces.iter().map(|o| o.mesh().tets().len()).sum();
+    let edits = session.log().edits.len();
+    let text = format!(
+        "{tets} tetrahedra ({} object{}), session {} replayed ({edits} edits); picture written to {}\n",
+        pieces.len(),
+        if pieces.len() > 1 { "s" } else { "" },
+        path.display(),
+        args.output.display()
+    );
+    let json = serde_json::json!({
+        "command": "diffuse",
+        "session": super::shown(path),
+        "edits": edits,
+        "tetrahedra": tets,
+        "objects": pieces.len(),
+        "output": super::shown(&args.output),
+        "seconds": context.timings_json(),
+    });
+    context.report(&text, json);
+    Ok(())
+}
+
+/// The outputs' names, before any long step.
+fn check_outputs(context: &Context, args: &Args) -> Result<()> {
     super::check_output(context, &args.output, &["png"])?;
     if let Some(p) = &args.exr {
         super::check_output(context, p, &["exr"])?;
@@ -169,16 +230,18 @@ fn check(context: &Context, args: &Args) -> Result<()> {
     if let Some(p) = &args.vtu {
         super::check_output(context, p, &["vtu"])?;
     }
-    if let Some(path) = &args.envmap {
-        super::check_input(path)?;
-    }
-    check_volume(&args.input, "diffuse", false)
+    Ok(())
 }
 
 /// Adds the lights (the default one when none is given) and the
 /// environment map to `object`; returns the lights the renderer shades
 /// with.
-fn light(context: &mut Context, args: &Args, object: &mut Object) -> Result<Vec<Light>> {
+fn light(
+    context: &mut Context,
+    args: &Args,
+    input: &Path,
+    object: &mut Object,
+) -> Result<Vec<Light>> {
     let mut lights: Vec<Light> = args.light.iter().map(|l| l.light.clone()).collect();
     if lights.is_empty() && args.envmap.is_none() {
         lights.push(default_light());
@@ -188,7 +251,7 @@ fn light(context: &mut Context, args: &Args, object: &mut Object) -> Result<Vec<
             .add_light(light.clone())
             .map_err(|e| match args.light.get(k) {
                 Some(spec) => arg_cause(format!("--light {}", spec.spec), e),
-                None => file_cause(&args.input, e),
+                None => file_cause(input, e),
             })?;
     }
     if let Some(path) = &args.envmap {
@@ -320,7 +383,7 @@ fn write_vtu(
 }
 
 /// The summary line, or the JSON object.
-fn report(context: &Context, args: &Args, solved: &Solved) {
+fn report(context: &Context, args: &Args, input: &Path, solved: &Solved) {
     let objects = &solved.objects;
     let tets: usize = objects.iter().map(|o| o.mesh().tets().len()).sum();
     let painted = &solved.painted;
@@ -347,7 +410,7 @@ fn report(context: &Context, args: &Args, solved: &Solved) {
     );
     let json = serde_json::json!({
         "command": "diffuse",
-        "input": super::shown(&args.input),
+        "input": super::shown(input),
         "tetrahedra": tets,
         "objects": objects.len(),
         "unit_mm": solved.unit_mm,

@@ -145,7 +145,7 @@ enum Command {
     #[command(subcommand)]
     Colors(colors::Command),
     Tetra(tetra::Args),
-    Diffuse(diffuse::Args),
+    Diffuse(Box<diffuse::Args>),
     Demo(demo::Args),
     Bench(bench::Args),
     #[cfg(feature = "view")]
@@ -235,7 +235,7 @@ pub(crate) fn run() -> ExitCode {
         Command::Sample(args) => sample::run(&mut context, args),
         Command::Colors(command) => colors::run(&mut context, command),
         Command::Tetra(args) => tetra::run(&mut context, args),
-        Command::Diffuse(args) => diffuse::run(&mut context, args),
+        Command::Diffuse(args) => diffuse::run(&mut context, *args),
         Command::Demo(args) => demo::run(&mut context, args),
         Command::Bench(args) => bench::run(&mut context, args),
         #[cfg(feature = "view")]

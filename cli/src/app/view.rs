@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use serde_json::{Value, json};
-use tet_diffusion::{Object, Session};
+use tet_diffusion::{Log, Object, Session};
 use trilux::view::protocol::ExportKind;
+use trilux::view::session_file::EnvFiles;
 
 use super::args::Material;
 use super::ops::object::{check_volume, default_light, diagonal, read_volume};
@@ -49,11 +50,12 @@ pub(crate) struct Args {
 }
 
 /// The object and edits of the session file at `path`.
-fn replay(context: &mut Context, path: &Path) -> Result<(Object, Value, tet_diffusion::Log)> {
+fn replay(context: &mut Context, path: &Path) -> Result<(Object, Value, Log, EnvFiles)> {
     super::check_input(path)?;
     let text = std::fs::read_to_string(path).map_err(|e| file_error(path, e))?;
-    let (source, log) =
-        trilux::view::session_file::from_json(&text).map_err(|e| file_error(path, e))?;
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let (source, log, envs) = trilux::view::session_file::from_json_in(&text, Some(dir))
+        .map_err(|e| file_error(path, e))?;
     let mesh = source
         .get("mesh")
         .and_then(Value::as_str)
@@ -73,7 +75,7 @@ fn replay(context: &mut Context, path: &Path) -> Result<(Object, Value, tet_diff
         ));
     }
     let (object, source) = load(context, mesh.as_deref(), material.as_ref(), unit)?;
-    Ok((object, source, log))
+    Ok((object, source, log, envs))
 }
 
 /// Loads the object a session file's `source` or the arguments describe.
@@ -154,106 +156,154 @@ impl trilux::view::Exporter for Cli {
         view: Option<DVec3>,
         overwrite: bool,
     ) -> std::result::Result<(), String> {
-        let fail = |e: trilux::Error| e.to_string();
-        match kind {
-            ExportKind::Png | ExportKind::Exr => {
-                let lights = session.pieces()[0].lights();
-                let picture =
-                    trilux::tet::render(session.pieces(), &lights, size, view.map(|v| v.as_vec3()));
-                let image = if kind == ExportKind::Png {
-                    trilux::tet::tone_map(&picture)
-                } else {
-                    picture.image
-                };
-                trilux::output::write_atomic(path, overwrite, |tmp| {
-                    if kind == ExportKind::Png {
-                        Ok(trilux_io::image::write_png(
-                            tmp,
-                            &image,
-                            trilux_io::image::PngDepth::Eight,
-                        )?)
-                    } else {
-                        Ok(trilux_io::image::write_exr(
-                            tmp,
-                            &image,
-                            trilux_io::image::ExrPrecision::F32,
-                        )?)
-                    }
-                })
-                .map_err(fail)
-            }
-            ExportKind::Vtu => {
-                let mesh = merged(session);
-                let mut phi: [Vec<f64>; 3] = Default::default();
-                let mut lum = Vec::new();
-                for o in session.pieces() {
-                    for (c, p) in phi.iter_mut().enumerate() {
-                        p.extend_from_slice(o.phi(c));
-                    }
-                    let mut l = vec![0.0; o.mesh().vertex_count()];
-                    for (k, &v) in o.mesh().boundary_vertices().iter().enumerate() {
-                        let r = o.radiance(None)[k];
-                        l[v as usize] = 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2];
-                    }
-                    lum.extend(l);
-                }
-                use trilux_io::tet::vtu::{Encoding, Field};
-                let fields = [
-                    Field {
-                        name: "phi_r",
-                        values: &phi[0],
-                    },
-                    Field {
-                        name: "phi_g",
-                        values: &phi[1],
-                    },
-                    Field {
-                        name: "phi_b",
-                        values: &phi[2],
-                    },
-                    Field {
-                        name: "radiance",
-                        values: &lum,
-                    },
-                ];
-                trilux::output::write_atomic(path, overwrite, |tmp| {
-                    Ok(trilux_io::tet::vtu::write(
-                        tmp,
-                        &mesh,
-                        &fields,
-                        &[],
-                        Encoding::Base64,
-                    )?)
-                })
-                .map_err(fail)
-            }
-            ExportKind::Tet => {
-                let ele = path.with_extension("ele");
-                for p in [path, ele.as_path()] {
-                    trilux::output::check_new(p, overwrite).map_err(fail)?;
-                }
-                let mesh = merged(session);
-                let tmp = trilux::output::temporary_name(path);
-                let tmp_ele = tmp.with_extension("ele");
-                let written = trilux_io::tet::tetgen::write(&tmp, &mesh)
-                    .map_err(|e| e.to_string())
-                    .and_then(|()| std::fs::rename(&tmp_ele, &ele).map_err(|e| e.to_string()))
-                    .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
-                if written.is_err() {
-                    let _ = std::fs::remove_file(&tmp);
-                    let _ = std::fs::remove_file(&tmp_ele);
-                }
-                written
-            }
-            ExportKind::Session => Err("session files are written by the server".into()),
-        }
+        let view = view.map(|v| v.as_vec3());
+        let written = match kind {
+            ExportKind::Png | ExportKind::Exr => write_picture(
+                session,
+                kind == ExportKind::Png,
+                path,
+                size,
+                view,
+                overwrite,
+            ),
+            ExportKind::Vtu => write_vtu(session, path, overwrite),
+            ExportKind::Tet => return write_tet(session, path, overwrite),
+            ExportKind::Session => return Err("session files are written by the server".into()),
+        };
+        written.map_err(|e| e.to_string())
     }
 }
 
+/// The picture of a session as the page's export draws it: every piece,
+/// lit by the first piece's lights (all pieces share them), from `view`.
+pub(crate) fn session_picture(
+    session: &Session,
+    size: u32,
+    view: Option<glam::Vec3>,
+) -> trilux::tet::Picture {
+    let lights = session.pieces()[0].lights();
+    trilux::tet::render(session.pieces(), &lights, size, view)
+}
+
+/// Writes the session's picture: tone-mapped 8-bit PNG (`png`) or linear
+/// EXR, atomically (an existing file only with `overwrite`).
+pub(crate) fn write_picture(
+    session: &Session,
+    png: bool,
+    path: &Path,
+    size: u32,
+    view: Option<glam::Vec3>,
+    overwrite: bool,
+) -> trilux::Result<()> {
+    let picture = session_picture(session, size, view);
+    let image = if png {
+        trilux::tet::tone_map(&picture)
+    } else {
+        picture.image
+    };
+    trilux::output::write_atomic(path, overwrite, |tmp| {
+        if png {
+            Ok(trilux_io::image::write_png(
+                tmp,
+                &image,
+                trilux_io::image::PngDepth::Eight,
+            )?)
+        } else {
+            Ok(trilux_io::image::write_exr(
+                tmp,
+                &image,
+                trilux_io::image::ExrPrecision::F32,
+            )?)
+        }
+    })
+}
+
+/// Writes the pieces (display frame) with φ per channel and the surface's
+/// luminance per node as VTU, atomically.
+pub(crate) fn write_vtu(session: &Session, path: &Path, overwrite: bool) -> trilux::Result<()> {
+    use trilux_io::tet::vtu::{Encoding, Field};
+    let mesh = merged(session);
+    let mut phi: [Vec<f64>; 3] = Default::default();
+    let mut lum = Vec::new();
+    for o in session.pieces() {
+        for (c, p) in phi.iter_mut().enumerate() {
+            p.extend_from_slice(o.phi(c));
+        }
+        let mut l = vec![0.0; o.mesh().vertex_count()];
+        for (&v, r) in o.mesh().boundary_vertices().iter().zip(o.radiance(None)) {
+            l[v as usize] = 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2];
+        }
+        lum.extend(l);
+    }
+    let field = |name, values| Field { name, values };
+    let fields = [
+        field("phi_r", &phi[0]),
+        field("phi_g", &phi[1]),
+        field("phi_b", &phi[2]),
+        field("radiance", &lum),
+    ];
+    trilux::output::write_atomic(path, overwrite, |tmp| {
+        Ok(trilux_io::tet::vtu::write(
+            tmp,
+            &mesh,
+            &fields,
+            &[],
+            Encoding::Base64,
+        )?)
+    })
+}
+
+/// Writes the pieces as TetGen `path` (.node) and its .ele, each atomic.
+fn write_tet(session: &Session, path: &Path, overwrite: bool) -> std::result::Result<(), String> {
+    let ele = path.with_extension("ele");
+    for p in [path, ele.as_path()] {
+        trilux::output::check_new(p, overwrite).map_err(|e| e.to_string())?;
+    }
+    let mesh = merged(session);
+    let tmp = trilux::output::temporary_name(path);
+    let tmp_ele = tmp.with_extension("ele");
+    let written = trilux_io::tet::tetgen::write(&tmp, &mesh)
+        .map_err(|e| e.to_string())
+        .and_then(|()| std::fs::rename(&tmp_ele, &ele).map_err(|e| e.to_string()))
+        .and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+        let _ = std::fs::remove_file(&tmp_ele);
+    }
+    written
+}
+
+/// The session a session file describes, replayed as `trilux view
+/// --replay` replays it and refined as the view refines it when idle
+/// (so that its pictures are those the page exports).
+///
+/// # Errors
+/// The file (unreadable, not a session file: the field named), its
+/// object, or the first edit that fails (named by its index and op).
+pub(crate) fn replayed(context: &mut Context, path: &Path) -> Result<Session> {
+    let (object, _, log, _) = replay(context, path)?;
+    let options = trilux::view::Options::default().session;
+    let mut session = context
+        .step("replaying", || Session::replay(object, options, &log))
+        .map_err(|(k, e)| {
+            let op = log.edits.get(k).map_or("edit", |l| l.edit.name());
+            file_error(path, format!("edits[{k}] ({op}): {e}"))
+        })?;
+    if session.needs_refinement() {
+        context
+            .step("solving", || session.refine_now())
+            .map_err(|e| file_error(path, format!("the last edit's solve: {e}")))?;
+    }
+    Ok(session)
+}
+
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    let mut environments = EnvFiles::new();
     let (object, source, log) = match &args.replay {
         Some(path) => {
-            let (o, s, log) = replay(context, path)?;
+            let (o, s, log, envs) = replay(context, path)?;
+            copy_environments(path, &envs, &args.export_dir)?;
+            environments = envs;
             (o, s, Some(log))
         }
         None => {
@@ -282,6 +332,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         host: args.host,
         port: args.port,
         export_dir: args.export_dir.clone(),
+        environments,
         ..Default::default()
     };
     let runtime = tokio::runtime::Runtime::new()
@@ -308,6 +359,19 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             .await
             .map_err(|e| super::invalid(format!("the server: {e}")))
     })
+}
+
+/// Copies the environment maps a replayed session file names into the
+/// export folder (where the session files it writes will name them).
+fn copy_environments(session: &Path, envs: &EnvFiles, export_dir: &Path) -> Result<()> {
+    let from = session.parent().unwrap_or(Path::new("."));
+    for (_, file) in envs {
+        let (a, b) = (from.join(file), export_dir.join(file));
+        if !b.exists() {
+            std::fs::copy(&a, &b).map_err(|e| file_error(&b, e))?;
+        }
+    }
+    Ok(())
 }
 
 /// Asks the desktop to open `url` (xdg-open, open, or start).

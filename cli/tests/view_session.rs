@@ -1,0 +1,223 @@
+//! A session of `trilux view` saved from its page and replayed: by
+//! `trilux view --replay` and by `trilux diffuse --session`, whose
+//! picture and VTU are byte for byte the page's exports of the live
+//! session; and a bad session file is an error naming the file and the
+//! entry.
+#![cfg(feature = "view")]
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+use futures_util::{SinkExt, StreamExt};
+use serde_json::{Value, json};
+use tokio_tungstenite::tungstenite::Message;
+use tokio_tungstenite::tungstenite::client::IntoClientRequest;
+
+type Socket =
+    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+
+fn trilux() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_trilux"))
+}
+
+/// The view server on `args`, exporting into `dir`; its address and token
+/// from the JSON line it prints.
+fn view(dir: &Path, args: &[&str]) -> (Child, String, String) {
+    let mut child = trilux()
+        .args(["--json", "view", "--export-dir"])
+        .arg(dir)
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let v: Value = serde_json::from_str(&line).unwrap_or_else(|e| panic!("{e}: {line:?}"));
+    let url = v["url"]
+        .as_str()
+        .unwrap_or_else(|| panic!("no url in {line:?}"));
+    let rest = url.strip_prefix("http://").unwrap();
+    let (addr, token) = rest.split_once('/').unwrap();
+    (
+        child,
+        addr.to_string(),
+        token.trim_end_matches('/').to_string(),
+    )
+}
+
+async fn connect(addr: &str, token: &str) -> Socket {
+    let mut request = format!("ws://{addr}/{token}/ws")
+        .into_client_request()
+        .unwrap();
+    request
+        .headers_mut()
+        .insert("Origin", format!("http://{addr}").parse().unwrap());
+    tokio_tungstenite::connect_async(request).await.unwrap().0
+}
+
+/// The next JSON message for which `pick` holds (binary frames and other
+/// messages are skipped); an error message fails the test.
+async fn until(s: &mut Socket, pick: impl Fn(&Value) -> bool) -> Value {
+    loop {
+        let m = tokio::time::timeout(Duration::from_secs(300), s.next())
+            .await
+            .expect("the server answers")
+            .expect("the connection stays open")
+            .expect("no protocol error");
+        if let Message::Text(t) = m {
+            let v: Value = serde_json::from_str(&t).unwrap();
+            assert_ne!(v["type"], "error", "{v}");
+            if pick(&v) {
+                return v;
+            }
+        }
+    }
+}
+
+async fn send(s: &mut Socket, v: Value) {
+    s.send(Message::Text(v.to_string().into())).await.unwrap();
+}
+
+fn status_of(seq: u64) -> impl Fn(&Value) -> bool {
+    move |v| {
+        v["type"] == "status"
+            && v["seqs"]
+                .as_array()
+                .is_some_and(|s| s.contains(&json!(seq)))
+    }
+}
+
+/// Exports the picture, VTU (and the session file, when `session`) of
+/// the server's session once it is refined.
+async fn export(s: &mut Socket, prefix: &str, session: bool) {
+    let mut seq = 100;
+    let mut kinds = vec![("png", "png"), ("vtu", "vtu")];
+    if session {
+        kinds.push(("session", "json"));
+    }
+    for (kind, ext) in kinds {
+        seq += 1;
+        send(
+            s,
+            json!({"seq": seq, "op": "export", "kind": kind, "name": format!("{prefix}.{ext}"),
+                   "size": 96, "view": [0.5, 1.0, 2.0]}),
+        )
+        .await;
+        until(s, |v| v["type"] == "export").await;
+    }
+}
+
+#[test]
+fn a_view_session_replays_in_diffuse_as_the_page_exports_it_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let runtime = tokio::runtime::Runtime::new().unwrap();
+    let (mut live, addr, token) = view(d, &[]);
+    runtime.block_on(async {
+        let mut s = connect(&addr, &token).await;
+        until(&mut s, |v| v["type"] == "hello").await;
+        let r = 20.0; // the built-in ball's radius
+        let edits = [
+            json!({"seq": 1, "op": "paint", "material": "ketchup", "radius": 0.2 * r, "strength": 1.0,
+                   "points": [[0.0, 0.0, r], [0.1 * r, 0.0, r]]}),
+            json!({"seq": 2, "op": "lights", "lights": [{"kind": "dir", "dir": [-0.5, 1, 0.2]}]}),
+            json!({"seq": 3, "op": "cut", "plane": {"point": [0, 0, 0.3 * r], "normal": [0.2, 0, 1]}}),
+            json!({"seq": 4, "op": "paint", "material": "skin1", "radius": 0.15 * r, "strength": 0.7,
+                   "points": [[0.0, 0.2 * r, 0.3 * r]]}),
+        ];
+        for (k, e) in edits.iter().enumerate() {
+            send(&mut s, e.clone()).await;
+            until(&mut s, status_of(k as u64 + 1)).await;
+        }
+        until(&mut s, |v| v["type"] == "status" && v["edit"] == "refine").await;
+        export(&mut s, "live", true).await;
+    });
+    live.kill().unwrap();
+    live.wait().unwrap();
+    let session = d.join("live.json");
+    let text = std::fs::read_to_string(&session).unwrap();
+    assert!(text.contains("\"op\": \"cut\""), "{text}");
+
+    // `trilux diffuse --session`: the same bytes as the page's exports.
+    let out = trilux()
+        .current_dir(d)
+        .args(["diffuse", "--session", "live.json", "--view", "0.5,1,2"])
+        .args(["--size", "96", "-o", "diffuse.png", "--vtu", "diffuse.vtu"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("replayed (4 edits)"), "{stdout}");
+    let read = |name: &str| std::fs::read(d.join(name)).unwrap();
+    assert!(read("diffuse.png") == read("live.png"), "the PNGs differ");
+    assert!(read("diffuse.vtu") == read("live.vtu"), "the VTUs differ");
+
+    // `trilux view --replay`: the page's exports of the replayed session
+    // are the same bytes again.
+    let (mut replay, addr, token) = view(d, &["--replay", session.to_str().unwrap()]);
+    runtime.block_on(async {
+        let mut s = connect(&addr, &token).await;
+        until(&mut s, |v| v["type"] == "hello").await;
+        until(&mut s, |v| v["type"] == "status").await;
+        export(&mut s, "replay", false).await;
+    });
+    replay.kill().unwrap();
+    replay.wait().unwrap();
+    assert!(read("replay.png") == read("live.png"), "the PNGs differ");
+    assert!(read("replay.vtu") == read("live.vtu"), "the VTUs differ");
+}
+
+#[test]
+fn a_bad_session_file_is_an_error_naming_the_file_and_the_entry() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let source = json!({"mesh": null, "material": null, "unit_mm": null});
+    let dab = |radius: Value| {
+        json!({"op": "paint", "refined": true, "dabs": [{"points": [[0, 0, 1]], "radius": radius,
+              "strength": 1, "medium": {"sigma_a": [0.1, 0.1, 0.1], "sigma_s_prime": [1, 1, 1]}}]})
+    };
+    let file = |edits: Vec<Value>| {
+        json!({"format": "trilux-session", "version": 1, "source": source,
+               "refined_initially": true, "edits": edits})
+        .to_string()
+    };
+    let cases = [
+        (
+            file(vec![dab(json!(0.2)), dab(json!("wide"))]),
+            "edits[1].dabs[0].radius: expected a number",
+        ),
+        (
+            file(vec![json!({"op": "cut", "refined": true,
+                "plane": {"point": [0, 0, -1000], "normal": [0, 0, 1]}})]),
+            "edits[0] (cut)",
+        ),
+        (file(vec![dab(json!(-1.0))]), "edits[0] (paint)"),
+        ("{\"format\": \"png\"}".to_string(), "format: expected"),
+    ];
+    for (k, (text, needle)) in cases.iter().enumerate() {
+        let name = format!("bad{k}.json");
+        std::fs::write(d.join(&name), text).unwrap();
+        let out = trilux()
+            .current_dir(d)
+            .args(["diffuse", "--session", &name, "-o", "x.png", "--size", "32"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{name}");
+        assert!(stderr.contains(&name), "{name}: {stderr}");
+        assert!(stderr.contains(needle), "{name}: {stderr}");
+        assert!(!d.join("x.png").exists());
+    }
+    // --session takes the object from the file: no MESH beside it.
+    let out = trilux()
+        .current_dir(d)
+        .args(["diffuse", "m.node", "--session", "bad0.json", "-o", "x.png"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
