@@ -12,6 +12,7 @@
 //! converges where plain CG does.
 
 use std::borrow::Cow;
+use std::sync::Arc;
 
 use rayon::prelude::*;
 use sprs::CsMat;
@@ -72,11 +73,12 @@ pub struct VCycle<'m> {
     fine_inverse_diagonal: Vec<f64>,
     /// Levels 1.. (Galerkin operators).
     levels: Vec<Level>,
-    /// `P_lᵀ` between level `l` and `l + 1` (`P_l` is the hierarchy's).
-    restrict: Vec<CsMat<f64>>,
+    /// `P_lᵀ` between level `l` and `l + 1` (`P_l` is the hierarchy's);
+    /// shared with [`refreshed`](VCycle::refreshed) copies.
+    restrict: Arc<Vec<CsMat<f64>>>,
     coarsest: Option<Cholesky>,
     options: VCycleOptions,
-    hierarchy: Hierarchy,
+    hierarchy: Arc<Hierarchy>,
     work: std::sync::Mutex<Option<Work>>,
 }
 
@@ -130,10 +132,10 @@ impl<'m> VCycle<'m> {
             fine: Cow::Borrowed(m),
             fine_inverse_diagonal,
             levels,
-            restrict,
+            restrict: Arc::new(restrict),
             coarsest,
             options: *options,
-            hierarchy,
+            hierarchy: Arc::new(hierarchy),
             work: std::sync::Mutex::new(None),
         })
     }
@@ -241,6 +243,29 @@ impl<'m> VCycle<'m> {
             .iter()
             .sum();
         sum / n as f64
+    }
+
+    /// Bytes this V-cycle holds apart from what it shares with the
+    /// V-cycle it was [refreshed](Self::refreshed) from (the
+    /// prolongations and the hierarchy's graphs): the matrix copy, the
+    /// coarse operators, the smoothers' diagonals and the coarsest
+    /// factorisation. What keeping an old V-cycle beside its refreshed
+    /// copy costs.
+    pub fn own_bytes(&self) -> usize {
+        let csr = |m: &CsMat<f64>| m.nnz() * 12 + (m.rows() + 1) * 8;
+        let levels: usize = self
+            .levels
+            .iter()
+            .map(|l| csr(&l.matrix) + 8 * l.inverse_diagonal.len())
+            .sum();
+        let dense = self.coarsest.as_ref().map_or(0, |_| {
+            let r = self
+                .levels
+                .last()
+                .map_or(self.fine.rows(), |l| l.matrix.rows());
+            8 * r * r
+        });
+        csr(&self.fine) + 8 * self.fine_inverse_diagonal.len() + levels + dense
     }
 
     /// Bytes of the operators, the prolongations and the hierarchy's

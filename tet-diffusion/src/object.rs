@@ -106,7 +106,7 @@ pub struct Budget<'a> {
 /// row, capped at 1). Paint changes few rows, so a stroke rarely reaches
 /// it; painting a third of the object with a very different medium does,
 /// where the stale operators would triple the iterations.
-pub const REFRESH_DRIFT: f64 = 0.05;
+pub const REFRESH_DRIFT: f64 = 0.1;
 
 /// The solver state kept across solves while the mesh stays the same.
 #[derive(Debug)]
@@ -870,12 +870,13 @@ impl Object {
         self.hierarchy_refreshes
     }
 
-    /// Bytes of the kept solver state (see
-    /// [`multires::VCycle::memory_bytes`]; 0 for Jacobi and the cascade,
-    /// whose size is not counted).
+    /// Bytes a kept solver state replaced by a refresh holds apart from
+    /// what the refreshed one shares with it (see
+    /// [`multires::VCycle::own_bytes`]; 0 for Jacobi and the cascade,
+    /// which are not refreshed).
     pub(crate) fn kept_bytes(kept: &Option<Arc<Kept>>) -> usize {
         match kept.as_deref().map(|k| &k.solver) {
-            Some(KeptSolver::VCycles(v)) => v.iter().map(VCycle::memory_bytes).sum(),
+            Some(KeptSolver::VCycles(v)) => v.iter().map(VCycle::own_bytes).sum(),
             _ => 0,
         }
     }

@@ -216,6 +216,14 @@ pub struct UndoMemory {
     pub undo_bytes: usize,
     /// Bytes of the pieces now ([`Object::memory_bytes`]).
     pub object_bytes: usize,
+    /// Of `undo_bytes`: the tets' previous media.
+    pub media_bytes: usize,
+    /// Of `undo_bytes`: the `φ` copies.
+    pub phi_bytes: usize,
+    /// Of `undo_bytes`: hierarchies replaced by refreshes.
+    pub hierarchy_bytes: usize,
+    /// Of `undo_bytes`: the checkpoints of cuts, fractures, recombinations.
+    pub checkpoint_bytes: usize,
 }
 
 impl UndoMemory {
@@ -253,6 +261,11 @@ enum Delta {
 
 impl Delta {
     fn bytes(&self) -> usize {
+        self.parts().iter().sum()
+    }
+
+    /// Bytes of `[media, lights and offsets, φ, hierarchies, checkpoints]`.
+    fn parts(&self) -> [usize; 5] {
         match self {
             Delta::Values {
                 media,
@@ -272,9 +285,11 @@ impl Delta {
                 });
                 let p: usize = phi.as_ref().map_or(0, |p| phi_bytes(p));
                 let k: usize = kept.iter().map(|(_, k)| Object::kept_bytes(k)).sum();
-                m + l + p + k
+                [m, l, p, k, 0]
             }
-            Delta::Checkpoint(pieces, _) => pieces.iter().map(Object::memory_bytes).sum(),
+            Delta::Checkpoint(pieces, _) => {
+                [0, 0, 0, 0, pieces.iter().map(Object::memory_bytes).sum()]
+            }
         }
     }
 }
@@ -1050,9 +1065,19 @@ impl Session {
     /// The undo history's bytes against the object's (the figure the
     /// memory budget of undo is stated in).
     pub fn undo_memory(&self) -> UndoMemory {
+        let mut parts = [0usize; 5];
+        for e in &self.history {
+            for (a, b) in parts.iter_mut().zip(e.delta.parts()) {
+                *a += b;
+            }
+        }
         UndoMemory {
-            undo_bytes: self.undo_bytes(),
+            undo_bytes: parts.iter().sum(),
             object_bytes: self.pieces.iter().map(Object::memory_bytes).sum(),
+            media_bytes: parts[0],
+            phi_bytes: parts[2],
+            hierarchy_bytes: parts[3],
+            checkpoint_bytes: parts[4],
         }
     }
 

@@ -362,6 +362,13 @@ fn undo_of_20_paint_steps_holds_at_most_a_tenth_of_the_object_and_restores_phi_e
         "{memory:?}: {}",
         memory.fraction()
     );
+    // φ copies: the anchors before edits 0, 8 and 16, and the newest.
+    let phi_copy = 3 * 8 * s.pieces()[0].mesh().vertex_count();
+    assert_eq!(memory.phi_bytes, 4 * phi_copy, "{memory:?}");
+    assert_eq!(
+        memory.media_bytes + memory.phi_bytes + memory.hierarchy_bytes,
+        memory.undo_bytes
+    );
     // Every undo gives the state before its paint bit for bit (φ
     // included, recomputed from an anchor where no copy is kept) ...
     for k in (0..20).rev() {
@@ -461,6 +468,8 @@ fn a_large_paint_refreshes_the_kept_operators_and_still_converges_fast() {
     let fine = s.refine_now().unwrap();
     let o = &s.pieces()[0];
     assert_eq!((o.hierarchy_builds(), o.hierarchy_refreshes()), (1, 1));
+    // The replaced operators are kept for undo, and counted.
+    assert!(s.undo_memory().hierarchy_bytes > 0);
     // The warm-started refinement with the refreshed operators needs no
     // more iterations than a fresh hierarchy from zero.
     let (after, plain) = fresh_iterations(o);
