@@ -481,6 +481,7 @@ impl Worker {
     ) {
         let s = &self.session;
         let (done, redo) = s.history();
+        let memory = s.undo_memory();
         let status = json!({
             "type": "status",
             "seqs": seqs,
@@ -501,8 +502,10 @@ impl Worker {
             "tets": s.pieces().iter().map(|o| o.mesh().tets().len()).collect::<Vec<_>>(),
             "surface_vertices": s.pieces().iter().map(|o| o.mesh().boundary_vertices().len()).collect::<Vec<_>>(),
             "history": {"done": done, "redo": redo},
-            "undo_bytes": s.undo_bytes(),
-            "object_bytes": s.pieces().iter().map(|o| o.memory_bytes()).sum::<usize>(),
+            "undo_bytes": memory.undo_bytes,
+            "object_bytes": memory.object_bytes,
+            "undo_parts": {"media": memory.media_bytes, "phi": memory.phi_bytes,
+                           "hierarchy": memory.hierarchy_bytes, "checkpoints": memory.checkpoint_bytes},
             "hierarchy_builds": s.pieces().iter().map(|o| o.hierarchy_builds()).collect::<Vec<_>>(),
             "lights": lights_json(s, &self.envs),
         })
