@@ -65,6 +65,30 @@ struct Level {
     inverse_diagonal: Vec<f64>,
 }
 
+impl Level {
+    /// The level below `finer`: its Galerkin operator over `step` and
+    /// its damped Jacobi step.
+    fn below(finer: &CsMat<f64>, step: &crate::Coarsening, damping: f64) -> Result<Self, Error> {
+        let matrix = galerkin(finer, step);
+        let inverse_diagonal = damped_inverse_diagonal(&matrix, damping)?;
+        Ok(Level {
+            matrix,
+            inverse_diagonal,
+        })
+    }
+}
+
+/// The exact factorisation of the coarsest operator (of `fine` when there
+/// are no levels), unless it is too large to factor densely.
+fn coarsest_of(levels: &[Level], fine: &CsMat<f64>) -> Result<Option<Cholesky>, Error> {
+    let last = levels.last().map_or(fine, |l| &l.matrix);
+    Ok(if last.rows() <= DENSE_LIMIT {
+        Some(Cholesky::new(last)?)
+    } else {
+        None
+    })
+}
+
 /// The V-cycle preconditioner of a matrix `m` it borrows (or owns, after
 /// [`into_owned`](VCycle::into_owned)).
 #[derive(Debug)]
@@ -107,14 +131,13 @@ impl<'m> VCycle<'m> {
         // (Called only for the steps the hierarchy keeps.)
         let mut levels: Vec<Level> = Vec::new();
         let hierarchy = Hierarchy::build(m, weights, &options.hierarchy, |_, step| {
-            let finer = levels.last().map_or(m, |l| &l.matrix);
-            let matrix = galerkin(finer, step);
-            let graph = Graph::from_matrix(&matrix);
-            let inverse_diagonal = damped_inverse_diagonal(&matrix, options.damping)?;
-            levels.push(Level {
-                matrix,
-                inverse_diagonal,
-            });
+            let level = Level::below(
+                levels.last().map_or(m, |l| &l.matrix),
+                step,
+                options.damping,
+            )?;
+            let graph = Graph::from_matrix(&level.matrix);
+            levels.push(level);
             Ok(graph)
         })?;
         let restrict: Vec<CsMat<f64>> = hierarchy
@@ -122,12 +145,7 @@ impl<'m> VCycle<'m> {
             .iter()
             .map(|s| transpose(&s.interpolation))
             .collect();
-        let last = levels.last().map_or(m, |l| &l.matrix);
-        let coarsest = if last.rows() <= DENSE_LIMIT {
-            Some(Cholesky::new(last)?)
-        } else {
-            None
-        };
+        let coarsest = coarsest_of(&levels, m)?;
         Ok(Self {
             fine: Cow::Borrowed(m),
             fine_inverse_diagonal,
@@ -192,19 +210,9 @@ impl<'m> VCycle<'m> {
         let mut levels: Vec<Level> = Vec::with_capacity(self.levels.len());
         for step in &self.hierarchy.steps {
             let finer = levels.last().map_or(m, |l| &l.matrix);
-            let matrix = galerkin(finer, step);
-            let inverse_diagonal = damped_inverse_diagonal(&matrix, damping)?;
-            levels.push(Level {
-                matrix,
-                inverse_diagonal,
-            });
+            levels.push(Level::below(finer, step, damping)?);
         }
-        let last = levels.last().map_or(m, |l| &l.matrix);
-        let coarsest = if last.rows() <= DENSE_LIMIT {
-            Some(Cholesky::new(last)?)
-        } else {
-            None
-        };
+        let coarsest = coarsest_of(&levels, m)?;
         Ok(VCycle {
             fine: Cow::Owned(m.clone()),
             fine_inverse_diagonal,
@@ -272,11 +280,6 @@ impl<'m> VCycle<'m> {
     /// index arrays (the matrix copy included), to budget kept copies.
     pub fn memory_bytes(&self) -> usize {
         let csr = |m: &CsMat<f64>| m.nnz() * 12 + (m.rows() + 1) * 8;
-        let levels: usize = self
-            .levels
-            .iter()
-            .map(|l| csr(&l.matrix) + 8 * l.inverse_diagonal.len())
-            .sum();
         let steps: usize = self
             .hierarchy
             .steps
@@ -289,14 +292,7 @@ impl<'m> VCycle<'m> {
             .iter()
             .map(|g| 4 * (g.len() + 2 * g.edges()))
             .sum();
-        let dense = self.coarsest.as_ref().map_or(0, |_| {
-            let r = self
-                .levels
-                .last()
-                .map_or(self.fine.rows(), |l| l.matrix.rows());
-            8 * r * r
-        });
-        csr(&self.fine) + 8 * self.fine_inverse_diagonal.len() + levels + steps + graphs + dense
+        self.own_bytes() + steps + graphs
     }
 
     /// Unknowns of the matrix it was built from.

@@ -260,6 +260,17 @@ enum Delta {
 }
 
 impl Delta {
+    /// The delta of an edit that changed media only.
+    fn media(media: Vec<Vec<(u32, Medium)>>, phi: Option<Vec<[Vec<f64>; 3]>>) -> Self {
+        Delta::Values {
+            media,
+            lights: None,
+            offsets: None,
+            phi,
+            kept: Vec::new(),
+        }
+    }
+
     fn bytes(&self) -> usize {
         self.parts().iter().sum()
     }
@@ -491,13 +502,7 @@ impl Session {
                 for piece in &mut self.pieces {
                     media.push(piece.set_all_media(*m));
                 }
-                let delta = Delta::Values {
-                    media,
-                    lights: None,
-                    offsets: None,
-                    phi,
-                    kept: Vec::new(),
-                };
+                let delta = Delta::media(media, phi);
                 Ok((delta, (0..n).collect()))
             }
             Edit::Lights(lights) => {
@@ -590,14 +595,7 @@ impl Session {
                 }
             }
         }
-        let delta = Delta::Values {
-            media,
-            lights: None,
-            offsets: None,
-            phi,
-            kept: Vec::new(),
-        };
-        Ok((delta, touched))
+        Ok((Delta::media(media, phi), touched))
     }
 
     /// [`perform`](Self::perform) of a cut.
