@@ -43,9 +43,11 @@ pub fn surface(mesh: &TetMesh) -> TriMesh {
     }
 }
 
-/// The six interior dihedral angles of a tetrahedron, in degrees: 0° and
-/// 180° for a flat one, NaN where a face has no area (two corners
-/// coincide).
+/// The six interior dihedral angles of a tetrahedron, in degrees, at the
+/// edges (2,3), (1,3), (1,2), (0,3), (0,2), (0,1): 0° and 180° for a flat
+/// one, NaN where a face has no area (two corners coincide). Any file's
+/// tets, flat or inverted; tet-stuffing's and tet-diffusion's (which
+/// need a proper tet) give the same angles (tested).
 pub fn dihedral_angles(p: [DVec3; 4]) -> [f64; 6] {
     // Outward-or-inward normal of the face opposite each vertex; the angle
     // at the edge shared by faces k and l is π minus the angle between
@@ -389,6 +391,34 @@ pub fn tone_map(picture: &Picture) -> trilux_io::image::Image {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The three dihedral-angle functions the dependency graph keeps
+    /// (this one for any file's tets, tet-stuffing's, tet-diffusion's for
+    /// validated meshes) agree on the same random tets.
+    #[test]
+    fn dihedral_angles_agree_with_the_crates_that_own_them() {
+        let mut rng = test_support::SplitMix64(24);
+        for _ in 0..200 {
+            let p: [DVec3; 4] =
+                std::array::from_fn(|_| DVec3::new(rng.f64(), rng.f64(), rng.f64()));
+            let here = dihedral_angles(p);
+            let stuffing = tet_stuffing::dihedral_angles(p).map(f64::to_degrees);
+            let Ok(mesh) = tet_diffusion::TetMesh::new(&p, &[[0, 1, 2, 3]]) else {
+                continue; // too flat for the solver's mesh
+            };
+            // The solver's mesh may have re-oriented the tet (swapping
+            // corners 0 and 1), which permutes the edges.
+            let swapped = mesh.tets()[0] != [0, 1, 2, 3];
+            let diffusion = mesh.dihedral_angles(0).map(f64::to_degrees);
+            // Edge e of (0,1) (0,2) (0,3) (1,2) (1,3) (2,3) is angle 5 − e
+            // here (the pair of faces opposite its two other corners).
+            for e in 0..6 {
+                let d = if swapped { [0, 3, 4, 1, 2, 5][e] } else { e };
+                assert!((here[5 - e] - stuffing[e]).abs() < 1e-8, "{p:?} edge {e}");
+                assert!((stuffing[e] - diffusion[d]).abs() < 1e-8, "{p:?} edge {e}");
+            }
+        }
+    }
 
     #[test]
     fn dropped_nodes_scatter_back_to_the_files_numbering() {
