@@ -1,10 +1,11 @@
 // End-to-end test of trilux view's page in headless Chromium: load, first
 // frame with radiance, orbit, stroke cut, paint, relight, undo, redo,
 // screenshot. Prints one JSON object with what it saw; the Rust test
-// asserts on it. Usage: node e2e.mjs URL SCREENSHOT_DIR
+// asserts on it. Usage: node e2e.mjs URL SCREENSHOT_DIR [first-frame]
+// (first-frame: only load the page and time its first frame with radiance).
 import { chromium } from 'playwright-core';
 
-const [url, dir] = process.argv.slice(2);
+const [url, dir, only] = process.argv.slice(2);
 const browser = await chromium.launch({
   executablePath: process.env.TRILUX_BROWSER || '/usr/bin/chromium',
   args: ['--headless', '--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader-webgl',
@@ -21,6 +22,10 @@ try {
   await page.goto(url);
   await page.waitForFunction(() => window.trilux && window.trilux.firstFrameAt !== null && window.trilux.renderer.frames > 2, null, { timeout: 60000 });
   out.first_frame_ms = Date.now() - t0;
+  if (only === 'first-frame') {
+    await page.screenshot({ path: dir + '/0-first-frame.png' });
+    throw null;
+  }
   const stats = () => page.evaluate(() => ({
     radiance: window.trilux.radianceFrames, surfaces: window.trilux.surfaceFrames,
     pieces: window.trilux.renderer.pieces.filter(Boolean).length,
@@ -102,7 +107,7 @@ try {
   await page.screenshot({ path: dir + '/4-help.png' });
   out.logs = logs;
 } catch (e) {
-  out.error = String(e && e.stack || e);
+  if (e !== null) out.error = String(e && e.stack || e);
 } finally {
   await browser.close();
 }
