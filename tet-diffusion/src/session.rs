@@ -240,7 +240,7 @@ enum Delta {
     /// Paint, lights, material or a move: values only.
     Values {
         /// Per piece, the changed tets and their previous media.
-        media: Vec<Vec<(u32, Medium)>>,
+        media: Vec<Previous>,
         /// The lights before (per piece), for a light edit.
         lights: Option<Vec<Vec<Light>>>,
         /// The offsets before, for a move.
@@ -263,7 +263,7 @@ impl Delta {
     /// The delta of an edit that changed media only.
     fn media(media: Vec<Vec<(u32, Medium)>>, phi: Option<Vec<[Vec<f64>; 3]>>) -> Self {
         Delta::Values {
-            media,
+            media: media.iter().map(|m| Previous::new(m)).collect(),
             lights: None,
             offsets: None,
             phi,
@@ -285,10 +285,7 @@ impl Delta {
                 kept,
                 ..
             } => {
-                let m: usize = media
-                    .iter()
-                    .map(|v| v.len() * std::mem::size_of::<(u32, Medium)>())
-                    .sum();
+                let m: usize = media.iter().map(Previous::bytes).sum();
                 let l = lights.as_ref().map_or(0, |l| {
                     l.iter()
                         .map(|v| v.len() * std::mem::size_of::<Light>())
@@ -302,6 +299,46 @@ impl Delta {
                 [0, 0, 0, 0, pieces.iter().map(Object::memory_bytes).sum()]
             }
         }
+    }
+}
+
+/// Tets (mesh indices, in the order they were changed) and their
+/// previous media, each medium stored once: a brush over one material
+/// keeps 8 bytes a tet, not 56.
+#[derive(Debug, Clone, Default)]
+struct Previous {
+    /// `(tet, index into palette)`.
+    tets: Vec<(u32, u32)>,
+    palette: Vec<Medium>,
+}
+
+impl Previous {
+    fn new(list: &[(u32, Medium)]) -> Self {
+        let mut index = std::collections::HashMap::new();
+        let mut palette = Vec::new();
+        let tets = list
+            .iter()
+            .map(|(t, m)| {
+                let bits = [m.sigma_a, m.sigma_s_prime].map(|v| v.map(f64::to_bits));
+                let k = *index.entry(bits).or_insert_with(|| {
+                    palette.push(*m);
+                    palette.len() as u32 - 1
+                });
+                (*t, k)
+            })
+            .collect();
+        Self { tets, palette }
+    }
+
+    fn expand(&self) -> Vec<(u32, Medium)> {
+        self.tets
+            .iter()
+            .map(|&(t, k)| (t, self.palette[k as usize]))
+            .collect()
+    }
+
+    fn bytes(&self) -> usize {
+        self.tets.len() * 8 + self.palette.len() * std::mem::size_of::<Medium>()
     }
 }
 
@@ -512,7 +549,7 @@ impl Session {
                     self.set_piece_lights(p, lights)?;
                 }
                 let delta = Delta::Values {
-                    media: vec![Vec::new(); n],
+                    media: vec![Previous::default(); n],
                     lights: Some(before),
                     offsets: None,
                     phi,
@@ -532,7 +569,7 @@ impl Session {
                 let display: Vec<Light> = lights.iter().map(|l| shift(l, before[*piece])).collect();
                 self.set_piece_lights(*piece, &display)?;
                 let delta = Delta::Values {
-                    media: vec![Vec::new(); n],
+                    media: vec![Previous::default(); n],
                     lights: None,
                     offsets: Some(before),
                     phi,
@@ -1023,10 +1060,11 @@ impl Session {
             std::mem::swap(&mut self.pieces[*p].kept, k);
         }
         for (piece, previous) in self.pieces.iter_mut().zip(media.iter()) {
+            let previous = previous.expand();
             if is_material {
-                piece.restore_all_media(previous);
+                piece.restore_all_media(&previous);
             } else {
-                piece.restore_media(previous);
+                piece.restore_media(&previous);
             }
         }
         if let Some(before) = offsets {
