@@ -1148,9 +1148,53 @@ fn sample_blue_noise_writes_the_library_points_for_the_seed() {
         "d.ply",
     );
     assert_eq!(cli, positions(library));
+    // The dense packing, uniform and with the density, the same points as
+    // the library's dense options in progressive order.
+    let dense = BlueNoiseOptions {
+        progressive: true,
+        ..BlueNoiseOptions::dense()
+    };
+    let library = blue_noise(&uniform, BlueNoiseTarget::Count(1500), 11, &dense).unwrap();
+    let cli = written(&["-n", "1500", "--packing", "dense"], "dense.ply");
+    assert_eq!(cli, positions(library));
+    let library = blue_noise(&sampler, BlueNoiseTarget::Count(1000), 11, &dense).unwrap();
+    let cli = written(
+        &[
+            "-n",
+            "1000",
+            "--packing",
+            "dense",
+            "--density",
+            noise.to_str().unwrap(),
+        ],
+        "dd.ply",
+    );
+    assert_eq!(cli, positions(library));
     // Rejection cannot give candidates; a radius must be positive and
-    // needs --blue-noise.
+    // needs --blue-noise, as does --packing.
     let t = torus.to_str().unwrap();
+    fails_with(
+        d,
+        2,
+        &["sample", t, "-n", "10", "--packing", "dense", "-o", "x.ply"],
+        &["--blue-noise"],
+    );
+    fails_with(
+        d,
+        2,
+        &[
+            "sample",
+            t,
+            "--blue-noise",
+            "-n",
+            "10",
+            "--packing",
+            "tight",
+            "-o",
+            "x.ply",
+        ],
+        &["tight", "elimination", "dense"],
+    );
     let n = noise.to_str().unwrap();
     let rejection = ["sample", t, "--blue-noise", "-n", "10", "--density", n];
     let rejection = [&rejection[..], &["--method", "rejection", "-o", "x.ply"]].concat();

@@ -10,7 +10,9 @@
 //! Writes `OUT_PREFIX.uniform.f64` (N × 3 positions, the mesh's origin
 //! added in f64) and `.uniform.i64` (face ids); with a density image also
 //! `.density.f64` / `.density.i64` (subdivision, luminance of the stored
-//! values); and `.blue.f64` / `.blue.i64` (blue noise of N / 10 points).
+//! values); `.blue.f64` / `.blue.i64` (blue noise of N / 10 points by
+//! elimination) and `.dense.f64` / `.dense.i64` (the dense packing, the
+//! Python default).
 
 use std::io::Write;
 use std::path::Path;
@@ -57,6 +59,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &BlueNoiseOptions::default(),
     )?;
     write(prefix, "blue", mesh.origin, &blue)?;
+    let dense = mesh_sampling::blue_noise(
+        &uniform,
+        BlueNoiseTarget::Count(n / 10),
+        seed,
+        &BlueNoiseOptions::dense(),
+    )?;
+    write(prefix, "dense", mesh.origin, &dense)?;
     if let Some(density) = rest.first() {
         let image = trilux_io::image::read_with(
             density,

@@ -480,10 +480,20 @@ pub(crate) fn sample_surface<'py>(
     points.into_tuple(py)
 }
 
-/// Blue-noise (Poisson-disk) points on a mesh that follow a density:
-/// weighted sample elimination (Yuksel 2015, *Sample Elimination for
-/// Generating Poisson Disk Sample Sets*) of `5 × count` candidates from
-/// the sampler `sample_surface` would use.
+/// Blue-noise (Poisson-disk) points on a mesh that follow a density,
+/// chosen among candidates from the sampler `sample_surface` would use.
+///
+/// `packing='dense'` (the default): weighted sample elimination (Yuksel
+/// 2015, *Sample Elimination for Generating Poisson Disk Sample Sets*) of
+/// `14 × count` candidates, then farthest-point relocation (the closest
+/// points move into the largest holes among the candidates; after
+/// Schlömer, Heck & Deussen 2011): relative radius ρ ≈ 0.76 on the data
+/// meshes, as point-cloud-utils' and MeshLab's Poisson-disk sampling
+/// (0.75–0.77). `packing='elimination'`: elimination of `5 × count`
+/// candidates alone, ρ ≈ 0.69, about 3× faster (Open3D's
+/// `sample_points_poisson_disk` is the same algorithm). ρ is half the
+/// smallest distance between two points over the radius of a hexagonal
+/// packing of as many disks (Lagae & Dutré 2008).
 ///
 /// Give `count` (exactly this many points) or `radius` (the points of a
 /// hexagonal packing of disks of this radius, in mesh units: neighbours
@@ -493,15 +503,18 @@ pub(crate) fn sample_surface<'py>(
 /// `method` (`'subdivision'` or `'exact'`) as for `sample_surface`; with a
 /// density the local spacing scales as `1/sqrt(density)`.
 /// `progressive=True` orders the points so that every prefix of length
-/// `count / 2**j` is itself well spread (Sec. 5; about twice the time).
+/// `count / 2**j` is itself well spread (Sec. 5; about twice the time;
+/// with the dense packing the prefixes have elimination's spacing, the
+/// whole set the dense one).
 ///
 /// Returns `(points, face_index)`, `(N, 3)` float64 and `(N,)` int64, and
 /// the optional arrays, as `sample_surface`; same seed, same points (bit
-/// for bit Rust's `mesh_sampling::blue_noise`). The GIL is released.
+/// for bit Rust's `mesh_sampling::blue_noise` with
+/// `BlueNoiseOptions::dense()` or `::default()`). The GIL is released.
 #[pyfunction]
 #[pyo3(signature = (mesh, count = None, *, radius = None, density = None, uv = None, channel = None,
     face_weight = None, vertex_weight = None, method = None, seed = None, progressive = false,
-    return_barycentric = false, return_pdf = false, return_normal = false))]
+    packing = None, return_barycentric = false, return_pdf = false, return_normal = false))]
 #[allow(clippy::too_many_arguments, reason = "the Python keyword arguments")]
 pub(crate) fn blue_noise<'py>(
     py: Python<'py>,
@@ -516,10 +529,12 @@ pub(crate) fn blue_noise<'py>(
     method: Option<&str>,
     seed: Option<i128>,
     progressive: bool,
+    packing: Option<&str>,
     return_barycentric: bool,
     return_pdf: bool,
     return_normal: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
+    let base = packing_options(packing)?;
     let target = match (count, radius) {
         (Some(c), None) => BlueNoiseTarget::Count(arrays::count(c, "count")?),
         (None, Some(r)) => BlueNoiseTarget::Radius(r),
@@ -542,7 +557,7 @@ pub(crate) fn blue_noise<'py>(
     };
     let options = BlueNoiseOptions {
         progressive,
-        ..BlueNoiseOptions::default()
+        ..base
     };
     let origin = mesh.origin;
     let points = detached(py, || {
@@ -560,9 +575,21 @@ pub(crate) fn blue_noise<'py>(
     points.into_tuple(py)
 }
 
+/// The options of `packing` (`None` is the dense packing).
+fn packing_options(packing: Option<&str>) -> std::result::Result<BlueNoiseOptions, Failure> {
+    match packing {
+        None | Some("dense") => Ok(BlueNoiseOptions::dense()),
+        Some("elimination") => Ok(BlueNoiseOptions::default()),
+        Some(other) => Err(Failure::input(format!(
+            "blue_noise: packing='{other}' is not a packing (use 'dense' or 'elimination')"
+        ))),
+    }
+}
+
 /// Evenly spread points, in trimesh's shape
 /// (`trimesh.sample.sample_surface_even(mesh, count, radius=None,
-/// seed=None)` → `(points, face_index)`), by `blue_noise`: exactly `count`
+/// seed=None)` → `(points, face_index)`), by `blue_noise` with its
+/// default (dense) packing: exactly `count`
 /// points when `radius` is `None`; with `radius` (the smallest distance
 /// between points, as trimesh means it) the points of disks of radius
 /// `radius / 2`, progressively ordered and cut to at most `count`.
@@ -584,7 +611,7 @@ pub(crate) fn sample_surface_even<'py>(
     };
     let options = BlueNoiseOptions {
         progressive,
-        ..BlueNoiseOptions::default()
+        ..BlueNoiseOptions::dense()
     };
     let origin = mesh.origin;
     let points = detached(py, || {

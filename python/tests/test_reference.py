@@ -32,9 +32,14 @@ def test_uniform_and_blue_noise_match_rust_bit_for_bit(data, reference_bin, tmp_
     # The arrays of a trilux.Mesh given back as plain arrays: the same bits.
     points2, faces2 = trilux.sample_surface((mesh.vertices, mesh.faces), 100_000, seed=7)
     assert np.array_equal(points2, rp) and np.array_equal(faces2, rf)
-    bp, bf = trilux.blue_noise(mesh, 10_000, seed=7)
+    bp, bf = trilux.blue_noise(mesh, 10_000, seed=7, packing="elimination")
     rbp, rbf = read("blue")
     assert np.array_equal(bp, rbp) and np.array_equal(bf, rbf)
+    # The default packing is the dense one.
+    dp, df = trilux.blue_noise(mesh, 10_000, seed=7)
+    rdp, rdf = read("dense")
+    assert np.array_equal(dp, rdp) and np.array_equal(df, rdf)
+    assert not np.array_equal(dp, bp)
     # Another seed gives other points.
     other, _ = trilux.sample_surface(mesh, 1000, seed=8)
     assert not np.array_equal(other, rp[:1000])

@@ -17,6 +17,7 @@ I64 = npt.NDArray[np.int64]
 MeshLike = Any
 Channel = Union[Literal["r", "g", "b", "a", "luminance"], int]
 Method = Literal["uniform", "subdivision", "exact", "rejection"]
+Packing = Literal["dense", "elimination"]
 MediumLike = Union[str, Tuple[Sequence[float], Sequence[float]]]
 
 class Error(Exception): ...
@@ -98,6 +99,7 @@ def blue_noise(
     method: Optional[Method] = None,
     seed: Optional[int] = None,
     progressive: bool = False,
+    packing: Optional[Packing] = None,
     return_barycentric: Literal[False] = False,
     return_pdf: Literal[False] = False,
     return_normal: Literal[False] = False,
@@ -116,6 +118,7 @@ def blue_noise(
     method: Optional[Method] = None,
     seed: Optional[int] = None,
     progressive: bool = False,
+    packing: Optional[Packing] = None,
     return_barycentric: bool = False,
     return_pdf: bool = False,
     return_normal: bool = False,

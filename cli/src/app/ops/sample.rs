@@ -6,8 +6,8 @@ use std::path::Path;
 use clap::ValueEnum;
 use glam::Vec3;
 use mesh_sampling::{
-    BlueNoiseOptions, BlueNoiseTarget, Channel, Density, DensitySampler, Mode, RejectionSampler,
-    SurfaceArea, SurfacePoint, SurfaceSampler, UniformSampler, blue_noise,
+    BlueNoiseOptions, BlueNoiseTarget, Channel, Density, DensitySampler, Mode, Packing,
+    RejectionSampler, SurfaceArea, SurfacePoint, SurfaceSampler, UniformSampler, blue_noise,
 };
 use trilux_io::mesh::TriMesh;
 
@@ -78,16 +78,22 @@ pub(crate) enum Source {
 pub(crate) enum Points {
     /// This many independent points.
     Random(usize),
-    /// Blue noise, progressive, by count or radius.
-    BlueNoise(BlueNoiseTarget),
+    /// Blue noise, progressive, by count or radius, packed by elimination
+    /// or densely.
+    BlueNoise(BlueNoiseTarget, Packing),
 }
 
-/// The blue-noise options of `trilux sample --blue-noise`: the library's
-/// defaults, in progressive order.
-pub(crate) fn blue_noise_options() -> BlueNoiseOptions {
+/// The blue-noise options of `trilux sample --blue-noise [--packing P]`:
+/// the library's defaults for the packing (`BlueNoiseOptions::default()`
+/// or `::dense()`), in progressive order.
+pub(crate) fn blue_noise_options(packing: Packing) -> BlueNoiseOptions {
+    let base = match packing {
+        Packing::Elimination => BlueNoiseOptions::default(),
+        Packing::Dense => BlueNoiseOptions::dense(),
+    };
     BlueNoiseOptions {
         progressive: true,
-        ..BlueNoiseOptions::default()
+        ..base
     }
 }
 
@@ -99,7 +105,9 @@ fn points_of<S: SurfaceSampler + SurfaceArea>(
 ) -> std::result::Result<Vec<SurfacePoint>, mesh_sampling::Error> {
     match points {
         Points::Random(n) => sampler.sample_n(seed, n),
-        Points::BlueNoise(target) => blue_noise(sampler, target, seed, &blue_noise_options()),
+        Points::BlueNoise(target, packing) => {
+            blue_noise(sampler, target, seed, &blue_noise_options(packing))
+        }
     }
 }
 
@@ -141,7 +149,7 @@ pub(crate) fn draw_points(
         (Method::Rejection, Points::Random(n)) => {
             RejectionSampler::new(mesh_ref, texture)?.sample_n(seed, n)
         }
-        (Method::Rejection, Points::BlueNoise(_)) => {
+        (Method::Rejection, Points::BlueNoise(..)) => {
             return Err(arg_error(
                 "--method rejection",
                 "blue noise draws its candidates by subdivision or exactly, not by rejection",
