@@ -17,6 +17,12 @@
 //! radius, `relative_radius_with_density`) and the number of candidates. Open3D (uniform only: it takes no density) is run through
 //! `bench/peers.sh`, which sets up a venv under `target/` on first use; its
 //! points come back through a file so that ρ is measured the same way.
+//! With `--peer-cy BIN`, Yuksel's own C++ elimination (cySampleElim, not
+//! part of this repository) is timed on the very candidates trilux's
+//! elimination draws (5 N uniform points for seed 0, written to a file):
+//! `BIN CANDIDATES.f32 N AREA OUT.f32` must eliminate the little-endian
+//! `f32` triples to N, write them to OUT.f32 and print `{"ms": …}` with
+//! the time of the elimination alone; ρ is measured here.
 //! Markdown on stdout, or with `--json` one object per line with the keys
 //! `mesh`, `density`, `n`, `tool`, `threads`, `ms`, `rho`, `candidates`.
 
@@ -38,6 +44,7 @@ struct Args {
     counts: Vec<usize>,
     meshes: Vec<String>,
     packings: Vec<Packing>,
+    peer_cy: Option<PathBuf>,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -47,6 +54,7 @@ fn parse_args() -> Result<Args, String> {
         counts: vec![10_000, 100_000, 1_000_000],
         meshes: MESHES.iter().map(ToString::to_string).collect(),
         packings: vec![Packing::Elimination, Packing::Dense],
+        peer_cy: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -72,6 +80,12 @@ fn parse_args() -> Result<Args, String> {
                     .ok_or("--mesh needs a comma-separated list of mesh names")?;
                 args.meshes = list.split(',').map(|s| s.trim().to_string()).collect();
             }
+            "--peer-cy" => {
+                args.peer_cy = Some(PathBuf::from(
+                    it.next()
+                        .ok_or("--peer-cy needs the path of the cySampleElim driver")?,
+                ));
+            }
             "--packing" => {
                 let list = it
                     .next()
@@ -89,7 +103,7 @@ fn parse_args() -> Result<Args, String> {
             }
             other => {
                 return Err(format!(
-                    "unknown argument '{other}' (try --json, --no-peers, --n, --mesh, --packing)"
+                    "unknown argument '{other}' (try --json, --no-peers, --n, --mesh, --packing, --peer-cy)"
                 ));
             }
         }
@@ -210,6 +224,59 @@ fn ours<S: SurfaceSampler + SurfaceArea>(
     Ok((median(times), relative_radius_with_density(&xyz, &pdf)))
 }
 
+/// cySampleElim's time (ms, the elimination alone, as the driver reports
+/// it) and ρ on trilux's own candidates for `n` points (seed 0).
+fn cy_sample_elim(
+    bin: &Path,
+    sampler: &UniformSampler<'_>,
+    n: usize,
+) -> Result<(f64, f64), String> {
+    let dir = std::env::temp_dir().join(format!("trilux-cy-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let candidates = sampler
+        .sample_positions(0, 5 * n)
+        .map_err(|e| e.to_string())?;
+    let bytes: Vec<u8> = candidates
+        .iter()
+        .flatten()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+    let (input, output) = (dir.join("candidates.f32"), dir.join("out.f32"));
+    std::fs::write(&input, bytes).map_err(|e| format!("{}: {e}", input.display()))?;
+    let area = sampler.surface_area();
+    let out = Command::new(bin)
+        .arg(&input)
+        .arg(n.to_string())
+        .arg(area.to_string())
+        .arg(&output)
+        .output()
+        .map_err(|e| format!("{}: {e}", bin.display()))?;
+    if !out.status.success() {
+        return Err(format!(
+            "{} failed: {}",
+            bin.display(),
+            String::from_utf8_lossy(&out.stderr)
+        ));
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    let ms: f64 = text
+        .split("\"ms\":")
+        .nth(1)
+        .and_then(|rest| rest.split([',', '}']).next())
+        .and_then(|v| v.trim().parse().ok())
+        .ok_or_else(|| format!("{}: no \"ms\" in its output {text:?}", bin.display()))?;
+    let bytes = std::fs::read(&output).map_err(|e| format!("{}: {e}", output.display()))?;
+    let xyz: Vec<Vec3> = bytes
+        .chunks_exact(12)
+        .map(|c| {
+            let f = |i: usize| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]);
+            Vec3::new(f(0), f(4), f(8))
+        })
+        .collect();
+    let _ = std::fs::remove_dir_all(&dir);
+    Ok((ms, relative_radius(&xyz, area)))
+}
+
 /// Open3D's rows for `file`, or an explanation of why there are none.
 fn open3d(file: &Path, counts: &[usize], area: f64) -> Result<Vec<(usize, f64, f64)>, String> {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -303,6 +370,24 @@ fn run() -> Result<(), String> {
                 }
             }
         }
+        if let Some(bin) = &args.peer_cy {
+            for &n in &args.counts {
+                eprintln!("{name}, N = {n}: cySampleElim…");
+                match cy_sample_elim(bin, &uniform, n) {
+                    Ok((ms, rho)) => rows.push(Row {
+                        mesh: name,
+                        density: "uniform",
+                        n,
+                        tool: "cySampleElim".into(),
+                        threads: rayon::current_num_threads(),
+                        ms,
+                        rho,
+                        candidates: 5 * n,
+                    }),
+                    Err(e) => eprintln!("cySampleElim did not run: {e}"),
+                }
+            }
+        }
         if args.peers {
             eprintln!("{name}: Open3D (first run installs it into target/peers-venv)…");
             match open3d(&file, &args.counts, uniform.surface_area()) {
@@ -346,24 +431,31 @@ fn run() -> Result<(), String> {
             r.candidates
         );
     }
-    println!("\nSpeed against Open3D at the same N (uniform; points/s ratio):\n");
-    for r in rows.iter().filter(|r| r.tool == "open3d") {
-        for t in [1, 2] {
-            if let Some(o) = rows.iter().find(|o| {
-                o.tool == "trilux"
-                    && o.mesh == r.mesh
-                    && o.n == r.n
-                    && o.density == "uniform"
-                    && o.threads == t
-            }) {
-                println!(
-                    "- {} N = {}, {t} thread(s): {:.1}× Open3D's rate, ρ {:.3} vs {:.3}",
-                    r.mesh,
-                    r.n,
-                    r.ms / o.ms,
-                    o.rho,
-                    r.rho
-                );
+    for peer in ["open3d", "cySampleElim"] {
+        if !rows.iter().any(|r| r.tool == peer) {
+            continue;
+        }
+        println!("\nSpeed against {peer} at the same N (uniform; points/s ratio):\n");
+        for r in rows.iter().filter(|r| r.tool == peer) {
+            for t in [1, 2] {
+                for tool in ["trilux", "trilux-dense"] {
+                    if let Some(o) = rows.iter().find(|o| {
+                        o.tool == tool
+                            && o.mesh == r.mesh
+                            && o.n == r.n
+                            && o.density == "uniform"
+                            && o.threads == t
+                    }) {
+                        println!(
+                            "- {} N = {}, {tool}, {t} thread(s): {:.1}× {peer}'s rate, ρ {:.3} vs {:.3}",
+                            r.mesh,
+                            r.n,
+                            r.ms / o.ms,
+                            o.rho,
+                            r.rho
+                        );
+                    }
+                }
             }
         }
     }

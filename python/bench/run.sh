@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The Python benchmark: builds the trilux wheel (release), installs it with
 # numpy and trimesh in a venv under target/, tries each peer library
-# (Open3D, point-cloud-utils, pytetwild, tetgen) on its own so that one
+# (Open3D, point-cloud-utils, pymeshlab, pytetwild, tetgen) on its own so that one
 # that will not install is skipped (bench.py says so), then prints the
 # Markdown tables of bench.py. Usage, from the workspace root:
 #
@@ -18,7 +18,7 @@ if ! ldconfig -p | grep -q libusb-1.0.so.0 && command -v apt-get >/dev/null; the
   (apt-get update -qq && apt-get install -y -qq --no-install-recommends libusb-1.0-0 >/dev/null) ||
     echo "note: libusb-1.0-0 did not install; Open3D's rows will be skipped" >&2
 fi
-for peer in open3d point-cloud-utils pytetwild pyvista tetgen; do
+for peer in open3d point-cloud-utils pymeshlab pytetwild pyvista tetgen; do
   "$VENV/bin/python" -m pip install -q "$peer" >/dev/null 2>&1 || echo "note: $peer did not install; its rows are skipped" >&2
 done
 rm -rf target/py-bench-wheels

@@ -22,7 +22,7 @@ fn as_array<'py>(
     let arr = np.call_method1("asarray", (obj,))?;
     let kind: String = arr.getattr("dtype")?.getattr("kind")?.extract()?;
     if !kinds.contains(kind.as_str()) {
-        let name: String = arr.getattr("dtype")?.getattr("name")?.extract()?;
+        let name = dtype_text(&arr.getattr("dtype")?)?;
         let wanted = if kinds.contains('f') {
             "a real (float or integer) dtype"
         } else {
@@ -31,6 +31,23 @@ fn as_array<'py>(
         return Err(Failure::input(format!("{what}: expected {wanted}, got {name}")).into());
     }
     np.call_method1("asarray", (arr, dtype))
+}
+
+/// A dtype as numpy prints it (`float64`, `<U168`, `object`), with what
+/// its kind is where the code alone does not say (numpy's `dtype.name`
+/// would say `str672`, the bits of a 168-character string).
+fn dtype_text(dtype: &Bound<'_, PyAny>) -> PyResult<String> {
+    let text = dtype.str()?.to_string();
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    let what = match kind.as_str() {
+        "U" | "S" => " (strings)",
+        "O" => " (Python objects)",
+        "c" => " (complex numbers)",
+        "M" | "m" => " (dates or times)",
+        "V" => " (structured records)",
+        _ => "",
+    };
+    Ok(format!("{text}{what}"))
 }
 
 fn shape_text(shape: &[usize]) -> String {
@@ -163,7 +180,7 @@ pub(crate) fn image_array(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<ImageA
         }
         "b" => 1.0,
         _ => {
-            let name: String = dtype.getattr("name")?.extract()?;
+            let name = dtype_text(&dtype)?;
             return Err(
                 Failure::input(format!("{what}: expected a real dtype, got {name}")).into(),
             );

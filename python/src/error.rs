@@ -102,6 +102,19 @@ impl Failure {
             message: message.into(),
         }
     }
+
+    /// A `trilux.FileError` when `path` is a directory where a file of
+    /// `what` was expected (the readers would only see its empty
+    /// extension).
+    pub(crate) fn if_directory(path: &std::path::Path, what: &str) -> Result<()> {
+        if path.is_dir() {
+            return Err(Self {
+                kind: Kind::File,
+                message: format!("{}: is a directory, not {what}", path.display()),
+            });
+        }
+        Ok(())
+    }
 }
 
 impl From<Failure> for PyErr {

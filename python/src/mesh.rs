@@ -382,6 +382,7 @@ impl Mesh {
 #[pyfunction]
 pub(crate) fn load(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Mesh> {
     let path = path_arg(path, "path")?;
+    Failure::if_directory(&path, "a mesh file (.obj, .gltf, .glb or .ply)")?;
     let inner = detached(py, || Ok(TriMesh::read(&path)?))?;
     Ok(Mesh {
         inner: Arc::new(inner),

@@ -105,6 +105,10 @@ pub(crate) fn load_tets<'py>(
     return_warnings: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let path = path_arg(path, "path")?;
+    Failure::if_directory(
+        &path,
+        "a tetrahedral mesh file (.node, .ele, .msh or .mesh)",
+    )?;
     let mesh = detached(py, || Ok(trilux_io::tet::TetMesh::read(&path)?))?;
     let mut items = tets_out(py, &mesh.positions, &mesh.tets)?;
     if return_warnings {

@@ -38,6 +38,11 @@ def test_array_errors():
     raises(trilux.InputError, "uv: 3 rows for 16 vertices (one per vertex)",
            trilux.sample_surface, (V, F), 10, uv=UV[:3], density=np.ones((2, 2)))
     raises(trilux.InputError, None, trilux.sample_surface, "not a mesh", 10)
+    # Dtypes as numpy prints them, not numpy's bit-count names (str672).
+    raises(trilux.InputError, "faces: expected an integer dtype, got <U168 (strings)",
+           trilux.sample_surface, (V, np.array([["x" * 168] * 3])), 10)
+    raises(trilux.InputError, "vertices: expected a real (float or integer) dtype, got object (Python objects)",
+           trilux.sample_surface, (np.array([[None] * 3] * 3), F[:1]), 10)
 
 
 def test_argument_errors():
@@ -83,6 +88,11 @@ def test_file_errors(tmp_path):
     e = raises(trilux.FileError, None, trilux.load, bad)
     assert "bad.obj" in str(e) and "line 4" in str(e)
     raises(trilux.FileError, None, trilux.load_tets, tmp_path / "missing.node")
+    # A folder is named as one, not as a file with the extension "".
+    raises(trilux.FileError, f"{tmp_path}: is a directory, not a mesh file (.obj, .gltf, .glb or .ply)",
+           trilux.load, tmp_path)
+    e = raises(trilux.FileError, None, trilux.load_tets, tmp_path)
+    assert "is a directory" in str(e)
     e = raises(trilux.FileError, None, trilux.save, tmp_path / "mesh.xyz", (V, F))
     assert "xyz" in str(e)
     junk = tmp_path / "junk.meshcolors"
