@@ -224,6 +224,18 @@ fn ours<S: SurfaceSampler + SurfaceArea>(
     Ok((median(times), relative_radius_with_density(&xyz, &pdf)))
 }
 
+/// Points stored as little-endian `f32` triples (what the peers write).
+fn read_points(path: &Path) -> Result<Vec<Vec3>, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(bytes
+        .chunks_exact(12)
+        .map(|c| {
+            let f = |i: usize| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]);
+            Vec3::new(f(0), f(4), f(8))
+        })
+        .collect())
+}
+
 /// cySampleElim's time (ms, the elimination alone, as the driver reports
 /// it) and ρ on trilux's own candidates for `n` points (seed 0).
 fn cy_sample_elim(
@@ -265,14 +277,7 @@ fn cy_sample_elim(
         .and_then(|rest| rest.split([',', '}']).next())
         .and_then(|v| v.trim().parse().ok())
         .ok_or_else(|| format!("{}: no \"ms\" in its output {text:?}", bin.display()))?;
-    let bytes = std::fs::read(&output).map_err(|e| format!("{}: {e}", output.display()))?;
-    let xyz: Vec<Vec3> = bytes
-        .chunks_exact(12)
-        .map(|c| {
-            let f = |i: usize| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]);
-            Vec3::new(f(0), f(4), f(8))
-        })
-        .collect();
+    let xyz = read_points(&output)?;
     let _ = std::fs::remove_dir_all(&dir);
     Ok((ms, relative_radius(&xyz, area)))
 }
@@ -311,14 +316,7 @@ fn open3d(file: &Path, counts: &[usize], area: f64) -> Result<Vec<(usize, f64, f
             .and_then(|v| v.parse().ok())
             .ok_or("Open3D: no ms")?;
         let path = PathBuf::from(field(line, "points").ok_or("Open3D: no points file")?);
-        let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let xyz: Vec<Vec3> = bytes
-            .chunks_exact(12)
-            .map(|c| {
-                let f = |i: usize| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]);
-                Vec3::new(f(0), f(4), f(8))
-            })
-            .collect();
+        let xyz = read_points(&path)?;
         rows.push((n, ms, relative_radius(&xyz, area)));
     }
     let _ = std::fs::remove_dir_all(&out_dir);

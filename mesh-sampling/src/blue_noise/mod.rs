@@ -434,17 +434,7 @@ mod tests {
         let n = 4000;
         let options = BlueNoiseOptions::default();
         let candidates = sampler.sample_n(3, 5 * n).unwrap();
-        let chi_square = |kept: &[u32]| {
-            let mut counts = [0.0f64; 4];
-            for &k in kept {
-                let uv = candidates[k as usize].uv.unwrap();
-                counts[usize::from(uv.x >= 0.5) + 2 * usize::from(uv.y >= 0.5)] += 1.0;
-            }
-            let expected = [0.1, 0.4, 0.4, 0.1].map(|p| p * n as f64);
-            (0..4)
-                .map(|q| (counts[q] - expected[q]).powi(2) / expected[q])
-                .sum::<f64>()
-        };
+        let chi_square = |kept: &[u32]| chi_square_of(&candidates, kept, n);
         // χ² with 3 degrees of freedom: 16.27 is the 0.1% critical value.
         let right = chi_square(&select(&candidates, n, &options));
         let positions: Vec<[f32; 3]> = candidates.iter().map(|p| p.position.to_array()).collect();
