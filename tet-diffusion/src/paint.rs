@@ -47,6 +47,50 @@ impl Object {
         self.paint_recorded(stroke).map(|(report, _)| report)
     }
 
+    /// Paints `medium`, all of it, into every tetrahedron whose centre `c`
+    /// is on the side `(c − point) · normal > 0` of a plane (the side a
+    /// [`Cut::Plane`](crate::Cut::Plane) of the same plane removes), and
+    /// updates the affected rows as [`paint`](Self::paint) does.
+    ///
+    /// `point` is a point of the plane and `normal` its normal toward the
+    /// painted side, both in mesh units (the normal need not be a unit
+    /// vector). The report counts the tetrahedra painted (including any
+    /// that already had `medium`) and the rows re-assembled.
+    ///
+    /// # Errors
+    /// [`Error::BadArgument`] for a non-finite point or normal, a zero
+    /// normal, or a bad medium.
+    pub fn paint_half_space(
+        &mut self,
+        point: DVec3,
+        normal: DVec3,
+        medium: Medium,
+    ) -> Result<PaintReport, Error> {
+        finite_vec("the painted half-space's point", point)?;
+        finite_vec("the painted half-space's normal", normal)?;
+        if normal.length_squared() == 0.0 {
+            return Err(Error::BadArgument {
+                what: "the length of the painted half-space's normal".into(),
+                value: 0.0,
+                need: "it must be non-zero",
+            });
+        }
+        medium.check("the painted medium")?;
+        let mesh = &self.mesh;
+        let tets: Vec<u32> = (0..mesh.tets().len())
+            .filter(|&t| (mesh.tet_center(t) - point).dot(normal) > 0.0)
+            .map(|t| t as u32)
+            .collect();
+        for &t in &tets {
+            self.media[mesh.original_ids()[t as usize] as usize] = medium;
+        }
+        let rows = self.update_rows_of(&tets);
+        Ok(PaintReport {
+            tets: tets.len(),
+            rows,
+        })
+    }
+
     /// [`paint`](Self::paint), also returning each changed tet (mesh index)
     /// with the medium it had, which [`restore_media`](Self::restore_media)
     /// puts back.

@@ -182,6 +182,49 @@ fn painting_updates_rows_exactly_as_a_full_assembly() {
 }
 
 #[test]
+fn painting_a_half_space_fills_the_tets_on_its_side_exactly_as_a_full_assembly() {
+    let mut o = lit_ball(8);
+    let skin = Medium::measured("skin1").unwrap();
+    let (point, normal) = (DVec3::new(0.0, 1.5, 0.0), DVec3::new(0.0, 2.0, 0.0));
+    let report = o.paint_half_space(point, normal, skin).unwrap();
+    let mesh = o.mesh();
+    let above: Vec<usize> = (0..mesh.tets().len())
+        .filter(|&t| mesh.tet_center(t).y > 1.5)
+        .collect();
+    assert!(!above.is_empty() && above.len() < mesh.tets().len());
+    assert_eq!(report.tets, above.len());
+    assert!(report.rows > 0 && report.rows < mesh.vertex_count());
+    let marble = Medium::measured("marble").unwrap();
+    for t in 0..mesh.tets().len() {
+        let m = o.media()[mesh.original_ids()[t] as usize];
+        assert_eq!(m, if above.contains(&t) { skin } else { marble }, "tet {t}");
+    }
+    let full = Object::new(o.mesh().clone(), 1.0, o.media().to_vec(), 1.3).unwrap();
+    for c in 0..3 {
+        assert_eq!(o.matrix(c).data(), full.matrix(c).data(), "channel {c}");
+    }
+    // The side beyond the whole ball paints nothing.
+    let none = o
+        .paint_half_space(DVec3::new(0.0, 6.0, 0.0), DVec3::Y, skin)
+        .unwrap();
+    assert_eq!((none.tets, none.rows), (0, 0));
+    // Bad planes.
+    for (p, n) in [
+        (DVec3::new(f64::NAN, 0.0, 0.0), DVec3::Y),
+        (DVec3::ZERO, DVec3::new(0.0, f64::INFINITY, 0.0)),
+        (DVec3::ZERO, DVec3::ZERO),
+    ] {
+        assert!(
+            matches!(
+                o.paint_half_space(p, n, skin),
+                Err(Error::BadArgument { .. })
+            ),
+            "{p} {n}"
+        );
+    }
+}
+
+#[test]
 fn fracture_and_recombine() {
     let mut o = lit_ball(6);
     o.solve().unwrap();

@@ -5,8 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use glam::DVec3;
-use tet_diffusion::{Cut, CutMethod, Light, Medium, Object};
+use tet_diffusion::{Cut, CutMethod, Light, Object};
 
 use super::args::{LightSpec, Material, Paint, PaintSpec, PictureArgs, Plane};
 use super::ops::object::{check_volume, default_light, diagonal, read_volume, unit_mm};
@@ -15,7 +14,7 @@ use super::{Context, Result, arg_cause, file_cause};
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Solve TransCut's diffusion on a tetrahedral mesh (or a surface, tetrahedralized first) and render it",
-    after_help = "Example:\n  trilux diffuse ../shared/data/tets/bunny_500k.msh --material marble \\\n      --light dir:0.3,1,0.6 --cut plane:0,0,1,0.01 -o bunny_marble.png\n\nPainting: the ears (the side y > 0.15) in skin, and a ball of ketchup:\n  trilux diffuse ../shared/data/tets/bunny_50k.node --material marble \\\n      --paint plane:0,1,0,0.15:skin1 --paint 0.03,0.08,0.03:0.01:ketchup -o bunny_painted.png\n\nMaterials: apple chicken1 chicken2 cream ketchup marble potato skimmilk skin1 skin2\nspectralon wholemilk, or noise:A,B (fractal noise between two of them).\n\nA session of `trilux view` (saved from its page), rendered as the page exports it:\n  trilux diffuse --session session.json --view 0.5,1,2 -o session.png"
+    after_help = "Example:\n  trilux diffuse ../shared/data/tets/bunny_500k.node --material marble --unit-mm 1000 \\\n      --light dir:0.3,1,0.6 --cut plane:0,0,1,0 -o bunny_marble.png --vtu bunny_marble.vtu\n\nPainting: the ears (the side y > 0.15) in skin, and a ball of ketchup:\n  trilux diffuse ../shared/data/tets/bunny_50k.node --material marble \\\n      --paint plane:0,1,0,0.15:skin1 --paint 0.03,0.08,0.03:0.01:ketchup -o bunny_painted.png\n\nMaterials: apple chicken1 chicken2 cream ketchup marble potato skimmilk skin1 skin2\nspectralon wholemilk, or noise:A,B (fractal noise between two of them).\n\nA session of `trilux view` (saved from its page), rendered as the page exports it:\n  trilux diffuse --session session.json --view 0.5,1,2 -o session.png"
 )]
 pub(crate) struct Args {
     /// A tetrahedral mesh (.node, .ele, .msh, .mesh) or a closed surface
@@ -80,25 +79,6 @@ pub(crate) struct Args {
 /// as jagged as the mesh until its vertices are pulled toward the plane.
 pub(crate) const CUT_RELAX_SWEEPS: usize = 20;
 
-/// Paints `medium` into every tetrahedron of `mesh` whose centre is on
-/// the side `(x − point) · normal > 0`; returns how many.
-fn paint_side(
-    mesh: &tet_diffusion::TetMesh,
-    media: &mut [Medium],
-    point: DVec3,
-    normal: DVec3,
-    medium: Medium,
-) -> usize {
-    let mut painted = 0;
-    for (t, &id) in mesh.original_ids().iter().enumerate() {
-        if (mesh.tet_center(t) - point).dot(normal) > 0.0 {
-            media[id as usize] = medium;
-            painted += 1;
-        }
-    }
-    painted
-}
-
 /// What a run made: the solved objects and what the summary reports.
 struct Solved {
     objects: Vec<Object>,
@@ -129,35 +109,15 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let mesh = tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_cause(input, e))?;
     let diagonal = diagonal(&positions);
     let unit_mm = unit_mm(args.unit_mm, diagonal);
-    let mut media = args
+    let media = args
         .material
         .media(&mesh, diagonal / 6.0)
         .map_err(|e| arg_cause(format!("--material {}", args.material), e))?;
-    // Sides of planes go into the media before assembly; balls are
-    // painted into the assembled object below.
-    let mut painted = vec![0; args.paint.len()];
-    for (spec, count) in args.paint.iter().zip(&mut painted) {
-        if let Paint::Side {
-            point,
-            normal,
-            medium,
-        } = spec.paint
-        {
-            *count = paint_side(&mesh, &mut media, point, normal, medium);
-        }
-    }
     let mut object = context
         .step("assembling", || Object::new(mesh, unit_mm, media, 1.3))
         .map_err(|e| file_cause(input, e))?;
     let lights = light(context, &args, input, &mut object)?;
-    for (spec, count) in args.paint.iter().zip(&mut painted) {
-        if let Paint::Ball(stroke) = &spec.paint {
-            *count = object
-                .paint(stroke)
-                .map_err(|e| arg_cause(format!("--paint {}", spec.spec), e))?
-                .tets;
-        }
-    }
+    let painted = paint(&args, &mut object)?;
     cut(context, &args, &mut object)?;
     let mut objects = fracture(&args, object, diagonal)?;
     let mut levels = None;
@@ -178,6 +138,31 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     write(context, &args, &solved)?;
     report(context, &args, input, &solved);
     Ok(())
+}
+
+/// `--paint`: the sides of planes first, then the balls, each in the
+/// order given; returns the tetrahedra each painted.
+fn paint(args: &Args, object: &mut Object) -> Result<Vec<usize>> {
+    let mut painted = vec![0; args.paint.len()];
+    for balls in [false, true] {
+        for (spec, count) in args.paint.iter().zip(&mut painted) {
+            let report = match (&spec.paint, balls) {
+                (
+                    Paint::Side {
+                        point,
+                        normal,
+                        medium,
+                    },
+                    false,
+                ) => object.paint_half_space(*point, *normal, *medium),
+                (Paint::Ball(stroke), true) => object.paint(stroke),
+                _ => continue,
+            }
+            .map_err(|e| arg_cause(format!("--paint {}", spec.spec), e))?;
+            *count = report.tets;
+        }
+    }
+    Ok(painted)
 }
 
 /// `--session`: the view's session replayed, and its picture (and EXR,
@@ -388,7 +373,7 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved) {
     let tets: usize = objects.iter().map(|o| o.mesh().tets().len()).sum();
     let painted = &solved.painted;
     let text = format!(
-        "{} tetrahedra ({} object{}), {} mm per unit{}, solved ({} levels); picture written to {}\n",
+        "{} tetrahedra ({} object{}), {} mm per unit{}, solved ({} level{}); picture written to {}\n",
         tets,
         objects.len(),
         if objects.len() > 1 { "s" } else { "" },
@@ -406,6 +391,7 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved) {
             )
         },
         solved.levels,
+        if solved.levels == 1 { "" } else { "s" },
         args.output.display()
     );
     let json = serde_json::json!({
@@ -435,15 +421,11 @@ use glam::Vec3;
 use trilux::tet::{Picture, exposure_white};
 pub(crate) use trilux::tet::{render, tone_map};
 
-/// Rec. 709 luminance of a pixel (the tests' measure of brightness).
-#[cfg(test)]
-fn luminance(p: [f32; 4]) -> f32 {
-    0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DVec3;
+    use tet_diffusion::Medium;
     use tet_diffusion::TetMesh;
     use tet_diffusion::fresnel::exit_radiance_factor;
 
@@ -576,7 +558,7 @@ mod tests {
             .iter()
             .zip(&picture.coverage)
             .filter(|&(_, &c)| c >= 1.0)
-            .map(|(p, _)| luminance(*p))
+            .map(|(p, _)| discrete_sampling::luminance([p[0], p[1], p[2]]))
             .collect();
         lum.sort_by(f32::total_cmp);
         lum[lum.len() * 99 / 100]
