@@ -82,9 +82,7 @@ mod mesh;
 mod object;
 mod paint;
 mod quality;
-// Public for its module docs (the session model), which `Session` links;
-// its items are re-exported at the root like every other.
-pub mod session;
+mod session;
 
 pub use cut::{
     ANGLE_BOUND_DEGREES, ANGLE_BOUND_FRACTION, Cut, CutMethod, CutReport, CutTimes,

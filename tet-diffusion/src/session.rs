@@ -1,42 +1,4 @@
-//! The interactive session of TransCut (Sec. 5 and the paper's title:
-//! *interactive* cutouts): one or more [`Object`]s (pieces, after a
-//! fracture), an edit log with undo and redo, and progressive solves —
-//! the model behind `trilux view`, `trilux diffuse --session` and Python.
-//!
-//! - Edits are queued by [`Session::push`] (checked at once, so a bad one
-//!   never reaches the object) and applied by [`Session::apply_pending`],
-//!   which coalesces what waits: consecutive light changes and piece moves
-//!   keep the last, consecutive paint dabs are all painted and solved once.
-//! - Each applied batch is solved to a loose tolerance first
-//!   ([`SessionOptions::coarse_tolerance`]: a picture within a few
-//!   iterations), then [`Session::refine`] solves it to the objects'
-//!   tolerance unless new input cancels it. An interrupted refinement puts
-//!   the coarse `φ` back, so `φ` after every edit is a function of the
-//!   log alone: a saved log ([`Session::log`]) replays bit-identically
-//!   ([`Session::replay`]) on any number of threads.
-//! - The solver's hierarchy is kept across paint, light, material and move
-//!   edits (see [`Object::hierarchy_builds`]); only cut, fracture and
-//!   recombine build a new one.
-//! - Undo keeps small deltas: a paint keeps the changed tets' previous
-//!   media (their rows are re-assembled from them, exactly), a light
-//!   change the previous lights, a move the previous offset, and an edit
-//!   whose solve refreshed the kept hierarchy the hierarchy before. Cut,
-//!   fracture and recombine keep a checkpoint (the pieces before).
-//! - `φ` is restored bit for bit, but not copied for every edit (a copy is
-//!   `3 × 8` bytes per vertex, 1.5–2% of the object): the newest applied
-//!   edit and every [`SessionOptions::phi_interval`]-th edit (an
-//!   *anchor*; also the first edit and the first after a cut) keep the
-//!   `φ` before them. Undoing another edit recomputes its `φ` from the
-//!   nearest anchor before it: `φ` after each edit is a deterministic
-//!   function of the `φ` before it and the edit (the same solves, the
-//!   same hierarchy), so re-doing the edits in between gives the same
-//!   bits. The `φ` passed on the way are kept until the next new edit,
-//!   so undoing step by step recomputes once per anchor interval. Redo
-//!   re-does the edit and its solves (the same bits again).
-//! - The deltas share a budget ([`SessionOptions::undo_budget_bytes`]):
-//!   past it, the oldest entries (up to the next anchor) leave the undo
-//!   history (they stay in the log). [`Session::undo_memory`] reports
-//!   the undo bytes against the object's.
+//! The interactive session (see [`Session`]).
 
 use std::collections::VecDeque;
 use std::sync::Arc;
@@ -188,8 +150,8 @@ pub struct SessionOptions {
     /// Bytes the undo deltas may hold together.
     pub undo_budget_bytes: usize,
     /// Every how many edits (since the start or the last cut) an edit
-    /// keeps a copy of `φ` before it (an anchor, see the [module
-    /// docs](self)): undoing the edits in between re-does at most this
+    /// keeps a copy of `φ` before it (an anchor, see [`Session`]):
+    /// undoing the edits in between re-does at most this
     /// many minus one edits' solves. At least 1 (1: every edit keeps its
     /// copy, no undo re-solves).
     pub phi_interval: usize,
@@ -381,7 +343,45 @@ pub struct Applied {
     pub topology_changed: bool,
 }
 
-/// An interactive TransCut session (see the [module docs](self)).
+/// An interactive session of TransCut (Sec. 5 and the paper's title:
+/// *interactive* cutouts): one or more [`Object`]s (pieces, after a
+/// fracture), an edit log with undo and redo, and progressive solves —
+/// the model behind `trilux view`, `trilux diffuse --session` and Python.
+///
+/// - Edits are queued by [`Session::push`] (checked at once, so a bad one
+///   never reaches the object) and applied by [`Session::apply_pending`],
+///   which coalesces what waits: consecutive light changes and piece moves
+///   keep the last, consecutive paint dabs are all painted and solved once.
+/// - Each applied batch is solved to a loose tolerance first
+///   ([`SessionOptions::coarse_tolerance`]: a picture within a few
+///   iterations), then [`Session::refine`] solves it to the objects'
+///   tolerance unless new input cancels it. An interrupted refinement puts
+///   the coarse `φ` back, so `φ` after every edit is a function of the
+///   log alone: a saved log ([`Session::log`]) replays bit-identically
+///   ([`Session::replay`]) on any number of threads.
+/// - The solver's hierarchy is kept across paint, light, material and move
+///   edits (see [`Object::hierarchy_builds`]); only cut, fracture and
+///   recombine build a new one.
+/// - Undo keeps small deltas: a paint keeps the changed tets' previous
+///   media (their rows are re-assembled from them, exactly), a light
+///   change the previous lights, a move the previous offset, and an edit
+///   whose solve refreshed the kept hierarchy the hierarchy before. Cut,
+///   fracture and recombine keep a checkpoint (the pieces before).
+/// - `φ` is restored bit for bit, but not copied for every edit (a copy is
+///   `3 × 8` bytes per vertex, 1.5–2% of the object): the newest applied
+///   edit and every [`SessionOptions::phi_interval`]-th edit (an
+///   *anchor*; also the first edit and the first after a cut) keep the
+///   `φ` before them. Undoing another edit recomputes its `φ` from the
+///   nearest anchor before it: `φ` after each edit is a deterministic
+///   function of the `φ` before it and the edit (the same solves, the
+///   same hierarchy), so re-doing the edits in between gives the same
+///   bits. The `φ` passed on the way are kept until the next new edit,
+///   so undoing step by step recomputes once per anchor interval. Redo
+///   re-does the edit and its solves (the same bits again).
+/// - The deltas share a budget ([`SessionOptions::undo_budget_bytes`]):
+///   past it, the oldest entries (up to the next anchor) leave the undo
+///   history (they stay in the log). [`Session::undo_memory`] reports
+///   the undo bytes against the object's.
 #[derive(Debug, Clone)]
 pub struct Session {
     pieces: Vec<Object>,
@@ -902,8 +902,8 @@ impl Session {
 
     /// Undoes the last applied edit: media, lights, offsets, pieces,
     /// hierarchy and `φ` bit for bit as they were before it (`φ` from its
-    /// copy, or recomputed from the nearest anchor: see the [module
-    /// docs](self)). Waiting edits are dropped. Returns the edit undone, or
+    /// copy, or recomputed from the nearest anchor: see
+    /// [`Session`]). Waiting edits are dropped. Returns the edit undone, or
     /// `None` when there is none.
     ///
     /// # Errors
