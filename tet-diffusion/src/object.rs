@@ -851,17 +851,38 @@ impl Object {
             return Ok(None);
         }
         let t = Instant::now();
+        self.kept = self.kept_for_matrices()?;
+        self.hierarchy_refreshes += 1;
+        Ok(Some(ms(t)))
+    }
+
+    /// The kept V-cycles with their operators recomputed for the current
+    /// matrices on the kept hierarchy ([`multires::VCycle::refreshed`]):
+    /// bit for bit the V-cycles a build or refresh made when the matrices
+    /// were these, so undo can re-derive a replaced hierarchy from the
+    /// media of that time instead of storing it. `None` without a kept
+    /// state; a kept state that is not refreshable (Jacobi, the cascade)
+    /// is returned as it is.
+    ///
+    /// # Errors
+    /// Those of [`multires::VCycle::refreshed`].
+    pub(crate) fn kept_for_matrices(&self) -> Result<Option<Arc<Kept>>, Error> {
+        let Some(kept) = &self.kept else {
+            return Ok(None);
+        };
+        let KeptSolver::VCycles(v) = &kept.solver else {
+            return Ok(Some(kept.clone()));
+        };
+        let channel = |k: usize| if v.len() == 3 { k } else { 1 };
         let mut fresh = Vec::with_capacity(v.len());
         for (k, v) in v.iter().enumerate() {
             fresh.push(v.refreshed(&self.matrices[channel(k)])?);
         }
-        self.kept = Some(Arc::new(Kept {
+        Ok(Some(Arc::new(Kept {
             method: kept.method,
             share_hierarchy: kept.share_hierarchy,
             solver: KeptSolver::VCycles(fresh),
-        }));
-        self.hierarchy_refreshes += 1;
-        Ok(Some(ms(t)))
+        })))
     }
 
     /// How many times the kept hierarchy's coarse operators were

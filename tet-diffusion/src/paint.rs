@@ -136,6 +136,20 @@ impl Object {
         ))
     }
 
+    /// The current medium of each tet (mesh index) `list` names, in its
+    /// order: what puts them back after a [`restore_media`](Self::restore_media)
+    /// of `list` (undo re-deriving a replaced hierarchy visits the media of
+    /// an earlier state and returns).
+    pub(crate) fn current_media(&self, list: &[(u32, Medium)]) -> Vec<(u32, Medium)> {
+        let ids = self.mesh.original_ids();
+        list.iter()
+            .filter_map(|&(t, _)| {
+                let id = *ids.get(t as usize)? as usize;
+                Some((t, *self.media.get(id)?))
+            })
+            .collect()
+    }
+
     /// Puts back the media [`paint_recorded`](Self::paint_recorded)
     /// returned (mesh tet index, medium), in reverse order so that a tet
     /// listed twice gets its first value, and re-assembles their rows.

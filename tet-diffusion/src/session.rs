@@ -182,7 +182,8 @@ pub struct UndoMemory {
     pub media_bytes: usize,
     /// Of `undo_bytes`: the `φ` copies.
     pub phi_bytes: usize,
-    /// Of `undo_bytes`: hierarchies replaced by refreshes.
+    /// Of `undo_bytes`: hierarchies replaced by refreshes that undo could
+    /// not re-derive (0 unless the media of their time were out of reach).
     pub hierarchy_bytes: usize,
     /// Of `undo_bytes`: the checkpoints of cuts, fractures, recombinations.
     pub checkpoint_bytes: usize,
@@ -211,10 +212,12 @@ enum Delta {
         /// applied edit, and those an undo recomputed (until the next new
         /// edit); `None` otherwise and while the edit is undone.
         phi: Option<Vec<[Vec<f64>; 3]>>,
-        /// The pieces whose hierarchy the edit's solve refreshed, each
-        /// with its hierarchy in the other state (before the edit while it
-        /// is applied, after it while it is undone).
-        kept: Vec<(usize, Option<Arc<Kept>>)>,
+        /// While the edit is applied: the pieces whose kept hierarchy its
+        /// solve refreshed, each with how undo gets the one it replaced
+        /// back. Empty while it is undone: redo's solve refreshes again
+        /// (the same state before it, so the same decision and the same
+        /// bits).
+        kept: Vec<(usize, Replaced)>,
     },
     /// Cut, fracture, recombine: the pieces and offsets in the other
     /// state.
@@ -254,7 +257,13 @@ impl Delta {
                         .sum()
                 });
                 let p: usize = phi.as_ref().map_or(0, |p| phi_bytes(p));
-                let k: usize = kept.iter().map(|(_, k)| Object::kept_bytes(k)).sum();
+                let k: usize = kept
+                    .iter()
+                    .map(|(_, k)| match k {
+                        Replaced::Derived => 0,
+                        Replaced::Stored(k) => Object::kept_bytes(k),
+                    })
+                    .sum();
                 [m, l, p, k, 0]
             }
             Delta::Checkpoint(pieces, _) => {
@@ -262,6 +271,22 @@ impl Delta {
             }
         }
     }
+}
+
+/// How undo gets back the kept hierarchy an edit's refresh replaced.
+#[derive(Debug, Clone)]
+enum Replaced {
+    /// Re-derived ([`Session::rederive_kept`]): the replaced V-cycles are
+    /// a deterministic function of the kept prolongations and the
+    /// matrices when they were made, and the media of that time are
+    /// reachable through the history (the previous media of the entries
+    /// since, and [`Session::base`]). Nothing stored: a stored copy
+    /// (matrix copy, coarse operators, coarsest factorisation) is a
+    /// quarter of the object.
+    Derived,
+    /// Stored, when the media of its time are not reachable (it was made
+    /// before a checkpoint or before what the budget dropped).
+    Stored(Option<Arc<Kept>>),
 }
 
 /// Tets (mesh indices, in the order they were changed) and their
@@ -302,6 +327,16 @@ impl Previous {
     fn bytes(&self) -> usize {
         self.tets.len() * 8 + self.palette.len() * std::mem::size_of::<Medium>()
     }
+
+    /// The tets of `self` (older) and of `newer`, each once with its
+    /// oldest medium: what puts the media of the state before both back.
+    fn merged_with_newer(&self, newer: &Previous) -> Previous {
+        let mut list = self.expand();
+        list.extend(newer.expand());
+        let mut seen = std::collections::HashSet::new();
+        list.retain(|(t, _)| seen.insert(*t));
+        Previous::new(&list)
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -311,6 +346,9 @@ struct Entry {
     /// Whether it keeps the `φ` before it while applied (see the module
     /// docs).
     anchor: bool,
+    /// The pieces whose kept hierarchy its solve built or refreshed (the
+    /// points the media of a replaced hierarchy's time are found from).
+    built: Vec<usize>,
 }
 
 impl Entry {
@@ -364,8 +402,12 @@ pub struct Applied {
 ///   recombine build a new one.
 /// - Undo keeps small deltas: a paint keeps the changed tets' previous
 ///   media (their rows are re-assembled from them, exactly), a light
-///   change the previous lights, a move the previous offset, and an edit
-///   whose solve refreshed the kept hierarchy the hierarchy before. Cut,
+///   change the previous lights, a move the previous offset. An edit whose
+///   solve refreshed the kept hierarchy keeps nothing for it: undo
+///   re-derives the hierarchy before (its operators recomputed on the kept
+///   prolongations for the media of the time it was made, which the
+///   previous media of the entries since lead back to; bit for bit the
+///   same), and stores it only when those media are out of reach. Cut,
 ///   fracture and recombine keep a checkpoint (the pieces before).
 /// - `φ` is restored bit for bit, but not copied for every edit (a copy is
 ///   `3 × 8` bytes per vertex, 1.5–2% of the object): the newest applied
@@ -396,6 +438,12 @@ pub struct Session {
     options: SessionOptions,
     /// Whether the last applied entry still waits for its refinement.
     unrefined: bool,
+    /// Per piece at the start of `history`: the tets whose media changed
+    /// between the making of the piece's kept hierarchy and that state,
+    /// with their media then (empty when it was made in that state);
+    /// `None` when unknown. What re-deriving a hierarchy made before the
+    /// history's start needs once the budget dropped the entries since.
+    base: Vec<Option<Previous>>,
 }
 
 impl Session {
@@ -413,8 +461,14 @@ impl Session {
             pending: VecDeque::new(),
             options,
             unrefined: true,
+            base: Vec::new(),
         };
+        let before = s.pieces[0].kept.clone();
         s.solve_coarse(&[0])?;
+        // An object that came with a kept hierarchy of an unknown state
+        // keeps it (no drift): undo cannot re-derive that one.
+        let made_now = !same_kept(&before, &s.pieces[0].kept);
+        s.base = vec![made_now.then(Previous::default)];
         Ok(s)
     }
 
@@ -501,6 +555,7 @@ impl Session {
             },
             delta,
             anchor,
+            built: Vec::new(),
         });
         self.cursor = k + 1;
         let solves = self.solve_recording_kept(k, &touched)?;
@@ -706,7 +761,8 @@ impl Session {
     }
 
     /// The coarse solve of the pieces `touched` by history entry `k`,
-    /// recording in its delta the hierarchies the solve replaced.
+    /// recording in it the pieces whose hierarchy the solve built or
+    /// refreshed, and how undo gets a refreshed one's predecessor back.
     fn solve_recording_kept(
         &mut self,
         k: usize,
@@ -717,21 +773,85 @@ impl Session {
             .map(|&p| self.pieces[p].kept.clone())
             .collect();
         let solves = self.solve_coarse(touched);
-        if let Delta::Values { kept, .. } = &mut self.history[k].delta {
-            for (&p, old) in touched.iter().zip(before) {
-                let same = match (&old, &self.pieces[p].kept) {
-                    (Some(a), Some(b)) => Arc::ptr_eq(a, b),
-                    (None, None) => true,
-                    _ => false,
+        let mut built = Vec::new();
+        let mut replaced = Vec::new();
+        for (&p, old) in touched.iter().zip(before) {
+            if same_kept(&old, &self.pieces[p].kept) {
+                continue;
+            }
+            built.push(p);
+            // A first build (after a topology change) is not undone:
+            // only a refresh of a kept hierarchy is.
+            if old.is_some() {
+                let how = if self.source_of_kept(k, p).is_some() {
+                    Replaced::Derived
+                } else {
+                    Replaced::Stored(old)
                 };
-                // A first build (after a topology change) is not undone:
-                // only a refresh of a kept hierarchy is.
-                if !same && old.is_some() {
-                    kept.push((p, old));
-                }
+                replaced.push((p, how));
             }
         }
+        let entry = &mut self.history[k];
+        entry.built = built;
+        if let Delta::Values { kept, .. } = &mut entry.delta {
+            *kept = replaced;
+        }
         solves
+    }
+
+    /// Where the media of the time piece `p`'s kept hierarchy before
+    /// applied entry `k` was made are found: the first entry after the one
+    /// that made it (its previous media, and those of the entries up to
+    /// `k`, lead back there), with [`base`](Self::base) when it was made
+    /// before the history's start. `None` when they cannot be found (made
+    /// before a checkpoint, or before dropped entries that changed it).
+    fn source_of_kept(&self, k: usize, p: usize) -> Option<(usize, Option<&Previous>)> {
+        for m in (0..k).rev() {
+            let e = &self.history[m];
+            if e.built.contains(&p) {
+                return Some((m + 1, None));
+            }
+            if matches!(e.delta, Delta::Checkpoint(..)) {
+                return None;
+            }
+        }
+        self.base.get(p)?.as_ref().map(|b| (0, Some(b)))
+    }
+
+    /// The kept hierarchy of piece `p` before applied entry `k`, which
+    /// refreshed it, with the media of entry `k` already put back: the
+    /// media are taken back to when that hierarchy was made, its
+    /// operators recomputed there on the kept prolongations (bit for bit
+    /// what was made then), and the media returned to what they were.
+    fn rederive_kept(&mut self, k: usize, p: usize) -> Result<Option<Arc<Kept>>, Error> {
+        let (from, before) = self.source_of_kept(k, p).ok_or(Error::BadArgument {
+            what: "the undo history".into(),
+            value: k as f64,
+            need: "a replaced hierarchy's media are reachable",
+        })?;
+        // Newest first, so that the oldest medium of a tet is the last set.
+        let mut lists: Vec<Vec<(u32, Medium)>> = (from..k)
+            .rev()
+            .filter_map(|m| match &self.history[m].delta {
+                Delta::Values { media, .. } => media.get(p).map(Previous::expand),
+                Delta::Checkpoint(..) => None,
+            })
+            .collect();
+        lists.extend(before.map(Previous::expand));
+        let piece = &mut self.pieces[p];
+        let changed = piece.values_changed;
+        let mut back = Vec::with_capacity(lists.len());
+        for list in lists.iter().filter(|l| !l.is_empty()) {
+            back.push(piece.current_media(list));
+            piece.restore_media(list);
+        }
+        let kept = piece.kept_for_matrices();
+        for list in back.iter().rev() {
+            piece.restore_media(list);
+        }
+        // The media are as before, so the drift check owes nothing new.
+        piece.values_changed = changed;
+        kept
     }
 
     /// Gives piece `p` `lights` (display frame).
@@ -1003,28 +1123,23 @@ impl Session {
     }
 
     /// Does history entry `i` (a values edit, undone) again with the
-    /// solves it had: the coarse one with the hierarchy it used, and the
-    /// refinement if it was refined. Its delta becomes the new one (the
-    /// `φ` slot keeps what it held).
+    /// solves it had: the coarse one (which refreshes the kept hierarchy
+    /// where it did then: the same state before it, the same drift) and
+    /// the refinement if it was refined. Its delta becomes the new one
+    /// (the `φ` slot keeps what it held).
     fn reapply(&mut self, i: usize) -> Result<(), Error> {
         let edit = self.history[i].logged.edit.clone();
         let refined = self.history[i].logged.refined;
         let (mut delta, touched) = self.perform(&edit)?;
-        let (swapped, held) = match &mut self.history[i].delta {
-            Delta::Values { kept, phi, .. } => (std::mem::take(kept), phi.take()),
-            Delta::Checkpoint(..) => (Vec::new(), None),
+        let held = match &mut self.history[i].delta {
+            Delta::Values { phi, .. } => phi.take(),
+            Delta::Checkpoint(..) => None,
         };
-        let mut replaced = Vec::with_capacity(swapped.len());
-        for (p, mut k) in swapped {
-            std::mem::swap(&mut self.pieces[p].kept, &mut k);
-            replaced.push((p, k));
-        }
-        if let Delta::Values { phi, kept, .. } = &mut delta {
+        if let Delta::Values { phi, .. } = &mut delta {
             *phi = held;
-            *kept = replaced;
         }
         self.history[i].delta = delta;
-        self.solve_coarse(&touched)?;
+        self.solve_recording_kept(i, &touched)?;
         if refined {
             let never = AtomicBool::new(false);
             self.solve_full(&never)?;
@@ -1040,9 +1155,8 @@ impl Session {
     }
 
     /// Puts back the media, lights, offsets and hierarchies entry `i`
-    /// (a values edit) changed; `φ` is left alone. The delta then holds
-    /// the hierarchies of the undone state (for redo); the rest of it is
-    /// re-made by redo.
+    /// (a values edit) changed; `φ` is left alone. Redo re-makes the
+    /// delta.
     fn swap_values_back(&mut self, i: usize) -> Result<(), Error> {
         let is_material = matches!(self.history[i].logged.edit, Edit::Material(_));
         let Delta::Values {
@@ -1056,9 +1170,7 @@ impl Session {
             return Ok(());
         };
         let (media, lights, offsets) = (std::mem::take(media), lights.take(), offsets.take());
-        for (p, k) in kept.iter_mut() {
-            std::mem::swap(&mut self.pieces[*p].kept, k);
-        }
+        let kept = std::mem::take(kept);
         for (piece, previous) in self.pieces.iter_mut().zip(media.iter()) {
             let previous = previous.expand();
             if is_material {
@@ -1090,12 +1202,24 @@ impl Session {
                 }
             }
         }
+        // After the media: re-deriving starts from the state before `i`.
+        for (p, how) in kept {
+            self.pieces[p].kept = match how {
+                Replaced::Stored(k) => k,
+                Replaced::Derived => self.rederive_kept(i, p)?,
+            };
+        }
         Ok(())
     }
 
     /// Bytes the undo and redo deltas hold.
     pub fn undo_bytes(&self) -> usize {
-        self.history.iter().map(|e| e.delta.bytes()).sum()
+        self.history.iter().map(|e| e.delta.bytes()).sum::<usize>() + self.base_bytes()
+    }
+
+    /// Bytes of [`base`](Self::base)'s media.
+    fn base_bytes(&self) -> usize {
+        self.base.iter().flatten().map(Previous::bytes).sum()
     }
 
     /// The undo history's bytes against the object's (the figure the
@@ -1107,6 +1231,7 @@ impl Session {
                 *a += b;
             }
         }
+        parts[0] += self.base_bytes();
         UndoMemory {
             undo_bytes: parts.iter().sum(),
             object_bytes: self.pieces.iter().map(Object::memory_bytes).sum(),
@@ -1143,9 +1268,42 @@ impl Session {
 
     fn drop_oldest(&mut self, total: &mut usize) {
         let e = self.history.remove(0);
-        *total -= e.delta.bytes();
+        self.base = match &e.delta {
+            // The pieces after a checkpoint: only those it built are known.
+            Delta::Checkpoint(..) => {
+                let n = e.built.iter().max().map_or(0, |&m| m + 1);
+                (0..n)
+                    .map(|p| e.built.contains(&p).then(Previous::default))
+                    .collect()
+            }
+            Delta::Values { media, .. } => {
+                let n = self.base.len().max(media.len());
+                (0..n)
+                    .map(|p| {
+                        if e.built.contains(&p) {
+                            return Some(Previous::default());
+                        }
+                        let older = self.base.get(p)?.as_ref()?;
+                        Some(match media.get(p) {
+                            Some(newer) if !newer.tets.is_empty() => older.merged_with_newer(newer),
+                            _ => older.clone(),
+                        })
+                    })
+                    .collect()
+            }
+        };
         self.settled.edits.push(e.logged);
         self.cursor -= 1;
+        *total = self.undo_bytes();
+    }
+}
+
+/// Whether two kept solver states are the same one.
+fn same_kept(a: &Option<Arc<Kept>>, b: &Option<Arc<Kept>>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+        (None, None) => true,
+        _ => false,
     }
 }
 

@@ -468,8 +468,8 @@ fn a_large_paint_refreshes_the_kept_operators_and_still_converges_fast() {
     let fine = s.refine_now().unwrap();
     let o = &s.pieces()[0];
     assert_eq!((o.hierarchy_builds(), o.hierarchy_refreshes()), (1, 1));
-    // The replaced operators are kept for undo, and counted.
-    assert!(s.undo_memory().hierarchy_bytes > 0);
+    // The replaced operators are not stored: undo re-derives them.
+    assert_eq!(s.undo_memory().hierarchy_bytes, 0);
     // The warm-started refinement with the refreshed operators needs no
     // more iterations than a fresh hierarchy from zero.
     let (after, plain) = fresh_iterations(o);
@@ -498,6 +498,93 @@ fn a_large_paint_refreshes_the_kept_operators_and_still_converges_fast() {
     let replayed = Session::replay(lit_ball(10), SessionOptions::default(), &log).unwrap();
     assert!(snapshot(&replayed) == snapshot(&s));
     assert_eq!(s.pieces()[0].hierarchy_refreshes(), 1);
+}
+
+/// Small paints, a big one (which refreshes the kept operators), small
+/// paints: the snapshots after each, and whether the big one refreshed.
+fn paints_across_a_refresh(s: &mut Session) -> (Vec<Snapshot>, bool) {
+    let mut states = vec![snapshot(s)];
+    let mut refreshed = false;
+    for k in 0..9 {
+        let x = -3.0 + 0.5 * k as f64;
+        let stroke = if k == 4 {
+            Stroke {
+                points: vec![DVec3::new(0.0, 0.0, 2.5)],
+                radius: 2.5,
+                ..dab(DVec3::ZERO, "skin1")
+            }
+        } else {
+            small_dab(DVec3::new(x, 0.0, 4.0))
+        };
+        s.push(Edit::Paint(vec![stroke])).unwrap();
+        let a = apply_all(s);
+        refreshed |= a[0].solves[0].hierarchy_refreshed;
+        states.push(snapshot(s));
+    }
+    (states, refreshed)
+}
+
+/// After undoing: a new small paint gives what a replay of the log gives,
+/// so the hierarchy undo put back is the one of that time (a wrong one
+/// changes the coarse solve's bits).
+fn continue_as_replay(s: &mut Session, options: SessionOptions) {
+    s.push(Edit::Paint(vec![small_dab(DVec3::new(1.0, 1.0, 4.0))]))
+        .unwrap();
+    apply_all(s);
+    let replayed = Session::replay(lit_ball(10), options, &s.log()).unwrap();
+    assert!(snapshot(&replayed) == snapshot(s));
+}
+
+#[test]
+fn undo_across_a_refresh_stores_no_hierarchy_and_restores_the_bits() {
+    let options = SessionOptions::default();
+    let mut s = Session::new(lit_ball(10), options).unwrap();
+    s.refine_now().unwrap();
+    let (states, refreshed) = paints_across_a_refresh(&mut s);
+    assert!(refreshed, "the big paint must refresh for this test");
+    let memory = s.undo_memory();
+    assert_eq!(memory.hierarchy_bytes, 0, "{memory:?}");
+    assert_eq!(memory.undo_bytes, memory.media_bytes + memory.phi_bytes);
+    for k in (0..9).rev() {
+        s.undo().unwrap().unwrap();
+        assert!(snapshot(&s) == states[k], "undo to {k}");
+    }
+    for k in 0..9 {
+        s.redo().unwrap().unwrap();
+        assert!(snapshot(&s) == states[k + 1], "redo to {k}");
+    }
+    // Back to before the big paint (φ recomputed from an anchor on the
+    // way: the edits re-done with the re-derived hierarchy), then on.
+    for k in (4..9).rev() {
+        s.undo().unwrap().unwrap();
+        assert!(snapshot(&s) == states[k], "second undo to {k}");
+    }
+    continue_as_replay(&mut s, options);
+}
+
+#[test]
+fn undo_across_a_refresh_after_the_budget_dropped_the_older_entries() {
+    let mut full = Session::new(lit_ball(10), SessionOptions::default()).unwrap();
+    full.refine_now().unwrap();
+    paints_across_a_refresh(&mut full);
+    // A budget that drops the first small paints, not the big one.
+    let options = SessionOptions {
+        undo_budget_bytes: full.undo_bytes() * 3 / 4,
+        phi_interval: 1,
+        ..SessionOptions::default()
+    };
+    let mut s = Session::new(lit_ball(10), options).unwrap();
+    s.refine_now().unwrap();
+    let (states, _) = paints_across_a_refresh(&mut s);
+    let kept = s.history().0.len();
+    assert!((2..6).contains(&kept), "{kept} entries kept");
+    assert_eq!(s.undo_memory().hierarchy_bytes, 0);
+    for k in (9 - kept..9).rev() {
+        s.undo().unwrap().unwrap();
+        assert!(snapshot(&s) == states[k], "undo to {k}");
+    }
+    assert!(s.undo().unwrap().is_none());
+    continue_as_replay(&mut s, options);
 }
 
 #[test]
