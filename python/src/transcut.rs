@@ -18,10 +18,7 @@ use crate::tets::{tets_in, tets_out};
 /// for `Object(..., medium=NAME)` and `Object.paint`.
 #[pyfunction]
 pub(crate) fn media() -> Vec<&'static str> {
-    tet_diffusion::material::MEASURED
-        .iter()
-        .map(|m| m.0)
-        .collect()
+    tet_diffusion::MEASURED.iter().map(|m| m.0).collect()
 }
 
 /// A medium: a measured one by name, or `(sigma_a, sigma_s_prime)`, two

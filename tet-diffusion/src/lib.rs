@@ -99,13 +99,6 @@ pub use paint::{PaintReport, Stroke};
 pub use quality::{POOR_DIHEDRAL_DEGREES, Quality};
 pub use session::{Applied, Edit, Log, Logged, Session, SessionOptions, UndoMemory};
 
-/// The old path of [`MEASURED`], kept (hidden) until the Python package's
-/// `media()` takes it from the root.
-#[doc(hidden)]
-pub mod material {
-    pub use crate::MEASURED;
-}
-
 pub use glam;
 pub use multires;
 pub use sprs;
