@@ -184,23 +184,15 @@ pub async fn start(
         Some(t) => t,
         None => random_token().map_err(|e| format!("no random token: {e}"))?,
     };
-    let session = tokio::task::spawn_blocking(move || match log {
-        Some(log) => Session::replay(object, options.session, &log)
-            .map_err(|(k, e)| format!("the session file's edit {k}: {e}")),
-        None => Session::new(object, options.session).map_err(|e| e.to_string()),
-    })
-    .await
-    .map_err(|e| e.to_string())??;
+    let session_options = options.session;
+    let session = tokio::task::spawn_blocking(move || open_session(object, session_options, log))
+        .await
+        .map_err(|e| e.to_string())??;
     let listener = tokio::net::TcpListener::bind((options.host, options.port))
         .await
         .map_err(|e| format!("{}:{}: {e}", options.host, options.port))?;
     let addr = listener.local_addr().map_err(|e| e.to_string())?;
-    let mut hosts = vec![addr.to_string()];
-    if options.host.is_loopback() {
-        hosts.push(format!("localhost:{}", addr.port()));
-        hosts.push(format!("127.0.0.1:{}", addr.port()));
-        hosts.push(format!("[::1]:{}", addr.port()));
-    }
+    let hosts = allowed_hosts(options.host, addr);
     let (requests, receiver) = mpsc::channel();
     let (out, _) = broadcast::channel(256);
     let cancel = Arc::new(AtomicBool::new(false));
@@ -232,13 +224,7 @@ pub async fn start(
         latest,
         stop: stop_rx.clone(),
     };
-    let app = Router::new()
-        .route("/{token}/ws", get(websocket))
-        .route("/{token}/", get(index))
-        .route("/{token}", get(slash))
-        .route("/{token}/{file}", get(asset))
-        .fallback(not_found)
-        .with_state(shared);
+    let app = router(shared);
     let mut stopped = stop_rx;
     let task = tokio::spawn(async move {
         axum::serve(listener, app)
@@ -253,6 +239,44 @@ pub async fn start(
         stop,
         task,
     })
+}
+
+/// The session the server edits: `object` as it is, or after replaying
+/// a session file's `log` (an edit that fails names its index).
+fn open_session(
+    object: Object,
+    options: SessionOptions,
+    log: Option<Log>,
+) -> Result<Session, String> {
+    match log {
+        Some(log) => Session::replay(object, options, &log)
+            .map_err(|(k, e)| format!("the session file's edit {k}: {e}")),
+        None => Session::new(object, options).map_err(|e| e.to_string()),
+    }
+}
+
+/// The `Host` headers a request may carry: the bound address, and on a
+/// loopback address its other loopback names (a DNS-rebinding page
+/// sends its own host name, which is never in this list).
+fn allowed_hosts(host: IpAddr, addr: SocketAddr) -> Vec<String> {
+    let mut hosts = vec![addr.to_string()];
+    if host.is_loopback() {
+        hosts.push(format!("localhost:{}", addr.port()));
+        hosts.push(format!("127.0.0.1:{}", addr.port()));
+        hosts.push(format!("[::1]:{}", addr.port()));
+    }
+    hosts
+}
+
+/// The routes: everything under the token; the rest is 404.
+fn router(shared: Shared) -> Router {
+    Router::new()
+        .route("/{token}/ws", get(websocket))
+        .route("/{token}/", get(index))
+        .route("/{token}", get(slash))
+        .route("/{token}/{file}", get(asset))
+        .fallback(not_found)
+        .with_state(shared)
 }
 
 /// The exposure's white point: the 99th percentile of the surface
@@ -460,90 +484,138 @@ async fn stopped(mut stop: watch::Receiver<bool>) {
 /// frames down. Closing it leaves the session as it is.
 async fn client(mut socket: WebSocket, s: Shared) {
     let mut frames = s.out.subscribe();
-    for m in latest_messages(&s) {
-        if socket.send(to_message(m)).await.is_err() {
-            return;
-        }
+    if let Flow::Close = send_all(&mut socket, latest_messages(&s)).await {
+        return;
     }
     let stop = stopped(s.stop.clone());
     tokio::pin!(stop);
-    let mut tokens = RATE.1;
-    let mut refilled = Instant::now();
+    let mut bucket = Bucket::full();
     loop {
-        tokio::select! {
+        let flow = tokio::select! {
             () = &mut stop => {
                 let _ = socket.send(Message::Close(None)).await;
-                return;
+                Flow::Close
             }
-            incoming = socket.recv() => {
-                let Some(Ok(message)) = incoming else { return };
-                let text = match message {
-                    Message::Text(t) if t.len() > MAX_MESSAGE => {
-                        let problem = format!("{} bytes: a text message may have at most {MAX_MESSAGE}", t.len());
-                        if socket.send(error_text(None, "(message)", &problem)).await.is_err() {
-                            return;
-                        }
-                        continue;
-                    }
-                    Message::Text(t) => t,
-                    Message::Close(_) => return,
-                    Message::Ping(_) | Message::Pong(_) => continue,
-                    Message::Binary(b) => {
-                        let sent = match protocol::parse_upload(&b) {
-                            Ok((seq, request)) => {
-                                s.cancel.store(true, Ordering::SeqCst);
-                                if s.requests.send((seq, request)).is_err() {
-                                    return;
-                                }
-                                Ok(())
-                            }
-                            Err(bad) => socket.send(error_text(None, &bad.field, &bad.problem)).await,
-                        };
-                        if sent.is_err() {
-                            return;
-                        }
-                        continue;
-                    }
-                };
-                let now = Instant::now();
-                tokens = (tokens + now.duration_since(refilled).as_secs_f64() * RATE.0).min(RATE.1);
-                refilled = now;
-                if tokens < 1.0 {
-                    let seq = serde_json::from_str::<Value>(&text).ok().as_ref().and_then(protocol::seq_of);
-                    if socket.send(error_text(seq, "(rate)", "too many messages; this one was dropped")).await.is_err() {
-                        return;
-                    }
-                    continue;
+            incoming = socket.recv() => match incoming {
+                Some(Ok(message)) => receive(&mut socket, &s, message, &mut bucket).await,
+                _ => Flow::Close,
+            },
+            frame = frames.recv() => match frame {
+                Ok(m) => send_all(&mut socket, vec![m]).await,
+                // Too slow for the stream: catch up with the latest state.
+                Err(broadcast::error::RecvError::Lagged(_)) => {
+                    send_all(&mut socket, latest_messages(&s)).await
                 }
-                tokens -= 1.0;
-                match protocol::parse(&text) {
-                    Ok((seq, request)) => {
-                        s.cancel.store(true, Ordering::SeqCst);
-                        if s.requests.send((seq, request)).is_err() {
-                            return;
-                        }
-                    }
-                    Err(bad) => {
-                        let seq = serde_json::from_str::<Value>(&text).ok().as_ref().and_then(protocol::seq_of);
-                        if socket.send(error_text(seq, &bad.field, &bad.problem)).await.is_err() {
-                            return;
-                        }
-                    }
-                }
-            }
-            frame = frames.recv() => {
-                let messages = match frame {
-                    Ok(m) => vec![m],
-                    // Too slow for the stream: catch up with the latest state.
-                    Err(broadcast::error::RecvError::Lagged(_)) => latest_messages(&s),
-                    Err(broadcast::error::RecvError::Closed) => return,
-                };
-                for m in messages {
-                    if socket.send(to_message(m)).await.is_err() {
-                        return;
-                    }
-                }
-            }
+                Err(broadcast::error::RecvError::Closed) => Flow::Close,
+            },
+        };
+        if let Flow::Close = flow {
+            return;
         }
     }
+}
+
+/// Whether a connection goes on after one message in or out.
+enum Flow {
+    Continue,
+    Close,
+}
+
+/// The per-connection rate limit: a token bucket refilled at `RATE.0`
+/// messages per second up to `RATE.1`.
+struct Bucket {
+    tokens: f64,
+    refilled: Instant,
+}
+
+impl Bucket {
+    fn full() -> Self {
+        Bucket {
+            tokens: RATE.1,
+            refilled: Instant::now(),
+        }
+    }
+
+    /// Takes a token; false when the client is over the limit.
+    fn take(&mut self) -> bool {
+        let now = Instant::now();
+        let refill = now.duration_since(self.refilled).as_secs_f64() * RATE.0;
+        self.tokens = (self.tokens + refill).min(RATE.1);
+        self.refilled = now;
+        if self.tokens < 1.0 {
+            return false;
+        }
+        self.tokens -= 1.0;
+        true
+    }
+}
+
+/// One message from the page: an edit is queued for the session worker
+/// (cancelling its refinement); anything wrong is answered with an error
+/// frame naming the field, and the connection goes on. Binary messages
+/// (uploads) are not rate-limited: they are size-checked instead.
+async fn receive(
+    socket: &mut WebSocket,
+    s: &Shared,
+    message: Message,
+    bucket: &mut Bucket,
+) -> Flow {
+    let text = match message {
+        Message::Text(t) if t.len() > MAX_MESSAGE => {
+            let problem = format!(
+                "{} bytes: a text message may have at most {MAX_MESSAGE}",
+                t.len()
+            );
+            return reply(socket, error_text(None, "(message)", &problem)).await;
+        }
+        Message::Text(t) => t,
+        Message::Close(_) => return Flow::Close,
+        Message::Ping(_) | Message::Pong(_) => return Flow::Continue,
+        Message::Binary(b) => {
+            return match protocol::parse_upload(&b) {
+                Ok(edit) => submit(s, edit),
+                Err(bad) => reply(socket, error_text(None, &bad.field, &bad.problem)).await,
+            };
+        }
+    };
+    // The sequence number of a message refused as a whole, when it has one.
+    let seq = || {
+        serde_json::from_str::<Value>(&text)
+            .ok()
+            .as_ref()
+            .and_then(protocol::seq_of)
+    };
+    if !bucket.take() {
+        let dropped = error_text(seq(), "(rate)", "too many messages; this one was dropped");
+        return reply(socket, dropped).await;
+    }
+    match protocol::parse(&text) {
+        Ok(edit) => submit(s, edit),
+        Err(bad) => reply(socket, error_text(seq(), &bad.field, &bad.problem)).await,
+    }
+}
+
+/// Queues an edit for the session worker, cancelling its refinement.
+fn submit(s: &Shared, edit: (u64, Request)) -> Flow {
+    s.cancel.store(true, Ordering::SeqCst);
+    match s.requests.send(edit) {
+        Ok(()) => Flow::Continue,
+        Err(_) => Flow::Close,
+    }
+}
+
+async fn reply(socket: &mut WebSocket, message: Message) -> Flow {
+    match socket.send(message).await {
+        Ok(()) => Flow::Continue,
+        Err(_) => Flow::Close,
+    }
+}
+
+async fn send_all(socket: &mut WebSocket, messages: Vec<Out>) -> Flow {
+    for m in messages {
+        if let Flow::Close = reply(socket, to_message(m)).await {
+            return Flow::Close;
+        }
+    }
+    Flow::Continue
 }
