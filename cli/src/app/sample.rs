@@ -128,7 +128,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             draw_points(&mesh, &source, method, args.seed, wanted)
         })
     })?
-    .map_err(|e| super::at(args.mesh.display(), e))?;
+    // A usage error names its argument already; anything else is the mesh's.
+    .map_err(|e| {
+        if e.is_usage() {
+            e
+        } else {
+            super::at(args.mesh.display(), e)
+        }
+    })?;
     write(context, &args, &mesh, &points)?;
     report(context, &args, &mesh, &points, method);
     Ok(())
@@ -285,8 +292,9 @@ fn report(context: &Context, args: &Args, mesh: &TriMesh, points: &[SurfacePoint
         method.name().to_string()
     };
     let text = format!(
-        "{} points ({kind}) on {} ({} triangles) written to {}{}\n",
+        "{} point{} ({kind}) on {} ({} triangles) written to {}{}\n",
         points.len(),
+        if points.len() == 1 { "" } else { "s" },
         args.mesh.display(),
         mesh.indices.len(),
         args.output.display(),

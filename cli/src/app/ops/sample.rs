@@ -97,17 +97,33 @@ pub(crate) fn blue_noise_options(packing: Packing) -> BlueNoiseOptions {
     }
 }
 
-/// The points of `sampler` that `points` asks for.
+/// The points of `sampler` that `points` asks for. A blue-noise target
+/// the library refuses (a radius so small the candidates exceed the
+/// memory budget) is an error of the argument that set it, `-n` or
+/// `--radius`: the options themselves are the library's defaults.
 fn points_of<S: SurfaceSampler + SurfaceArea>(
     sampler: &S,
     points: Points,
     seed: u64,
-) -> std::result::Result<Vec<SurfacePoint>, mesh_sampling::Error> {
+) -> Result<Vec<SurfacePoint>> {
     match points {
-        Points::Random(n) => sampler.sample_n(seed, n),
+        Points::Random(n) => Ok(sampler.sample_n(seed, n)?),
         Points::BlueNoise(target, packing) => {
-            blue_noise(sampler, target, seed, &blue_noise_options(packing))
+            blue_noise(sampler, target, seed, &blue_noise_options(packing)).map_err(|e| match e {
+                mesh_sampling::Error::InvalidOption(problem) => {
+                    arg_error(target_argument(target), problem)
+                }
+                e => e.into(),
+            })
         }
+    }
+}
+
+/// The argument as typed that set a blue-noise target.
+fn target_argument(target: BlueNoiseTarget) -> String {
+    match target {
+        BlueNoiseTarget::Count(n) => format!("-n {n}"),
+        BlueNoiseTarget::Radius(r) => format!("--radius {r}"),
     }
 }
 
@@ -137,17 +153,17 @@ pub(crate) fn draw_points(
         Source::Texture(t) => (base, Some(t)),
         Source::FaceWeights(w) => {
             let sampler = DensitySampler::new(base, Density::PerFace(w))?;
-            return Ok(points_of(&sampler, points, seed)?);
+            return points_of(&sampler, points, seed);
         }
         Source::Atlas(density) => (density.mesh_ref(), Some(&density.texture)),
     };
     let Some(texture) = texture else {
-        return Ok(points_of(&UniformSampler::new(mesh_ref)?, points, seed)?);
+        return points_of(&UniformSampler::new(mesh_ref)?, points, seed);
     };
-    let points = match (method, points) {
+    match (method, points) {
         (Method::Uniform, _) => points_of(&UniformSampler::new(mesh_ref)?, points, seed),
         (Method::Rejection, Points::Random(n)) => {
-            RejectionSampler::new(mesh_ref, texture)?.sample_n(seed, n)
+            Ok(RejectionSampler::new(mesh_ref, texture)?.sample_n(seed, n)?)
         }
         (Method::Rejection, Points::BlueNoise(..)) => {
             return Err(arg_error(
@@ -168,8 +184,7 @@ pub(crate) fn draw_points(
                 DensitySampler::with_options(mesh_ref, Density::Texture(texture), &options)?;
             points_of(&sampler, points, seed)
         }
-    };
-    Ok(points?)
+    }
 }
 
 /// Reads per-face weights: one number per line, blank lines and `#`
