@@ -429,14 +429,7 @@ fn data_meshes_are_spread() {
     // Every data mesh, at a count whose 10⁵ candidates take the tiled
     // parallel elimination; ρ at least 0.65 (Yuksel's elimination reaches
     // about 0.69; independent points about 0.01).
-    for name in [
-        "fandisk",
-        "nefertiti",
-        "spot",
-        "stanford-bunny",
-        "suzanne",
-        "teapot",
-    ] {
+    for name in data_dir::MESHES {
         let mesh = trilux_io::mesh::TriMesh::read(dir.join(format!("meshes/{name}.obj"))).unwrap();
         let s = UniformSampler::new(MeshRef::new(&mesh.positions, &mesh.indices)).unwrap();
         let (blue, random) = rho_pair(&s, 20_000, 4);

@@ -24,6 +24,18 @@ pub fn data_dir() -> Option<PathBuf> {
     found
 }
 
+/// The six surface meshes of the data README (`meshes/NAME.obj`), open
+/// and closed: the set every real-data test of a surface algorithm runs
+/// on.
+pub const MESHES: [&str; 6] = [
+    "fandisk",
+    "nefertiti",
+    "spot",
+    "stanford-bunny",
+    "suzanne",
+    "teapot",
+];
+
 /// A file of the data folder; call it only after [`data_dir`] or
 /// [`have_data`] said the folder is there.
 ///

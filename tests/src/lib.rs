@@ -2,29 +2,8 @@
 //! the data folder, statistics. (The end-to-end tests of the `trilux`
 //! binary are in `cli/tests/`, where cargo builds the binary for them.)
 
-use std::path::PathBuf;
-
-/// The data folder named by `TRILUX_DATA`, or `None` (tests that need it
-/// are `#[ignore]`d at build time when it is unset, see `build.rs`).
-pub fn data_dir() -> Option<PathBuf> {
-    std::env::var_os("TRILUX_DATA").map(PathBuf::from)
-}
-
-/// A file of the data folder (panics with a readable message when
-/// `TRILUX_DATA` is unset: only real-data tests call it).
-pub fn data(relative: &str) -> PathBuf {
-    let dir = data_dir().expect("TRILUX_DATA names the data folder");
-    // CI gives a path relative to the workspace root; tests run in the
-    // package folder.
-    let dir = if dir.is_relative() {
-        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("..")
-            .join(dir)
-    } else {
-        dir
-    };
-    dir.join(relative)
-}
+// The one data-folder lookup of the workspace's tests.
+pub use test_support::data::{MESHES, data, data_dir};
 
 /// Upper quantile of the chi-square distribution with `dof` degrees of
 /// freedom at `z` standard normal deviations (Wilson–Hilferty).

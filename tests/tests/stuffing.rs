@@ -51,16 +51,7 @@ fn the_stuffed_blob_is_a_valid_diffusion_mesh() {
     ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
 )]
 fn every_stuffed_data_mesh_is_a_valid_diffusion_mesh() {
-    // The six meshes of the data README, open and closed.
-    let names = [
-        "fandisk",
-        "nefertiti",
-        "spot",
-        "stanford-bunny",
-        "suzanne",
-        "teapot",
-    ];
-    let files = names.map(|n| trilux_tests::data(&format!("meshes/{n}.obj")));
+    let files = trilux_tests::MESHES.map(|n| trilux_tests::data(&format!("meshes/{n}.obj")));
     for f in &files {
         let m = trilux_io::mesh::TriMesh::read(f).expect("a readable mesh");
         let p: Vec<DVec3> = m.positions.iter().map(|p| p.as_dvec3()).collect();
