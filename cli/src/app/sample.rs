@@ -34,8 +34,9 @@ pub(crate) struct Args {
     )]
     pub(crate) count: Option<i64>,
     /// Blue noise: points that keep their distance (Poisson-disk), following
-    /// the density, by weighted sample elimination (Yuksel 2015), in
-    /// progressive order (every prefix of N/2^k points is itself spread).
+    /// the density, by weighted sample elimination (Yuksel 2015; --packing
+    /// dense packs them closer), in progressive order (every prefix of N/2^k
+    /// points is itself spread).
     #[arg(long)]
     pub(crate) blue_noise: bool,
     /// With --blue-noise, instead of -n: the disk radius in the mesh's unit
