@@ -165,12 +165,10 @@ pub(crate) fn draw_points(
         (Method::Rejection, Points::Random(n)) => {
             Ok(RejectionSampler::new(mesh_ref, texture)?.sample_n(seed, n)?)
         }
-        (Method::Rejection, Points::BlueNoise(..)) => {
-            return Err(arg_error(
-                "--method rejection",
-                "blue noise draws its candidates by subdivision or exactly, not by rejection",
-            ));
-        }
+        (Method::Rejection, Points::BlueNoise(..)) => Err(arg_error(
+            "--method rejection",
+            "blue noise draws its candidates by subdivision or exactly, not by rejection",
+        )),
         (Method::Subdivision | Method::Exact, _) => {
             let options = mesh_sampling::Options {
                 mode: if method == Method::Exact {
