@@ -7,7 +7,7 @@
 //!
 //! ```text
 //! cargo run --release -p mesh-sampling --example paper -- [--json] [--mesh FILE]
-//!     [--density D] [--threads T] [--no-peers] [--no-tiled] [--tiled-only]
+//!     [--density D[,D…]] [--threads T] [--no-peers] [--no-tiled] [--tiled-only]
 //! ```
 //!
 //! Meshes: every mesh in `$TRILUX_DATA/meshes` (those without UVs get
@@ -92,7 +92,7 @@ fn parse_args() -> Result<Args, String> {
             }
             "-h" | "--help" => {
                 return Err(
-                    "usage: paper [--json] [--mesh FILE] [--density D] [--threads T] [--no-peers] [--no-tiled] [--tiled-only]"
+                    "usage: paper [--json] [--mesh FILE] [--density D[,D...]] [--threads T] [--no-peers] [--no-tiled] [--tiled-only]"
                         .into(),
                 );
             }
@@ -318,7 +318,9 @@ fn densities(filter: Option<&str>) -> Result<Vec<(String, DensityTexture)>, Stri
     }
     let mut out = Vec::new();
     for name in names {
-        if filter.is_some_and(|f| f != name && !(f == "hdr" && name.starts_with("hdr:"))) {
+        // A comma-separated list of names (`hdr` for every image).
+        let wanted = |f: &str| f == name || (f == "hdr" && name.starts_with("hdr:"));
+        if filter.is_some_and(|f| !f.split(',').any(wanted)) {
             continue;
         }
         let texels: Vec<f32> = match name.as_str() {

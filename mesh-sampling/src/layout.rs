@@ -269,9 +269,9 @@ impl PieceAlias {
     /// Fills `out` with pieces, one `u64` of `rng` each, in blocks whose
     /// memory accesses are issued a stage at a time so that the misses of
     /// a block overlap: the columns from the random numbers; the columns'
-    /// loads alone, a loop of independent loads; the side, and the loads
-    /// of the aliases' columns (a miss only for draws that take the alias
-    /// side); then the records, read from lines now cached.
+    /// loads alone, a loop of independent loads; the sides, a loop without
+    /// loads; the picked columns' loads alone (a miss only for draws that
+    /// take the alias side); then the records, read from lines now cached.
     #[inline]
     pub(crate) fn fill<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [Piece]) {
         const B: usize = crate::parallel::BLOCK;
@@ -288,9 +288,14 @@ impl PieceAlias {
             for (c, &i) in loaded[..len].iter_mut().zip(&index[..len]) {
                 *c = self.columns[i];
             }
+            // The sides first, in a loop without loads, so that the loads
+            // of the next loop are issued back to back (a loop mixing the
+            // two keeps few of them in flight).
             for k in 0..len {
-                let picked = format.side(index[k], loaded[k], frac[k]);
-                loaded[k] = self.columns[picked];
+                index[k] = format.side(index[k], loaded[k], frac[k]);
+            }
+            for (c, &i) in loaded[..len].iter_mut().zip(&index[..len]) {
+                *c = self.columns[i];
             }
             for (slot, &c) in block.iter_mut().zip(&loaded[..len]) {
                 *slot = format.own(c);
