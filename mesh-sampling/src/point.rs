@@ -90,8 +90,9 @@ impl SurfacePoint {
     }
 
     /// [`on`](Self::on) with the triangle's frame at hand: the samplers
-    /// keep one per triangle, so that a point costs one memory access for
-    /// its geometry.
+    /// keep one per triangle, so that a point costs one memory access (one
+    /// cache line) for its geometry and texture coordinate; the corner
+    /// indices are read only for shading normals.
     #[inline]
     pub(crate) fn in_frame(
         mesh: &MeshRef<'_>,
@@ -101,53 +102,74 @@ impl SurfacePoint {
         pdf: f32,
     ) -> Self {
         let [w0, w1, w2] = barycentric;
-        let corners = || mesh.indices[face as usize];
         let lerp3 = |v: [Vec3; 3]| v[0] * w0 + v[1] * w1 + v[2] * w2;
         Self {
             position: frame.at(w1, w2),
             face,
             barycentric,
-            normal: frame.normal,
-            shading_normal: mesh
-                .normals
-                .map(|n| lerp3(corners().map(|i| n[i as usize])).normalize_or_zero()),
-            uv: mesh.uvs.map(|t| {
-                let [ta, tb, tc] = corners().map(|i| t[i as usize]);
-                ta + (tb - ta) * w1 + (tc - ta) * w2
+            normal: frame.normal(),
+            shading_normal: mesh.normals.map(|n| {
+                lerp3(mesh.indices[face as usize].map(|i| n[i as usize])).normalize_or_zero()
             }),
+            uv: mesh.uvs.map(|_| frame.uv_at(w1, w2)),
             pdf,
         }
     }
 }
 
-/// A triangle as its first corner `a`, its edges `b − a` and `c − a`, and
-/// its unit normal (right-hand rule): a point is `a + w1 (b − a) + w2 (c − a)`,
-/// exact when the corners share a coordinate (a point on the plane z = 1
-/// has z = 1 exactly), unlike `w0 a + w1 b + w2 c`.
+/// A triangle as its first corner `a` and its edges `b − a` and `c − a`
+/// (a point is `a + w1 (b − a) + w2 (c − a)`, exact when the corners share
+/// a coordinate: a point on the plane z = 1 has z = 1 exactly, unlike
+/// `w0 a + w1 b + w2 c`), and the same for its texture coordinates when
+/// the mesh has them: 64 bytes, one cache line, so that a point reads one
+/// line of its triangle. The unit normal (right-hand rule) is the edges'
+/// cross product times a stored reciprocal length, bit for bit
+/// `(b − a).cross(c − a).normalize_or_zero()`.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[repr(C, align(64))]
 pub(crate) struct Frame {
     origin: Vec3,
     e1: Vec3,
     e2: Vec3,
-    normal: Vec3,
+    /// `1 / |e1 × e2|`, or 0 where that is not finite and positive (the
+    /// normal is then zero).
+    normal_scale: f32,
+    uv_origin: Vec2,
+    uv_e1: Vec2,
+    uv_e2: Vec2,
 }
 
 impl Frame {
-    /// A word from each end of the record (48 bytes, which may span two
-    /// cache lines): reading it brings the whole frame into the cache.
+    /// A word of the record (64 bytes, one cache line): reading it brings
+    /// the whole frame into the cache.
     #[inline]
     pub(crate) fn touch(&self) -> u32 {
-        self.origin.x.to_bits() ^ self.normal.z.to_bits()
+        self.origin.x.to_bits()
     }
 
     /// The frame of a triangle of a validated mesh (all zero otherwise).
     pub(crate) fn new(mesh: &MeshRef<'_>, face: usize) -> Self {
         let [a, b, c] = mesh.corners(face).unwrap_or_default();
+        let [ta, tb, tc] = match (mesh.uvs, mesh.indices.get(face)) {
+            (Some(t), Some(tri)) if tri.iter().all(|&i| (i as usize) < t.len()) => {
+                tri.map(|i| t[i as usize])
+            }
+            _ => [Vec2::ZERO; 3],
+        };
+        let (e1, e2) = (b - a, c - a);
+        let rcp = e1.cross(e2).length_recip();
         Self {
             origin: a,
-            e1: b - a,
-            e2: c - a,
-            normal: (b - a).cross(c - a).normalize_or_zero(),
+            e1,
+            e2,
+            normal_scale: if rcp.is_finite() && rcp > 0.0 {
+                rcp
+            } else {
+                0.0
+            },
+            uv_origin: ta,
+            uv_e1: tb - ta,
+            uv_e2: tc - ta,
         }
     }
 
@@ -156,6 +178,22 @@ impl Frame {
     #[inline]
     pub(crate) fn at(&self, w1: f32, w2: f32) -> Vec3 {
         self.origin + self.e1 * w1 + self.e2 * w2
+    }
+
+    /// The texture coordinate there (zero for a mesh without UVs).
+    #[inline]
+    pub(crate) fn uv_at(&self, w1: f32, w2: f32) -> Vec2 {
+        self.uv_origin + self.uv_e1 * w1 + self.uv_e2 * w2
+    }
+
+    /// The unit normal (right-hand rule; zero for a degenerate triangle).
+    #[inline]
+    pub(crate) fn normal(&self) -> Vec3 {
+        if self.normal_scale > 0.0 {
+            self.e1.cross(self.e2) * self.normal_scale
+        } else {
+            Vec3::ZERO
+        }
     }
 
     /// The frames of every triangle of `mesh`.

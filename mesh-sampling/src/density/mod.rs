@@ -484,32 +484,25 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
     }
 
     /// Loads what the points of `pieces` will read of their faces: the
-    /// frame and corner indices, then the corners' UVs and normals, each a
-    /// pass of independent loads, so that a block's cache misses overlap
+    /// frames (one cache line each, with the texture coordinates), and for
+    /// shading normals the corner indices, then the corners' normals, each
+    /// a pass of independent loads, so that a block's cache misses overlap
     /// instead of coming one point at a time (the point computations
     /// between them are too long for the core to look ahead past). The
     /// values are kept (and passed to `black_box`) only so that the loads
     /// are not optimised away; the points read the lines again from L1.
     #[inline]
     fn touch_faces(&self, pieces: &[Piece]) {
-        let mut corners = [[0u32; 3]; BLOCK];
         let mut seen = [0u32; BLOCK];
-        for ((c, s), p) in corners.iter_mut().zip(&mut seen).zip(pieces) {
-            let f = p.face as usize;
-            *s = self.frames[f].touch();
-            *c = self.mesh.indices[f];
-        }
-        let n = pieces.len();
-        if let Some(uvs) = self.mesh.uvs {
-            for (s, c) in seen.iter_mut().zip(&corners[..n]) {
-                *s ^= c
-                    .map(|i| uvs[i as usize].x.to_bits())
-                    .iter()
-                    .fold(0, |a, b| a ^ b);
-            }
+        for (s, p) in seen.iter_mut().zip(pieces) {
+            *s = self.frames[p.face as usize].touch();
         }
         if let Some(normals) = self.mesh.normals {
-            for (s, c) in seen.iter_mut().zip(&corners[..n]) {
+            let mut corners = [[0u32; 3]; BLOCK];
+            for (c, p) in corners.iter_mut().zip(pieces) {
+                *c = self.mesh.indices[p.face as usize];
+            }
+            for (s, c) in seen.iter_mut().zip(&corners[..pieces.len()]) {
                 *s ^= c
                     .map(|i| normals[i as usize].x.to_bits())
                     .iter()
