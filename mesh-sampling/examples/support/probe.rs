@@ -3,8 +3,9 @@
 //! batches of the sampler's streams (chunks of 16,384 on the current rayon
 //! pool), measured two ways:
 //!
-//! - **latency**: one read at a time, each address computed from the last
-//!   value read (a pointer chase): what a draw costs when nothing overlaps;
+//! - **latency**: one read at a time, each address the last value read (a
+//!   pointer chase along one random cycle through the whole table): what a
+//!   draw costs when nothing overlaps;
 //! - **batch**: the sampler's pattern, blocks of 64 addresses from the
 //!   random stream (one `u64` each, scaled by a 128-bit product like the
 //!   alias table's column), their loads issued in a loop of loads alone,
@@ -30,12 +31,26 @@ pub(crate) struct Probe {
     pub(crate) batch: f64,
 }
 
-/// A table of `records` 16-byte records of random bits.
+/// A table of `records` 16-byte records: the first word of each is the
+/// index of its successor on one random cycle through all of them (the
+/// records in shuffled order, the last linked to the first), the second
+/// random bits. A chase along the cycle
+/// visits every record; a chase through a random function instead would
+/// fall, after about √n steps, into a cycle of about √n records, which
+/// the cache then holds.
 pub(crate) fn table(records: usize) -> Vec<[u64; 2]> {
-    let mut rng = Pcg64Mcg::seed_from_u64(records as u64);
-    (0..records.max(1))
-        .map(|_| [rng.next_u64(), rng.next_u64()])
-        .collect()
+    let n = records.max(1);
+    let mut rng = Pcg64Mcg::seed_from_u64(n as u64);
+    let mut order: Vec<u64> = (0..n as u64).collect();
+    for i in (1..n).rev() {
+        let j = index(rng.next_u64(), i + 1);
+        order.swap(i, j);
+    }
+    let mut t = vec![[0u64; 2]; n];
+    for k in 0..n {
+        t[order[k] as usize] = [order[(k + 1) % n], rng.next_u64()];
+    }
+    t
 }
 
 fn index(bits: u64, n: usize) -> usize {
@@ -50,9 +65,8 @@ fn chase(table: &[[u64; 2]], reads: usize) -> f64 {
         let mut rng = Pcg64Mcg::seed_from_u64(k as u64);
         let mut at = index(rng.next_u64(), n);
         for _ in 0..CHUNK {
-            let r = table[at];
-            // The next address depends on the value just read.
-            at = index(r[0] ^ r[1].rotate_left(17), n);
+            // The next address is the value just read.
+            at = table[at][0] as usize;
         }
         black_box(at);
     });
