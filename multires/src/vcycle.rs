@@ -24,7 +24,7 @@ use crate::graph::Graph;
 use crate::hierarchy::{Hierarchy, HierarchyOptions, Weights};
 use crate::krylov::{Monitor, Preconditioner, Report, SolveOptions, pcg_checked};
 use crate::matrix::{check_square, check_symmetric, inverse_diagonal, mul_vec, transpose};
-use crate::vector::{CHUNK, scale};
+use crate::vector::{CHUNK, norm, scale};
 
 /// How the V-cycle is built and smooths.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -307,6 +307,121 @@ impl<'m> VCycle<'m> {
         (self.fine.nnz() + coarse) as f64 / self.fine.nnz() as f64
     }
 
+    /// Unknowns per level, the original first.
+    pub fn level_rows(&self) -> Vec<usize> {
+        (0..=self.levels.len())
+            .map(|l| self.matrix(l).0.rows())
+            .collect()
+    }
+
+    /// A coarse-grid approximation of `M⁻¹ r` (the correction that brings
+    /// an iterate with residual `r` toward the solution): `r` restricted
+    /// to level `level` (`Pᵀ` per step; clamped to the coarsest), that
+    /// level's Galerkin system solved from zero by CG preconditioned by the
+    /// V-cycle below it (or by the coarsest factorisation, exactly) to
+    /// `options.tolerance` relative to the restricted residual, and the
+    /// solution prolonged back to the original unknowns (`P` per step),
+    /// with `sweeps[0]` damped Jacobi sweeps against the restricted
+    /// residual on each intermediate level on the way up and `sweeps[1]`
+    /// against `r` on the original level (one mat-vec each). Returns the
+    /// coarse solve's report (for the coarse system) and the level used.
+    ///
+    /// This is the multi-resolution preview of TransCut (Sec. 4.2): a
+    /// coarse level's solution interpolated to the fine vertices, at the
+    /// cost of a few coarse iterations and one restriction and
+    /// prolongation; a deterministic function of `r` (bit for bit on any
+    /// number of threads), so it can stand as a state to warm-start from.
+    ///
+    /// # Errors
+    /// [`Error::DimensionMismatch`] for `r` or `z` of another length;
+    /// those of [`crate::pcg`] on the coarse system.
+    pub fn coarse_correction(
+        &self,
+        level: usize,
+        r: &[f64],
+        z: &mut [f64],
+        [sweeps, fine_sweeps]: [usize; 2],
+        options: &SolveOptions,
+        monitor: Monitor<'_>,
+    ) -> Result<(Report, usize), Error> {
+        let n = self.fine.rows();
+        for (what, len) in [("the residual", r.len()), ("the correction", z.len())] {
+            if len != n {
+                return Err(Error::DimensionMismatch {
+                    what,
+                    expected: n,
+                    found: len,
+                });
+            }
+        }
+        let level = level.min(self.levels.len());
+        if level == 0 {
+            z.fill(0.0);
+            let report = pcg_checked(&self.fine, r, z, self, options, monitor)?;
+            return Ok((report, 0));
+        }
+        // Restricted residuals r_1..=r_level.
+        let mut rs: Vec<Vec<f64>> = Vec::with_capacity(level);
+        for l in 0..level {
+            let mut next = vec![0.0; self.restrict[l].rows()];
+            mul_vec(&self.restrict[l], rs.last().map_or(r, |v| v), &mut next);
+            rs.push(next);
+        }
+        let b = &rs[level - 1];
+        let mut e = vec![0.0; b.len()];
+        let report = match (&self.coarsest, level == self.levels.len()) {
+            (Some(c), true) => {
+                c.solve(b, &mut e);
+                let (a, _) = self.matrix(level);
+                let mut t = vec![0.0; b.len()];
+                mul_vec(a, &e, &mut t);
+                t.iter_mut().zip(b).for_each(|(t, b)| *t = b - *t);
+                let (res, scale) = (norm(&t), norm(b));
+                Report {
+                    stop: crate::Stop::Converged,
+                    iterations: 1,
+                    residual: if scale > 0.0 { res / scale } else { 0.0 },
+                }
+            }
+            _ => {
+                let (a, _) = self.matrix(level);
+                let pre = FromLevel {
+                    vcycle: self,
+                    level,
+                };
+                pcg_checked(a, b, &mut e, &pre, options, monitor)?
+            }
+        };
+        // Up: prolong, and smooth on the intermediate levels.
+        for l in (0..level).rev() {
+            let interpolation = &self.hierarchy.steps[l].interpolation;
+            if l == 0 {
+                mul_vec(interpolation, &e, z);
+                if fine_sweeps > 0 {
+                    let mut t = vec![0.0; n];
+                    self.smooth(
+                        &self.fine,
+                        &self.fine_inverse_diagonal,
+                        r,
+                        z,
+                        &mut t,
+                        fine_sweeps,
+                    );
+                }
+                break;
+            }
+            let mut up = vec![0.0; interpolation.rows()];
+            mul_vec(interpolation, &e, &mut up);
+            if sweeps > 0 {
+                let (a, inv) = self.matrix(l);
+                let mut t = vec![0.0; up.len()];
+                self.smooth(a, inv, &rs[l - 1], &mut up, &mut t, sweeps);
+            }
+            e = up;
+        }
+        Ok((report, level))
+    }
+
     fn matrix(&self, level: usize) -> (&CsMat<f64>, &[f64]) {
         match level {
             0 => (&*self.fine, &self.fine_inverse_diagonal),
@@ -317,12 +432,13 @@ impl<'m> VCycle<'m> {
         }
     }
 
-    /// `z₀ ← V r₀`: down the levels (smooth from zero, restrict the
-    /// residual), the exact coarsest solve, up the levels (prolong the
-    /// correction, smooth again).
-    fn cycle(&self, work: &mut Work) {
+    /// `z_from ← V r_from`: from level `from` down the levels (smooth
+    /// from zero, restrict the residual), the exact coarsest solve, up the
+    /// levels (prolong the correction, smooth again). `from = 0` is the
+    /// whole V-cycle.
+    fn cycle(&self, work: &mut Work, from: usize) {
         let coarse_levels = self.levels.len();
-        for l in 0..coarse_levels {
+        for l in from..coarse_levels {
             let (a, inv) = self.matrix(l);
             let (r, z, t) = (&work.r[l], &mut work.z[l], &mut work.t[l]);
             self.smooth_from_zero(a, inv, r, z, t);
@@ -345,7 +461,7 @@ impl<'m> VCycle<'m> {
                 }
             }
         }
-        for l in (0..coarse_levels).rev() {
+        for l in (from..coarse_levels).rev() {
             let (a, inv) = self.matrix(l);
             let (fine, coarse) = work.z.split_at_mut(l + 1);
             let t = &mut work.t[l];
@@ -471,7 +587,28 @@ impl Preconditioner for VCycle<'_> {
             .unwrap_or_else(std::sync::PoisonError::into_inner);
         let work = guard.get_or_insert_with(|| self.new_work());
         work.r[0].copy_from_slice(r);
-        self.cycle(work);
+        self.cycle(work, 0);
         z.copy_from_slice(&work.z[0]);
+    }
+}
+
+/// The V-cycle from one of its coarse levels down: the preconditioner of
+/// that level's system in [`VCycle::coarse_correction`].
+struct FromLevel<'v, 'm> {
+    vcycle: &'v VCycle<'m>,
+    level: usize,
+}
+
+impl Preconditioner for FromLevel<'_, '_> {
+    fn apply(&self, r: &[f64], z: &mut [f64]) {
+        let v = self.vcycle;
+        let mut guard = v
+            .work
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let work = guard.get_or_insert_with(|| v.new_work());
+        work.r[self.level].copy_from_slice(r);
+        v.cycle(work, self.level);
+        z.copy_from_slice(&work.z[self.level]);
     }
 }

@@ -142,8 +142,18 @@ pub struct Log {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SessionOptions {
     /// Relative residual of the first result after an edit (10⁻²: with
-    /// the V-cycle, a few iterations).
+    /// the V-cycle, a few iterations), on the system it is solved on (see
+    /// `preview_rows`).
     pub coarse_tolerance: f64,
+    /// The first result after an edit of a piece with more vertices than
+    /// this is TransCut's (Sec. 4.2): solved on a coarse level of the
+    /// solver's hierarchy (see `preview_rows`) and interpolated to the
+    /// vertices ([`Object::solve_preview`]); smaller pieces are solved on
+    /// their own system. `usize::MAX`: always on the original system.
+    pub preview_above: usize,
+    /// The level of such a first result: the finest with at most this
+    /// many unknowns.
+    pub preview_rows: usize,
     /// How cuts cut (see [`Object::cut`]): exact by default, or the
     /// paper's relaxation.
     pub cut_method: crate::CutMethod,
@@ -158,10 +168,13 @@ pub struct SessionOptions {
 }
 
 impl Default for SessionOptions {
-    /// 10⁻², exact cuts, 512 MiB of undo, a `φ` anchor every 8 edits.
+    /// 10⁻² (on a level of at most 5 000 unknowns for pieces above 30 000
+    /// vertices), exact cuts, 512 MiB of undo, a `φ` anchor every 8 edits.
     fn default() -> Self {
         Self {
             coarse_tolerance: 1e-2,
+            preview_above: 30_000,
+            preview_rows: 5_000,
             cut_method: crate::CutMethod::Exact,
             undo_budget_bytes: 512 << 20,
             phi_interval: 8,
@@ -392,8 +405,10 @@ pub struct Applied {
 ///   keep the last, consecutive paint dabs are all painted and solved once.
 /// - Each applied batch is solved to a loose tolerance first
 ///   ([`SessionOptions::coarse_tolerance`]: a picture within a few
-///   iterations), then [`Session::refine`] solves it to the objects'
-///   tolerance unless new input cancels it. An interrupted refinement puts
+///   iterations; for a large piece on a coarse level of its hierarchy,
+///   interpolated, as TransCut's interactive result is, see
+///   [`SessionOptions::preview_above`]), then [`Session::refine`] solves
+///   it to the objects' tolerance unless new input cancels it. An interrupted refinement puts
 ///   the coarse `φ` back, so `φ` after every edit is a function of the
 ///   log alone: a saved log ([`Session::log`]) replays bit-identically
 ///   ([`Session::replay`]) on any number of threads.
@@ -876,6 +891,8 @@ impl Session {
                 let o = &mut self.pieces[p];
                 if o.settings.tolerance >= self.options.coarse_tolerance {
                     o.solve()
+                } else if o.mesh().vertex_count() > self.options.preview_above {
+                    o.solve_preview(self.options.preview_rows, self.options.coarse_tolerance)
                 } else {
                     o.solve_monitored(&budget)
                 }

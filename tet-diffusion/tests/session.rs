@@ -628,3 +628,80 @@ fn the_log_replays_bit_identically_on_one_and_two_threads() {
     assert!(snapshot(&one) == snapshot(&live));
     assert!(snapshot(&two) == snapshot(&live));
 }
+
+/// Options under which the ball's first results come from a coarse level
+/// of its hierarchy (as a large mesh's do by default).
+fn coarse_first() -> SessionOptions {
+    SessionOptions {
+        preview_above: 100,
+        preview_rows: 300,
+        ..SessionOptions::default()
+    }
+}
+
+#[test]
+fn a_coarse_level_first_result_refines_to_the_plain_solve_and_replays_exactly() {
+    let build = || {
+        let mut s = Session::new(lit_ball(8), coarse_first()).unwrap();
+        let mut levels = Vec::new();
+        s.push(Edit::Paint(vec![dab(DVec3::new(0.0, 4.0, 0.0), "ketchup")]))
+            .unwrap();
+        levels.push(s.apply_pending().unwrap().unwrap().solves[0].coarse_level);
+        // Not refined: the next edit warm-starts from the coarse result.
+        s.push(light(0.6)).unwrap();
+        levels.push(s.apply_pending().unwrap().unwrap().solves[0].coarse_level);
+        let cancel = AtomicBool::new(true);
+        let coarse = snapshot(&s);
+        assert!(!s.refine(&cancel).unwrap().1);
+        assert!(snapshot(&s) == coarse, "a cancelled refinement keeps it");
+        s.refine_now().unwrap();
+        s.push(Edit::Paint(vec![dab(DVec3::new(1.0, 0.0, 4.0), "skin1")]))
+            .unwrap();
+        levels.push(s.apply_pending().unwrap().unwrap().solves[0].coarse_level);
+        (s, levels)
+    };
+    let (mut live, levels) = build();
+    assert!(
+        levels.iter().all(|l| l.is_some_and(|l| l >= 1)),
+        "{levels:?}"
+    );
+    let log = live.log();
+    let replay = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| Session::replay(lit_ball(8), coarse_first(), &log).unwrap())
+    };
+    assert!(snapshot(&replay(1)) == snapshot(&live));
+    assert!(snapshot(&replay(2)) == snapshot(&live));
+    // Undo and redo give the coarse results' bits back.
+    let after = snapshot(&live);
+    live.undo().unwrap();
+    live.undo().unwrap();
+    live.redo().unwrap();
+    live.redo().unwrap();
+    assert!(snapshot(&live) == after);
+    // The preview is close to the solution, and refines to it.
+    let preview = live.pieces()[0].clone();
+    let mut refined = preview.clone();
+    refined.solve().unwrap();
+    let mut plain = lit_ball(8);
+    plain
+        .paint(&dab(DVec3::new(0.0, 4.0, 0.0), "ketchup"))
+        .unwrap();
+    plain.clear_lights();
+    if let Edit::Lights(l) = light(0.6) {
+        plain.add_light(l[0].clone()).unwrap();
+    }
+    plain
+        .paint(&dab(DVec3::new(1.0, 0.0, 4.0), "skin1"))
+        .unwrap();
+    plain.solve().unwrap();
+    for c in 0..3 {
+        let e = rel_l2(plain.mesh(), refined.phi(c), plain.phi(c));
+        assert!(e < 1e-5, "channel {c}: {e}");
+        let e = rel_l2(plain.mesh(), preview.phi(c), plain.phi(c));
+        assert!(e < 0.2, "the preview of channel {c}: {e}");
+    }
+}

@@ -495,6 +495,7 @@ impl Worker {
                 "residual": r.channels.map(|c| if c.residual.is_finite() { c.residual } else { -1.0 }),
                 "hierarchy_built": r.hierarchy_built,
                 "hierarchy_ms": r.hierarchy_ms,
+                "coarse_level": r.coarse_level,
                 "solve_ms": r.solve_ms,
             })).collect::<Vec<_>>(),
             "pieces": s.pieces().len(),
