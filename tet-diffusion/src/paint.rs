@@ -99,11 +99,21 @@ impl Object {
         stroke: &Stroke,
     ) -> Result<(PaintReport, Vec<(u32, Medium)>), Error> {
         stroke.check()?;
+        let grid = self
+            .centres
+            .get_or_init(|| std::sync::Arc::new(CentreGrid::new(&self.mesh)))
+            .clone();
         let mesh = &self.mesh;
-        let reach2 = (3.0 * stroke.radius).powi(2);
-        let weights: Vec<(usize, f64)> = (0..mesh.tets().len())
+        let reach = 3.0 * stroke.radius;
+        let reach2 = reach.powi(2);
+        // Candidates from the grid (every tet whose centre is within the
+        // reach of a point, ascending), then exactly the test of every
+        // tet: the same tets and weights as testing them all.
+        let candidates = grid.near(&stroke.points, reach);
+        let weights: Vec<(usize, f64)> = candidates
             .into_par_iter()
             .with_min_len(1024)
+            .map(|t| t as usize)
             .filter_map(|t| {
                 let c = mesh.tet_center(t);
                 let d2 = stroke
@@ -224,5 +234,108 @@ impl Stroke {
         }
         stroke.medium.check("the painted medium")?;
         Ok(())
+    }
+}
+
+/// Tet centres binned in a uniform grid of about [`PER_CELL`] tets a cell
+/// over the centres' bounding box (a counting sort, once per mesh): the
+/// brush looks at the cells its reach overlaps, not at every tet.
+#[derive(Debug)]
+pub(crate) struct CentreGrid {
+    lo: DVec3,
+    cell: f64,
+    dims: [usize; 3],
+    /// Cell `k`'s tets are `tets[start[k]..start[k + 1]]`, ascending.
+    start: Vec<u32>,
+    tets: Vec<u32>,
+}
+
+/// Tets per grid cell, on average.
+const PER_CELL: f64 = 8.0;
+
+impl CentreGrid {
+    pub(crate) fn new(mesh: &crate::TetMesh) -> Self {
+        let centres: Vec<DVec3> = (0..mesh.tets().len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .map(|t| mesh.tet_center(t))
+            .collect();
+        let (lo, hi) = centres
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &c| {
+                (a.min(c), b.max(c))
+            });
+        let n = centres.len().max(1) as f64;
+        let extent = if centres.is_empty() {
+            DVec3::ONE
+        } else {
+            (hi - lo).max(DVec3::splat(1e-12))
+        };
+        let lo = if centres.is_empty() { DVec3::ZERO } else { lo };
+        // Cubic cells, about PER_CELL centres each over the box (at most
+        // 2²⁴ cells, so a flat mesh does not make a huge grid).
+        let cell = (extent.x * extent.y * extent.z * PER_CELL / n)
+            .cbrt()
+            .max(extent.max_element() / 256.0);
+        let dims = [extent.x, extent.y, extent.z].map(|e| ((e / cell) as usize + 1).min(256));
+        let index = |c: DVec3| -> usize {
+            let k = ((c - lo) / cell).to_array();
+            let i: [usize; 3] = std::array::from_fn(|a| (k[a].max(0.0) as usize).min(dims[a] - 1));
+            (i[2] * dims[1] + i[1]) * dims[0] + i[0]
+        };
+        let cells = dims[0] * dims[1] * dims[2];
+        let mut start = vec![0u32; cells + 1];
+        let keys: Vec<usize> = centres.iter().map(|&c| index(c)).collect();
+        for &k in &keys {
+            start[k + 1] += 1;
+        }
+        for k in 0..cells {
+            start[k + 1] += start[k];
+        }
+        let mut fill = start.clone();
+        let mut tets = vec![0u32; keys.len()];
+        for (t, &k) in keys.iter().enumerate() {
+            tets[fill[k] as usize] = t as u32;
+            fill[k] += 1;
+        }
+        Self {
+            lo,
+            cell,
+            dims,
+            start,
+            tets,
+        }
+    }
+
+    /// The tets (ascending, each once) of the cells within `reach` of
+    /// any of `points`: every tet whose centre is within `reach` of one.
+    pub(crate) fn near(&self, points: &[DVec3], reach: f64) -> Vec<u32> {
+        let cells = self.dims.iter().product::<usize>();
+        let mut seen = vec![false; cells];
+        let mut out = Vec::new();
+        // A margin far above the rounding of the cell indices.
+        let reach = reach + 1e-6 * self.cell;
+        for &p in points {
+            let range = |a: usize, v: f64| {
+                let lo = ((v - reach - self.lo[a]) / self.cell).floor();
+                let hi = ((v + reach - self.lo[a]) / self.cell).floor();
+                let max = self.dims[a] as f64 - 1.0;
+                (lo.clamp(0.0, max) as usize, hi.clamp(0.0, max) as usize)
+            };
+            let (x, y, z) = (range(0, p.x), range(1, p.y), range(2, p.z));
+            for k in z.0..=z.1 {
+                for j in y.0..=y.1 {
+                    for i in x.0..=x.1 {
+                        let c = (k * self.dims[1] + j) * self.dims[0] + i;
+                        if !std::mem::replace(&mut seen[c], true) {
+                            let (a, b) = (self.start[c] as usize, self.start[c + 1] as usize);
+                            out.extend_from_slice(&self.tets[a..b]);
+                        }
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        out
     }
 }

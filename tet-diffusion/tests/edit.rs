@@ -182,6 +182,53 @@ fn painting_updates_rows_exactly_as_a_full_assembly() {
 }
 
 #[test]
+fn the_brush_grid_paints_the_tets_testing_every_centre_would() {
+    // Strokes of several radii (a grid cell is a few tets wide), points
+    // inside, on and outside the ball, one on a lattice plane.
+    let mut o = lit_ball(9);
+    let ketchup = Medium::measured("ketchup").unwrap();
+    let strokes = [
+        (vec![DVec3::new(0.0, 4.9, 0.0)], 0.05),
+        (
+            vec![DVec3::new(0.3, -2.0, 1.1), DVec3::new(1.0, -1.0, 1.5)],
+            0.7,
+        ),
+        (vec![DVec3::new(5.5, 0.0, 0.0)], 0.4),
+        (vec![DVec3::new(0.0, 0.0, 0.0)], 3.0),
+        (vec![DVec3::new(9.0, 9.0, 9.0)], 0.5),
+    ];
+    for (points, radius) in strokes {
+        let before = o.media().to_vec();
+        let stroke = Stroke {
+            points: points.clone(),
+            radius,
+            medium: ketchup,
+            strength: 0.7,
+        };
+        let report = o.paint(&stroke).unwrap();
+        let mesh = o.mesh();
+        let mut painted = 0;
+        for t in 0..mesh.tets().len() {
+            let c = mesh.tet_center(t);
+            let d2 = points
+                .iter()
+                .map(|p| p.distance_squared(c))
+                .fold(f64::INFINITY, f64::min);
+            let id = mesh.original_ids()[t] as usize;
+            let want = if d2 <= (3.0 * radius).powi(2) {
+                painted += 1;
+                let w = 0.7 * (-d2 / (2.0 * radius * radius)).exp();
+                before[id].lerp(&ketchup, w)
+            } else {
+                before[id]
+            };
+            assert_eq!(o.media()[id], want, "tet {t}, radius {radius}");
+        }
+        assert_eq!(report.tets, painted, "radius {radius}");
+    }
+}
+
+#[test]
 fn painting_a_half_space_fills_the_tets_on_its_side_exactly_as_a_full_assembly() {
     let mut o = lit_ball(8);
     let skin = Medium::measured("skin1").unwrap();
