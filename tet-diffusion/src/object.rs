@@ -800,19 +800,15 @@ impl Object {
         let n = self.phi[0].len();
         let (mut r, mut z) = (vec![0.0; n], vec![0.0; n]);
         let mut reports = Vec::with_capacity(3);
-        for c in 0..3 {
+        for (c, v) in v.iter().enumerate() {
             multires::matrix::mul_vec(&self.matrices[c], &self.phi[c], &mut r);
             r.iter_mut()
                 .zip(&self.rhs[c])
                 .for_each(|(r, b)| *r = b - *r);
-            let (report, _) = v[c].coarse_correction(
-                level,
-                &r,
-                &mut z,
-                PREVIEW_SWEEPS,
-                &options,
-                &mut |_, _| ControlFlow::Continue(()),
-            )?;
+            let (report, _) =
+                v.coarse_correction(level, &r, &mut z, PREVIEW_SWEEPS, &options, &mut |_, _| {
+                    ControlFlow::Continue(())
+                })?;
             self.phi[c].iter_mut().zip(&z).for_each(|(x, z)| *x += z);
             reports.push(report);
         }
