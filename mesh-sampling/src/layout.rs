@@ -49,6 +49,15 @@ pub(crate) struct Piece {
     pub(crate) value: f32,
 }
 
+impl Piece {
+    /// A placeholder (face 0, the root, value 0).
+    pub(crate) const EMPTY: Self = Self {
+        face: 0,
+        part: SubTriangle::ROOT,
+        value: 0.0,
+    };
+}
+
 /// Bit widths of a packed column, from the least significant bit: the
 /// value (32, an `f32`), the compact sub-triangle code (`part`), the face
 /// (`face`), the alias's column (`alias`), and the threshold in the top
@@ -264,6 +273,28 @@ impl PieceAlias {
         let k = (x >> 64) as usize;
         let picked = self.format.side(k, self.columns[k], x as u64);
         self.get(picked)
+    }
+
+    /// The column and the side fraction for one `u64` of random bits (the
+    /// high and low parts of `bits · n`), as [`piece`](Self::piece) splits
+    /// them.
+    #[inline]
+    pub(crate) fn split(&self, bits: u64) -> (usize, u64) {
+        let x = u128::from(bits) * self.columns.len() as u128;
+        ((x >> 64) as usize, x as u64)
+    }
+
+    /// The column a draw takes in column `k` for the fraction `frac`: `k`
+    /// or its alias (reads column `k`).
+    #[inline]
+    pub(crate) fn side(&self, k: usize, frac: u64) -> usize {
+        self.format.side(k, self.columns[k], frac)
+    }
+
+    /// Asks for column `k`'s cache line ahead of its use (a hint: no read).
+    #[inline(always)]
+    pub(crate) fn prefetch(&self, k: usize) {
+        crate::prefetch::prefetch(&self.columns, k);
     }
 
     /// Fills `out` with pieces, one `u64` of `rng` each, in blocks whose

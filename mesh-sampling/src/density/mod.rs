@@ -15,6 +15,7 @@ use rand::distr::Distribution;
 use crate::layout::{Piece, PieceAlias};
 use crate::parallel::{BLOCK, unit};
 use crate::point::Frame;
+use crate::prefetch::prefetch;
 use crate::subdivision::{MAX_LEVEL, SubTriangle};
 use crate::{DensityTexture, Error, Layout, MeshRef, SurfacePoint, SurfaceSampler};
 
@@ -512,12 +513,113 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         std::hint::black_box(&seen);
     }
 
+    /// The batch path of the alias layout (not in exact mode): a software
+    /// pipeline over blocks of [`BLOCK`] draws, [`DEPTH`] blocks in
+    /// flight. Each turn draws a new block's random numbers and prefetches
+    /// its columns, picks the sides of the block before it (whose columns
+    /// have arrived meanwhile) and prefetches the picked columns, reads
+    /// the records of the block before that and prefetches its frames, and
+    /// computes the points of the oldest block: every miss of a draw is
+    /// asked for a turn before its use, and overlaps a block's
+    /// computation. The random numbers are drawn in the order of the
+    /// blockwise loop (a block's `u64` for the pieces, then its two per
+    /// point), so the points are the same bit for bit.
+    fn sample_alias<R: Rng + ?Sized>(
+        &self,
+        alias: &PieceAlias,
+        rng: &mut R,
+        out: &mut [SurfacePoint],
+    ) {
+        let blocks = out.len().div_ceil(BLOCK);
+        let mut ring = [Stage::EMPTY; DEPTH];
+        let needs_indices =
+            self.mesh.normals.is_some() || matches!(self.density, Density::PerVertex(_));
+        for t in 0..blocks + DEPTH - 1 {
+            if t < blocks {
+                let s = &mut ring[t % DEPTH];
+                s.len = (out.len() - t * BLOCK).min(BLOCK);
+                for (c, f) in s.column[..s.len].iter_mut().zip(&mut s.frac[..s.len]) {
+                    (*c, *f) = alias.split(rng.next_u64());
+                }
+                for xi in &mut s.xi[..s.len] {
+                    *xi = [rng.next_u64(), rng.next_u64()];
+                }
+                for &c in &s.column[..s.len] {
+                    alias.prefetch(c);
+                }
+            }
+            if let Some(b) = t.checked_sub(1).filter(|&b| b < blocks) {
+                let s = &mut ring[b % DEPTH];
+                for (c, &f) in s.column[..s.len].iter_mut().zip(&s.frac[..s.len]) {
+                    *c = alias.side(*c, f);
+                }
+                for &c in &s.column[..s.len] {
+                    alias.prefetch(c);
+                }
+            }
+            if let Some(b) = t.checked_sub(2).filter(|&b| b < blocks) {
+                let s = &mut ring[b % DEPTH];
+                for (p, &c) in s.piece[..s.len].iter_mut().zip(&s.column[..s.len]) {
+                    *p = alias.get(c);
+                }
+                for p in &s.piece[..s.len] {
+                    prefetch(&self.frames, p.face as usize);
+                    if needs_indices {
+                        prefetch(self.mesh.indices, p.face as usize);
+                    }
+                }
+            }
+            if let Some(b) = t.checked_sub(DEPTH - 1).filter(|&b| b < blocks) {
+                let s = &ring[b % DEPTH];
+                if let Some(normals) = self.mesh.normals {
+                    for p in &s.piece[..s.len] {
+                        for i in self.mesh.indices[p.face as usize] {
+                            prefetch(normals, i as usize);
+                        }
+                    }
+                }
+                let block = &mut out[b * BLOCK..][..s.len];
+                for ((slot, &piece), &[x1, x2]) in block.iter_mut().zip(&s.piece).zip(&s.xi) {
+                    let bary = self.place(piece, unit(x1), unit(x2));
+                    *slot = self.point(piece, bary, self.value(piece, bary));
+                }
+            }
+        }
+    }
+
     fn exact_texture(&self) -> Option<&DensityTexture> {
         match (self.density, self.mode) {
             (Density::Texture(t), Mode::Exact) => Some(t),
             _ => None,
         }
     }
+}
+
+/// Blocks in flight in [`DensitySampler::sample_alias`]'s pipeline: one
+/// drawing its columns, one picking its sides, one reading its records,
+/// one computing its points.
+const DEPTH: usize = 4;
+
+/// One block of [`DensitySampler::sample_alias`]'s pipeline.
+#[derive(Clone, Copy)]
+struct Stage {
+    len: usize,
+    /// The drawn columns, then the picked ones.
+    column: [usize; BLOCK],
+    frac: [u64; BLOCK],
+    /// The two `u64` of each point in its piece.
+    xi: [[u64; 2]; BLOCK],
+    piece: [Piece; BLOCK],
+}
+
+impl Stage {
+    const EMPTY: Self = Self {
+        len: 0,
+        column: [0; BLOCK],
+        frac: [0; BLOCK],
+        xi: [[0; 2]; BLOCK],
+        piece: [Piece::EMPTY; BLOCK],
+    };
 }
 
 /// Three `u64` of the random stream per point (one for the piece, two for
@@ -548,6 +650,9 @@ impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {
                 }
             }
             return;
+        }
+        if let Table::Alias(alias) = &self.table {
+            return self.sample_alias(alias, rng, out);
         }
         for block in out.chunks_mut(BLOCK) {
             let n = block.len();
