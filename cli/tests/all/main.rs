@@ -1,0 +1,13 @@
+//! Integration tests of `trilux`: one binary, one module a topic.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod cli;
+mod cmd;
+mod help;
+mod info_warnings;
+mod tet_cli;
+mod view_browser;
+mod view_protocol;
+mod view_session;

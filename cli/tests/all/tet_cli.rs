@@ -1,0 +1,662 @@
+//! End-to-end tests of `trilux tetra` and `trilux diffuse`: the files they
+//! write parse back with trilux-io and carry the counts the command
+//! reported; bad inputs fail with a message naming the problem and the
+//! file or argument; outputs are not clobbered without `--force`.
+
+use std::path::{Path, PathBuf};
+
+use crate::common;
+use common::{data, fails, have_data, json, run, trilux};
+use glam::Vec3;
+use trilux_io::mesh::TriMesh;
+
+/// The built-in bumpy blob (closed, about unit size) written as OBJ.
+fn blob(dir: &Path) -> PathBuf {
+    let path = dir.join("blob.obj");
+    trilux::shapes::blob(2).write(&path).unwrap();
+    path
+}
+
+/// The blob tetrahedralized at spacing `size` into `blob.node` (+ `.ele`).
+fn stuffed_blob(dir: &Path, size: &str) {
+    let blob = blob(dir);
+    trilux(dir)
+        .args([
+            "tetra",
+            blob.to_str().unwrap(),
+            "--spacing",
+            size,
+            "-o",
+            "blob.node",
+        ])
+        .assert()
+        .success();
+}
+
+#[test]
+fn tetra_writes_tetgen_medit_and_vtu_with_the_reported_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    for out in ["blob.node", "blob.mesh"] {
+        let report = json(d, &["tetra", blob, "--spacing", "0.15", "-o", out]);
+        let mesh = trilux_io::tet::read(d.join(out)).unwrap();
+        assert!(!mesh.tets.is_empty());
+        assert_eq!(report["tetrahedra"], mesh.tets.len());
+        assert_eq!(report["vertices"], mesh.positions.len());
+        let [lo, hi] = [
+            &report["dihedral_degrees"][0],
+            &report["dihedral_degrees"][1],
+        ]
+        .map(|v| v.as_f64().unwrap());
+        assert!(0.0 < lo && lo <= hi && hi < 180.0, "{lo} {hi}");
+    }
+    // The same lattice gives the same mesh in every format.
+    let report = json(d, &["tetra", blob, "--spacing", "0.15", "-o", "blob.vtu"]);
+    let vtu = std::fs::read_to_string(d.join("blob.vtu")).unwrap();
+    let cells = format!("NumberOfCells=\"{}\"", report["tetrahedra"]);
+    assert!(vtu.contains(&cells), "{cells} not in the VTU header");
+    // Grading keeps the surface's resolution with fewer tetrahedra inside.
+    let graded = json(
+        d,
+        &[
+            "tetra",
+            blob,
+            "--spacing",
+            "0.05",
+            "--graded",
+            "-o",
+            "g.node",
+        ],
+    );
+    let uniform = json(d, &["tetra", blob, "--spacing", "0.05", "-o", "u.node"]);
+    assert!(
+        graded["tetrahedra"].as_u64() < uniform["tetrahedra"].as_u64(),
+        "graded {} vs uniform {}",
+        graded["tetrahedra"],
+        uniform["tetrahedra"]
+    );
+}
+
+#[test]
+fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let triangle = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices: vec![[0, 1, 2]],
+        ..TriMesh::default()
+    };
+    triangle.write(d.join("triangle.obj")).unwrap();
+    fails(
+        d,
+        &["tetra", "triangle.obj", "--spacing", "0.1", "-o", "t.node"],
+        &["triangle.obj", "encloses nothing"],
+    );
+    assert!(!d.join("t.node").exists() && !d.join("t.ele").exists());
+    // An open sheet: a grid of triangles in a plane.
+    let n = 8u32;
+    let sheet = TriMesh {
+        positions: (0..=n)
+            .flat_map(|j| (0..=n).map(move |i| Vec3::new(i as f32, j as f32, 0.0) / n as f32))
+            .collect(),
+        indices: (0..n)
+            .flat_map(|j| {
+                (0..n).flat_map(move |i| {
+                    let a = j * (n + 1) + i;
+                    [[a, a + 1, a + n + 2], [a, a + n + 2, a + n + 1]]
+                })
+            })
+            .collect(),
+        ..TriMesh::default()
+    };
+    sheet.write(d.join("sheet.obj")).unwrap();
+    fails(
+        d,
+        &["tetra", "sheet.obj", "--spacing", "0.1", "-o", "s.node"],
+        &["sheet.obj", "encloses nothing"],
+    );
+    fails(
+        d,
+        &["tetra", "missing.obj", "-o", "m.node"],
+        &["missing.obj"],
+    );
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    fails(
+        d,
+        &["tetra", blob, "--spacing=-1", "-o", "neg.node"],
+        &["--spacing"],
+    );
+    // An existing output is kept without --force, replaced with it.
+    std::fs::write(d.join("kept.mesh"), "precious").unwrap();
+    fails(
+        d,
+        &["tetra", blob, "--spacing", "0.2", "-o", "kept.mesh"],
+        &["kept.mesh", "--force"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.join("kept.mesh")).unwrap(),
+        "precious"
+    );
+    trilux(d)
+        .args([
+            "tetra",
+            blob,
+            "--spacing",
+            "0.2",
+            "-o",
+            "kept.mesh",
+            "--force",
+        ])
+        .assert()
+        .success();
+    assert!(
+        !trilux_io::tet::read(d.join("kept.mesh"))
+            .unwrap()
+            .tets
+            .is_empty()
+    );
+}
+
+#[test]
+fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    stuffed_blob(d, "0.12");
+    let tets = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--material",
+            "marble",
+            "--unit-mm",
+            "20",
+            "--light",
+            "dir:0.3,1,0.6",
+            "--light",
+            "point:2,2,2:0.5,0.5,1",
+            "--cut",
+            "plane:0,0,1,0.2",
+            "--size",
+            "96",
+            "-o",
+            "marble.png",
+            "--exr",
+            "marble.exr",
+            "--vtu",
+            "marble.vtu",
+        ],
+    );
+    assert_eq!(report["objects"], 1);
+    // The cut removes the cap above z = 0.2 (splitting the tetrahedra it
+    // crosses): fewer remain than were stuffed, but most of the blob.
+    let cut = report["tetrahedra"].as_u64().unwrap();
+    let stuffed = tets.tets.len() as u64;
+    assert!(stuffed / 3 < cut && cut < stuffed, "{cut} of {stuffed}");
+    let png = trilux_io::image::read(d.join("marble.png")).unwrap();
+    assert_eq!((png.width, png.height), (96, 96));
+    let lit = png
+        .pixels
+        .iter()
+        .filter(|p| p[0] + p[1] + p[2] > 0.05 && **p != png.pixels[0])
+        .count();
+    assert!(lit > 96 * 96 / 20, "only {lit} lit pixels");
+    let exr = trilux_io::image::read(d.join("marble.exr")).unwrap();
+    assert_eq!((exr.width, exr.height), (96, 96));
+    let vtu = std::fs::read_to_string(d.join("marble.vtu")).unwrap();
+    for field in ["phi_r", "phi_g", "phi_b", "radiance"] {
+        assert!(vtu.contains(&format!("Name=\"{field}\"")), "{field}");
+    }
+    // Paint a ball of skin into the marble, then break the blob in two.
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "0.5,0,0:0.4:skin1",
+            "--fracture",
+            "plane:1,0,0,0",
+            "--view=0,0.3,1",
+            "--size",
+            "64",
+            "-o",
+            "broken.png",
+        ],
+    );
+    assert_eq!(report["objects"], 2);
+    // The fracture splits the tetrahedra the plane crosses (both crack
+    // faces flat), so the pieces hold more than were stuffed.
+    let pieces = report["tetrahedra"].as_u64().unwrap();
+    assert!(pieces > tets.tets.len() as u64, "{pieces}");
+    fails(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "0,0,0:-1:skin1",
+            "-o",
+            "p.png",
+        ],
+        &["--paint", "radius"],
+    );
+    // A surface is tetrahedralized first; noise between two materials.
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            "blob.obj",
+            "--material",
+            "noise:marble,skin1",
+            "--size",
+            "64",
+            "-o",
+            "noise.png",
+        ],
+    );
+    assert!(report["tetrahedra"].as_u64().unwrap() > 100);
+    assert!(d.join("noise.png").exists());
+}
+
+#[test]
+fn diffuse_names_a_bad_material_light_cut_or_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    fails(
+        d,
+        &["diffuse", blob, "--material", "jade", "-o", "a.png"],
+        &["jade", "marble"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--material", "noise:marble", "-o", "a.png"],
+        &["noise:A,B"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--light", "sun:0,1,0", "-o", "a.png"],
+        &["--light", "sun"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--light", "dir:0,1", "-o", "a.png"],
+        &["--light", "3"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--cut", "plane:0,0,0,1", "-o", "a.png"],
+        &["--cut", "zero"],
+    );
+    fails(
+        d,
+        &["diffuse", blob, "--view", "0,0,0", "-o", "a.png"],
+        &["--view", "zero"],
+    );
+    fails(
+        d,
+        &["diffuse", "missing.node", "-o", "a.png"],
+        &["missing.node"],
+    );
+    assert!(!d.join("a.png").exists());
+}
+
+#[test]
+fn tetra_stuffs_the_raw_bunny_and_diffuse_accepts_it() {
+    if !have_data("tetra_stuffs_the_raw_bunny_and_diffuse_accepts_it") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bunny = data("meshes/stanford-bunny.obj");
+    let report = json(d, &["tetra", bunny.to_str().unwrap(), "-o", "bunny.node"]);
+    let min = report["dihedral_degrees"][0].as_f64().unwrap();
+    assert!(min >= 8.9, "minimum dihedral {min}°");
+    let mesh = trilux_io::tet::read(d.join("bunny.node")).unwrap();
+    assert_eq!(report["tetrahedra"], mesh.tets.len());
+    trilux(d)
+        .args([
+            "diffuse",
+            "bunny.node",
+            "--material",
+            "marble",
+            "--unit-mm",
+            "1000",
+            "--cut",
+            "plane:0,0,1,0",
+            "--size",
+            "128",
+            "-o",
+            "bunny.png",
+        ])
+        .assert()
+        .success();
+    assert_eq!(
+        trilux_io::image::read(d.join("bunny.png")).unwrap().width,
+        128
+    );
+}
+
+/// Writes `faces` as a TetGen `.face` file (1-based, boundary markers).
+fn write_face_file(path: &Path, faces: &[[u32; 3]]) {
+    let mut text = format!("# boundary triangles\n{} 1\n", faces.len());
+    for (k, f) in faces.iter().enumerate() {
+        text.push_str(&format!(
+            "{} {} {} {} 1\n",
+            k + 1,
+            f[0] + 1,
+            f[1] + 1,
+            f[2] + 1
+        ));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+#[test]
+fn info_reads_a_tetgen_face_file_beside_its_node_and_ele_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    stuffed_blob(d, "0.15");
+    let mesh = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    let boundary = mesh.boundary();
+    write_face_file(&d.join("blob.face"), &boundary);
+    let report = json(d, &["info", "blob.face"]);
+    assert_eq!(report["kind"], "TetGen faces", "{report}");
+    assert_eq!(report["faces"], boundary.len(), "{report}");
+    assert_eq!(report["tetrahedra"], mesh.tets.len(), "{report}");
+    assert_eq!(report["matches_tetrahedra"], true, "{report}");
+    assert_eq!(report["closed"], true, "{report}");
+    assert_eq!(report["holes"], 0, "{report}");
+    let out = run(d, &["info", "blob.face"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(&format!("faces: {}", boundary.len())),
+        "{text}"
+    );
+    // A face list that is not the tetrahedra's boundary says so.
+    write_face_file(&d.join("blob.face"), &boundary[1..]);
+    let report = json(d, &["info", "blob.face"]);
+    assert_eq!(report["matches_tetrahedra"], false, "{report}");
+    assert_eq!(report["closed"], false, "{report}");
+    // The .node and .ele files it refers to are needed, and named.
+    std::fs::copy(d.join("blob.face"), d.join("lonely.face")).unwrap();
+    fails(d, &["info", "lonely.face"], &["lonely.node"]);
+}
+
+#[test]
+fn info_reads_the_face_files_of_the_data_folder() {
+    if !have_data("info_reads_the_face_files_of_the_data_folder") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["bunny_50k", "sphere_20k"] {
+        let file = data(&format!("tets/{name}.face"));
+        let report = json(dir.path(), &["info", file.to_str().unwrap()]);
+        assert_eq!(report["matches_tetrahedra"], true, "{name}: {report}");
+        assert_eq!(report["closed"], true, "{name}: {report}");
+    }
+}
+
+#[test]
+fn diffuse_paints_the_side_of_a_plane_with_one_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    stuffed_blob(d, "0.12");
+    let help = run(d, &["diffuse", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains("--paint plane:"), "no example in\n{help}");
+    // Ketchup (red) on the side x > 0 of a 4 cm marble blob seen from +z
+    // (+x to the right of the picture).
+    let report = json(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "plane:1,0,0,0:ketchup",
+            "--unit-mm",
+            "20",
+            "--view=0,0,1",
+            "--size",
+            "64",
+            "-o",
+            "half.png",
+        ],
+    );
+    let mesh = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    let right = mesh
+        .tets
+        .iter()
+        .filter(|t| t.iter().map(|&v| mesh.positions[v as usize].x).sum::<f64>() > 0.0)
+        .count();
+    assert_eq!(report["paint"][0]["spec"], "plane:1,0,0,0:ketchup");
+    assert_eq!(report["paint"][0]["tetrahedra"], right, "{report}");
+    let image = trilux_io::image::read(d.join("half.png")).unwrap();
+    let red = |columns: std::ops::Range<u32>| {
+        let mut n = 0;
+        for y in 0..image.height {
+            for x in columns.clone() {
+                let p = image.pixels[(y * image.width + x) as usize];
+                n += usize::from(p[0] > 0.1 && p[0] > 2.0 * p[1]);
+            }
+        }
+        n
+    };
+    let (left, right) = (red(0..28), red(36..64));
+    assert!(
+        right > 100 && left * 10 < right,
+        "red pixels: left {left}, right {right}"
+    );
+    fails(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "plane:0,0,0,1:skin1",
+            "-o",
+            "p.png",
+        ],
+        &["'plane:0,0,0,1:skin1' for '--paint <SPEC>'", "zero"],
+    );
+    fails(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--paint",
+            "plane:1,0,0,0:jade",
+            "-o",
+            "p.png",
+        ],
+        &["'plane:1,0,0,0:jade' for '--paint <SPEC>'", "marble"],
+    );
+    assert!(!d.join("p.png").exists());
+}
+
+#[test]
+fn tetra_refuses_a_spacing_too_fine_before_computing_and_reports_the_one_it_used() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    // A user trial's tiny spacing ran for minutes and aborted on memory:
+    // now it is a usage error naming the argument, in readable numbers.
+    for size in ["0.0004", "1e-300"] {
+        let err = common::fails_with(
+            d,
+            2,
+            &["tetra", blob, "--spacing", size, "-o", "t.node"],
+            &[
+                "--spacing",
+                "too fine for this surface",
+                "use a larger --spacing",
+            ],
+        );
+        assert!(err.len() < 300, "{err}");
+    }
+    assert!(!d.join("t.node").exists());
+    // The old name still works, says it is deprecated, and errors name it
+    // as typed.
+    let out = run(d, &["tetra", blob, "--size", "0.3", "-o", "old.node"]);
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    assert!(
+        common::stderr(&out)
+            .contains("warning: `trilux tetra --size` is deprecated, use --spacing")
+    );
+    common::fails_with(
+        d,
+        2,
+        &["tetra", blob, "--size", "1e-300", "-o", "t.node"],
+        &["--size 1e-300: ", "use a larger --size"],
+    );
+    common::fails_with(
+        d,
+        2,
+        &[
+            "tetra",
+            blob,
+            "--size",
+            "0.3",
+            "--spacing",
+            "0.3",
+            "-o",
+            "t.node",
+        ],
+        &["--spacing"],
+    );
+    // The spacing used (here the default) and every file written, in a
+    // stable order, preview included.
+    let report = json(d, &["tetra", blob, "-o", "b.node", "--preview", "b.png"]);
+    let h = report["spacing"].as_f64().unwrap();
+    assert!(h > 0.0 && h < 0.2, "{h}");
+    let files: Vec<&str> = report["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    assert_eq!(files.len(), 3, "{files:?}");
+    assert!(files.windows(2).all(|w| w[0] <= w[1]), "{files:?}");
+    assert!(files.iter().any(|f| f.ends_with("b.png")));
+}
+
+#[test]
+fn huge_and_far_away_coordinates_are_measured_where_the_file_puts_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let tet = |scale: f32, at: Vec3| TriMesh {
+        positions: [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z]
+            .map(|p| at + p * scale)
+            .to_vec(),
+        indices: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        ..TriMesh::default()
+    };
+    // Coordinates near 1e30: the default spacing used to overflow in f32
+    // and blame a --size nobody gave.
+    tet(1e30, Vec3::ZERO).write(d.join("huge.obj")).unwrap();
+    let report = json(d, &["tetra", "huge.obj", "-o", "h.node"]);
+    assert!(report["tetrahedra"].as_u64().unwrap() > 0);
+    // A unit tetrahedron at 100000: `info` used to show the reader's
+    // shifted bounds, around 0.
+    tet(1.0, Vec3::splat(100_000.0))
+        .write(d.join("far.obj"))
+        .unwrap();
+    let info = json(d, &["info", "far.obj"]);
+    let lo = info["bounds"][0][0].as_f64().unwrap();
+    let hi = info["bounds"][1][0].as_f64().unwrap();
+    assert!(
+        (lo - 100_000.0).abs() < 1e-3 && (hi - 100_001.0).abs() < 1e-3,
+        "{info}"
+    );
+}
+
+#[test]
+fn diffuse_names_the_formats_it_reads() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("x.vtu"), "<VTKFile/>").unwrap();
+    common::fails_with(
+        d,
+        1,
+        &["diffuse", "x.vtu", "-o", "x.png"],
+        &["x.vtu", ".node", ".obj"],
+    );
+}
+
+/// A TetGen mesh with nodes no tetrahedron uses (one before all others,
+/// one after: what TetGen's `-r` and meshio's point lists leave): diffuse
+/// and view drop them with a warning naming the file and the first node,
+/// and the VTU keeps the file's nodes and tetrahedra (NaN where dropped).
+#[test]
+fn diffuse_drops_nodes_no_tetrahedron_uses_and_writes_the_files_numbering() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    stuffed_blob(d, "0.3");
+    let mut mesh = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    mesh.positions.insert(0, glam::DVec3::new(9.0, 9.0, 9.0));
+    mesh.positions.push(glam::DVec3::new(-9.0, 9.0, 9.0));
+    for t in &mut mesh.tets {
+        *t = t.map(|v| v + 1);
+    }
+    trilux_io::tet::write(d.join("loose.node"), &mesh).unwrap();
+    assert_eq!(mesh.unused_nodes(), [0, mesh.positions.len() as u32 - 1]);
+    let out = run(
+        d,
+        &[
+            "diffuse",
+            "loose.node",
+            "--size",
+            "32",
+            "-o",
+            "loose.png",
+            "--vtu",
+            "loose.vtu",
+        ],
+    );
+    let err = common::stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: loose.node: 2 nodes are used by no tetrahedron (first: node 0"),
+        "{err}"
+    );
+    let vtu = std::fs::read_to_string(d.join("loose.vtu")).unwrap();
+    let piece = format!(
+        "NumberOfPoints=\"{}\" NumberOfCells=\"{}\"",
+        mesh.positions.len(),
+        mesh.tets.len()
+    );
+    assert!(vtu.contains(&piece), "{piece}");
+}
+
+#[test]
+fn diffuse_warns_when_a_cut_plane_misses_the_object() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    stuffed_blob(d, "0.2");
+    let base = ["diffuse", "blob.node", "--unit-mm", "20", "--size", "32"];
+    // z > 5 is far above the unit-size blob: nothing is cut.
+    let miss = run(
+        d,
+        &[&base[..], &["--cut", "plane:0,0,1,5", "-o", "a.png"]].concat(),
+    );
+    assert!(miss.status.success());
+    let err = common::stderr(&miss);
+    assert!(
+        err.contains("warning: --cut plane:0,0,1,5: the plane misses the object"),
+        "{err}"
+    );
+    // A plane through the middle cuts and says nothing of the kind.
+    let hit = run(
+        d,
+        &[&base[..], &["--cut", "plane:0,0,1,0", "-o", "b.png"]].concat(),
+    );
+    assert!(hit.status.success());
+    assert!(!common::stderr(&hit).contains("misses"));
+}

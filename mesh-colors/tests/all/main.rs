@@ -1,0 +1,18 @@
+//! Integration tests of `mesh-colors`: one binary, one module a topic.
+
+#[path = "../support/mod.rs"]
+mod support;
+
+// The textured meshes of the data folder (shared with the `lookup` example).
+#[path = "../support/data.rs"]
+mod data;
+
+mod atlas;
+mod convert;
+mod edit;
+mod file;
+mod filtering;
+mod limits;
+mod paint;
+mod structure;
+mod texture;

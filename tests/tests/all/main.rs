@@ -1,0 +1,5 @@
+//! Integration tests of `trilux-tests`: one binary, one module a topic.
+
+mod adapters;
+mod cross;
+mod stuffing;

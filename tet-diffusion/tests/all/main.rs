@@ -1,0 +1,10 @@
+//! Integration tests of `tet-diffusion`: one binary, one module a topic.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod data;
+mod edit;
+mod lights;
+mod session;
+mod solver;
