@@ -154,6 +154,34 @@ pub(crate) fn index_rows<const K: usize>(
     Ok(out)
 }
 
+/// A PIL image whose array is not colour values — a palette image's
+/// indices (mode `P`, `PA`; trimesh keeps palette PNGs so), or CMYK,
+/// YCbCr, LAB, HSV channels — converted to RGB (RGBA with transparency)
+/// first, as PIL shows it; anything else is returned as it is.
+fn pil_as_colours<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    // Not a PIL image, or one that cannot be touched (trimesh's placeholder
+    // without Pillow): numpy's conversion below reports it.
+    let Some(mode) = obj
+        .getattr("mode")
+        .ok()
+        .and_then(|m| m.extract::<String>().ok())
+    else {
+        return Ok(obj.clone());
+    };
+    let transparent = || -> bool {
+        obj.getattr("info")
+            .and_then(|info| info.contains("transparency"))
+            .unwrap_or(false)
+    };
+    let target = match mode.as_str() {
+        "PA" => "RGBA",
+        "P" if transparent() => "RGBA",
+        "P" | "CMYK" | "YCbCr" | "LAB" | "HSV" => "RGB",
+        _ => return Ok(obj.clone()),
+    };
+    obj.call_method1("convert", (target,))
+}
+
 /// An image as a numpy array: `(H, W)` or `(H, W, C)` with `C` in 1..=4,
 /// any real dtype; integers are scaled to `[0, 1]` by their type's maximum
 /// (`uint8` by 255, `uint16` by 65535). Returns width, height, channels
@@ -168,7 +196,8 @@ pub(crate) struct ImageArray {
 
 pub(crate) fn image_array(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<ImageArray> {
     let np = obj.py().import("numpy")?;
-    let arr = np.call_method1("asarray", (obj,))?;
+    let obj = pil_as_colours(obj)?;
+    let arr = np.call_method1("asarray", (&obj,))?;
     let dtype = arr.getattr("dtype")?;
     let kind: String = dtype.getattr("kind")?.extract()?;
     let scale = match kind.as_str() {

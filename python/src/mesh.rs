@@ -153,22 +153,44 @@ fn visual_texture(visual: &Bound<'_, PyAny>) -> PyResult<Option<Image>> {
         }
         let place = format!("mesh.visual.material.{name}");
         return match image_from(&img, &place, true) {
-            Ok(image) => Ok(Some(image)),
+            Ok(image) => {
+                if is_placeholder(&image) {
+                    let message = format!(
+                        "{place} is a single-colour {}×{} image, the one trimesh makes when the \
+                         file names no texture (no mtllib or map_Kd): to use a texture, pass its \
+                         image (e.g. MeshColors.from_texture(mesh, image))",
+                        image.width, image.height
+                    );
+                    warn_user(visual.py(), &message)?;
+                }
+                Ok(Some(image))
+            }
             Err(e) => {
                 let py = visual.py();
                 let message = format!(
                     "{place} could not be read ({}); the mesh is used without its texture",
                     e.value(py)
                 );
-                let message = std::ffi::CString::new(message.replace('\0', " "))
-                    .unwrap_or_else(|_| c"the mesh's texture could not be read".to_owned());
-                let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
-                PyErr::warn(py, category.as_any(), &message, 1)?;
+                warn_user(py, &message)?;
                 Ok(None)
             }
         };
     }
     Ok(None)
+}
+
+/// A texture of at most 4 texels, all one colour: what trimesh's
+/// `empty_material` holds for a file with UVs and no texture.
+fn is_placeholder(image: &Image) -> bool {
+    image.pixels.len() <= 4 && image.pixels.windows(2).all(|w| w[0] == w[1])
+}
+
+/// A Python `UserWarning` with this message.
+fn warn_user(py: Python<'_>, message: &str) -> PyResult<()> {
+    let message = std::ffi::CString::new(message.replace('\0', " "))
+        .unwrap_or_else(|_| c"trilux: a warning could not be formatted".to_owned());
+    let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+    PyErr::warn(py, category.as_any(), &message, 1)
 }
 
 /// The mesh a function was given: a `trilux.Mesh` (used as it is), an

@@ -127,3 +127,22 @@ def test_textured_trimesh_brings_its_uv_and_texture(data):
     assert abs(colors.sample_count - own.sample_count) <= own.sample_count // 100
     rgb = colors.lookup(faces[:1000], bary[:1000])
     assert rgb.shape == (1000, 3) and rgb.dtype == np.float32 and (rgb >= 0).all()
+
+
+def test_palette_pil_images_are_read_as_their_colours():
+    """trimesh keeps palette PNGs as PIL images of mode "P": their array is
+    palette indices, so they are converted to RGB first (as PIL shows them)."""
+    from PIL import Image
+
+    rng = np.random.default_rng(3)
+    rgb = Image.fromarray(rng.integers(0, 255, (16, 16, 3), dtype=np.uint8))
+    palette = rgb.quantize(colors=8)
+    assert palette.mode == "P"
+    as_rgb = np.asarray(palette.convert("RGB"))
+    a = trilux.Distribution2D(palette)
+    b = trilux.Distribution2D(as_rgb)
+    u = rng.random((1000, 2))
+    assert np.array_equal(a.sample_u(u)[0], b.sample_u(u)[0])
+    indices = np.asarray(palette)  # what a plain array conversion would read
+    c = trilux.Distribution2D(indices)
+    assert not np.array_equal(a.sample_u(u)[0], c.sample_u(u)[0])

@@ -104,3 +104,35 @@ def test_an_unreadable_texture_is_left_out_with_a_warning_not_an_error():
         points, faces = trilux.sample_surface(_TexturedMesh(), 100, seed=1)
     assert points.shape == (100, 3)
     assert (faces == 0).all()
+
+
+class _PlainMaterial:
+    def __init__(self, image):
+        self.image = image
+
+
+class _MeshWithImage:
+    def __init__(self, image):
+        self.vertices = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+        self.faces = np.array([[0, 1, 2]])
+        self.visual = _Visual(3)
+        self.visual.uv = np.array([[0.0, 0], [1, 0], [0, 1]])
+        self.visual.material = _PlainMaterial(image)
+
+
+def test_trimesh_single_colour_placeholder_texture_warns():
+    """trimesh's `empty_material` (an OBJ with UVs and no texture) is a 2×2
+    image of one colour: mesh colours from it are one colour, so say so."""
+    import pytest
+
+    grey = np.full((2, 2, 3), 102, dtype=np.uint8)
+    with pytest.warns(UserWarning, match=r"single-colour 2×2 image.*names no texture"):
+        colors = trilux.MeshColors.from_texture(_MeshWithImage(grey))
+    assert colors is not None
+    # A real texture (more than 4 texels, or not one colour) does not warn.
+    import warnings
+
+    texture = np.random.default_rng(1).integers(0, 255, (8, 8, 3), dtype=np.uint8)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        trilux.MeshColors.from_texture(_MeshWithImage(texture))
