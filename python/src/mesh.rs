@@ -135,6 +135,9 @@ pub(crate) fn image_to<'py>(py: Python<'py>, image: &Image) -> PyResult<Bound<'p
 /// (trimesh's `SimpleMaterial`) or `visual.material.baseColorTexture`
 /// (its `PBRMaterial`), when there is one.
 ///
+/// trimesh's placeholder (`empty_material`: at most 4 texels of one
+/// colour, made for a file with UVs and no texture) counts as no texture.
+///
 /// A texture that cannot be read (trimesh without Pillow hands out a
 /// placeholder that raises when touched) is left out with a Python
 /// `UserWarning` instead of failing the call: the geometry is intact, and
@@ -153,18 +156,10 @@ fn visual_texture(visual: &Bound<'_, PyAny>) -> PyResult<Option<Image>> {
         }
         let place = format!("mesh.visual.material.{name}");
         return match image_from(&img, &place, true) {
-            Ok(image) => {
-                if is_placeholder(&image) {
-                    let message = format!(
-                        "{place} is a single-colour {}×{} image, the one trimesh makes when the \
-                         file names no texture (no mtllib or map_Kd): to use a texture, pass its \
-                         image (e.g. MeshColors.from_texture(mesh, image))",
-                        image.width, image.height
-                    );
-                    warn_user(visual.py(), &message)?;
-                }
-                Ok(Some(image))
-            }
+            // trimesh's placeholder is not the file's texture: a call that
+            // needs one then says the mesh has none, instead of baking one grey.
+            Ok(image) if is_placeholder(&image) => Ok(None),
+            Ok(image) => Ok(Some(image)),
             Err(e) => {
                 let py = visual.py();
                 let message = format!(

@@ -120,19 +120,17 @@ class _MeshWithImage:
         self.visual.material = _PlainMaterial(image)
 
 
-def test_trimesh_single_colour_placeholder_texture_warns():
+def test_trimesh_single_colour_placeholder_is_no_texture():
     """trimesh's `empty_material` (an OBJ with UVs and no texture) is a 2×2
-    image of one colour: mesh colours from it are one colour, so say so."""
+    image of one colour: it is not the file's texture, so mesh colours from
+    it are refused with the message that asks for one, not baked grey."""
     import pytest
 
     grey = np.full((2, 2, 3), 102, dtype=np.uint8)
-    with pytest.warns(UserWarning, match=r"single-colour 2×2 image.*names no texture"):
-        colors = trilux.MeshColors.from_texture(_MeshWithImage(grey))
-    assert colors is not None
-    # A real texture (more than 4 texels, or not one colour) does not warn.
-    import warnings
-
+    with pytest.raises(trilux.InputError, match=r"no material with a texture: give one"):
+        trilux.MeshColors.from_texture(_MeshWithImage(grey))
+    # A real texture (more than 4 texels, or not one colour) is used.
     texture = np.random.default_rng(1).integers(0, 255, (8, 8, 3), dtype=np.uint8)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        trilux.MeshColors.from_texture(_MeshWithImage(texture))
+    trilux.MeshColors.from_texture(_MeshWithImage(texture))
+    two = np.array([[[0, 0, 0], [255, 255, 255]]], dtype=np.uint8)
+    trilux.MeshColors.from_texture(_MeshWithImage(two))
