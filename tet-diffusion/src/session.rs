@@ -529,6 +529,25 @@ impl Session {
     /// not recombine, an index past the pieces); the session is then as
     /// before the edit, and the coalesced edits are dropped.
     pub fn apply_pending(&mut self) -> Option<Result<Applied, Error>> {
+        self.apply_pending_with(|_, _| {})
+    }
+
+    /// [`apply_pending`](Self::apply_pending), calling `performed` once the
+    /// edit is done to the pieces and before they are solved: the pieces
+    /// then hold the edit with the `φ` of before carried over (the solve's
+    /// warm start; a cut's created vertices interpolated along their
+    /// edges). A viewer shows a cut's new surface from there, since the
+    /// solve after a cut (a new hierarchy, then the coarse solve) takes
+    /// longer than the cut. `performed` is not called for an edit that
+    /// fails; what it sees is not the edit's result, which
+    /// [`Session::pieces`] gives after this returns.
+    ///
+    /// # Errors
+    /// Those of [`apply_pending`](Self::apply_pending).
+    pub fn apply_pending_with(
+        &mut self,
+        performed: impl FnOnce(&Session, &Edit),
+    ) -> Option<Result<Applied, Error>> {
         let first = self.pending.pop_front()?;
         let mut coalesced = 1;
         let mut edit = first;
@@ -554,10 +573,15 @@ impl Session {
             self.pending.pop_front();
             coalesced += 1;
         }
-        Some(self.apply(edit, coalesced))
+        Some(self.apply(edit, coalesced, performed))
     }
 
-    fn apply(&mut self, edit: Edit, coalesced: usize) -> Result<Applied, Error> {
+    fn apply(
+        &mut self,
+        edit: Edit,
+        coalesced: usize,
+        performed: impl FnOnce(&Session, &Edit),
+    ) -> Result<Applied, Error> {
         let start = Instant::now();
         let (delta, touched) = self.perform(&edit)?;
         self.history.truncate(self.cursor);
@@ -573,6 +597,7 @@ impl Session {
             built: Vec::new(),
         });
         self.cursor = k + 1;
+        performed(self, &edit);
         let solves = self.solve_recording_kept(k, &touched)?;
         self.unrefined = true;
         self.thin_phi();
@@ -707,7 +732,9 @@ impl Session {
 
     /// [`perform`](Self::perform) of a cut.
     fn perform_cut(&mut self, cut: &Cut) -> Result<(Delta, Vec<usize>), Error> {
-        let before = (self.pieces.clone(), self.offsets.clone());
+        // The pieces before become the checkpoint as they are: each piece
+        // is copied once (the one cut, or one the cut does not reach),
+        // not once for the checkpoint and again for the cut.
         let mut pieces = Vec::new();
         let mut offsets = Vec::new();
         let mut touched = Vec::new();
@@ -738,9 +765,9 @@ impl Session {
         if pieces.is_empty() {
             return Err(Error::CutRemovesEverything { tets: removed_all });
         }
-        self.pieces = pieces;
-        self.offsets = offsets;
-        Ok((Delta::Checkpoint(before.0, before.1), touched))
+        let before_pieces = std::mem::replace(&mut self.pieces, pieces);
+        let before_offsets = std::mem::replace(&mut self.offsets, offsets);
+        Ok((Delta::Checkpoint(before_pieces, before_offsets), touched))
     }
 
     /// Whether an edit applied at history index `k` is an anchor: the
@@ -1010,7 +1037,7 @@ impl Session {
                     need: "an edit was lost",
                 },
             ))?;
-            s.apply(edit, 1).map_err(|e| (k, e))?;
+            s.apply(edit, 1, |_, _| {}).map_err(|e| (k, e))?;
             if l.refined {
                 s.refine_now().map_err(|e| (k, e))?;
             }

@@ -151,33 +151,29 @@ impl Worker {
         let t = Instant::now();
         let c = cpu_ms();
         let mut reports: Vec<SolveReport> = Vec::new();
-        let mut topology = false;
         let mut name = "edit";
-        while let Some(result) = self.session.apply_pending() {
+        let last = seqs.last().copied().unwrap_or(0);
+        let (out, latest) = (&self.out, &self.latest);
+        // A cut's new surface goes out before its solve (a new hierarchy
+        // and the coarse solve take longer than the cut), coloured by the
+        // φ carried over until the solved radiance follows.
+        let show_new_surface = |s: &Session, edit: &Edit| {
+            if edit.changes_topology() {
+                publish_surfaces(out, latest, s);
+                publish_radiance(out, latest, s, false, last);
+            }
+        };
+        while let Some(result) = self.session.apply_pending_with(show_new_surface) {
             match result {
-                Ok(Applied {
-                    edit,
-                    solves,
-                    topology_changed,
-                    ..
-                }) => {
+                Ok(Applied { edit, solves, .. }) => {
                     name = edit.name();
-                    topology |= topology_changed;
                     reports.extend(solves);
                 }
                 Err(e) => {
-                    self.error(
-                        seqs.last().copied().unwrap_or(0),
-                        &field_of(&e),
-                        &e.to_string(),
-                    );
+                    self.error(last, &field_of(&e), &e.to_string());
                 }
             }
         }
-        if topology {
-            self.send_surfaces();
-        }
-        let last = seqs.last().copied().unwrap_or(0);
         self.send_radiance(!self.session.needs_refinement(), last);
         self.send_status(seqs, name, &reports, t, c, self.session.needs_refinement());
     }
@@ -393,81 +389,15 @@ impl Worker {
     }
 
     fn latest_mut(&self) -> std::sync::MutexGuard<'_, Latest> {
-        self.latest
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
+        lock(&self.latest)
     }
 
     fn send_surfaces(&mut self) {
-        let n = self.session.pieces().len();
-        let frames: Vec<Arc<Vec<u8>>> = self
-            .session
-            .pieces()
-            .iter()
-            .enumerate()
-            .map(|(p, o)| {
-                let m = o.mesh();
-                let bv = m.boundary_vertices();
-                let mut payload = Vec::with_capacity(bv.len() * 24 + m.boundary().len() * 12);
-                protocol::put_f32(
-                    &mut payload,
-                    bv.iter()
-                        .flat_map(|&v| m.positions()[v as usize].as_vec3().to_array()),
-                );
-                protocol::put_f32(
-                    &mut payload,
-                    bv.iter()
-                        .flat_map(|&v| m.vertex_normals()[v as usize].as_vec3().to_array()),
-                );
-                protocol::put_u32(
-                    &mut payload,
-                    m.boundary()
-                        .iter()
-                        .flat_map(|t| t.map(|v| m.boundary_index(v as usize).unwrap_or(0) as u32)),
-                );
-                let flags = if p + 1 == n { LAST } else { 0 };
-                Arc::new(protocol::frame(
-                    SURFACE,
-                    flags,
-                    p as u8,
-                    bv.len() as u32,
-                    m.boundary().len() as u32,
-                    &payload,
-                ))
-            })
-            .collect();
-        for f in &frames {
-            self.send(Out::Binary(f.clone()));
-        }
-        self.latest_mut().surfaces = frames;
+        publish_surfaces(&self.out, &self.latest, &self.session);
     }
 
     fn send_radiance(&mut self, refined: bool, seq: u64) {
-        let n = self.session.pieces().len();
-        let frames: Vec<Arc<Vec<u8>>> = self
-            .session
-            .pieces()
-            .iter()
-            .enumerate()
-            .map(|(p, o)| {
-                let l = o.radiance(None);
-                let mut payload = Vec::with_capacity(l.len() * 12);
-                protocol::put_f32(&mut payload, l.iter().flat_map(|c| c.map(|x| x as f32)));
-                let flags = if refined { FINAL } else { 0 } | if p + 1 == n { LAST } else { 0 };
-                Arc::new(protocol::frame(
-                    RADIANCE,
-                    flags,
-                    p as u8,
-                    l.len() as u32,
-                    seq as u32,
-                    &payload,
-                ))
-            })
-            .collect();
-        for f in &frames {
-            self.send(Out::Binary(f.clone()));
-        }
-        self.latest_mut().radiance = frames;
+        publish_radiance(&self.out, &self.latest, &self.session, refined, seq);
     }
 
     fn send_status(
@@ -514,6 +444,98 @@ impl Worker {
         self.latest_mut().status = Some(status.clone());
         self.send(Out::Text(status));
     }
+}
+
+/// Sends each piece's boundary surface (positions, normals, triangles)
+/// and keeps the frames for pages that connect later.
+fn publish_surfaces(out: &broadcast::Sender<Out>, latest: &Mutex<Latest>, session: &Session) {
+    let frames = piece_frames(session, |p, o, last| {
+        let m = o.mesh();
+        let bv = m.boundary_vertices();
+        let mut payload = Vec::with_capacity(bv.len() * 24 + m.boundary().len() * 12);
+        protocol::put_f32(
+            &mut payload,
+            bv.iter()
+                .flat_map(|&v| m.positions()[v as usize].as_vec3().to_array()),
+        );
+        protocol::put_f32(
+            &mut payload,
+            bv.iter()
+                .flat_map(|&v| m.vertex_normals()[v as usize].as_vec3().to_array()),
+        );
+        protocol::put_u32(
+            &mut payload,
+            m.boundary()
+                .iter()
+                .flat_map(|t| t.map(|v| m.boundary_index(v as usize).unwrap_or(0) as u32)),
+        );
+        protocol::frame(
+            SURFACE,
+            last,
+            p as u8,
+            bv.len() as u32,
+            m.boundary().len() as u32,
+            &payload,
+        )
+    });
+    broadcast_frames(out, &frames);
+    lock(latest).surfaces = frames;
+}
+
+/// Sends each piece's radiance per boundary vertex, tagged with the edit
+/// `seq` and whether it is refined, and keeps the frames.
+fn publish_radiance(
+    out: &broadcast::Sender<Out>,
+    latest: &Mutex<Latest>,
+    session: &Session,
+    refined: bool,
+    seq: u64,
+) {
+    let frames = piece_frames(session, |p, o, last| {
+        let l = o.radiance(None);
+        let mut payload = Vec::with_capacity(l.len() * 12);
+        protocol::put_f32(&mut payload, l.iter().flat_map(|c| c.map(|x| x as f32)));
+        let flags = if refined { FINAL } else { 0 } | last;
+        protocol::frame(
+            RADIANCE,
+            flags,
+            p as u8,
+            l.len() as u32,
+            seq as u32,
+            &payload,
+        )
+    });
+    broadcast_frames(out, &frames);
+    lock(latest).radiance = frames;
+}
+
+/// One frame per piece, made by `frame(piece index, piece, flag)`, where
+/// the flag is [`LAST`] for the last piece and 0 before it.
+fn piece_frames(
+    session: &Session,
+    frame: impl Fn(usize, &tet_diffusion::Object, u8) -> Vec<u8>,
+) -> Vec<Arc<Vec<u8>>> {
+    let n = session.pieces().len();
+    session
+        .pieces()
+        .iter()
+        .enumerate()
+        .map(|(p, o)| Arc::new(frame(p, o, if p + 1 == n { LAST } else { 0 })))
+        .collect()
+}
+
+fn broadcast_frames(out: &broadcast::Sender<Out>, frames: &[Arc<Vec<u8>>]) {
+    for f in frames {
+        // No page connected is not an error: the state is kept in
+        // `latest` for the next one.
+        let _ = out.send(Out::Binary(f.clone()));
+    }
+}
+
+fn lock(latest: &Mutex<Latest>) -> std::sync::MutexGuard<'_, Latest> {
+    latest
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// The field an edit's error names: the argument for a bad one, else the

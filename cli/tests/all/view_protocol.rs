@@ -117,6 +117,7 @@ async fn until(s: &mut Socket, kind: &str, seen: &mut Seen) -> Value {
                         let t = u32::from_le_bytes(b[12..16].try_into().unwrap()) as usize;
                         assert_eq!(b.len(), 16 + a * 24 + t * 12);
                         seen.surfaces += 1;
+                        seen.frames.push(Frame::Surface);
                     }
                     protocol::RADIANCE => {
                         assert_eq!(b.len(), 16 + a * 12);
@@ -125,6 +126,8 @@ async fn until(s: &mut Socket, kind: &str, seen: &mut Seen) -> Value {
                             .all(|c| f32::from_le_bytes(c.try_into().unwrap()).is_finite());
                         assert!(finite);
                         seen.radiance += 1;
+                        let tag = u32::from_le_bytes(b[12..16].try_into().unwrap());
+                        seen.frames.push(Frame::Radiance(tag as u64));
                         if b[6] & protocol::FINAL != 0 {
                             seen.finals += 1;
                         }
@@ -143,6 +146,16 @@ struct Seen {
     surfaces: usize,
     radiance: usize,
     finals: usize,
+    /// The binary frames in arrival order.
+    frames: Vec<Frame>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Frame {
+    Surface,
+    /// Radiance, with the edit's sequence number it answers (0: a
+    /// refinement or a reconnection).
+    Radiance(u64),
 }
 
 async fn send(s: &mut Socket, v: Value) {
@@ -293,6 +306,7 @@ async fn every_edit_through_the_protocol() {
     ];
     for (m, name, pieces) in &edits {
         let surfaces = seen.surfaces;
+        let frames = seen.frames.len();
         send(&mut s, m.clone()).await;
         let st = loop {
             let st = until(&mut s, "status", &mut seen).await;
@@ -317,6 +331,23 @@ async fn every_edit_through_the_protocol() {
         }
         let topology = ["cut", "fracture", "recombine"].contains(name);
         assert_eq!(seen.surfaces > surfaces, topology, "{m}");
+        // A new surface goes out before the solve, with the radiance of
+        // the φ carried over; the solved radiance follows. Other edits
+        // send the solved radiance alone.
+        let seq = m["seq"].as_u64().unwrap();
+        let ours: Vec<Frame> = seen.frames[frames..]
+            .iter()
+            .copied()
+            .filter(|&f| f == Frame::Surface || f == Frame::Radiance(seq))
+            .collect();
+        let p = *pieces;
+        let mut expected = Vec::new();
+        if topology {
+            expected.extend(vec![Frame::Surface; p]);
+            expected.extend(vec![Frame::Radiance(seq); p]);
+        }
+        expected.extend(vec![Frame::Radiance(seq); p]);
+        assert_eq!(ours, expected, "{m}");
     }
     // The cuts removed tets; recombining gave back the cut object.
     let after_recombine = until(&mut s, "status", &mut seen).await;

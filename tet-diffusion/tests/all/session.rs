@@ -242,6 +242,47 @@ fn the_coarse_result_comes_first_and_refines_to_the_plain_solve() {
 }
 
 #[test]
+fn a_cut_is_seen_before_its_solve_with_the_phi_carried_over() {
+    let mut s = Session::new(lit_ball(8), SessionOptions::default()).unwrap();
+    s.refine_now().unwrap();
+    let before = s.pieces()[0].fluence();
+    s.push(stroke_cut()).unwrap();
+    let mut seen = Vec::new();
+    let a = s
+        .apply_pending_with(|s, edit| {
+            let o = &s.pieces()[0];
+            seen.push((edit.name(), o.mesh().tets().len(), o.fluence()));
+        })
+        .unwrap()
+        .unwrap();
+    assert!(a.topology_changed);
+    let [(name, tets, phi)] = &seen[..] else {
+        panic!("called {} times", seen.len());
+    };
+    assert_eq!(*name, "cut");
+    // The cut's mesh, not the solve's φ: the solve came after.
+    let after = &s.pieces()[0];
+    assert_eq!(*tets, after.mesh().tets().len());
+    assert!(*tets < lit_ball(8).mesh().tets().len());
+    assert_eq!(phi.len(), after.fluence().len());
+    assert_ne!(*phi, after.fluence());
+    assert!(a.solves[0].channels.iter().all(|r| r.iterations > 0));
+    // The φ seen is the one before, carried over: a vertex away from
+    // the cut keeps its value.
+    let kept = phi.iter().filter(|v| before.contains(v)).count();
+    assert!(kept * 2 > phi.len(), "{kept} of {}", phi.len());
+    // An edit that fails is not seen.
+    s.push(Edit::Cut(Cut::Plane {
+        point: DVec3::splat(-100.0),
+        normal: DVec3::X,
+    }))
+    .unwrap();
+    let mut called = false;
+    assert!(s.apply_pending_with(|_, _| called = true).unwrap().is_err());
+    assert!(!called);
+}
+
+#[test]
 fn a_cancelled_refinement_puts_the_coarse_result_back() {
     let mut s = Session::new(lit_ball(8), SessionOptions::default()).unwrap();
     s.push(light(0.5)).unwrap();
