@@ -8,7 +8,8 @@
 # stdout carries only the results, one JSON object per peer and line (the
 # Rust benchmark parses it); all set-up chatter goes to stderr. The first
 # run creates a venv at ${CARGO_TARGET_DIR:-<workspace>/target}/peers-venv
-# and pip-installs numpy, trimesh and open3d-cpu into it (20 s to minutes);
+# and pip-installs numpy, trimesh and open3d-cpu into it (20 s to minutes),
+# and pymeshlab for blue_noise_peer.py (MeshLab's Poisson-disk sampling);
 # later runs only check the imports. Open3D's wheel needs the system library
 # libusb-1.0-0, which is apt-get installed if missing. A peer that cannot be
 # installed is reported as {"peer": "...", "error": "..."} by peers.py, and
@@ -48,6 +49,10 @@ if ! "$py" -c 'import open3d' 2>/dev/null; then
             { $sudo apt-get update -q && $sudo apt-get install -y -q libusb-1.0-0; } ||
             say "could not install libusb-1.0-0"
     fi
+fi
+
+if [ "$script" = blue_noise_peer.py ] && ! "$py" -c 'import pymeshlab' 2>/dev/null; then
+    pip_install pymeshlab || say "could not install pymeshlab"
 fi
 
 exec "$py" "$here/$script" "$@" 1>&3 3>&-

@@ -1,10 +1,11 @@
 //! Blue-noise points on the data meshes by weighted sample elimination
 //! (`trilux`) and by the dense packing (`trilux-dense`: elimination of 14
 //! candidates per point, then farthest-point relocation), beside Open3D's
-//! `sample_points_poisson_disk` timed in the same run.
+//! `sample_points_poisson_disk` and MeshLab's Poisson-disk sampling timed in
+//! the same run, and optionally Yuksel's own C++ elimination.
 //!
 //! ```sh
-//! TRILUX_DATA=../shared/data cargo run --release -p mesh-sampling --example blue_noise -- [--json] [--no-peers] [--n 10000,100000] [--mesh spot] [--packing elimination,dense]
+//! TRILUX_DATA=../shared/data cargo run --release -p mesh-sampling --example blue_noise -- [--json] [--no-peers] [--n 10000,100000] [--mesh spot] [--packing elimination,dense] [--peer-cy auto|BIN]
 //! ```
 //!
 //! For each of the Stanford bunny, spot and fandisk, at N = 10⁴, 10⁵ and
@@ -14,17 +15,45 @@
 //! 10⁶ points, one run at 10⁶), output points per second, the relative
 //! radius ρ of Lagae & Dutré (1 for a hexagonal packing; with a density,
 //! each point's spacing is measured against its own density's packing
-//! radius, `relative_radius_with_density`) and the number of candidates. Open3D (uniform only: it takes no density) is run through
-//! `bench/peers.sh`, which sets up a venv under `target/` on first use; its
-//! points come back through a file so that ρ is measured the same way.
-//! With `--peer-cy BIN`, Yuksel's own C++ elimination (cySampleElim, not
-//! part of this repository) is timed on the very candidates trilux's
-//! elimination draws (5 N uniform points for seed 0, written to a file):
-//! `BIN CANDIDATES.f32 N AREA OUT.f32` must eliminate the little-endian
-//! `f32` triples to N, write them to OUT.f32 and print `{"ms": …}` with
-//! the time of the elimination alone; ρ is measured here.
+//! radius, `relative_radius_with_density`) and the number of candidates.
+//!
+//! **Python peers** (uniform only: they take no density) run through
+//! `bench/peers.sh` with `bench/blue_noise_peer.py`, which sets up a venv
+//! under `target/` on first use (numpy, open3d-cpu, pymeshlab); their points
+//! come back through a file so that ρ is measured the same way. Open3D's
+//! `sample_points_poisson_disk(N)` returns N points; MeshLab's
+//! `generate_sampling_poisson_disk(samplenum = N)` (pymeshlab, defaults)
+//! returns a count near N but not N (about 1.46 N on the bunny), so its row
+//! shows its own count, its ρ is measured at that count and the speed
+//! ratios compare points per second. `cpu_ms / ms` of the peer script gives
+//! the peers' thread count (both keep one thread busy).
+//!
+//! **cySampleElim.** With `--peer-cy BIN`, Yuksel's own C++ elimination
+//! (cySampleElim.h of his cyCodeBase, not part of this repository) is timed
+//! on the very candidates trilux's elimination draws (5 N uniform points
+//! for seed 0, written to a file): `BIN CANDIDATES.f32 N AREA OUT.f32` must
+//! eliminate the little-endian `f32` triples to N, write them to OUT.f32
+//! and print `{"ms": …, "threads": …}` with the time of the elimination
+//! alone; ρ is measured here. `bench/cy_sample_elim.cpp` is such a driver,
+//! with the library's default weight function (α = 8, weight limiting
+//! β = 0.65, γ = 1.5), Euclidean 3D distances and the weight radius
+//! `2 r_max` of N disks over the surface area, as trilux's. `--peer-cy auto`
+//! builds it into `target/peer-cy/`: set `CYCODEBASE` to a checkout of
+//! cyCodeBase (or its bare git directory; its `HEAD` is read) on the first
+//! run, which copies the five headers it needs to
+//! `target/peer-cy/include/`; later runs reuse them. It compiles with
+//! `${CXX:-g++} -O3 -march=native`, against TBB when `-ltbb` links (Debian:
+//! `apt-get install libtbb-dev`): cySampleElim is sequential except for its
+//! k-d tree build, which only TBB parallelises, and the row's thread count
+//! is what the driver reports. For example
+//!
+//! ```sh
+//! CYCODEBASE=/path/to/cyCodeBase TRILUX_DATA=../shared/data cargo run --release -p mesh-sampling --example blue_noise -- --n 100000 --packing elimination,dense --peer-cy auto
+//! ```
+//!
 //! Markdown on stdout, or with `--json` one object per line with the keys
-//! `mesh`, `density`, `n`, `tool`, `threads`, `ms`, `rho`, `candidates`.
+//! `mesh`, `density`, `n`, `points` (the output count: N except MeshLab's),
+//! `tool`, `threads`, `ms`, `rho`, `candidates`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -44,7 +73,15 @@ struct Args {
     counts: Vec<usize>,
     meshes: Vec<String>,
     packings: Vec<Packing>,
-    peer_cy: Option<PathBuf>,
+    peer_cy: Option<PeerCy>,
+}
+
+/// Where the cySampleElim driver comes from.
+enum PeerCy {
+    /// A driver built elsewhere.
+    Bin(PathBuf),
+    /// `bench/cy_sample_elim.cpp`, built into `target/peer-cy/`.
+    Auto,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -81,10 +118,14 @@ fn parse_args() -> Result<Args, String> {
                 args.meshes = list.split(',').map(|s| s.trim().to_string()).collect();
             }
             "--peer-cy" => {
-                args.peer_cy = Some(PathBuf::from(
-                    it.next()
-                        .ok_or("--peer-cy needs the path of the cySampleElim driver")?,
-                ));
+                let bin = it
+                    .next()
+                    .ok_or("--peer-cy needs the path of the cySampleElim driver, or auto")?;
+                args.peer_cy = Some(if bin == "auto" {
+                    PeerCy::Auto
+                } else {
+                    PeerCy::Bin(PathBuf::from(bin))
+                });
             }
             "--packing" => {
                 let list = it
@@ -116,6 +157,8 @@ struct Row {
     mesh: &'static str,
     density: &'static str,
     n: usize,
+    /// The output count: `n`, except for MeshLab's rows.
+    points: usize,
     tool: String,
     threads: usize,
     ms: f64,
@@ -126,10 +169,11 @@ struct Row {
 impl Row {
     fn json(&self) -> String {
         format!(
-            "{{\"mesh\": \"{}\", \"density\": \"{}\", \"n\": {}, \"tool\": \"{}\", \"threads\": {}, \"ms\": {:.2}, \"rho\": {:.4}, \"candidates\": {}}}",
+            "{{\"mesh\": \"{}\", \"density\": \"{}\", \"n\": {}, \"points\": {}, \"tool\": \"{}\", \"threads\": {}, \"ms\": {:.2}, \"rho\": {:.4}, \"candidates\": {}}}",
             self.mesh,
             self.density,
             self.n,
+            self.points,
             self.tool,
             self.threads,
             self.ms,
@@ -236,13 +280,121 @@ fn read_points(path: &Path) -> Result<Vec<Vec3>, String> {
         .collect())
 }
 
+/// A JSON line's value for `key` (numbers and strings without commas).
+fn field(line: &str, key: &str) -> Option<String> {
+    let at = line.find(&format!("\"{key}\": "))? + key.len() + 4;
+    let rest = &line[at..];
+    let end = rest.find([',', '}'])?;
+    Some(rest[..end].trim().trim_matches('"').to_string())
+}
+
+/// The cySampleElim driver's source (`--peer-cy auto` compiles it).
+const CY_DRIVER: &str = include_str!("../bench/cy_sample_elim.cpp");
+
+/// The cyCodeBase headers the driver includes, directly or not.
+const CY_HEADERS: [&str; 5] = [
+    "cyCore.h",
+    "cyHeap.h",
+    "cyPointCloud.h",
+    "cySampleElim.h",
+    "cyVector.h",
+];
+
+/// Builds `bench/cy_sample_elim.cpp` into `target/peer-cy/` (headers from
+/// `$CYCODEBASE`, a checkout or a bare git directory, or from an earlier
+/// run) and returns the driver's path. Rebuilds only when the source or a
+/// header changed.
+fn build_cy_driver() -> Result<PathBuf, String> {
+    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(
+        || Path::new(env!("CARGO_MANIFEST_DIR")).join("../target"),
+        PathBuf::from,
+    );
+    let dir = target.join("peer-cy");
+    let include = dir.join("include");
+    std::fs::create_dir_all(&include).map_err(|e| format!("{}: {e}", include.display()))?;
+    let mut changed = false;
+    let mut put = |path: &Path, bytes: &[u8]| -> Result<(), String> {
+        if std::fs::read(path).ok().as_deref() != Some(bytes) {
+            std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+            changed = true;
+        }
+        Ok(())
+    };
+    if let Some(source) = std::env::var_os("CYCODEBASE").map(PathBuf::from) {
+        for header in CY_HEADERS {
+            let bytes = if source.join(header).is_file() {
+                std::fs::read(source.join(header))
+                    .map_err(|e| format!("{}: {e}", source.join(header).display()))?
+            } else {
+                let out = Command::new("git")
+                    .arg("--git-dir")
+                    .arg(&source)
+                    .arg("show")
+                    .arg(format!("HEAD:{header}"))
+                    .output()
+                    .map_err(|e| format!("git: {e}"))?;
+                if !out.status.success() {
+                    return Err(format!(
+                        "CYCODEBASE={}: no {header} there, nor in its git HEAD ({})",
+                        source.display(),
+                        String::from_utf8_lossy(&out.stderr).trim()
+                    ));
+                }
+                out.stdout
+            };
+            put(&include.join(header), &bytes)?;
+        }
+    } else if let Some(missing) = CY_HEADERS.iter().find(|h| !include.join(h).is_file()) {
+        return Err(format!(
+            "--peer-cy auto: no {missing} in {}; set CYCODEBASE to a checkout of Cem Yuksel's \
+             cyCodeBase (or its bare git directory) once, and its headers are copied there",
+            include.display()
+        ));
+    }
+    let source = dir.join("cy_sample_elim.cpp");
+    put(&source, CY_DRIVER.as_bytes())?;
+    let bin = dir.join("cy_sample_elim");
+    if bin.is_file() && !changed {
+        return Ok(bin);
+    }
+    let cxx = std::env::var("CXX").unwrap_or_else(|_| "g++".to_string());
+    let compile = |tbb: bool| -> Result<std::process::Output, String> {
+        let mut cmd = Command::new(&cxx);
+        cmd.args(["-O3", "-march=native", "-std=c++17"]);
+        if tbb {
+            cmd.arg("-DTRILUX_CY_TBB");
+        }
+        cmd.arg("-I").arg(&include).arg(&source).arg("-o").arg(&bin);
+        if tbb {
+            cmd.arg("-ltbb");
+        }
+        eprintln!("building the cySampleElim driver: {cmd:?}");
+        cmd.output().map_err(|e| format!("{cxx}: {e}"))
+    };
+    let with_tbb = compile(true)?;
+    if with_tbb.status.success() {
+        return Ok(bin);
+    }
+    eprintln!("(no TBB: cySampleElim's k-d tree build stays sequential)");
+    let plain = compile(false)?;
+    if !plain.status.success() {
+        return Err(format!(
+            "{cxx} could not build {}: {}",
+            source.display(),
+            String::from_utf8_lossy(&plain.stderr)
+        ));
+    }
+    Ok(bin)
+}
+
 /// cySampleElim's time (ms, the elimination alone, as the driver reports
-/// it) and ρ on trilux's own candidates for `n` points (seed 0).
+/// it), ρ and thread count on trilux's own candidates for `n` points
+/// (seed 0).
 fn cy_sample_elim(
     bin: &Path,
     sampler: &UniformSampler<'_>,
     n: usize,
-) -> Result<(f64, f64), String> {
+) -> Result<(f64, f64, usize), String> {
     let dir = std::env::temp_dir().join(format!("trilux-cy-{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let candidates = sampler
@@ -271,19 +423,38 @@ fn cy_sample_elim(
         ));
     }
     let text = String::from_utf8_lossy(&out.stdout);
-    let ms: f64 = text
-        .split("\"ms\":")
-        .nth(1)
-        .and_then(|rest| rest.split([',', '}']).next())
-        .and_then(|v| v.trim().parse().ok())
+    let ms: f64 = field(&text, "ms")
+        .and_then(|v| v.parse().ok())
         .ok_or_else(|| format!("{}: no \"ms\" in its output {text:?}", bin.display()))?;
+    // A driver that does not say runs on one thread.
+    let threads = field(&text, "threads")
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1);
     let xyz = read_points(&output)?;
     let _ = std::fs::remove_dir_all(&dir);
-    Ok((ms, relative_radius(&xyz, area)))
+    if xyz.len() != n {
+        return Err(format!(
+            "{} wrote {} points, not {n}",
+            bin.display(),
+            xyz.len()
+        ));
+    }
+    Ok((ms, relative_radius(&xyz, area), threads))
 }
 
-/// Open3D's rows for `file`, or an explanation of why there are none.
-fn open3d(file: &Path, counts: &[usize], area: f64) -> Result<Vec<(usize, f64, f64)>, String> {
+/// One row of a Python peer.
+struct PeerRow {
+    tool: String,
+    n: usize,
+    points: usize,
+    ms: f64,
+    threads: usize,
+    rho: f64,
+}
+
+/// Open3D's and MeshLab's rows for `file`, or an explanation of why there
+/// are none.
+fn python_peers(file: &Path, counts: &[usize], area: f64) -> Result<Vec<PeerRow>, String> {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
     let out_dir = std::env::temp_dir().join(format!("trilux-blue-noise-{}", std::process::id()));
     std::fs::create_dir_all(&out_dir).map_err(|e| format!("{}: {e}", out_dir.display()))?;
@@ -297,27 +468,31 @@ fn open3d(file: &Path, counts: &[usize], area: f64) -> Result<Vec<(usize, f64, f
         .output()
         .map_err(|e| format!("bench/peers.sh: {e}"))?;
     let text = String::from_utf8_lossy(&output.stdout);
-    let field = |line: &str, key: &str| -> Option<String> {
-        let at = line.find(&format!("\"{key}\": "))? + key.len() + 4;
-        let rest = &line[at..];
-        let end = rest.find([',', '}'])?;
-        Some(rest[..end].trim().trim_matches('"').to_string())
-    };
     let mut rows = Vec::new();
     for line in text.lines().filter(|l| l.starts_with('{')) {
+        let peer = field(line, "peer").ok_or("a peer line without \"peer\"")?;
         if let Some(e) = field(line, "error") {
-            eprintln!("Open3D: {e}");
+            eprintln!("{peer}: {e}");
             continue;
         }
-        let n: usize = field(line, "n")
-            .and_then(|v| v.parse().ok())
-            .ok_or("Open3D: no n")?;
-        let ms: f64 = field(line, "ms")
-            .and_then(|v| v.parse().ok())
-            .ok_or("Open3D: no ms")?;
-        let path = PathBuf::from(field(line, "points").ok_or("Open3D: no points file")?);
+        let number = |key: &str| -> Result<f64, String> {
+            field(line, key)
+                .and_then(|v| v.parse().ok())
+                .ok_or_else(|| format!("{peer}: no {key} in {line}"))
+        };
+        let (ms, cpu_ms) = (number("ms")?, number("cpu_ms")?);
+        let path =
+            PathBuf::from(field(line, "file").ok_or_else(|| format!("{peer}: no points file"))?);
         let xyz = read_points(&path)?;
-        rows.push((n, ms, relative_radius(&xyz, area)));
+        let n = number("n")? as usize;
+        rows.push(PeerRow {
+            tool: peer,
+            n,
+            points: xyz.len(),
+            ms,
+            threads: (cpu_ms / ms).round().max(1.0) as usize,
+            rho: relative_radius(&xyz, area),
+        });
     }
     let _ = std::fs::remove_dir_all(&out_dir);
     Ok(rows)
@@ -328,6 +503,11 @@ fn run() -> Result<(), String> {
     let dir = PathBuf::from(std::env::var_os("TRILUX_DATA").ok_or(
         "set TRILUX_DATA to the data folder (for example ../shared/data): the benchmark reads its meshes",
     )?);
+    let peer_cy = match &args.peer_cy {
+        None => None,
+        Some(PeerCy::Bin(bin)) => Some(bin.clone()),
+        Some(PeerCy::Auto) => Some(build_cy_driver()?),
+    };
     let mut rows: Vec<Row> = Vec::new();
     for name in &args.meshes {
         let name: &'static str = MESHES
@@ -358,6 +538,7 @@ fn run() -> Result<(), String> {
                             mesh: name,
                             density,
                             n,
+                            points: n,
                             tool: tool.into(),
                             threads,
                             ms: row.0,
@@ -368,16 +549,17 @@ fn run() -> Result<(), String> {
                 }
             }
         }
-        if let Some(bin) = &args.peer_cy {
+        if let Some(bin) = &peer_cy {
             for &n in &args.counts {
                 eprintln!("{name}, N = {n}: cySampleElim…");
                 match cy_sample_elim(bin, &uniform, n) {
-                    Ok((ms, rho)) => rows.push(Row {
+                    Ok((ms, rho, threads)) => rows.push(Row {
                         mesh: name,
                         density: "uniform",
                         n,
+                        points: n,
                         tool: "cySampleElim".into(),
-                        threads: rayon::current_num_threads(),
+                        threads,
                         ms,
                         rho,
                         candidates: 5 * n,
@@ -387,23 +569,29 @@ fn run() -> Result<(), String> {
             }
         }
         if args.peers {
-            eprintln!("{name}: Open3D (first run installs it into target/peers-venv)…");
-            match open3d(&file, &args.counts, uniform.surface_area()) {
+            eprintln!(
+                "{name}: Open3D and MeshLab (the first run installs them into target/peers-venv)…"
+            );
+            match python_peers(&file, &args.counts, uniform.surface_area()) {
                 Ok(peer) => {
-                    for (n, ms, rho) in peer {
+                    for r in peer {
+                        // Open3D eliminates 5 N candidates; MeshLab throws
+                        // darts at a Monte Carlo pool of 20 N points.
+                        let candidates = if r.tool == "meshlab" { 20 } else { 5 } * r.n;
                         rows.push(Row {
                             mesh: name,
                             density: "uniform",
-                            n,
-                            tool: "open3d".into(),
-                            threads: 1,
-                            ms,
-                            rho,
-                            candidates: 5 * n,
+                            n: r.n,
+                            points: r.points,
+                            tool: r.tool,
+                            threads: r.threads,
+                            ms: r.ms,
+                            rho: r.rho,
+                            candidates,
                         });
                     }
                 }
-                Err(e) => eprintln!("Open3D did not run: {e}"),
+                Err(e) => eprintln!("the Python peers did not run: {e}"),
             }
         }
     }
@@ -413,27 +601,28 @@ fn run() -> Result<(), String> {
         }
         return Ok(());
     }
-    println!("| mesh | density | N | tool | threads | ms | M points/s | ρ | candidates |");
-    println!("|---|---|---:|---|---:|---:|---:|---:|---:|");
+    println!("| mesh | density | N | points | tool | threads | ms | M points/s | ρ | candidates |");
+    println!("|---|---|---:|---:|---|---:|---:|---:|---:|---:|");
     for r in &rows {
         println!(
-            "| {} | {} | {} | {} | {} | {:.1} | {:.3} | {:.3} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.3} | {:.3} | {} |",
             r.mesh,
             r.density,
             r.n,
+            r.points,
             r.tool,
             r.threads,
             r.ms,
-            r.n as f64 / r.ms / 1e3,
+            r.points as f64 / r.ms / 1e3,
             r.rho,
             r.candidates
         );
     }
-    for peer in ["open3d", "cySampleElim"] {
+    for peer in ["cySampleElim", "open3d", "meshlab"] {
         if !rows.iter().any(|r| r.tool == peer) {
             continue;
         }
-        println!("\nSpeed against {peer} at the same N (uniform; points/s ratio):\n");
+        println!("\nSpeed against {peer} at the same target N (uniform; ratio of points/s):\n");
         for r in rows.iter().filter(|r| r.tool == peer) {
             for t in [1, 2] {
                 for tool in ["trilux", "trilux-dense"] {
@@ -444,11 +633,18 @@ fn run() -> Result<(), String> {
                             && o.density == "uniform"
                             && o.threads == t
                     }) {
+                        // Points per second: MeshLab's count is not N.
+                        let rate = |x: &Row| x.points as f64 / x.ms;
+                        let count = if r.points == r.n {
+                            String::new()
+                        } else {
+                            format!(" ({peer} returned {} points)", r.points)
+                        };
                         println!(
-                            "- {} N = {}, {tool}, {t} thread(s): {:.1}× {peer}'s rate, ρ {:.3} vs {:.3}",
+                            "- {} N = {}, {tool}, {t} thread(s): {:.2}× {peer}'s rate{count}, ρ {:.3} vs {:.3}",
                             r.mesh,
                             r.n,
-                            r.ms / o.ms,
+                            rate(o) / rate(r),
                             o.rho,
                             r.rho
                         );
