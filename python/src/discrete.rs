@@ -6,11 +6,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use rand::SeedableRng;
 
-use crate::arrays;
+use crate::arrays::{self, Int};
 use crate::error::{Failure, detached};
 
 /// The generator of the `seed` argument (default 0).
-fn rng(seed: Option<i128>) -> PyResult<rand_pcg::Pcg64Mcg> {
+fn rng(seed: Option<&Int>) -> PyResult<rand_pcg::Pcg64Mcg> {
     Ok(rand_pcg::Pcg64Mcg::seed_from_u64(arrays::seed(seed)?))
 }
 
@@ -41,11 +41,11 @@ impl Distribution1D {
     fn sample<'py>(
         &self,
         py: Python<'py>,
-        n: i128,
-        seed: Option<i128>,
+        n: Int,
+        seed: Option<Int>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = arrays::count(n, "n")?;
-        let mut rng = rng(seed)?;
+        let n = arrays::count(&n, "n")?;
+        let mut rng = rng(seed.as_ref())?;
         let out = detached(py, || {
             let mut out = vec![0usize; n];
             self.table.sample_into(&mut rng, &mut out);
@@ -179,11 +179,11 @@ impl Distribution2D {
     fn sample<'py>(
         &self,
         py: Python<'py>,
-        n: i128,
-        seed: Option<i128>,
+        n: Int,
+        seed: Option<Int>,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let n = arrays::count(n, "n")?;
-        let mut rng = rng(seed)?;
+        let n = arrays::count(&n, "n")?;
+        let mut rng = rng(seed.as_ref())?;
         let out = detached(py, || {
             let mut out = vec![Sample2D::default(); n];
             self.inner.sample_into(&mut rng, &mut out);
@@ -219,12 +219,12 @@ impl Distribution2D {
     fn sample_direction<'py>(
         &self,
         py: Python<'py>,
-        n: i128,
-        seed: Option<i128>,
+        n: Int,
+        seed: Option<Int>,
     ) -> PyResult<Bound<'py, PyTuple>> {
         use rand::RngExt;
-        let n = arrays::count(n, "n")?;
-        let mut rng = rng(seed)?;
+        let n = arrays::count(&n, "n")?;
+        let mut rng = rng(seed.as_ref())?;
         let out = detached(py, || {
             Ok((0..n)
                 .map(|_| {

@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use trilux_io::mesh::TriMesh;
 
-use crate::arrays;
+use crate::arrays::{self, Int};
 use crate::error::{Failure, Result, detached};
 use crate::mesh::{mesh_arg, path_arg};
 
@@ -447,20 +447,20 @@ pub(crate) enum Sampler<'a> {
 pub(crate) fn sample_surface<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, PyAny>,
-    count: i128,
+    count: Int,
     density: Option<&Bound<'py, PyAny>>,
     uv: Option<&Bound<'py, PyAny>>,
     channel: Option<&Bound<'py, PyAny>>,
     face_weight: Option<&Bound<'py, PyAny>>,
     vertex_weight: Option<&Bound<'py, PyAny>>,
     method: Option<&str>,
-    seed: Option<i128>,
+    seed: Option<Int>,
     return_barycentric: bool,
     return_pdf: bool,
     return_normal: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let n = arrays::count(count, "count")?;
-    let seed = arrays::seed(seed)?;
+    let n = arrays::count(&count, "count")?;
+    let seed = arrays::seed(seed.as_ref())?;
     let mesh: Arc<TriMesh> = mesh_arg(mesh, uv)?;
     let density = density_arg(density, channel, face_weight, vertex_weight)?;
     let method = method_arg(method, &density)?;
@@ -519,7 +519,7 @@ pub(crate) fn sample_surface<'py>(
 pub(crate) fn blue_noise<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, PyAny>,
-    count: Option<i128>,
+    count: Option<Int>,
     radius: Option<f64>,
     density: Option<&Bound<'py, PyAny>>,
     uv: Option<&Bound<'py, PyAny>>,
@@ -527,7 +527,7 @@ pub(crate) fn blue_noise<'py>(
     face_weight: Option<&Bound<'py, PyAny>>,
     vertex_weight: Option<&Bound<'py, PyAny>>,
     method: Option<&str>,
-    seed: Option<i128>,
+    seed: Option<Int>,
     progressive: bool,
     packing: Option<&str>,
     return_barycentric: bool,
@@ -536,11 +536,11 @@ pub(crate) fn blue_noise<'py>(
 ) -> PyResult<Bound<'py, PyTuple>> {
     let base = packing_options(packing)?;
     let target = match (count, radius) {
-        (Some(c), None) => BlueNoiseTarget::Count(arrays::count(c, "count")?),
+        (Some(c), None) => BlueNoiseTarget::Count(arrays::count(&c, "count")?),
         (None, Some(r)) => BlueNoiseTarget::Radius(r),
         _ => return Err(Failure::input("give exactly one of count and radius").into()),
     };
-    let seed = arrays::seed(seed)?;
+    let seed = arrays::seed(seed.as_ref())?;
     let mesh = mesh_arg(mesh, uv)?;
     let density = density_arg(density, channel, face_weight, vertex_weight)?;
     let method = method_arg(method, &density)?;
@@ -598,12 +598,12 @@ fn packing_options(packing: Option<&str>) -> std::result::Result<BlueNoiseOption
 pub(crate) fn sample_surface_even<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, PyAny>,
-    count: i128,
+    count: Int,
     radius: Option<f64>,
-    seed: Option<i128>,
+    seed: Option<Int>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let n = arrays::count(count, "count")?;
-    let seed = arrays::seed(seed)?;
+    let n = arrays::count(&count, "count")?;
+    let seed = arrays::seed(seed.as_ref())?;
     let mesh = mesh_arg(mesh, None)?;
     let (target, progressive) = match radius {
         None => (BlueNoiseTarget::Count(n), false),

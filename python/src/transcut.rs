@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use tet_diffusion::{Cut, Light, Medium, Stroke};
 
-use crate::arrays;
+use crate::arrays::{self, Int};
 use crate::error::{Failure, detached};
 use crate::mesh::image_from;
 use crate::tets::{tets_in, tets_out};
@@ -112,7 +112,8 @@ impl Object {
     /// (mesh units) with `intensity` (RGB, W/sr) for a point light; or
     /// `envmap`, an equirectangular HDR image `(H, W, 3)` (linear).
     #[pyo3(signature = (direction = None, *, irradiance = (1.0, 1.0, 1.0), position = None,
-        intensity = (1.0, 1.0, 1.0), envmap = None, envmap_samples = 256))]
+        intensity = (1.0, 1.0, 1.0), envmap = None, envmap_samples = Int::Value(256)),
+        text_signature = "($self, direction=None, *, irradiance=..., position=None, intensity=..., envmap=None, envmap_samples=256)")]
     #[allow(clippy::too_many_arguments, reason = "the Python keyword arguments")]
     fn add_light(
         &mut self,
@@ -122,8 +123,15 @@ impl Object {
         position: Option<&Bound<'_, PyAny>>,
         intensity: (f64, f64, f64),
         envmap: Option<&Bound<'_, PyAny>>,
-        envmap_samples: usize,
+        envmap_samples: Int,
     ) -> PyResult<usize> {
+        let envmap_samples: usize = envmap_samples.to("envmap_samples", "1..")?;
+        if envmap_samples == 0 {
+            return Err(Failure::input(
+                "envmap_samples: 0 is not in 1.. (an environment light needs at least one sample)",
+            )
+            .into());
+        }
         let light = match (direction, position, envmap) {
             (Some(d), None, None) => Light::Directional {
                 to_light: vec3_arg(d, "direction")?,
@@ -196,15 +204,17 @@ impl Object {
     /// `removed_tets`, `removed_vertices`, `moved_vertices`, `sweeps`,
     /// `split_tets`, `created_tets`, `created_vertices`,
     /// `min_created_dihedral` (degrees). Solve again after.
-    #[pyo3(signature = (point, normal, *, method = "exact", relax_sweeps = 20))]
+    #[pyo3(signature = (point, normal, *, method = "exact", relax_sweeps = Int::Value(20)),
+        text_signature = "($self, point, normal, *, method=\"exact\", relax_sweeps=20)")]
     fn cut<'py>(
         &mut self,
         py: Python<'py>,
         point: &Bound<'py, PyAny>,
         normal: &Bound<'py, PyAny>,
         method: &str,
-        relax_sweeps: usize,
+        relax_sweeps: Int,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let relax_sweeps: usize = relax_sweeps.to("relax_sweeps", "0..")?;
         let method = match method {
             "exact" => tet_diffusion::CutMethod::Exact,
             "relax" => tet_diffusion::CutMethod::Relax {
@@ -302,12 +312,13 @@ impl Object {
     /// the object toward the eye. `exposure='auto'` scales the brightest
     /// 1 % of the object's pixels to 1 (as `trilux diffuse` writes its
     /// PNG); `None` keeps the radiance.
-    #[pyo3(signature = (*, view = None, size = 512, exposure = Some("auto")))]
+    #[pyo3(signature = (*, view = None, size = Int::Value(512), exposure = Some("auto")),
+        text_signature = "($self, *, view=None, size=512, exposure=...)")]
     fn render<'py>(
         &self,
         py: Python<'py>,
         view: Option<&Bound<'py, PyAny>>,
-        size: u32,
+        size: Int,
         exposure: Option<&str>,
     ) -> PyResult<Bound<'py, PyAny>> {
         render_objects(
@@ -366,12 +377,14 @@ fn render_objects<'py>(
     objects: &[tet_diffusion::Object],
     lights: &[Light],
     view: Option<&Bound<'py, PyAny>>,
-    size: u32,
+    size: Int,
     exposure: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if !(1..=8192).contains(&size) {
-        return Err(Failure::input(format!("size: {size} is not in 1..8192")).into());
-    }
+    let size = size.value("size", "1..8192")?;
+    let size = match u32::try_from(size) {
+        Ok(s) if (1..=8192).contains(&s) => s,
+        _ => return Err(Failure::input(format!("size: {size} is not in 1..8192")).into()),
+    };
     let auto = match exposure {
         None => false,
         Some("auto") => true,
@@ -404,12 +417,13 @@ fn render_objects<'py>(
 /// their display offsets) with the lights of the first: as
 /// `Object.render`.
 #[pyfunction]
-#[pyo3(signature = (objects, *, view = None, size = 512, exposure = Some("auto")))]
+#[pyo3(signature = (objects, *, view = None, size = Int::Value(512), exposure = Some("auto")),
+    text_signature = "(objects, *, view=None, size=512, exposure=...)")]
 pub(crate) fn render<'py>(
     py: Python<'py>,
     objects: Vec<PyRef<'py, Object>>,
     view: Option<&Bound<'py, PyAny>>,
-    size: u32,
+    size: Int,
     exposure: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
     // The renderer takes a slice of objects: copies, for pieces held by

@@ -119,3 +119,40 @@ def test_transcut_errors():
     raises(trilux.InputError, "method: \"saw\" is not 'exact' or 'relax'", obj.cut, [0, 0, 0], [1, 0, 0], method="saw")
     raises(trilux.InputError, "tets: row 0 references node 4, but there are only 4 nodes",
            trilux.Object, nodes, [[1, 2, 3, 4]])
+
+
+def test_integer_arguments_name_themselves_in_type_errors():
+    def type_error(message, call, *args, **kwargs):
+        with pytest.raises(TypeError) as info:
+            call(*args, **kwargs)
+        assert str(info.value) == message, str(info.value)
+
+    type_error("count must be an int, got str", trilux.sample_surface, (V, F), "10")
+    type_error("count must be an int, got float", trilux.sample_surface, (V, F), count=1.5)
+    type_error("count must be an int, got bool", trilux.sample_surface, (V, F), True)
+    type_error("count must be an int, got float", trilux.blue_noise, (V, F), 10.0)
+    type_error("count must be an int, got float", trilux.sample_surface_even, (V, F), 2.0)
+    type_error("seed must be an int, got float", trilux.sample_surface, (V, F), 10, seed=1.0)
+    d = trilux.Distribution1D([1.0, 2.0])
+    type_error("n must be an int, got str", d.sample, "3")
+    type_error("seed must be an int, got str", d.sample, 3, seed="x")
+    type_error("n must be an int, got float", trilux.Distribution2D(np.ones((2, 2))).sample_direction, 2.5)
+    nodes = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+    obj = trilux.Object(nodes, [[0, 1, 2, 3]])
+    type_error("envmap_samples must be an int, got float", obj.add_light, envmap=np.ones((4, 8, 3)),
+               envmap_samples=2.5)
+    type_error("relax_sweeps must be an int, got str", obj.cut, [0, 0, 0], [1, 0, 0], method="relax",
+               relax_sweeps="3")
+    type_error("size must be an int, got float", obj.render, size=2.0)
+    type_error("gutter must be an int, got float",
+               trilux.MeshColors.from_texture(trilux.Mesh(V, F, uv=UV), np.ones((4, 4, 3))).bake, gutter=1.0)
+    # numpy integers are integers; too large or negative ones are InputErrors naming the argument.
+    assert trilux.sample_surface((V, F), np.int32(10), seed=np.uint64(3))[0].shape == (10, 3)
+    raises(trilux.InputError, f"count: {2**200} is too large a count", trilux.sample_surface, (V, F), 2**200)
+    raises(trilux.InputError, "seed: 18446744073709551616 is not in 0..2**64",
+           trilux.sample_surface, (V, F), 1, seed=2**64)
+    raises(trilux.InputError, "envmap_samples: 0 is not in 1.. (an environment light needs at least one sample)",
+           obj.add_light, envmap=np.ones((4, 8, 3)), envmap_samples=0)
+    raises(trilux.InputError, "relax_sweeps: -1 is not in 0..", obj.cut, [0, 0, 0], [1, 0, 0], method="relax",
+           relax_sweeps=-1)
+
