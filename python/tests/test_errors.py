@@ -121,6 +121,37 @@ def test_transcut_errors():
            trilux.Object, nodes, [[1, 2, 3, 4]])
 
 
+def test_distribution1d_index_out_of_range_is_an_error_naming_it():
+    # Before: pdf gave 0 and invert NaN for such an index, which a caller
+    # would take for a probability and a variate.
+    d = trilux.Distribution1D([1.0, 2.0, 3.0])
+    raises(trilux.InputError, "index: entry 1 is 3, not an index of the 3 entries (0..2)", d.pdf, [0, 3])
+    raises(trilux.InputError, "index: entry 0 is -1, not an index of the 3 entries (0..2)", d.pdf, [-1, 0])
+    raises(trilux.InputError, "index: entry 2 is 7, not an index of the 3 entries (0..2)", d.invert, [0, 1, 7])
+    assert np.allclose(d.pdf([0, 1, 2]), [1 / 6, 2 / 6, 3 / 6])
+    assert np.allclose(d.invert([0, 1, 2]), [0, 1 / 6, 3 / 6])
+
+
+def test_variates_outside_the_unit_interval_are_errors_naming_them():
+    d = trilux.Distribution1D([1.0, 2.0, 3.0])
+    raises(trilux.InputError, "u: entry 1 is 1, not in [0, 1)", d.sample_u, [0.5, 1.0])
+    raises(trilux.InputError, "u: entry 0 is -0.1, not in [0, 1)", d.sample_u, [-0.1])
+    raises(trilux.InputError, "u: entry 2 is NaN, not in [0, 1)", d.sample_u, [0.0, 0.5, np.nan])
+    assert d.sample_u([0.0, 0.999]).tolist() == [0, 2]
+    d2 = trilux.Distribution2D(np.ones((4, 4)))
+    raises(trilux.InputError, "u: row 1 is [0.5, 1], not in [0, 1)²", d2.sample_u, [[0.5, 0.5], [0.5, 1.0]])
+    raises(trilux.InputError, "u: row 0 is [-0.5, 0.5], not in [0, 1)²", d2.sample_u, [[-0.5, 0.5]])
+    raises(trilux.InputError, "points: row 0 is [NaN, 0.2], not in [0, 1)²", d2.pdf, [[np.nan, 0.2]])
+    raises(trilux.InputError, "points: row 1 is [0.2, 1.5], not in [0, 1)²", d2.pdf, [[0.2, 0.2], [0.2, 1.5]])
+    raises(trilux.InputError, "directions: row 1 is [inf, 0, 0], not a finite direction",
+           d2.pdf_direction, [[0, 0, 1], [np.inf, 0, 0]])
+    raises(trilux.InputError, "directions: row 0 is [0, NaN, 1], not a finite direction",
+           d2.pdf_direction, [[0, np.nan, 1]])
+    assert np.allclose(d2.pdf([[0.2, 0.7]]), [1.0])
+    # A zero direction is still a density of 0, not an error.
+    assert d2.pdf_direction([[0.0, 0.0, 0.0]]).tolist() == [0.0]
+
+
 def test_integer_arguments_name_themselves_in_type_errors():
     def type_error(message, call, *args, **kwargs):
         with pytest.raises(TypeError) as info:
