@@ -108,3 +108,26 @@ def test_transcut_object_solve_cut_paint_fracture_render():
     both = trilux.render([a, b], size=32, exposure=None)
     assert both.shape == (32, 32, 3)
 
+
+def test_load_tets_keeps_the_file_orientation_and_object_reorients(tmp_path):
+    """load_tets returns a tet as the file stores it, inverted or not (as
+    its docstring says); Object re-orients an inverted tet by swapping its
+    first two nodes, so Object.mesh has positive volumes only."""
+    nodes = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
+    tets = np.array([[0, 1, 2, 3], [2, 1, 3, 4]])  # the second is inverted
+
+    def volumes(n, t):
+        p = n[t]
+        return np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), p[:, 3] - p[:, 0]) / 6
+
+    assert volumes(nodes, tets)[1] < 0 < volumes(nodes, tets)[0]
+    path = tmp_path / "two.mesh"
+    trilux.save_tets(path, nodes, tets)
+    n, t = trilux.load_tets(path)
+    assert np.array_equal(t, tets) and np.array_equal(n, nodes)
+    mesh_nodes, mesh_tets = trilux.Object(n, t).mesh
+    assert mesh_tets.tolist() == [[0, 1, 2, 3], [1, 2, 3, 4]]
+    assert (volumes(mesh_nodes, mesh_tets) > 0).all()
+    assert "not\nre-oriented" in trilux.load_tets.__doc__ or "not re-oriented" in " ".join(
+        trilux.load_tets.__doc__.split())
+    assert "swapping its first two nodes" in " ".join(trilux.Object.__doc__.split())

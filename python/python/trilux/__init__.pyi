@@ -215,6 +215,15 @@ def save_points(
 def media() -> list[str]: ...
 
 class Object:
+    """A translucent object (TransCut). Tets may come in either
+    orientation: an inverted one (negative signed volume,
+    det[p1 - p0, p2 - p0, p3 - p0] < 0) is re-oriented by swapping its
+    first two nodes, so `mesh` returns every tet with positive volume; a
+    tet of zero volume, a repeated, unused or NaN node raises InputError.
+    `solve` warns (UserWarning, one per colour channel) when the mesh is
+    too coarse to resolve a medium's diffusion length; `render`, `radiance` and `fluence` warn when the object was
+    not solved since it was made or changed."""
+
     def __init__(
         self,
         nodes: ArrayLike,
