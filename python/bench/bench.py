@@ -10,6 +10,7 @@ import argparse
 import importlib
 import os
 import pathlib
+import re
 import statistics
 import sys
 import time
@@ -65,8 +66,15 @@ def median_seconds(call, repeats):
     return statistics.median(times)
 
 
+def cell(value):
+    """A table cell: a peer's error text may hold `|` (which would end the
+    cell) or newlines (which would end the table), so `|` is escaped and
+    each run of line breaks becomes one space."""
+    return re.sub(r"\s*[\r\n]+\s*", " ", str(value).replace("|", "\\|")).strip()
+
+
 def row(cells):
-    print("| " + " | ".join(str(c) for c in cells) + " |")
+    print("| " + " | ".join(cell(c) for c in cells) + " |")
 
 
 def nearest_rho(points, area):
@@ -120,7 +128,7 @@ def main():
     print(f"Bunny: {len(f)} triangles; medians of {repeats}; load average {os.getloadavg()[0]:.2f}; "
           f"{os.cpu_count()} cores.\n")
 
-    print("#### Uniform points on the bunny (Python wall time, s)\n")
+    print("### Uniform points on the bunny (Python wall time, s)\n")
     row(["points", "trilux.sample_surface", "trimesh.sample.sample_surface", "Open3D sample_points_uniformly",
          "pcu.sample_mesh_random", "vs trimesh", "vs pcu"])
     row(["---"] * 7)
@@ -141,7 +149,7 @@ def main():
 
     image = np.asarray(Image.open(data / "textures" / "spot_texture.png").convert("L"), dtype=np.float64) / 255
     n = counts[0]
-    print(f"#### With a density ({n:.0e} points on the textured cow, s)\n")
+    print(f"### With a density ({n:.0e} points on the textured cow, s)\n")
     t = median_seconds(lambda: trilux.sample_surface(spot, n, density=image, seed=1), repeats)
     te = median_seconds(lambda: trilux.sample_surface(spot, n, density=image, method="exact", seed=1), repeats)
 
@@ -162,7 +170,7 @@ def main():
     row(["trimesh face weights (density at face centroids: per-face constant)", f"{tt:.3f}", "1.0×"])
     print()
 
-    print(f"#### Blue noise, {blue_n} points on the bunny (s; ρ = min distance / (2 r_max), higher is better)\n")
+    print(f"### Blue noise, {blue_n} points on the bunny (s; ρ = min distance / (2 r_max), higher is better)\n")
     row(["library", "seconds", "ρ"])
     row(["---"] * 3)
     # The default (dense) packing answers #28's bar against pcu (and #29's
@@ -205,7 +213,7 @@ def main():
         row(["Open3D sample_points_poisson_disk", "skipped", "—"])
     print()
 
-    print("#### Tetrahedra of the bunny (s)\n")
+    print("### Tetrahedra of the bunny (s)\n")
     row(["library", "tetrahedra", "seconds", "dihedral range (°)"])
     row(["---"] * 4)
     t = median_seconds(lambda: trilux.tetrahedralize(mesh), repeats)

@@ -282,22 +282,92 @@ pub(crate) fn index_matrix<'py, const K: usize>(
     matrix(py, data, K)
 }
 
-/// A `seed` argument as the `u64` the samplers seed their generators
-/// with: 0 when not given, an error naming it outside `0..2**64`.
-pub(crate) fn seed(seed: Option<i128>) -> Result<u64, Failure> {
-    match seed {
-        None => Ok(0),
-        Some(s) => {
-            u64::try_from(s).map_err(|_| Failure::input(format!("seed: {s} is not in 0..2**64")))
+/// An integer argument as the caller gave it. Extraction never fails, so
+/// that the function, which knows the argument's name, says what was
+/// wrong: PyO3's own message (`'float' object cannot be interpreted as an
+/// integer`) names no argument. A Python `int` or anything with
+/// `__index__` (numpy's integers) is an integer; `bool` is not, though
+/// Python makes it an `int` subclass (`count=True` is a slip, not 1).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum Int {
+    /// The value.
+    Value(i128),
+    /// An integer beyond `i128`, as Python prints it.
+    Huge(String),
+    /// Not an integer: the type's name.
+    Wrong(String),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Int {
+    type Error = PyErr;
+
+    fn extract(obj: pyo3::Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if obj.is_instance_of::<pyo3::types::PyBool>() {
+            return Ok(Self::Wrong("bool".into()));
+        }
+        match obj.extract::<i128>() {
+            Ok(v) => Ok(Self::Value(v)),
+            Err(e) if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(obj.py()) => {
+                Ok(Self::Huge(obj.str()?.to_string()))
+            }
+            Err(_) => Ok(Self::Wrong(obj.get_type().name()?.to_string())),
         }
     }
 }
 
-/// A count argument named `what` as a `usize`: an error naming it when
-/// negative (or beyond the address space).
-pub(crate) fn count(count: i128, what: &str) -> Result<usize, Failure> {
-    usize::try_from(count)
-        .map_err(|_| Failure::input(format!("{what}: {count} is not a count (0 or more)")))
+impl Int {
+    /// The value, or a `TypeError` naming the argument `what` and the type
+    /// given (`count must be an int, got float`); beyond `i128`, a
+    /// `trilux.InputError` with `range`, the values `what` takes.
+    pub(crate) fn value(&self, what: &str, range: &str) -> PyResult<i128> {
+        match self {
+            Self::Value(v) => Ok(*v),
+            Self::Huge(text) => {
+                Err(Failure::input(format!("{what}: {text} is not in {range}")).into())
+            }
+            Self::Wrong(ty) => Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "{what} must be an int, got {ty}"
+            ))),
+        }
+    }
+
+    /// The value as a `T` (an unsigned or small integer type), else an
+    /// error naming `what`, the value and `range` (as Python writes
+    /// ranges, e.g. `0..2**32`).
+    pub(crate) fn to<T: TryFrom<i128>>(&self, what: &str, range: &str) -> PyResult<T> {
+        let v = self.value(what, range)?;
+        T::try_from(v).map_err(|_| Failure::input(format!("{what}: {v} is not in {range}")).into())
+    }
+}
+
+/// A `seed` argument as the `u64` the samplers seed their generators
+/// with: 0 when not given (or `None`), an error naming it when it is not
+/// an integer or outside `0..2**64`.
+pub(crate) fn seed(seed: Option<&Int>) -> PyResult<u64> {
+    match seed {
+        None => Ok(0),
+        Some(s) => s.to("seed", "0..2**64"),
+    }
+}
+
+/// A count argument named `what` as a `usize`: a `TypeError` naming it
+/// when it is not an integer, a `trilux.InputError` when negative (or
+/// beyond the address space).
+pub(crate) fn count(count: &Int, what: &str) -> PyResult<usize> {
+    let n = match count {
+        Int::Huge(text) => {
+            return Err(Failure::input(format!("{what}: {text} is too large a count")).into());
+        }
+        _ => count.value(what, "0 or more")?,
+    };
+    usize::try_from(n).map_err(|_| {
+        let why = if n < 0 {
+            "is not a count (0 or more)"
+        } else {
+            "is too large a count"
+        };
+        Failure::input(format!("{what}: {n} {why}")).into()
+    })
 }
 
 /// A vector as a 1-D array.

@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use trilux::{ColorMesh, ConvertOptions};
 
-use crate::arrays;
+use crate::arrays::{self, Int};
 use crate::error::{Failure, Kind, detached};
 use crate::mesh::{Mesh, image_from, image_to, mesh_arg, path_arg};
 
@@ -68,15 +68,20 @@ impl MeshColors {
     /// or an image file; by default the mesh's own textures (its
     /// materials', or a trimesh's `visual.material.image`).
     #[staticmethod]
-    #[pyo3(signature = (mesh, image = None, *, density = 1.0, max_level = 8, max_samples = None))]
+    #[pyo3(signature = (mesh, image = None, *, density = 1.0, max_level = Int::Value(8), max_samples = None),
+        text_signature = "(mesh, image=None, *, density=1.0, max_level=8, max_samples=None)")]
     fn from_texture(
         py: Python<'_>,
         mesh: &Bound<'_, PyAny>,
         image: Option<&Bound<'_, PyAny>>,
         density: f64,
-        max_level: u8,
-        max_samples: Option<usize>,
+        max_level: Int,
+        max_samples: Option<Int>,
     ) -> PyResult<Self> {
+        let max_level: u8 = max_level.to("max_level", "0..256")?;
+        let max_samples: Option<usize> = max_samples
+            .map(|m| arrays::count(&m, "max_samples"))
+            .transpose()?;
         let mesh = mesh_arg(mesh, None)?;
         let image = match image {
             None => None,
@@ -209,8 +214,9 @@ impl MeshColors {
     /// (face `f` is face `f` of the mesh), and the atlas, `(H, W, 4)`
     /// float32 linear RGBA. Bilinear filtering of the atlas reproduces the
     /// linear filter. `gutter`: texels between blocks.
-    #[pyo3(signature = (*, gutter = 1))]
-    fn bake<'py>(&self, py: Python<'py>, gutter: u32) -> PyResult<Bound<'py, PyTuple>> {
+    #[pyo3(signature = (*, gutter = Int::Value(1)), text_signature = "($self, *, gutter=1)")]
+    fn bake<'py>(&self, py: Python<'py>, gutter: Int) -> PyResult<Bound<'py, PyTuple>> {
+        let gutter: u32 = gutter.to("gutter", "0..2**32")?;
         let options = mesh_colors::atlas::Options {
             gutter,
             ..Default::default()

@@ -6,12 +6,62 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use rand::SeedableRng;
 
-use crate::arrays;
+use crate::arrays::{self, Int};
 use crate::error::{Failure, detached};
 
 /// The generator of the `seed` argument (default 0).
-fn rng(seed: Option<i128>) -> PyResult<rand_pcg::Pcg64Mcg> {
+fn rng(seed: Option<&Int>) -> PyResult<rand_pcg::Pcg64Mcg> {
     Ok(rand_pcg::Pcg64Mcg::seed_from_u64(arrays::seed(seed)?))
+}
+
+/// `index` (the argument of `pdf` and `invert`) as indices into `len`
+/// entries: one out of range (negative, `>= len`) is an error naming the
+/// entry and its value, not a probability of 0 or a NaN that a caller
+/// would take for an answer.
+fn indices(index: &Bound<'_, PyAny>, len: usize) -> PyResult<Vec<usize>> {
+    arrays::values_i64(index, "index")?
+        .iter()
+        .enumerate()
+        .map(|(k, &i)| {
+            usize::try_from(i).ok().filter(|&i| i < len).ok_or_else(|| {
+                Failure::input(format!(
+                    "index: entry {k} is {i}, not an index of the {len} entries (0..{})",
+                    len.saturating_sub(1)
+                ))
+                .into()
+            })
+        })
+        .collect()
+}
+
+/// Whether `x` is a variate, in `[0, 1)` (NaN is not).
+fn is_variate(x: f64) -> bool {
+    (0.0..1.0).contains(&x)
+}
+
+/// A row of a `(n, 2)` or `(n, 3)` argument as the message prints it.
+fn row_text(r: &[f64]) -> String {
+    let parts: Vec<String> = r.iter().map(f64::to_string).collect();
+    format!("[{}]", parts.join(", "))
+}
+
+/// `(n, 2)` points of the unit square `[0, 1)²` (the variates of
+/// `sample_u`, the points of `pdf`): a row outside it, or with a NaN, is
+/// an error naming `what`, the row and its value.
+fn unit_square(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[f64; 2]>> {
+    let rows = arrays::rows_f64::<2>(obj, what)?;
+    if let Some((k, r)) = rows
+        .iter()
+        .enumerate()
+        .find(|(_, r)| !r.iter().all(|&x| is_variate(x)))
+    {
+        return Err(Failure::input(format!(
+            "{what}: row {k} is {}, not in [0, 1)²",
+            row_text(r)
+        ))
+        .into());
+    }
+    Ok(rows)
 }
 
 /// A discrete distribution over `len(weights)` entries, entry `i` with
@@ -41,11 +91,11 @@ impl Distribution1D {
     fn sample<'py>(
         &self,
         py: Python<'py>,
-        n: i128,
-        seed: Option<i128>,
+        n: Int,
+        seed: Option<Int>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let n = arrays::count(n, "n")?;
-        let mut rng = rng(seed)?;
+        let n = arrays::count(&n, "n")?;
+        let mut rng = rng(seed.as_ref())?;
         let out = detached(py, || {
             let mut out = vec![0usize; n];
             self.table.sample_into(&mut rng, &mut out);
@@ -55,45 +105,38 @@ impl Distribution1D {
     }
 
     /// The indices for your own variates `u` in `[0, 1)` (stratified, QMC),
-    /// `(n,)` int64; the order of `u` is kept (inversion of the CDF).
+    /// `(n,)` int64; the order of `u` is kept (inversion of the CDF). A
+    /// variate outside `[0, 1)` or NaN raises `trilux.InputError` naming
+    /// it.
     fn sample_u<'py>(&self, py: Python<'py>, u: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let u = arrays::values_f64(u, "u")?;
+        if let Some((k, x)) = u.iter().enumerate().find(|(_, x)| !is_variate(**x)) {
+            return Err(Failure::input(format!("u: entry {k} is {x}, not in [0, 1)")).into());
+        }
         let out: Vec<i64> = u.iter().map(|&x| self.table.sample_u(x) as i64).collect();
         Ok(arrays::vector(py, out))
     }
 
-    /// The probability of each index, `(n,)` float64 (0 outside the range).
+    /// The probability of each index, `(n,)` float64; an index out of
+    /// range raises `trilux.InputError` naming it.
     fn pdf<'py>(&self, py: Python<'py>, index: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        let index = arrays::values_i64(index, "index")?;
-        let out: Vec<f64> = index
-            .iter()
-            .map(|&i| {
-                usize::try_from(i)
-                    .ok()
-                    .filter(|&i| i < self.table.len())
-                    .map_or(0.0, |i| self.table.pdf(i))
-            })
-            .collect();
+        let index = indices(index, self.table.len())?;
+        let out: Vec<f64> = index.iter().map(|&i| self.table.pdf(i)).collect();
         Ok(arrays::vector(py, out))
     }
 
     /// The smallest variate `u` that `sample_u` maps to each index (the
-    /// start of its CDF interval), `(n,)` float64; NaN for an index out of
-    /// range.
+    /// start of its CDF interval), `(n,)` float64; an index out of range
+    /// raises `trilux.InputError` naming it.
     fn invert<'py>(
         &self,
         py: Python<'py>,
         index: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let index = arrays::values_i64(index, "index")?;
+        let index = indices(index, self.table.len())?;
         let out: Vec<f64> = index
             .iter()
-            .map(|&i| {
-                usize::try_from(i)
-                    .ok()
-                    .and_then(|i| self.table.invert(i))
-                    .unwrap_or(f64::NAN)
-            })
+            .map(|&i| self.table.invert(i).unwrap_or(f64::NAN))
             .collect();
         Ok(arrays::vector(py, out))
     }
@@ -179,11 +222,11 @@ impl Distribution2D {
     fn sample<'py>(
         &self,
         py: Python<'py>,
-        n: i128,
-        seed: Option<i128>,
+        n: Int,
+        seed: Option<Int>,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let n = arrays::count(n, "n")?;
-        let mut rng = rng(seed)?;
+        let n = arrays::count(&n, "n")?;
+        let mut rng = rng(seed.as_ref())?;
         let out = detached(py, || {
             let mut out = vec![Sample2D::default(); n];
             self.inner.sample_into(&mut rng, &mut out);
@@ -192,20 +235,23 @@ impl Distribution2D {
         samples_out(py, &out)
     }
 
-    /// The points for your own variates `u` `(n, 2)` in `[0, 1)²`.
+    /// The points for your own variates `u` `(n, 2)` in `[0, 1)²` (a row
+    /// outside it, or with a NaN, raises `trilux.InputError` naming it).
     fn sample_u<'py>(
         &self,
         py: Python<'py>,
         u: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let u = arrays::rows_f64::<2>(u, "u")?;
+        let u = unit_square(u, "u")?;
         let out: Vec<Sample2D> = u.iter().map(|&u| self.inner.sample_u(u)).collect();
         samples_out(py, &out)
     }
 
-    /// The density w.r.t. area at `points` `(n, 2)`, `(n,)` float64.
+    /// The density w.r.t. area at `points` `(n, 2)` in `[0, 1)²`, `(n,)`
+    /// float64 (a point outside the square, or with a NaN, raises
+    /// `trilux.InputError` naming it).
     fn pdf<'py>(&self, py: Python<'py>, points: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
-        let p = arrays::rows_f64::<2>(points, "points")?;
+        let p = unit_square(points, "points")?;
         Ok(arrays::vector(
             py,
             p.iter().map(|&p| self.inner.pdf(p)).collect(),
@@ -219,12 +265,12 @@ impl Distribution2D {
     fn sample_direction<'py>(
         &self,
         py: Python<'py>,
-        n: i128,
-        seed: Option<i128>,
+        n: Int,
+        seed: Option<Int>,
     ) -> PyResult<Bound<'py, PyTuple>> {
         use rand::RngExt;
-        let n = arrays::count(n, "n")?;
-        let mut rng = rng(seed)?;
+        let n = arrays::count(&n, "n")?;
+        let mut rng = rng(seed.as_ref())?;
         let out = detached(py, || {
             Ok((0..n)
                 .map(|_| {
@@ -240,13 +286,26 @@ impl Distribution2D {
 
     /// The density per steradian with which `sample_direction` draws each
     /// of `directions` `(n, 3)` (any length; 0 for a zero direction): what
-    /// multiple importance sampling needs for a BSDF-sampled direction.
+    /// multiple importance sampling needs for a BSDF-sampled direction. A
+    /// direction with a NaN or infinite component raises
+    /// `trilux.InputError` naming it.
     fn pdf_direction<'py>(
         &self,
         py: Python<'py>,
         directions: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let d = arrays::rows_f64::<3>(directions, "directions")?;
+        if let Some((k, r)) = d
+            .iter()
+            .enumerate()
+            .find(|(_, r)| !r.iter().all(|x| x.is_finite()))
+        {
+            return Err(Failure::input(format!(
+                "directions: row {k} is {}, not a finite direction",
+                row_text(r)
+            ))
+            .into());
+        }
         Ok(arrays::vector(
             py,
             d.iter().map(|&d| self.inner.pdf_direction(d)).collect(),

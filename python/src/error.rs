@@ -150,10 +150,14 @@ impl From<trilux::Error> for Failure {
             }
             _ => Kind::Input,
         };
-        Self {
-            kind,
-            message: chain(&e),
-        }
+        let message = match &e {
+            // The command line's way to give a texture is not Python's.
+            trilux::Error::MissingTexture => "the mesh has no material with a texture: give one \
+                (MeshColors.from_texture(mesh, image), image an array or an image file)"
+                .to_string(),
+            _ => chain(&e),
+        };
+        Self { kind, message }
     }
 }
 
@@ -167,12 +171,122 @@ macro_rules! input_error {
         }
     )*};
 }
-input_error!(
-    mesh_sampling::Error,
-    discrete_sampling::Error,
-    tet_diffusion::Error,
-    tet_stuffing::Error
+input_error!(discrete_sampling::Error);
+
+// The messages below are the crates' own, reworded where they name a Rust
+// item or a command-line flag (`length_unit_mm`, `h`, `sample_stream`,
+// `--texture`, "the approximate mode") instead of the Python argument the
+// caller can change (`unit_mm`, `spacing`, `count`, `method=`): the
+// Python user reads them, not the Rust one.
+
+/// "…; use the approximate mode" in Python's words.
+const APPROXIMATE: (&str, &str) = (
+    "(use the approximate mode)",
+    "(use method='subdivision', the default with a texture)",
 );
+
+impl From<mesh_sampling::Error> for Failure {
+    fn from(e: mesh_sampling::Error) -> Self {
+        use mesh_sampling::Error as E;
+        match &e {
+            E::TooManyPoints { requested, budget } => Self::input(format!(
+                "count: {requested} points is more than one call returns (at most {budget} = \
+                 2**{}); ask for fewer, and call again with another seed for more",
+                budget.trailing_zeros()
+            )),
+            E::IntegrationTooLarge { .. } | E::AcceptanceTooLow { .. } => {
+                Self::input(chain(&e).replace(APPROXIMATE.0, APPROXIMATE.1).replace(
+                    "for the exact mode or rejection sampling",
+                    "for method='exact' or method='rejection'",
+                ))
+            }
+            _ => Self::input(chain(&e)),
+        }
+    }
+}
+
+impl From<tet_diffusion::Error> for Failure {
+    fn from(e: tet_diffusion::Error) -> Self {
+        use tet_diffusion::Error as E;
+        // Python calls a tet mesh's positions `nodes` (trilux.Object,
+        // load_tets), so the mesh's checks say "node".
+        let message = match &e {
+            E::NonFinitePosition { vertex, position } => format!(
+                "nodes: node {vertex} has a non-finite position [{}, {}, {}]",
+                position[0], position[1], position[2]
+            ),
+            E::IndexOutOfRange {
+                tet,
+                index,
+                vertices,
+            } => format!(
+                "tets: row {tet} references node {index}, but there are only {vertices} nodes"
+            ),
+            E::RepeatedVertex { tet, index } => format!("tets: row {tet} repeats node {index}"),
+            E::UnusedVertex { vertex, count } => format!(
+                "nodes: node {vertex} is used by no tetrahedron ({count} such nodes); drop unused nodes \
+                 (and renumber tets) before making the Object"
+            ),
+            E::DegenerateTet {
+                tet,
+                vertices,
+                volume,
+            } => format!(
+                "tets: row {tet} (nodes {vertices:?}) has zero volume ({volume:e}): its nodes are coplanar"
+            ),
+            E::BadArgument { what, value, need } if what == "length_unit_mm" => {
+                format!("unit_mm is {value}: {need}")
+            }
+            E::BadArgument { what, value, need } if what == "the index of refraction eta" => {
+                format!("eta (the index of refraction) is {value}: {need}")
+            }
+            _ => chain(&e),
+        };
+        Self::input(message)
+    }
+}
+
+impl From<tet_stuffing::Error> for Failure {
+    fn from(e: tet_stuffing::Error) -> Self {
+        use tet_stuffing::Error as E;
+        // The stuffing's `h` is tetrahedralize's `spacing`.
+        let message = match &e {
+            E::InvalidSpacing { h } => {
+                format!("spacing: {h} is not a positive finite length (mesh units)")
+            }
+            E::LatticeTooLarge {
+                h,
+                vertices,
+                limit,
+                limit_mib,
+            } => {
+                let vertices = if *vertices == u128::MAX {
+                    "more than 10^36".to_string()
+                } else {
+                    vertices.to_string()
+                };
+                format!(
+                    "spacing={h:e}: the lattice over this surface needs {vertices} vertices, more \
+                     than the limit of {limit} (about {limit_mib} MiB); choose a larger spacing"
+                )
+            }
+            E::TooManyTetrahedra {
+                h,
+                estimated,
+                limit,
+            } => format!(
+                "spacing={h:e}: the mesh would have about {estimated} tetrahedra, more than the \
+                 limit of {limit}; choose a larger spacing (or graded=True)"
+            ),
+            E::EmptyVolume { h } => format!(
+                "the surface encloses no volume at spacing={h} (winding number above 1/2 at no \
+                 lattice vertex): it is open, flat, or thinner than the spacing"
+            ),
+            _ => chain(&e),
+        };
+        Self::input(message)
+    }
+}
 
 impl From<mesh_colors::Error> for Failure {
     fn from(e: mesh_colors::Error) -> Self {

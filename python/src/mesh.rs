@@ -181,7 +181,7 @@ fn is_placeholder(image: &Image) -> bool {
 }
 
 /// A Python `UserWarning` with this message.
-fn warn_user(py: Python<'_>, message: &str) -> PyResult<()> {
+pub(crate) fn warn_user(py: Python<'_>, message: &str) -> PyResult<()> {
     let message = std::ffi::CString::new(message.replace('\0', " "))
         .unwrap_or_else(|_| c"trilux: a warning could not be formatted".to_owned());
     let category = py.get_type::<pyo3::exceptions::PyUserWarning>();

@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyTuple;
 use trilux_io::mesh::TriMesh;
 
-use crate::arrays;
+use crate::arrays::{self, Int};
 use crate::error::{Failure, Result, detached};
 use crate::mesh::{mesh_arg, path_arg};
 
@@ -165,7 +165,8 @@ fn draw<S: SurfaceSampler>(
     want: Want,
 ) -> Result<Points> {
     if n as u64 > mesh_sampling::MAX_POINTS as u64 {
-        // The same check (and message) as sample_n's, before allocating.
+        // The same check as sample_n's, before allocating; the message is
+        // the Python one (crate::error words mesh-sampling's for Python).
         return Err(mesh_sampling::Error::TooManyPoints {
             requested: n as f64,
             budget: mesh_sampling::MAX_POINTS,
@@ -447,20 +448,20 @@ pub(crate) enum Sampler<'a> {
 pub(crate) fn sample_surface<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, PyAny>,
-    count: i128,
+    count: Int,
     density: Option<&Bound<'py, PyAny>>,
     uv: Option<&Bound<'py, PyAny>>,
     channel: Option<&Bound<'py, PyAny>>,
     face_weight: Option<&Bound<'py, PyAny>>,
     vertex_weight: Option<&Bound<'py, PyAny>>,
     method: Option<&str>,
-    seed: Option<i128>,
+    seed: Option<Int>,
     return_barycentric: bool,
     return_pdf: bool,
     return_normal: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let n = arrays::count(count, "count")?;
-    let seed = arrays::seed(seed)?;
+    let n = arrays::count(&count, "count")?;
+    let seed = arrays::seed(seed.as_ref())?;
     let mesh: Arc<TriMesh> = mesh_arg(mesh, uv)?;
     let density = density_arg(density, channel, face_weight, vertex_weight)?;
     let method = method_arg(method, &density)?;
@@ -519,7 +520,7 @@ pub(crate) fn sample_surface<'py>(
 pub(crate) fn blue_noise<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, PyAny>,
-    count: Option<i128>,
+    count: Option<Int>,
     radius: Option<f64>,
     density: Option<&Bound<'py, PyAny>>,
     uv: Option<&Bound<'py, PyAny>>,
@@ -527,7 +528,7 @@ pub(crate) fn blue_noise<'py>(
     face_weight: Option<&Bound<'py, PyAny>>,
     vertex_weight: Option<&Bound<'py, PyAny>>,
     method: Option<&str>,
-    seed: Option<i128>,
+    seed: Option<Int>,
     progressive: bool,
     packing: Option<&str>,
     return_barycentric: bool,
@@ -536,11 +537,12 @@ pub(crate) fn blue_noise<'py>(
 ) -> PyResult<Bound<'py, PyTuple>> {
     let base = packing_options(packing)?;
     let target = match (count, radius) {
-        (Some(c), None) => BlueNoiseTarget::Count(arrays::count(c, "count")?),
-        (None, Some(r)) => BlueNoiseTarget::Radius(r),
+        (Some(c), None) => BlueNoiseTarget::Count(arrays::count(&c, "count")?),
+        (None, Some(r)) => BlueNoiseTarget::Radius(radius_arg(r)?),
         _ => return Err(Failure::input("give exactly one of count and radius").into()),
     };
-    let seed = arrays::seed(seed)?;
+    let dense = base.packing == mesh_sampling::Packing::Dense;
+    let seed = arrays::seed(seed.as_ref())?;
     let mesh = mesh_arg(mesh, uv)?;
     let density = density_arg(density, channel, face_weight, vertex_weight)?;
     let method = method_arg(method, &density)?;
@@ -563,16 +565,61 @@ pub(crate) fn blue_noise<'py>(
     let points = detached(py, || {
         with_sampler(&mesh, &density, method, |s| {
             let points = match &s {
-                Sampler::Uniform(s) => mesh_sampling::blue_noise(s, target, seed, &options)?,
-                Sampler::Density(s) => mesh_sampling::blue_noise(s, target, seed, &options)?,
+                Sampler::Uniform(s) => mesh_sampling::blue_noise(s, target, seed, &options),
+                Sampler::Density(s) => mesh_sampling::blue_noise(s, target, seed, &options),
                 Sampler::Rejection(_) => {
                     return Err(Failure::input("blue_noise: no rejection sampling"));
                 }
-            };
+            }
+            .map_err(|e| blue_noise_failure(e, target, dense))?;
             Ok(Points::of(&points, origin, want))
         })
     })?;
     points.into_tuple(py)
+}
+
+/// A `radius` argument of `blue_noise` / `sample_surface_even`: finite and
+/// positive, else an error naming it.
+fn radius_arg(r: f64) -> Result<f64> {
+    if r > 0.0 && r.is_finite() {
+        Ok(r)
+    } else {
+        Err(Failure::input(format!(
+            "radius: {r} is not a positive finite length (mesh units)"
+        )))
+    }
+}
+
+/// mesh-sampling's blue-noise errors in Python's words: its budget
+/// messages name Rust options (`BlueNoiseOptions::max_memory_bytes`,
+/// "fewer candidates per point"); here they name the argument the caller
+/// gave (`asked`: `count` or `radius` as the caller gave it) and the
+/// arguments that help.
+fn blue_noise_failure(e: mesh_sampling::Error, asked: BlueNoiseTarget, dense: bool) -> Failure {
+    let mesh_sampling::Error::InvalidOption(text) = &e else {
+        return e.into();
+    };
+    let body = text.strip_prefix("blue noise: ").unwrap_or(text);
+    let over_budget =
+        body.contains("candidates need about") || body.contains("more than a run can index");
+    if !over_budget {
+        return Failure::input(format!("blue_noise: {body}"));
+    }
+    let body = body
+        .replace(" (BlueNoiseOptions::max_memory_bytes)", "")
+        .replace("; ask for fewer points or fewer candidates per point", "");
+    let (argument, remedy) = match asked {
+        BlueNoiseTarget::Count(n) => (format!("count={n}"), "ask for fewer points (count)"),
+        BlueNoiseTarget::Radius(r) => (format!("radius={r}"), "use a larger radius"),
+    };
+    // Fewer candidates per point help a run that is over the memory
+    // budget, not one that asks for more points than a run can index.
+    let elimination = if dense && body.contains("candidates need about") {
+        ", or packing='elimination' (5 candidates per point instead of 14)"
+    } else {
+        ""
+    };
+    Failure::input(format!("{argument}: {body}; {remedy}{elimination}"))
 }
 
 /// The options of `packing` (`None` is the dense packing).
@@ -598,16 +645,25 @@ fn packing_options(packing: Option<&str>) -> std::result::Result<BlueNoiseOption
 pub(crate) fn sample_surface_even<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, PyAny>,
-    count: i128,
+    count: Int,
     radius: Option<f64>,
-    seed: Option<i128>,
+    seed: Option<Int>,
 ) -> PyResult<Bound<'py, PyTuple>> {
-    let n = arrays::count(count, "count")?;
-    let seed = arrays::seed(seed)?;
+    let n = arrays::count(&count, "count")?;
+    let seed = arrays::seed(seed.as_ref())?;
     let mesh = mesh_arg(mesh, None)?;
-    let (target, progressive) = match radius {
-        None => (BlueNoiseTarget::Count(n), false),
-        Some(r) => (BlueNoiseTarget::Radius(r / 2.0), true),
+    // What the caller asked for (trimesh's radius is the distance between
+    // points), for the messages; and what blue_noise is given.
+    let (asked, target, progressive) = match radius {
+        None => (BlueNoiseTarget::Count(n), BlueNoiseTarget::Count(n), false),
+        Some(r) => {
+            let r = radius_arg(r)?;
+            (
+                BlueNoiseTarget::Radius(r),
+                BlueNoiseTarget::Radius(r / 2.0),
+                true,
+            )
+        }
     };
     let options = BlueNoiseOptions {
         progressive,
@@ -616,7 +672,8 @@ pub(crate) fn sample_surface_even<'py>(
     let origin = mesh.origin;
     let points = detached(py, || {
         let sampler = UniformSampler::new(trilux::mesh_ref(&mesh))?;
-        let mut points = mesh_sampling::blue_noise(&sampler, target, seed, &options)?;
+        let mut points = mesh_sampling::blue_noise(&sampler, target, seed, &options)
+            .map_err(|e| blue_noise_failure(e, asked, true))?;
         points.truncate(n);
         Ok(Points::of(&points, origin, Want::default()))
     })?;

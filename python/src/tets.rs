@@ -97,6 +97,13 @@ pub(crate) fn tetrahedralize<'py>(
 /// `return_warnings=True`, the list of str naming what the reader skipped
 /// without refusing the file (Gmsh elements that are not tetrahedra, for
 /// one), each with the file and the section or line.
+///
+/// The tets come back as the file stores them, in its node order, not
+/// re-oriented: a tet may have negative signed volume
+/// (`det[p1 - p0, p2 - p0, p3 - p0] < 0`, an inverted tet).
+/// `trilux.Object` accepts either orientation and re-orients an inverted
+/// tet (its first two nodes swapped); `tetrahedralize` only makes tets of
+/// positive volume.
 #[pyfunction]
 #[pyo3(signature = (path, *, return_warnings = false))]
 pub(crate) fn load_tets<'py>(

@@ -9,9 +9,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 use tet_diffusion::{Cut, Light, Medium, Stroke};
 
-use crate::arrays;
+use crate::arrays::{self, Int};
 use crate::error::{Failure, detached};
-use crate::mesh::image_from;
+use crate::mesh::{image_from, warn_user};
 use crate::tets::{tets_in, tets_out};
 
 /// The names of the measured media (Jensen et al. 2001, Fig. 5, in mm⁻¹),
@@ -53,10 +53,87 @@ fn vec3_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<DVec3> {
 /// index of refraction of the boundary. The cotangent-weight diffusion
 /// matrix (Eq. 4–14) is assembled here; `solve` runs the multi-resolution
 /// solver with the GIL released.
+///
+/// Tetrahedra may come in either orientation: one with negative signed
+/// volume (`det[p1 - p0, p2 - p0, p3 - p0] < 0`, an inverted tet) is
+/// re-oriented by swapping its first two nodes, so `Object.mesh` returns
+/// every tet with positive volume; a tet of (numerically) zero volume, a
+/// repeated node, an unused node or a NaN node raises `trilux.InputError`
+/// naming the row or node.
+///
+/// `solve` issues a `UserWarning` for each channel in which a medium's
+/// diffusion length is below the mesh's mean edge length (the mesh is too
+/// coarse to resolve it), before solving; `render`, `radiance` and
+/// `fluence` issue one when the object has not been solved since it was
+/// made or changed (`add_light`, `cut`, `paint`, `fracture`,
+/// `recombine`): their values are then of the last solution (zero before
+/// the first).
 #[pyclass(module = "trilux")]
 pub(crate) struct Object {
     inner: tet_diffusion::Object,
     lights: Vec<Light>,
+    /// Whether `solve` ran after the last change (else `render`,
+    /// `radiance` and `fluence` warn).
+    solved: bool,
+}
+
+impl Object {
+    fn unsolved(inner: tet_diffusion::Object, lights: Vec<Light>) -> Self {
+        Self {
+            inner,
+            lights,
+            solved: false,
+        }
+    }
+
+    /// The `UserWarning` of `what` (`Object.render`, …) on an object not
+    /// solved since its last change.
+    fn warn_if_unsolved(&self, py: Python<'_>, what: &str) -> PyResult<()> {
+        if self.solved {
+            return Ok(());
+        }
+        warn_user(
+            py,
+            &format!(
+                "{what}: the object has not been solved since it was made or last changed \
+                 (add_light, cut, paint, fracture, recombine): the values are of the last \
+                 solution (zero before the first); call solve() first"
+            ),
+        )
+    }
+}
+
+/// The messages of `solve`'s `UserWarning`s: one per channel that some
+/// medium cannot resolve, however many media (a `paint` stroke gives each
+/// tet it blends its own medium, and a warning per medium would be
+/// thousands), naming the shortest diffusion length and a tet with it.
+fn resolution_warnings(found: &[tet_diffusion::ResolutionWarning]) -> Vec<String> {
+    (0..3)
+        .filter_map(|c| {
+            let of_channel: Vec<_> = found.iter().filter(|w| w.channel == c).collect();
+            let shortest = of_channel
+                .iter()
+                .min_by(|a, b| a.diffusion_length_mm.total_cmp(&b.diffusion_length_mm))?;
+            let colour = ["red", "green", "blue"][c];
+            let (l, e, t) = (
+                shortest.diffusion_length_mm,
+                shortest.edge_length_mm,
+                shortest.tet,
+            );
+            let media = match of_channel.len() {
+                1 => format!("the diffusion length {l:.3} mm (the medium of tetrahedron {t})"),
+                n => format!(
+                    "the diffusion length of {n} media, down to {l:.3} mm (the medium of \
+                     tetrahedron {t}),"
+                ),
+            };
+            Some(format!(
+                "Object.solve: in the {colour} channel {media} is below the mesh's mean edge \
+                 length {e:.3} mm: the mesh is too coarse to resolve the light's fall-off there; \
+                 refine it (tetrahedralize with a smaller spacing)"
+            ))
+        })
+        .collect()
 }
 
 fn solve_report<'py>(
@@ -101,10 +178,7 @@ impl Object {
                 mesh, unit_mm, medium, eta,
             )?)
         })?;
-        Ok(Self {
-            inner,
-            lights: Vec::new(),
-        })
+        Ok(Self::unsolved(inner, Vec::new()))
     }
 
     /// Adds a light and returns its index: `direction` (toward the light)
@@ -112,7 +186,8 @@ impl Object {
     /// (mesh units) with `intensity` (RGB, W/sr) for a point light; or
     /// `envmap`, an equirectangular HDR image `(H, W, 3)` (linear).
     #[pyo3(signature = (direction = None, *, irradiance = (1.0, 1.0, 1.0), position = None,
-        intensity = (1.0, 1.0, 1.0), envmap = None, envmap_samples = 256))]
+        intensity = (1.0, 1.0, 1.0), envmap = None, envmap_samples = Int::Value(256)),
+        text_signature = "($self, direction=None, *, irradiance=..., position=None, intensity=..., envmap=None, envmap_samples=256)")]
     #[allow(clippy::too_many_arguments, reason = "the Python keyword arguments")]
     fn add_light(
         &mut self,
@@ -122,8 +197,15 @@ impl Object {
         position: Option<&Bound<'_, PyAny>>,
         intensity: (f64, f64, f64),
         envmap: Option<&Bound<'_, PyAny>>,
-        envmap_samples: usize,
+        envmap_samples: Int,
     ) -> PyResult<usize> {
+        let envmap_samples: usize = envmap_samples.to("envmap_samples", "1..")?;
+        if envmap_samples == 0 {
+            return Err(Failure::input(
+                "envmap_samples: 0 is not in 1.. (an environment light needs at least one sample)",
+            )
+            .into());
+        }
         let light = match (direction, position, envmap) {
             (Some(d), None, None) => Light::Directional {
                 to_light: vec3_arg(d, "direction")?,
@@ -156,15 +238,22 @@ impl Object {
         let l = light.clone();
         let index = detached(py, || Ok(obj.add_light(l)?))?;
         self.lights.push(light);
+        self.solved = false;
         Ok(index)
     }
 
     /// Solves the diffusion equation for `φ` (three channels); returns a
     /// report dict: `levels`, `iterations` and `residuals` per channel,
-    /// `hierarchy_ms`, `solve_ms`.
+    /// `hierarchy_ms`, `solve_ms`. Before solving, a `UserWarning` for each
+    /// channel in which a medium's diffusion length is below the mesh's
+    /// mean edge length (too coarse a mesh to resolve it).
     fn solve<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        for w in resolution_warnings(&self.inner.warnings()) {
+            warn_user(py, &w)?;
+        }
         let obj = &mut self.inner;
         let r = detached(py, || Ok(obj.solve()?))?;
+        self.solved = true;
         solve_report(py, &r)
     }
 
@@ -178,6 +267,7 @@ impl Object {
         toward: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let toward = toward.map(|t| vec3_arg(t, "toward")).transpose()?;
+        self.warn_if_unsolved(py, "Object.radiance")?;
         let obj = &self.inner;
         let r = detached(py, || Ok(obj.radiance(toward)))?;
         arrays::matrix(py, r.into_iter().flatten().collect(), 3)
@@ -186,6 +276,7 @@ impl Object {
     /// `φ` per node and channel, `(n, 3)` float64 (the fluence).
     #[getter]
     fn fluence<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.warn_if_unsolved(py, "Object.fluence")?;
         arrays::matrix(py, self.inner.fluence().into_iter().flatten().collect(), 3)
     }
 
@@ -196,15 +287,17 @@ impl Object {
     /// `removed_tets`, `removed_vertices`, `moved_vertices`, `sweeps`,
     /// `split_tets`, `created_tets`, `created_vertices`,
     /// `min_created_dihedral` (degrees). Solve again after.
-    #[pyo3(signature = (point, normal, *, method = "exact", relax_sweeps = 20))]
+    #[pyo3(signature = (point, normal, *, method = "exact", relax_sweeps = Int::Value(20)),
+        text_signature = "($self, point, normal, *, method=\"exact\", relax_sweeps=20)")]
     fn cut<'py>(
         &mut self,
         py: Python<'py>,
         point: &Bound<'py, PyAny>,
         normal: &Bound<'py, PyAny>,
         method: &str,
-        relax_sweeps: usize,
+        relax_sweeps: Int,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let relax_sweeps: usize = relax_sweeps.to("relax_sweeps", "0..")?;
         let method = match method {
             "exact" => tet_diffusion::CutMethod::Exact,
             "relax" => tet_diffusion::CutMethod::Relax {
@@ -222,6 +315,7 @@ impl Object {
         };
         let obj = &mut self.inner;
         let r = detached(py, || Ok(obj.cut(&cut, method)?))?;
+        self.solved = false;
         let d = PyDict::new(py);
         d.set_item("removed_tets", r.removed_tets)?;
         d.set_item("removed_vertices", r.removed_vertices)?;
@@ -253,7 +347,9 @@ impl Object {
             strength,
         };
         let obj = &mut self.inner;
-        Ok(detached(py, || Ok(obj.paint(&stroke)?))?.tets)
+        let changed = detached(py, || Ok(obj.paint(&stroke)?))?.tets;
+        self.solved = false;
+        Ok(changed)
     }
 
     /// Splits the object along the plane through `point` with `normal`
@@ -272,16 +368,8 @@ impl Object {
         let obj = &self.inner;
         let [a, mut b] = detached(py, || Ok(obj.fracture(p, n)?))?;
         b.set_transform(DAffine3::from_translation(n.normalize_or_zero() * offset));
-        let wrap = |o| {
-            Bound::new(
-                py,
-                Object {
-                    inner: o,
-                    lights: self.lights.clone(),
-                },
-            )
-            .map(Bound::into_any)
-        };
+        let wrap =
+            |o| Bound::new(py, Object::unsolved(o, self.lights.clone())).map(Bound::into_any);
         PyTuple::new(py, [wrap(a)?, wrap(b)?])
     }
 
@@ -290,10 +378,7 @@ impl Object {
     fn recombine(py: Python<'_>, a: PyRef<'_, Object>, b: PyRef<'_, Object>) -> PyResult<Object> {
         let (ia, ib) = (&a.inner, &b.inner);
         let inner = detached(py, || Ok(tet_diffusion::Object::recombine(ia, ib)?))?;
-        Ok(Object {
-            inner,
-            lights: a.lights.clone(),
-        })
+        Ok(Object::unsolved(inner, a.lights.clone()))
     }
 
     /// A picture: the boundary with the radiance toward the camera (Eq. 3)
@@ -302,12 +387,13 @@ impl Object {
     /// the object toward the eye. `exposure='auto'` scales the brightest
     /// 1 % of the object's pixels to 1 (as `trilux diffuse` writes its
     /// PNG); `None` keeps the radiance.
-    #[pyo3(signature = (*, view = None, size = 512, exposure = Some("auto")))]
+    #[pyo3(signature = (*, view = None, size = Int::Value(512), exposure = Some("auto")),
+        text_signature = "($self, *, view=None, size=512, exposure=...)")]
     fn render<'py>(
         &self,
         py: Python<'py>,
         view: Option<&Bound<'py, PyAny>>,
-        size: u32,
+        size: Int,
         exposure: Option<&str>,
     ) -> PyResult<Bound<'py, PyAny>> {
         render_objects(
@@ -317,6 +403,7 @@ impl Object {
             view,
             size,
             exposure,
+            || self.warn_if_unsolved(py, "Object.render"),
         )
     }
 
@@ -361,17 +448,24 @@ impl Object {
     }
 }
 
+/// The picture of `render` and `Object.render`; `warn` issues the
+/// not-solved warnings, after the arguments are checked (a call that
+/// raises does not also warn).
+#[allow(clippy::too_many_arguments, reason = "the Python keyword arguments")]
 fn render_objects<'py>(
     py: Python<'py>,
     objects: &[tet_diffusion::Object],
     lights: &[Light],
     view: Option<&Bound<'py, PyAny>>,
-    size: u32,
+    size: Int,
     exposure: Option<&str>,
+    warn: impl FnOnce() -> PyResult<()>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    if !(1..=8192).contains(&size) {
-        return Err(Failure::input(format!("size: {size} is not in 1..8192")).into());
-    }
+    let size = size.value("size", "1..8192")?;
+    let size = match u32::try_from(size) {
+        Ok(s) if (1..=8192).contains(&s) => s,
+        _ => return Err(Failure::input(format!("size: {size} is not in 1..8192")).into()),
+    };
     let auto = match exposure {
         None => false,
         Some("auto") => true,
@@ -384,6 +478,7 @@ fn render_objects<'py>(
     let view: Option<Vec3> = view
         .map(|v| vec3_arg(v, "view").map(|v| v.as_vec3()))
         .transpose()?;
+    warn()?;
     let image = detached(py, || {
         let picture = trilux::tet::render(objects, lights, size, view);
         Ok(if auto {
@@ -404,12 +499,13 @@ fn render_objects<'py>(
 /// their display offsets) with the lights of the first: as
 /// `Object.render`.
 #[pyfunction]
-#[pyo3(signature = (objects, *, view = None, size = 512, exposure = Some("auto")))]
+#[pyo3(signature = (objects, *, view = None, size = Int::Value(512), exposure = Some("auto")),
+    text_signature = "(objects, *, view=None, size=512, exposure=...)")]
 pub(crate) fn render<'py>(
     py: Python<'py>,
     objects: Vec<PyRef<'py, Object>>,
     view: Option<&Bound<'py, PyAny>>,
-    size: u32,
+    size: Int,
     exposure: Option<&str>,
 ) -> PyResult<Bound<'py, PyAny>> {
     // The renderer takes a slice of objects: copies, for pieces held by
@@ -419,5 +515,11 @@ pub(crate) fn render<'py>(
         .first()
         .map(|o| o.lights.clone())
         .unwrap_or_default();
-    render_objects(py, &inner, &lights, view, size, exposure)
+    let warn = || {
+        objects
+            .iter()
+            .enumerate()
+            .try_for_each(|(i, o)| o.warn_if_unsolved(py, &format!("render (objects[{i}])")))
+    };
+    render_objects(py, &inner, &lights, view, size, exposure, warn)
 }

@@ -2,6 +2,7 @@
 TransCut from Python."""
 
 import numpy as np
+import pytest
 
 import trilux
 from conftest import grid
@@ -91,11 +92,42 @@ def test_transcut_object_solve_cut_paint_fracture_render():
     assert cut["removed_tets"] > 0 and cut["split_tets"] > 0
     relaxed = trilux.Object(nodes, tets).cut([0, 0, 0], [0, 1, 0], method="relax", relax_sweeps=5)
     assert relaxed["removed_tets"] > 0 and relaxed["split_tets"] == 0
-    obj.solve()
+    # Ketchup's green and blue diffusion lengths are below this coarse
+    # mesh's edges: solve says so, once per channel.
+    with pytest.warns(UserWarning, match="diffusion length") as record:
+        obj.solve()
+    assert [str(w.message).split(" channel")[0] for w in record] == [
+        "Object.solve: in the green", "Object.solve: in the blue"]
     a, b = trilux.Object(nodes, tets).fracture([0, 0, 0], [1, 0, 0], offset=0.5)
     whole = trilux.Object.recombine(a, b)
     # The fracture splits the tets the plane crosses; recombining joins
     # the pieces' tets back into one object.
     assert len(whole.mesh[1]) == len(a.mesh[1]) + len(b.mesh[1]) >= len(tets)
+    a.solve()
+    b.solve()
     both = trilux.render([a, b], size=32, exposure=None)
     assert both.shape == (32, 32, 3)
+
+
+def test_load_tets_keeps_the_file_orientation_and_object_reorients(tmp_path):
+    """load_tets returns a tet as the file stores it, inverted or not (as
+    its docstring says); Object re-orients an inverted tet by swapping its
+    first two nodes, so Object.mesh has positive volumes only."""
+    nodes = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
+    tets = np.array([[0, 1, 2, 3], [2, 1, 3, 4]])  # the second is inverted
+
+    def volumes(n, t):
+        p = n[t]
+        return np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), p[:, 3] - p[:, 0]) / 6
+
+    assert volumes(nodes, tets)[1] < 0 < volumes(nodes, tets)[0]
+    path = tmp_path / "two.mesh"
+    trilux.save_tets(path, nodes, tets)
+    n, t = trilux.load_tets(path)
+    assert np.array_equal(t, tets) and np.array_equal(n, nodes)
+    mesh_nodes, mesh_tets = trilux.Object(n, t).mesh
+    assert mesh_tets.tolist() == [[0, 1, 2, 3], [1, 2, 3, 4]]
+    assert (volumes(mesh_nodes, mesh_tets) > 0).all()
+    assert "not\nre-oriented" in trilux.load_tets.__doc__ or "not re-oriented" in " ".join(
+        trilux.load_tets.__doc__.split())
+    assert "swapping its first two nodes" in " ".join(trilux.Object.__doc__.split())

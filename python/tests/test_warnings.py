@@ -134,3 +134,71 @@ def test_trimesh_single_colour_placeholder_is_no_texture():
     trilux.MeshColors.from_texture(_MeshWithImage(texture))
     two = np.array([[[0, 0, 0], [255, 255, 255]]], dtype=np.uint8)
     trilux.MeshColors.from_texture(_MeshWithImage(two))
+
+
+NODES = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
+
+
+def _lit_tet():
+    obj = trilux.Object(NODES, [[0, 1, 2, 3]], medium="marble", unit_mm=1.0)
+    obj.add_light([0.0, 1.0, 0.0])
+    return obj
+
+
+def test_results_of_an_unsolved_object_warn():
+    import warnings
+
+    import pytest
+
+    obj = _lit_tet()
+    for name, call in [
+        ("Object.render", lambda: obj.render(size=8)),
+        ("Object.radiance", obj.radiance),
+        ("Object.fluence", lambda: obj.fluence),
+        (r"render \(objects\[0\]\)", lambda: trilux.render([obj], size=8)),
+    ]:
+        with pytest.warns(UserWarning, match=name + ": the object has not been solved"):
+            call()
+    obj.solve()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        obj.render(size=8)
+        obj.radiance()
+        obj.fluence
+        trilux.render([obj], size=8)
+    # A change makes the solution stale again.
+    obj.add_light([1.0, 0.0, 0.0])
+    with pytest.warns(UserWarning, match="Object.render: the object has not been solved"):
+        obj.render(size=8)
+    obj.solve()
+    obj.paint([0, 0, 0], 0.1, "marble")
+    with pytest.warns(UserWarning, match="Object.fluence"):
+        obj.fluence
+    # A call that raises does not also warn.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(trilux.InputError, match="size: 0 is not in 1..8192"):
+            obj.render(size=0)
+
+
+def test_solve_warns_when_the_mesh_cannot_resolve_the_medium():
+    import warnings
+
+    import pytest
+
+    # Ketchup's green and blue diffusion lengths (about 0.6 and 0.4 mm) are
+    # below this tet's mean edge (3.6 mm at 3 mm per unit); its red one
+    # (4.8 mm) is not.
+    obj = trilux.Object(NODES, [[0, 1, 2, 3]], medium="ketchup", unit_mm=3.0)
+    obj.add_light([0.0, 1.0, 0.0])
+    with pytest.warns(UserWarning) as record:
+        obj.solve()
+    messages = [str(w.message) for w in record]
+    assert len(messages) == 2, messages
+    assert messages[0].startswith("Object.solve: in the green channel the diffusion length "), messages
+    assert messages[1].startswith("Object.solve: in the blue channel the diffusion length "), messages
+    assert all("(the medium of tetrahedron 0) is below the mesh's mean edge length" in m for m in messages)
+    # Marble at 1 mm per unit is resolved: no warning.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _lit_tet().solve()

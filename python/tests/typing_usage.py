@@ -8,6 +8,8 @@ import numpy.typing as npt
 
 import trilux
 
+F64 = npt.NDArray[np.float64]
+I64 = npt.NDArray[np.int64]
 
 def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     mesh: trilux.Mesh = trilux.load(path)
@@ -16,6 +18,29 @@ def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     points, faces = trilux.sample_surface(mesh, 1000, seed=1)
     more = trilux.sample_surface(mesh, 10, return_pdf=True, return_barycentric=True)
     assert len(more) == 4
+    # Literal flags pick the overload: each array's type is known.
+    p4, f4, bary4, pdf4 = more
+    with_normals: Tuple[F64, I64, F64] = trilux.sample_surface(mesh, 10, return_normal=True)
+    everything: Tuple[F64, I64, F64, F64, F64] = trilux.sample_surface(
+        mesh, 10, return_barycentric=True, return_pdf=True, return_normal=True
+    )
+    plain: Tuple[F64, I64] = trilux.sample_surface(mesh, 10, return_pdf=False)
+    blue_pdf: Tuple[F64, I64, F64] = trilux.blue_noise(mesh, 10, return_pdf=True)
+    blue_all: Tuple[F64, I64, F64, F64, F64] = trilux.blue_noise(
+        mesh, radius=0.1, return_barycentric=True, return_pdf=True, return_normal=True
+    )
+    # A plain bool gives one of the tuples: its length is checked at run time.
+    flag: bool = len(path) > 3
+    either = trilux.sample_surface(mesh, 10, return_pdf=flag)
+    if len(either) == 3:
+        chosen_pdf: F64 = either[2]
+        del chosen_pdf
+    some_tets = trilux.tetrahedralize(mesh, return_report=flag)
+    some_tet_files = trilux.load_tets(path, return_warnings=flag)
+    no_report: Tuple[F64, I64] = trilux.tetrahedralize(mesh, return_report=False)
+    no_warnings: Tuple[F64, I64] = trilux.load_tets(path, return_warnings=False)
+    del p4, f4, bary4, pdf4, with_normals, everything, plain, blue_pdf, blue_all, either
+    del some_tets, some_tet_files, no_report, no_warnings
     blue, _ = trilux.blue_noise((vertices, mesh.faces), 100, seed=2)
     even, _ = trilux.sample_surface_even(mesh, 100)
     d = trilux.Distribution1D([1.0, 2.0])

@@ -1,6 +1,7 @@
 # Type stubs of trilux (the compiled module trilux._trilux, re-exported).
-# Checked against the module by `mypy --strict` on tests/typing_usage.py
-# and by the stub test in tests/test_api.py.
+# Kept in sync with the module by tests/test_stubs.py (names, signatures,
+# and an overload per value of every `return_*` flag, plus a plain-`bool`
+# fallback), and checked by `mypy --strict` on tests/typing_usage.py.
 import os
 from typing import Any, Literal, Optional, Sequence, Tuple, Union, overload
 
@@ -19,6 +20,13 @@ Channel = Union[Literal["r", "g", "b", "a", "luminance"], int]
 Method = Literal["uniform", "subdivision", "exact", "rejection"]
 Packing = Literal["dense", "elimination"]
 MediumLike = Union[str, Tuple[Sequence[float], Sequence[float]]]
+# What sample_surface / blue_noise return when the flags are plain bools.
+PointArrays = Union[
+    Tuple[F64, I64],
+    Tuple[F64, I64, F64],
+    Tuple[F64, I64, F64, F64],
+    Tuple[F64, I64, F64, F64, F64],
+]
 
 class Error(Exception): ...
 class InputError(Error, ValueError): ...
@@ -53,6 +61,9 @@ class Mesh:
 def load(path: PathLike) -> Mesh: ...
 def save(path: PathLike, mesh: MeshLike) -> None: ...
 
+# sample_surface / blue_noise return (points, face_index) and then, in this
+# order, barycentric, pdf and normals for each flag that is True: all float64,
+# so the type only depends on how many flags are set.
 @overload
 def sample_surface(
     mesh: MeshLike,
@@ -81,10 +92,122 @@ def sample_surface(
     vertex_weight: Optional[ArrayLike] = None,
     method: Optional[Method] = None,
     seed: Optional[int] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64]: ...
+@overload
+def sample_surface(
+    mesh: MeshLike,
+    count: int,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[True],
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64, F64]: ...
+@overload
+def sample_surface(
+    mesh: MeshLike,
+    count: int,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[True],
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64, F64]: ...
+@overload
+def sample_surface(
+    mesh: MeshLike,
+    count: int,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64, F64]: ...
+@overload
+def sample_surface(
+    mesh: MeshLike,
+    count: int,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64, F64]: ...
+@overload
+def sample_surface(
+    mesh: MeshLike,
+    count: int,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[True],
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64, F64, F64]: ...
+@overload
+def sample_surface(
+    mesh: MeshLike,
+    count: int,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[True],
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64, F64, F64]: ...
+@overload
+def sample_surface(
+    mesh: MeshLike,
+    count: int,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
     return_barycentric: bool = False,
     return_pdf: bool = False,
     return_normal: bool = False,
-) -> Tuple[npt.NDArray[Any], ...]: ...
+) -> PointArrays: ...
 @overload
 def blue_noise(
     mesh: MeshLike,
@@ -119,10 +242,143 @@ def blue_noise(
     seed: Optional[int] = None,
     progressive: bool = False,
     packing: Optional[Packing] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64]: ...
+@overload
+def blue_noise(
+    mesh: MeshLike,
+    count: Optional[int] = None,
+    *,
+    radius: Optional[float] = None,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    progressive: bool = False,
+    packing: Optional[Packing] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[True],
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64, F64]: ...
+@overload
+def blue_noise(
+    mesh: MeshLike,
+    count: Optional[int] = None,
+    *,
+    radius: Optional[float] = None,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    progressive: bool = False,
+    packing: Optional[Packing] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[True],
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64, F64]: ...
+@overload
+def blue_noise(
+    mesh: MeshLike,
+    count: Optional[int] = None,
+    *,
+    radius: Optional[float] = None,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    progressive: bool = False,
+    packing: Optional[Packing] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64, F64]: ...
+@overload
+def blue_noise(
+    mesh: MeshLike,
+    count: Optional[int] = None,
+    *,
+    radius: Optional[float] = None,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    progressive: bool = False,
+    packing: Optional[Packing] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64, F64]: ...
+@overload
+def blue_noise(
+    mesh: MeshLike,
+    count: Optional[int] = None,
+    *,
+    radius: Optional[float] = None,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    progressive: bool = False,
+    packing: Optional[Packing] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[True],
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64, F64, F64]: ...
+@overload
+def blue_noise(
+    mesh: MeshLike,
+    count: Optional[int] = None,
+    *,
+    radius: Optional[float] = None,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    progressive: bool = False,
+    packing: Optional[Packing] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[True],
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64, F64, F64]: ...
+@overload
+def blue_noise(
+    mesh: MeshLike,
+    count: Optional[int] = None,
+    *,
+    radius: Optional[float] = None,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_weight: Optional[ArrayLike] = None,
+    vertex_weight: Optional[ArrayLike] = None,
+    method: Optional[Method] = None,
+    seed: Optional[int] = None,
+    progressive: bool = False,
+    packing: Optional[Packing] = None,
     return_barycentric: bool = False,
     return_pdf: bool = False,
     return_normal: bool = False,
-) -> Tuple[npt.NDArray[Any], ...]: ...
+) -> PointArrays: ...
 def sample_surface_even(
     mesh: MeshLike, count: int, radius: Optional[float] = None, seed: Optional[int] = None
 ) -> Tuple[F64, I64]: ...
@@ -201,9 +457,25 @@ def tetrahedralize(
     return_report: Literal[True],
 ) -> Tuple[F64, I64, dict[str, Any]]: ...
 @overload
+def tetrahedralize(
+    mesh: MeshLike,
+    *,
+    spacing: Optional[float] = None,
+    graded: bool = False,
+    return_report: bool = False,
+) -> Union[Tuple[F64, I64], Tuple[F64, I64, dict[str, Any]]]: ...
+# load_tets: the tets as the file stores them, in its node order, not
+# re-oriented (a tet may have negative signed volume, det[p1 - p0, p2 - p0,
+# p3 - p0] < 0); trilux.Object accepts either orientation and re-orients an
+# inverted tet by swapping its first two nodes.
+@overload
 def load_tets(path: PathLike, *, return_warnings: Literal[False] = False) -> Tuple[F64, I64]: ...
 @overload
 def load_tets(path: PathLike, *, return_warnings: Literal[True]) -> Tuple[F64, I64, list[str]]: ...
+@overload
+def load_tets(
+    path: PathLike, *, return_warnings: bool = False
+) -> Union[Tuple[F64, I64], Tuple[F64, I64, list[str]]]: ...
 def save_tets(path: PathLike, nodes: ArrayLike, tets: ArrayLike) -> None: ...
 def save_points(
     path: PathLike,
@@ -215,6 +487,15 @@ def save_points(
 def media() -> list[str]: ...
 
 class Object:
+    """A translucent object (TransCut). Tets may come in either
+    orientation: an inverted one (negative signed volume,
+    det[p1 - p0, p2 - p0, p3 - p0] < 0) is re-oriented by swapping its
+    first two nodes, so `mesh` returns every tet with positive volume; a
+    tet of zero volume, a repeated, unused or NaN node raises InputError.
+    `solve` warns (UserWarning, one per colour channel) when the mesh is
+    too coarse to resolve a medium's diffusion length; `render`, `radiance` and `fluence` warn when the object was
+    not solved since it was made or changed."""
+
     def __init__(
         self,
         nodes: ArrayLike,
