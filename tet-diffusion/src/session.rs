@@ -1118,6 +1118,12 @@ impl Session {
             }
         }
         self.cursor = i + 1;
+        // A redone edit whose first result was never refined is as
+        // unrefined as it was then, so idle time refines it. Only at the
+        // end of the history: an entry still to be redone holds a state
+        // (a cut's checkpoint) computed from this coarse result, which
+        // refining now would leave stale against the log.
+        self.unrefined = !self.can_redo() && !self.history[i].logged.refined;
         self.thin_phi();
         Ok(Some(self.history[i].logged.edit.clone()))
     }

@@ -368,6 +368,37 @@ fn undo_and_redo_restore_the_object_and_phi_exactly() {
     assert_eq!(s.history().0.len(), edits.len());
 }
 
+#[test]
+fn a_redone_coarse_edit_is_refined_when_idle_as_a_replay_is() {
+    let mut s = Session::new(lit_ball(7), SessionOptions::default()).unwrap();
+    s.refine_now().unwrap();
+    s.push(light(0.3)).unwrap();
+    apply_all(&mut s);
+    // The last edit keeps its coarse result: undone before any refinement.
+    s.push(Edit::Paint(vec![dab(DVec3::new(0.0, 0.0, 4.0), "ketchup")]))
+        .unwrap();
+    s.apply_pending().unwrap().unwrap();
+    assert!(s.needs_refinement());
+    let coarse = snapshot(&s);
+    s.undo().unwrap().unwrap();
+    assert!(!s.needs_refinement());
+    s.undo().unwrap().unwrap();
+    // With an edit still to redo, the redone one stays as it was logged.
+    s.redo().unwrap().unwrap();
+    assert!(!s.needs_refinement() && s.can_redo());
+    s.redo().unwrap().unwrap();
+    assert!(snapshot(&s) == coarse);
+    assert!(
+        s.needs_refinement(),
+        "the redone coarse paint waits for refinement"
+    );
+    s.refine_now().unwrap();
+    assert!(s.log().edits[1].refined);
+    let replayed = Session::replay(lit_ball(7), SessionOptions::default(), &s.log()).unwrap();
+    assert!(snapshot(&replayed) == snapshot(&s));
+    assert!(snapshot(&s) != coarse);
+}
+
 fn paint_steps(s: &mut Session, steps: usize) -> Vec<Snapshot> {
     let mut states = vec![snapshot(s)];
     for k in 0..steps {
