@@ -46,7 +46,7 @@ pub fn bounds(mesh: &TriMesh) -> Option<(Vec3, Vec3)> {
 pub struct Shape {
     /// Vertices after welding equal positions (used ones only).
     pub welded_vertices: usize,
-    /// Connected parts (through shared welded vertices).
+    /// Connected parts: faces joined through shared (welded) edges.
     pub parts: usize,
     /// Edges with one face.
     pub boundary_edges: usize,
@@ -67,15 +67,12 @@ pub fn shape(mesh: &TriMesh) -> Shape {
         }
         used
     };
-    let mut edges: HashMap<(u32, u32), u32> = HashMap::with_capacity(faces.len() * 3 / 2);
-    for f in &faces {
-        for k in 0..3 {
-            let (a, b) = (f[k], f[(k + 1) % 3]);
-            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
-    }
-    // Parts by union-find over the faces' vertices.
-    let mut parent: Vec<u32> = (0..welded.len() as u32).collect();
+    // Per edge: its face count and its first face.
+    let mut edges: HashMap<(u32, u32), (u32, u32)> = HashMap::with_capacity(faces.len() * 3 / 2);
+    // Parts by union-find over faces that share an edge, as trimesh's
+    // `split` and MeshLab's connected components count them: parts that
+    // touch at a single vertex (Suzanne's eyes) stay apart.
+    let mut parent: Vec<u32> = (0..faces.len() as u32).collect();
     fn find(parent: &mut [u32], mut x: u32) -> u32 {
         while parent[x as usize] != x {
             parent[x as usize] = parent[parent[x as usize] as usize];
@@ -83,20 +80,23 @@ pub fn shape(mesh: &TriMesh) -> Shape {
         }
         x
     }
-    for f in &faces {
-        for k in 1..3 {
-            let (a, b) = (find(&mut parent, f[0]), find(&mut parent, f[k]));
-            if a != b {
-                parent[a as usize] = b;
+    for (i, f) in faces.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            let entry = edges.entry((a.min(b), a.max(b))).or_insert((0, i as u32));
+            entry.0 += 1;
+            let (r, q) = (find(&mut parent, entry.1), find(&mut parent, i as u32));
+            if r != q {
+                parent[r as usize] = q;
             }
         }
     }
-    let parts = (0..welded.len() as u32)
-        .filter(|&v| used[v as usize] && find(&mut parent, v) == v)
+    let parts = (0..faces.len() as u32)
+        .filter(|&f| find(&mut parent, f) == f)
         .count();
     let boundary: Vec<(u32, u32)> = edges
         .iter()
-        .filter(|&(_, &n)| n == 1)
+        .filter(|&(_, &(n, _))| n == 1)
         .map(|(&e, _)| e)
         .collect();
     // Holes: connected components of the boundary edges.
@@ -131,7 +131,7 @@ pub fn shape(mesh: &TriMesh) -> Shape {
         welded_vertices: used.iter().filter(|&&u| u).count(),
         parts,
         boundary_edges: boundary.len(),
-        non_manifold_edges: edges.values().filter(|&&n| n > 2).count(),
+        non_manifold_edges: edges.values().filter(|&&(n, _)| n > 2).count(),
         holes,
     }
 }
@@ -147,5 +147,64 @@ pub fn unit_guess(diagonal: f32) -> &'static str {
         "millimetres or centimetres"
     } else {
         "millimetres or smaller"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed surface of a tetrahedron at `offset`, its four corners
+    /// numbered from `first`.
+    fn tet_surface(offset: Vec3, first: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let p = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z].map(|p| p + offset);
+        let f =
+            [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]].map(|t: [u32; 3]| t.map(|i| i + first));
+        (p.to_vec(), f.to_vec())
+    }
+
+    fn two_tets(offset: Vec3) -> TriMesh {
+        let (mut positions, mut indices) = tet_surface(Vec3::ZERO, 0);
+        let (p, f) = tet_surface(offset, 4);
+        positions.extend(p);
+        indices.extend(f);
+        TriMesh {
+            positions,
+            indices,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn parts_touching_at_a_vertex_stay_apart() {
+        // The second tetrahedron's first corner is the first one's (1, 0,
+        // 0): one shared (welded) vertex and no shared edge, as Suzanne's
+        // eyes touch her head.
+        let s = shape(&two_tets(Vec3::X));
+        assert_eq!(s.welded_vertices, 7);
+        assert_eq!((s.parts, s.holes, s.boundary_edges), (2, 0, 0));
+        assert_eq!(s.non_manifold_edges, 0);
+        // Apart: two parts; one tetrahedron: one.
+        assert_eq!(shape(&two_tets(Vec3::splat(5.0))).parts, 2);
+        let (positions, indices) = tet_surface(Vec3::ZERO, 0);
+        let one = TriMesh {
+            positions,
+            indices,
+            ..Default::default()
+        };
+        assert_eq!(shape(&one).parts, 1);
+    }
+
+    #[test]
+    fn faces_sharing_an_edge_are_one_part_with_its_hole() {
+        // Two triangles on one edge (an open quad): one part, one hole of
+        // four boundary edges.
+        let mesh = TriMesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y],
+            indices: vec![[0, 1, 2], [0, 2, 3]],
+            ..Default::default()
+        };
+        let s = shape(&mesh);
+        assert_eq!((s.parts, s.holes, s.boundary_edges), (1, 1, 4));
     }
 }
