@@ -52,7 +52,9 @@ pub(crate) struct Args {
     /// With --blue-noise: elimination (Yuksel 2015, 5 candidates per point,
     /// relative radius about 0.69) or dense (14 candidates, then the
     /// closest points move into the largest holes: about 0.76, as MeshLab's
-    /// Poisson-disk sampling; about 3x the time).
+    /// Poisson-disk sampling; about 6x the time). Default: elimination, as
+    /// the library's `BlueNoiseOptions::default()` (Python's
+    /// `trilux.blue_noise` defaults to dense).
     #[arg(long, value_enum, value_name = "PACKING", requires = "blue_noise")]
     pub(crate) packing: Option<PackingArg>,
     /// A density texture (PNG, JPEG, HDR, EXR), looked up at the mesh's UVs;

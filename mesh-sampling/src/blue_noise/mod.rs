@@ -79,7 +79,7 @@ pub enum Packing {
     /// farthest from every kept point while that raises the smallest
     /// spacing. ρ ≈ 0.76 on the data meshes (uniform and with a density)
     /// with [`BlueNoiseOptions::dense`]'s 14 candidates per point (0.755
-    /// with 12, 0.765 with 15), about 3× the time of elimination at 5.
+    /// with 12, 0.765 with 15), about 6× the time of elimination at 5.
     /// Every output point is still one of the sampler's candidates; with
     /// `progressive`, the dense set is ordered by eliminating it to `N/2`,
     /// `N/4`, … (the prefixes have elimination's spacing, the whole set the
