@@ -34,7 +34,7 @@ pub(crate) struct Args {
     pub(crate) material: Material,
     /// Millimetres per mesh unit (default: 1000 when the mesh's diagonal is
     /// under 5 units, as for scans in metres; 1 otherwise).
-    #[arg(long, value_name = "X", value_parser = super::args::unit_mm)]
+    #[arg(long, value_name = "X", allow_negative_numbers = true, value_parser = super::args::unit_mm)]
     pub(crate) unit_mm: Option<f64>,
     /// dir:x,y,z[:r,g,b] (toward the light) or point:x,y,z[:r,g,b];
     /// repeatable. Default: one light from the upper front.

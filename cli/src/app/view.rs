@@ -28,8 +28,9 @@ pub(crate) struct Args {
     /// A measured material (Jensen et al. 2001) or noise:A,B.
     #[arg(long, value_parser = Material::parse)]
     pub(crate) material: Option<Material>,
-    /// Millimetres per mesh unit (default as for `trilux diffuse`).
-    #[arg(long, value_name = "X", value_parser = super::args::unit_mm)]
+    /// Millimetres per mesh unit (default: 1000 when the mesh's diagonal is
+    /// under 5 units, as for scans in metres; 1 otherwise).
+    #[arg(long, value_name = "X", allow_negative_numbers = true, value_parser = super::args::unit_mm)]
     pub(crate) unit_mm: Option<f64>,
     /// Port (default: a free one).
     #[arg(long, default_value_t = 0)]

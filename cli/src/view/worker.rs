@@ -236,9 +236,16 @@ impl Worker {
                     )),
                     Err(e) => {
                         let exists = path.exists() && !overwrite;
+                        // The page asks whether to replace the file: the
+                        // command line's "pass --force" means nothing there.
+                        let message = if exists {
+                            format!("{}: the file exists", path.display())
+                        } else {
+                            e.to_string()
+                        };
                         self.send(Out::Text(
                             json!({"type": "error", "seq": seq, "field": "name",
-                                   "message": e, "exists": exists})
+                                   "message": message, "exists": exists})
                             .to_string(),
                         ));
                     }

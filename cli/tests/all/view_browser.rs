@@ -98,6 +98,8 @@ async fn the_page_cuts_paints_relights_undoes_and_redoes_in_chromium() {
             .map(|x| x.as_str().unwrap().to_string())
             .collect()
     };
+    // Keys pressed after picking the material switch modes, not the material.
+    assert_eq!(step("paint")["material_after_keys"], "ketchup");
     let paint = done("paint");
     assert!(paint.len() >= 2 && paint[0] == "cut" && paint[1..].iter().all(|e| e == "paint"));
     let lit = done("light");

@@ -390,6 +390,10 @@ async fn every_edit_through_the_protocol() {
     .await;
     let e = until(&mut s, "error", &mut seen).await;
     assert_eq!(e["exists"], true);
+    // The page shows this in its "Replace it?" dialog: no command-line advice.
+    let message = e["message"].as_str().unwrap();
+    assert!(message.ends_with("shot.png: the file exists"), "{message}");
+    assert!(!message.contains("--force"), "{message}");
     assert_eq!(std::fs::read_to_string(&path).unwrap(), first);
     send(&mut s, json!({"seq": 34, "op": "export", "kind": "png", "name": name, "size": 128, "overwrite": true})).await;
     until(&mut s, "export", &mut seen).await;

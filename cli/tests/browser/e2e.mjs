@@ -68,10 +68,15 @@ try {
   // Paint a stroke of ketchup on the object.
   s = await stats();
   await page.keyboard.press('p');
+  // As a user does: click the list, pick, then press a shortcut. The key
+  // must reach the page, not change the list's choice by type-ahead.
+  await page.focus('#material');
   await page.selectOption('#material', 'ketchup');
+  await page.keyboard.press('c'); await page.keyboard.press('p');
+  const afterKeys = await page.evaluate(() => ({ material: document.getElementById('material').value }));
   await page.mouse.move(330, 280); await page.mouse.down(); await page.mouse.move(360, 320, { steps: 6 }); await page.mouse.up();
   await waitEdit('paint', s.answered);
-  out.steps.paint = { ...(await stats()), ...(await pixels()) };
+  out.steps.paint = { ...(await stats()), ...(await pixels()), material_after_keys: afterKeys.material };
   // Relight: drag the light to the left.
   s = await stats();
   await page.keyboard.press('l');

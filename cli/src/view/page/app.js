@@ -339,6 +339,12 @@ function exportFile(kind, overwrite = false) {
 }
 for (const b of document.querySelectorAll('[data-export]')) b.onclick = () => exportFile(b.dataset.export);
 
+// A control of the panel, once used, gives the focus back: a focused
+// <select> would take the next key (C for cut) as type-ahead and change
+// the material, and the shortcuts below ignore keys aimed at controls.
+for (const el of document.querySelectorAll('#panel select, #panel input[type=checkbox], #panel input[type=range]')) {
+  el.addEventListener('change', () => el.blur());
+}
 window.addEventListener('keydown', (e) => {
   if (e.target.tagName === 'INPUT' || e.target.tagName === 'SELECT') return;
   const k = e.key.toLowerCase();
