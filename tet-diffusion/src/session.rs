@@ -126,6 +126,11 @@ pub struct Logged {
     pub edit: Edit,
     /// Whether [`Session::refine`] finished for it.
     pub refined: bool,
+    /// The user's gesture it belongs to (one paint stroke, one light or
+    /// piece drag: the page sends it as many edits), if any: consecutive
+    /// entries of one gesture are undone and redone together, as an
+    /// editor's undo takes back a stroke, not each of its dabs.
+    pub gesture: Option<u64>,
 }
 
 /// A session's log: enough, with the object it started from, to rebuild
@@ -449,7 +454,8 @@ pub struct Session {
     history: Vec<Entry>,
     /// Entries `..cursor` are applied; `cursor..` can be redone.
     cursor: usize,
-    pending: VecDeque<Edit>,
+    /// Waiting edits, each with its gesture.
+    pending: VecDeque<(Edit, Option<u64>)>,
     options: SessionOptions,
     /// Whether the last applied entry still waits for its refinement.
     unrefined: bool,
@@ -507,8 +513,18 @@ impl Session {
     /// # Errors
     /// [`Error::BadArgument`] from [`Edit::check`]; the queue is unchanged.
     pub fn push(&mut self, edit: Edit) -> Result<(), Error> {
+        self.push_in(edit, None)
+    }
+
+    /// Queues an edit of a gesture (see [`Logged::gesture`]): edits only
+    /// coalesce within one gesture (or among edits of none), and the
+    /// entries of one gesture undo and redo as one.
+    ///
+    /// # Errors
+    /// As [`push`](Self::push).
+    pub fn push_in(&mut self, edit: Edit, gesture: Option<u64>) -> Result<(), Error> {
         edit.check()?;
-        self.pending.push_back(edit);
+        self.pending.push_back((edit, gesture));
         Ok(())
     }
 
@@ -548,10 +564,12 @@ impl Session {
         &mut self,
         performed: impl FnOnce(&Session, &Edit),
     ) -> Option<Result<Applied, Error>> {
-        let first = self.pending.pop_front()?;
+        let (mut edit, gesture) = self.pending.pop_front()?;
         let mut coalesced = 1;
-        let mut edit = first;
-        while let Some(next) = self.pending.front() {
+        while let Some((next, g)) = self.pending.front() {
+            if *g != gesture {
+                break;
+            }
             let merged = match (&mut edit, next) {
                 (Edit::Paint(a), Edit::Paint(b)) => {
                     a.extend(b.iter().cloned());
@@ -573,12 +591,13 @@ impl Session {
             self.pending.pop_front();
             coalesced += 1;
         }
-        Some(self.apply(edit, coalesced, performed))
+        Some(self.apply(edit, gesture, coalesced, performed))
     }
 
     fn apply(
         &mut self,
         edit: Edit,
+        gesture: Option<u64>,
         coalesced: usize,
         performed: impl FnOnce(&Session, &Edit),
     ) -> Result<Applied, Error> {
@@ -591,6 +610,7 @@ impl Session {
             logged: Logged {
                 edit: edit.clone(),
                 refined: false,
+                gesture,
             },
             delta,
             anchor,
@@ -1003,8 +1023,19 @@ impl Session {
     }
 
     /// Names of the applied edits and of those that can be redone.
+    /// One name per undo step: the entries of one gesture count once.
     pub fn history(&self) -> (Vec<&'static str>, Vec<&'static str>) {
-        let names = |e: &[Entry]| e.iter().map(|e| e.logged.edit.name()).collect();
+        let names = |e: &[Entry]| {
+            e.iter()
+                .enumerate()
+                .filter(|&(k, x)| {
+                    k == 0
+                        || x.logged.gesture.is_none()
+                        || x.logged.gesture != e[k - 1].logged.gesture
+                })
+                .map(|(_, x)| x.logged.edit.name())
+                .collect()
+        };
         (
             names(&self.history[..self.cursor]),
             names(&self.history[self.cursor..]),
@@ -1027,9 +1058,9 @@ impl Session {
             s.refine_now().map_err(|e| (0, e))?;
         }
         for (k, l) in log.edits.iter().enumerate() {
-            s.push(l.edit.clone()).map_err(|e| (k, e))?;
+            s.push_in(l.edit.clone(), l.gesture).map_err(|e| (k, e))?;
             // One at a time: the log already holds coalesced edits.
-            let edit = s.pending.pop_front().ok_or((
+            let (edit, gesture) = s.pending.pop_front().ok_or((
                 k,
                 Error::BadArgument {
                     what: "the log".into(),
@@ -1037,7 +1068,7 @@ impl Session {
                     need: "an edit was lost",
                 },
             ))?;
-            s.apply(edit, 1, |_, _| {}).map_err(|e| (k, e))?;
+            s.apply(edit, gesture, 1, |_, _| {}).map_err(|e| (k, e))?;
             if l.refined {
                 s.refine_now().map_err(|e| (k, e))?;
             }
@@ -1068,12 +1099,30 @@ impl Session {
     /// hierarchy and `φ` bit for bit as they were before it (`φ` from its
     /// copy, or recomputed from the nearest anchor: see
     /// [`Session`]). Waiting edits are dropped. Returns the edit undone, or
-    /// `None` when there is none.
+    /// `None` when there is none. The entries of the last edit's gesture
+    /// (see [`Logged::gesture`]) are undone together; the one returned
+    /// is the latest of them.
     ///
     /// # Errors
     /// Those of re-doing the edits since the anchor (which succeeded
     /// before, so none in practice).
     pub fn undo(&mut self) -> Result<Option<Edit>, Error> {
+        let Some(last) = self.undo_one()? else {
+            return Ok(None);
+        };
+        let gesture = self.history[self.cursor].logged.gesture;
+        while gesture.is_some()
+            && self
+                .cursor
+                .checked_sub(1)
+                .is_some_and(|i| self.history[i].logged.gesture == gesture)
+        {
+            self.undo_one()?;
+        }
+        Ok(Some(last))
+    }
+
+    fn undo_one(&mut self) -> Result<Option<Edit>, Error> {
         self.pending.clear();
         let Some(i) = self.cursor.checked_sub(1) else {
             return Ok(None);
@@ -1096,12 +1145,31 @@ impl Session {
 
     /// Redoes the last undone edit (the same media, lights, hierarchy and
     /// `φ` as when it was first applied: the edit and its solves again).
-    /// Returns it, or `None` when there is none.
+    /// Returns it, or `None` when there is none. The entries of its
+    /// gesture are redone together; the one returned is the latest of them.
     ///
     /// # Errors
     /// Those of the edit and its solves (which succeeded before, so none
     /// in practice).
     pub fn redo(&mut self) -> Result<Option<Edit>, Error> {
+        let Some(mut last) = self.redo_one()? else {
+            return Ok(None);
+        };
+        let gesture = self.history[self.cursor - 1].logged.gesture;
+        while gesture.is_some()
+            && self
+                .history
+                .get(self.cursor)
+                .is_some_and(|e| e.logged.gesture == gesture)
+        {
+            if let Some(e) = self.redo_one()? {
+                last = e;
+            }
+        }
+        Ok(Some(last))
+    }
+
+    fn redo_one(&mut self) -> Result<Option<Edit>, Error> {
         self.pending.clear();
         if self.cursor >= self.history.len() {
             return Ok(None);

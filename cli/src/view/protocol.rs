@@ -5,7 +5,9 @@
 //! echoed in every answer to it. Ops: `paint`, `lights`, `material`,
 //! `cut`, `fracture`, `move`, `recombine`, `undo`, `redo`, `probe`,
 //! `export`, `hello` (see [`parse`]). Points are in the display frame,
-//! mesh units. One binary message uploads an environment map
+//! mesh units. An edit may carry `"gesture": N`, an id the page gives
+//! every message of one drag (a paint stroke, a light or piece drag): the
+//! session undoes those as one step. One binary message uploads an environment map
 //! ([`parse_upload`]): a 16-byte header — magic `TLXU`, version 1, kind 1
 //! (environment), two zero bytes, the `seq` as u64 — then the Radiance
 //! `.hdr` file's bytes, at most [`MAX_UPLOAD`]; no bytes remove the map.
@@ -65,8 +67,10 @@ pub const MAX_UPLOAD: usize = 40 << 20;
 /// A message from the page, parsed and checked.
 #[derive(Debug, Clone)]
 pub enum Request {
-    /// An edit of the session.
-    Edit(Edit),
+    /// An edit of the session, and the gesture it belongs to (the
+    /// message's optional `gesture`: one paint stroke or light or piece
+    /// drag, undone as one step).
+    Edit(Edit, Option<u64>),
     /// Undo the last edit.
     Undo,
     /// Redo the last undone edit.
@@ -305,25 +309,34 @@ pub fn parse(text: &str) -> Result<(u64, Request), BadField> {
         "undo" => Request::Undo,
         "redo" => Request::Redo,
         "paint" => paint(o)?,
-        "material" => Request::Edit(Edit::Material(medium(get(o, "material")?, "material")?)),
+        "material" => Request::Edit(
+            Edit::Material(medium(get(o, "material")?, "material")?),
+            None,
+        ),
         "lights" => lights(o)?,
         "cut" => cut(o)?,
-        "fracture" => Request::Edit(Edit::Fracture {
-            piece: index(get(o, "piece")?, "piece")?,
-            point: vec3(get(o, "point")?, "point")?,
-            normal: nonzero(vec3(get(o, "normal")?, "normal")?, "normal")?,
-        }),
-        "move" => Request::Edit(Edit::Move {
-            piece: index(get(o, "piece")?, "piece")?,
-            offset: vec3(get(o, "offset")?, "offset")?,
-        }),
+        "fracture" => Request::Edit(
+            Edit::Fracture {
+                piece: index(get(o, "piece")?, "piece")?,
+                point: vec3(get(o, "point")?, "point")?,
+                normal: nonzero(vec3(get(o, "normal")?, "normal")?, "normal")?,
+            },
+            None,
+        ),
+        "move" => Request::Edit(
+            Edit::Move {
+                piece: index(get(o, "piece")?, "piece")?,
+                offset: vec3(get(o, "offset")?, "offset")?,
+            },
+            None,
+        ),
         "recombine" => {
             let a = index(get(o, "a")?, "a")?;
             let b = index(get(o, "b")?, "b")?;
             if a == b {
                 return Err(BadField::new("b", "must differ from a"));
             }
-            Request::Edit(Edit::Recombine { a, b })
+            Request::Edit(Edit::Recombine { a, b }, None)
         }
         "probe" => Request::Probe {
             piece: index(get(o, "piece")?, "piece")?,
@@ -334,7 +347,23 @@ pub fn parse(text: &str) -> Result<(u64, Request), BadField> {
             return Err(BadField::new("op", format!("unknown op {other:?}")));
         }
     };
+    let request = match request {
+        Request::Edit(edit, _) => Request::Edit(edit, gesture(o)?),
+        other => other,
+    };
     Ok((seq, request))
+}
+
+/// The optional `gesture` of an edit message: an id the page gives all
+/// the messages of one drag.
+fn gesture(o: &Map<String, Value>) -> Result<Option<u64>, BadField> {
+    match o.get("gesture") {
+        None | Some(Value::Null) => Ok(None),
+        Some(g) => g
+            .as_u64()
+            .map(Some)
+            .ok_or_else(|| BadField::new("gesture", "expected a non-negative integer")),
+    }
 }
 
 /// A paint stroke of one or more points.
@@ -349,12 +378,15 @@ fn paint(o: &Map<String, Value>) -> Result<Request, BadField> {
         return Err(BadField::new("strength", "must be in [0, 1]"));
     }
     let pts = points(get(o, "points")?, "points", 1)?;
-    Ok(Request::Edit(Edit::Paint(vec![Stroke {
-        points: pts,
-        radius,
-        medium: m,
-        strength,
-    }])))
+    Ok(Request::Edit(
+        Edit::Paint(vec![Stroke {
+            points: pts,
+            radius,
+            medium: m,
+            strength,
+        }]),
+        None,
+    ))
 }
 
 /// The scene's lights (replacing all of them).
@@ -407,7 +439,7 @@ fn lights(o: &Map<String, Value>) -> Result<Request, BadField> {
             }
         });
     }
-    Ok(Request::Edit(Edit::Lights(lights)))
+    Ok(Request::Edit(Edit::Lights(lights), None))
 }
 
 /// A cut by a plane or a screen stroke.
@@ -416,37 +448,43 @@ fn cut(o: &Map<String, Value>) -> Result<Request, BadField> {
         let po = p
             .as_object()
             .ok_or_else(|| BadField::new("plane", "expected {point, normal}"))?;
-        Request::Edit(Edit::Cut(Cut::Plane {
-            point: vec3(
-                get(po, "point").map_err(|_| missing("plane.point"))?,
-                "plane.point",
-            )?,
-            normal: nonzero(
-                vec3(
-                    get(po, "normal").map_err(|_| missing("plane.normal"))?,
+        Request::Edit(
+            Edit::Cut(Cut::Plane {
+                point: vec3(
+                    get(po, "point").map_err(|_| missing("plane.point"))?,
+                    "plane.point",
+                )?,
+                normal: nonzero(
+                    vec3(
+                        get(po, "normal").map_err(|_| missing("plane.normal"))?,
+                        "plane.normal",
+                    )?,
                     "plane.normal",
                 )?,
-                "plane.normal",
-            )?,
-        }))
+            }),
+            None,
+        )
     } else if let Some(s) = o.get("stroke") {
         let so = s
             .as_object()
             .ok_or_else(|| BadField::new("stroke", "expected {points, view}"))?;
-        Request::Edit(Edit::Cut(Cut::Stroke {
-            points: points(
-                get(so, "points").map_err(|_| missing("stroke.points"))?,
-                "stroke.points",
-                2,
-            )?,
-            view: nonzero(
-                vec3(
-                    get(so, "view").map_err(|_| missing("stroke.view"))?,
+        Request::Edit(
+            Edit::Cut(Cut::Stroke {
+                points: points(
+                    get(so, "points").map_err(|_| missing("stroke.points"))?,
+                    "stroke.points",
+                    2,
+                )?,
+                view: nonzero(
+                    vec3(
+                        get(so, "view").map_err(|_| missing("stroke.view"))?,
+                        "stroke.view",
+                    )?,
                     "stroke.view",
                 )?,
-                "stroke.view",
-            )?,
-        }))
+            }),
+            None,
+        )
     } else {
         return Err(BadField::new("plane", "a cut needs plane or stroke"));
     })
@@ -609,6 +647,10 @@ mod tests {
             ),
             (r#"{"seq":1,"op":"recombine","a":1,"b":1}"#, "b"),
             (
+                r#"{"seq":1,"op":"move","piece":1,"offset":[0,0,0],"gesture":-3}"#,
+                "gesture",
+            ),
+            (
                 r#"{"seq":1,"op":"move","piece":1,"offset":[1e999,0,0]}"#,
                 "(message)",
             ),
@@ -617,6 +659,17 @@ mod tests {
             let e = parse(m).unwrap_err();
             assert_eq!(e.field, field, "{m}: {e:?}");
         }
+    }
+
+    #[test]
+    fn an_edit_carries_its_gesture() {
+        let m = r#"{"seq":1,"op":"lights","gesture":77,"lights":[{"kind":"dir","dir":[0,1,0]}]}"#;
+        assert!(matches!(
+            parse(m),
+            Ok((1, Request::Edit(Edit::Lights(_), Some(77))))
+        ));
+        let m = r#"{"seq":2,"op":"material","material":"apple"}"#;
+        assert!(matches!(parse(m), Ok((2, Request::Edit(_, None)))));
     }
 
     #[test]

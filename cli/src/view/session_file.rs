@@ -11,6 +11,9 @@
 //!             "lights": [{"kind": "dir", "dir": [0.3, 1, 0.6], "rgb": [1, 1, 1]}]}]}
 //! ```
 //!
+//! Edits of one gesture (a paint stroke, a light drag) carry its id as
+//! `"gesture": N`, so a replayed session undoes them as one step.
+//!
 //! An environment-map light is saved as the name of its `.hdr` file
 //! (`{"kind": "env", "file": "env-….hdr", "samples": 256}`), which the
 //! server wrote beside the exports when the page uploaded it; a replay
@@ -304,6 +307,9 @@ pub fn to_json(source: &Value, log: &Log, envs: &EnvFiles) -> Result<Value, Stri
         .map(|l| {
             let mut v = encode(&l.edit, envs)?;
             v["refined"] = json!(l.refined);
+            if let Some(g) = l.gesture {
+                v["gesture"] = json!(g);
+            }
             Ok(v)
         })
         .collect::<Result<Vec<_>, String>>()?;
@@ -340,19 +346,26 @@ pub fn from_json_in(text: &str, dir: Option<&Path>) -> Result<(Value, Log, EnvFi
     if v.get("version").and_then(Value::as_u64) != Some(1) {
         return Err("version: expected 1".into());
     }
-    let edits = field(&v, "edits", "(file)")?
-        .as_array()
-        .ok_or("edits: expected an array")?
-        .iter()
-        .enumerate()
-        .map(|(k, e)| {
-            let at = format!("edits[{k}]");
-            Ok(Logged {
-                edit: decode_in(e, &at, &mut maps)?,
-                refined: e.get("refined").and_then(Value::as_bool).unwrap_or(true),
+    let edits =
+        field(&v, "edits", "(file)")?
+            .as_array()
+            .ok_or("edits: expected an array")?
+            .iter()
+            .enumerate()
+            .map(|(k, e)| {
+                let at = format!("edits[{k}]");
+                Ok(Logged {
+                    edit: decode_in(e, &at, &mut maps)?,
+                    refined: e.get("refined").and_then(Value::as_bool).unwrap_or(true),
+                    gesture: match e.get("gesture") {
+                        None | Some(Value::Null) => None,
+                        Some(g) => Some(g.as_u64().ok_or_else(|| {
+                            format!("{at}.gesture: expected a non-negative integer")
+                        })?),
+                    },
+                })
             })
-        })
-        .collect::<Result<Vec<_>, String>>()?;
+            .collect::<Result<Vec<_>, String>>()?;
     let envs = maps.read.into_iter().map(|(file, e)| (e, file)).collect();
     Ok((
         v.get("source").cloned().unwrap_or(Value::Null),

@@ -121,7 +121,7 @@ impl Worker {
         let mut request = Some(first);
         while let Some((seq, r)) = request.take() {
             match r {
-                Request::Edit(mut edit) => {
+                Request::Edit(mut edit, gesture) => {
                     // The page's lights are the directional and point ones:
                     // the environment map loaded stays.
                     if let Edit::Lights(l) = &mut edit
@@ -130,7 +130,7 @@ impl Worker {
                     {
                         l.push(Light::Environment(env));
                     }
-                    match self.session.push(edit) {
+                    match self.session.push_in(edit, gesture) {
                         Ok(()) => seqs.push(seq),
                         Err(e) => self.error(seq, &field_of(&e), &e.to_string()),
                     }
@@ -182,7 +182,7 @@ impl Worker {
         let t = Instant::now();
         let c = cpu_ms();
         match r {
-            Request::Edit(_) => {}
+            Request::Edit(..) => {}
             Request::Hello => self.send_all(&[seq]),
             Request::Undo | Request::Redo => {
                 let undo = matches!(r, Request::Undo);

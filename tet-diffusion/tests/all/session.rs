@@ -399,6 +399,60 @@ fn a_redone_coarse_edit_is_refined_when_idle_as_a_replay_is() {
     assert!(snapshot(&s) != coarse);
 }
 
+#[test]
+fn the_edits_of_one_gesture_undo_and_redo_as_one_step() {
+    let mut s = Session::new(lit_ball(7), SessionOptions::default()).unwrap();
+    s.refine_now().unwrap();
+    let start = snapshot(&s);
+    // One paint stroke sent as three messages, applied one by one (a
+    // fast machine solves each before the next arrives).
+    for k in 0..3 {
+        let dab = dab(DVec3::new(0.4 * k as f64, 0.0, 4.0), "ketchup");
+        s.push_in(Edit::Paint(vec![dab]), Some(5)).unwrap();
+        apply_all(&mut s);
+    }
+    let painted = snapshot(&s);
+    // One light drag, then a lone material change.
+    for k in 0..3 {
+        s.push_in(light(0.2 * k as f64), Some(6)).unwrap();
+        apply_all(&mut s);
+    }
+    let lit = snapshot(&s);
+    s.push(Edit::Material(Medium::measured("skin1").unwrap()))
+        .unwrap();
+    apply_all(&mut s);
+    assert_eq!(s.history().0, ["paint", "lights", "material"]);
+    assert_eq!(s.log().edits.len(), 7);
+    // The log keeps the gestures: a replay groups its undo alike.
+    let mut replayed = Session::replay(lit_ball(7), SessionOptions::default(), &s.log()).unwrap();
+    assert!(snapshot(&replayed) == snapshot(&s));
+    for session in [&mut s, &mut replayed] {
+        assert_eq!(session.undo().unwrap().unwrap().name(), "material");
+        assert!(snapshot(session) == lit);
+        assert_eq!(session.undo().unwrap().unwrap().name(), "lights");
+        assert!(
+            snapshot(session) == painted,
+            "the whole light drag is undone"
+        );
+        session.undo().unwrap().unwrap();
+        assert!(snapshot(session) == start, "the whole stroke is undone");
+        assert!(!session.can_undo());
+        assert_eq!(session.history().1, ["paint", "lights", "material"]);
+        session.redo().unwrap().unwrap();
+        assert!(snapshot(session) == painted, "the whole stroke is redone");
+        session.redo().unwrap().unwrap();
+        assert!(snapshot(session) == lit);
+    }
+    // Edits of different gestures do not coalesce; of one, they do.
+    s.push_in(light(0.5), Some(8)).unwrap();
+    s.push_in(light(0.6), Some(9)).unwrap();
+    assert_eq!(s.apply_pending().unwrap().unwrap().coalesced, 1);
+    assert_eq!(s.apply_pending().unwrap().unwrap().coalesced, 1);
+    s.push_in(light(0.7), Some(10)).unwrap();
+    s.push_in(light(0.8), Some(10)).unwrap();
+    assert_eq!(s.apply_pending().unwrap().unwrap().coalesced, 2);
+}
+
 fn paint_steps(s: &mut Session, steps: usize) -> Vec<Snapshot> {
     let mut states = vec![snapshot(s)];
     for k in 0..steps {

@@ -22,7 +22,13 @@ state.renderer = renderer;
 
 const conn = new Connection(onText, onFrame, (s) => { $('status').textContent = s; if (s === 'connected') conn.send('hello'); });
 state.conn = conn;
+// The id of the drag in progress (a paint stroke, a light or piece drag):
+// its many messages carry it, and the server undoes them as one step.
+// Random, so that ids from before a reload never meet the new ones.
+let gesture = null;
+const GESTURE_OPS = new Set(['paint', 'lights', 'move']);
 function send(op, fields) {
+  if (gesture !== null && GESTURE_OPS.has(op)) fields = { ...fields, gesture };
   const seq = conn.send(op, fields);
   state.pending.set(seq, performance.now());
   return seq;
@@ -170,9 +176,10 @@ function svgLine(points, color) {
 canvas.addEventListener('pointerdown', (e) => {
   canvas.setPointerCapture(e.pointerId);
   pointers.set(e.pointerId, [e.clientX, e.clientY]);
-  if (pointers.size === 2) { const [a, b] = [...pointers.values()]; pinch = { d: Math.hypot(a[0] - b[0], a[1] - b[1]), c: [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2] }; drag = null; return; }
+  if (pointers.size === 2) { const [a, b] = [...pointers.values()]; pinch = { d: Math.hypot(a[0] - b[0], a[1] - b[1]), c: [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2] }; drag = null; gesture = null; return; }
   const orbit = state.mode === 'orbit' || e.button === 1 || e.altKey || e.button === 2 || e.shiftKey && state.mode === 'orbit';
   drag = { x: e.clientX, y: e.clientY, kind: orbit ? (e.button === 2 || e.shiftKey ? 'pan' : 'orbit') : state.mode, points: [[e.clientX, e.clientY]] };
+  gesture = ['paint', 'light', 'move'].includes(drag.kind) ? Math.floor(Math.random() * 2 ** 52) : null;
   if (drag.kind === 'paint') paintAt(e.clientX, e.clientY, true);
   if (drag.kind === 'move') { const h = hit(e.clientX, e.clientY); drag.piece = h ? h.piece : null; drag.start = h ? [...renderer.pieces[h.piece].offset] : null; }
 });
@@ -228,7 +235,7 @@ canvas.addEventListener('pointermove', (e) => {
 canvas.addEventListener('pointerup', (e) => {
   pointers.delete(e.pointerId);
   if (pointers.size < 2) pinch = null;
-  if (!drag) return;
+  if (!drag) { gesture = null; return; }
   const d = drag; drag = null;
   if (d.kind === 'orbit' || d.kind === 'pan' || d.kind === 'move') reexpose();
   if ((d.kind === 'cut' || d.kind === 'fracture') && d.points.length >= 2 && state.camera) {
@@ -247,6 +254,7 @@ canvas.addEventListener('pointerup', (e) => {
   if (d.kind === 'light') send('lights', { lights: lights() });
   if (d.kind === 'move' && d.piece != null && d.start) send('move', { piece: d.piece, offset: d.start });
   if (d.kind === 'paint') flushPaint();
+  gesture = null;
 });
 let wheelTimer = null;
 canvas.addEventListener('wheel', (e) => {
