@@ -262,7 +262,7 @@ async fn every_edit_through_the_protocol() {
     let edits = [
         (
             json!({"seq": 1, "op": "paint", "material": "ketchup", "radius": 0.2 * r0, "strength": 1.0,
-                 "points": [[0.0, 0.0, r0], [0.1 * r0, 0.0, r0]]}),
+                 "points": [[0.0, 0.0, r0], [0.1 * r0, 0.0, r0]], "gesture": 42}),
             "paint",
             1,
         ),
@@ -413,6 +413,9 @@ async fn every_edit_through_the_protocol() {
     let (_, log) = trilux::view::session_file::from_json(&text).unwrap();
     let names: Vec<&str> = log.edits.iter().map(|l| l.edit.name()).collect();
     assert_eq!(names, ["paint", "lights", "material", "cut", "cut"]);
+    // The stroke's gesture is kept (a replay undoes it as one step).
+    let gestures: Vec<Option<u64>> = log.edits.iter().map(|l| l.gesture).collect();
+    assert_eq!(gestures, [Some(42), None, None, None, None]);
     // No temporary files left behind.
     let left: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
