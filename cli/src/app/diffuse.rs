@@ -171,8 +171,10 @@ fn paint(args: &Args, object: &mut Object) -> Result<Vec<usize>> {
 fn run_session(context: &mut Context, args: &Args, path: &Path) -> Result<()> {
     check_outputs(context, args)?;
     super::check_input(path)?;
-    let session = super::view::replayed(context, path)?;
-    let (size, view) = (args.picture.size, args.picture.direction());
+    let (session, saved) = super::view::replayed(context, path)?;
+    // --view, else the camera the page saved the session with.
+    let view = args.picture.direction().or(saved.map(|v| v.as_vec3()));
+    let size = args.picture.size;
     let force = context.force;
     context.step("rendering", || {
         super::view::write_picture(&session, true, &args.output, size, view, force)

@@ -75,8 +75,13 @@ fn replay(context: &mut Context, path: &Path) -> Result<(Object, Value, Log, Env
             format!("unit_mm {mm}: millimetres per mesh unit must be a positive number"),
         ));
     }
-    let (object, source) = load(context, mesh.as_deref(), material.as_ref(), unit)?;
-    Ok((object, source, log, envs))
+    let view = trilux::view::session_file::saved_view(&source).map_err(|e| file_error(path, e))?;
+    let (object, mut loaded) = load(context, mesh.as_deref(), material.as_ref(), unit)?;
+    // The camera it was saved with: the page starts there.
+    if let (Some(v), Some(o)) = (view, loaded.as_object_mut()) {
+        o.insert("view".into(), json!(v.to_array()));
+    }
+    Ok((object, loaded, log, envs))
 }
 
 /// Loads the object a session file's `source` or the arguments describe.
@@ -281,8 +286,9 @@ fn write_tet(session: &Session, path: &Path, overwrite: bool) -> std::result::Re
 /// # Errors
 /// The file (unreadable, not a session file: the field named), its
 /// object, or the first edit that fails (named by its index and op).
-pub(crate) fn replayed(context: &mut Context, path: &Path) -> Result<Session> {
-    let (object, _, log, _) = replay(context, path)?;
+pub(crate) fn replayed(context: &mut Context, path: &Path) -> Result<(Session, Option<DVec3>)> {
+    let (object, source, log, _) = replay(context, path)?;
+    let view = trilux::view::session_file::saved_view(&source).map_err(|e| file_error(path, e))?;
     let options = trilux::view::Options::default().session;
     let mut session = context
         .step("replaying", || Session::replay(object, options, &log))
@@ -295,7 +301,7 @@ pub(crate) fn replayed(context: &mut Context, path: &Path) -> Result<Session> {
             .step("solving", || session.refine_now())
             .map_err(|e| file_error(path, format!("the last edit's solve: {e}")))?;
     }
-    Ok(session)
+    Ok((session, view))
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {

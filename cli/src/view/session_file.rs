@@ -11,6 +11,11 @@
 //!             "lights": [{"kind": "dir", "dir": [0.3, 1, 0.6], "rgb": [1, 1, 1]}]}]}
 //! ```
 //!
+//! `source` also keeps `"view"`, the direction from the object toward the
+//! camera when the page saved the file: `trilux view --replay` starts
+//! there and `trilux diffuse --session` renders from there unless given
+//! `--view`.
+//!
 //! Edits of one gesture (a paint stroke, a light drag) carry its id as
 //! `"gesture": N`, so a replayed session undoes them as one step.
 //!
@@ -380,6 +385,29 @@ pub fn from_json_in(text: &str, dir: Option<&Path>) -> Result<(Value, Log, EnvFi
     ))
 }
 
+/// The camera direction a session file's `source` keeps (`"view"`, from
+/// the object toward the camera), if any.
+///
+/// # Errors
+/// A message naming `source.view` when it is not three finite numbers
+/// with a non-zero length.
+pub fn saved_view(source: &Value) -> Result<Option<DVec3>, String> {
+    let Some(v) = source.get("view").filter(|v| !v.is_null()) else {
+        return Ok(None);
+    };
+    let bad = || "source.view: expected three finite numbers, not all zero".to_string();
+    let a = v.as_array().filter(|a| a.len() == 3).ok_or_else(bad)?;
+    let x: Vec<f64> = a
+        .iter()
+        .map(|x| x.as_f64().ok_or_else(bad))
+        .collect::<Result<_, _>>()?;
+    let d = DVec3::new(x[0], x[1], x[2]);
+    if !d.is_finite() || d.length() == 0.0 {
+        return Err(bad());
+    }
+    Ok(Some(d.normalize()))
+}
+
 /// Writes the file atomically; an existing file only with `overwrite`.
 ///
 /// # Errors
@@ -389,9 +417,14 @@ pub fn write(
     source: &Value,
     log: &Log,
     envs: &EnvFiles,
+    view: Option<DVec3>,
     overwrite: bool,
 ) -> Result<(), String> {
-    let v = to_json(source, log, envs)?;
+    let mut source = source.clone();
+    if let (Some(view), Some(o)) = (view, source.as_object_mut()) {
+        o.insert("view".into(), v3(view));
+    }
+    let v = to_json(&source, log, envs)?;
     crate::output::write_atomic(path, overwrite, |tmp| {
         std::fs::write(tmp, format!("{v:#}\n")).map_err(|source| crate::Error::File {
             path: tmp.to_path_buf(),

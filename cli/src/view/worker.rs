@@ -224,7 +224,7 @@ impl Worker {
                 let path = self.export_dir.join(&name);
                 let result = if kind == ExportKind::Session {
                     let log = self.session.log();
-                    session_file::write(&path, &self.source, &log, &self.envs, overwrite)
+                    session_file::write(&path, &self.source, &log, &self.envs, view, overwrite)
                 } else {
                     self.exporter
                         .export(&self.session, kind, &path, size, view, overwrite)

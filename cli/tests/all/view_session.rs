@@ -156,6 +156,36 @@ fn a_view_session_replays_in_diffuse_as_the_page_exports_it_byte_for_byte() {
     let read = |name: &str| std::fs::read(d.join(name)).unwrap();
     assert!(read("diffuse.png") == read("live.png"), "the PNGs differ");
     assert!(read("diffuse.vtu") == read("live.vtu"), "the VTUs differ");
+    // The file keeps the page's camera; without --view, diffuse renders
+    // from there.
+    let saved: Value = serde_json::from_str(&text).unwrap();
+    let camera = saved["source"]["view"].as_array().unwrap();
+    let x = camera
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect::<Vec<_>>();
+    assert!(
+        (x[0] / x[2] - 0.25).abs() < 1e-12 && (x[1] / x[2] - 0.5).abs() < 1e-12,
+        "{x:?}"
+    );
+    let out = trilux()
+        .current_dir(d)
+        .args([
+            "diffuse",
+            "--session",
+            "live.json",
+            "--size",
+            "96",
+            "-o",
+            "saved_view.png",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    assert!(
+        read("saved_view.png") == read("live.png"),
+        "not the saved camera"
+    );
 
     // `trilux view --replay`: the page's exports of the replayed session
     // are the same bytes again.
@@ -198,6 +228,12 @@ fn a_bad_session_file_is_an_error_naming_the_file_and_the_entry() {
         ),
         (file(vec![dab(json!(-1.0))]), "edits[0] (paint)"),
         ("{\"format\": \"png\"}".to_string(), "format: expected"),
+        (
+            json!({"format": "trilux-session", "version": 1, "refined_initially": true,
+                   "source": {"mesh": null, "view": [0, 0, 0]}, "edits": []})
+            .to_string(),
+            "source.view: expected three finite numbers",
+        ),
     ];
     for (k, (text, needle)) in cases.iter().enumerate() {
         let name = format!("bad{k}.json");

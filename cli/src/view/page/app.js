@@ -37,7 +37,11 @@ function send(op, fields) {
 function onText(m) {
   if (m.type === 'hello') {
     state.hello = m; state.eta = m.eta; state.white = m.white;
-    if (!state.camera) state.camera = new Camera(m.bounds[0], m.bounds[1]);
+    if (!state.camera) {
+      state.camera = new Camera(m.bounds[0], m.bounds[1]);
+      // A replayed session starts from the camera it was saved with.
+      if (m.source && Array.isArray(m.source.view)) state.camera.lookFrom(m.source.view);
+    }
     state.camera.bounds = m.bounds;
     const sel = $('material');
     if (!sel.options.length) for (const name of m.materials) sel.add(new Option(name, name, name === 'ketchup', name === 'ketchup'));

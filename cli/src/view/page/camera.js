@@ -28,6 +28,13 @@ export class Camera {
     const r = normalize(cross(f, [0, 1, 0]));
     return { f, r, u: cross(r, f) };
   }
+  // Looks at the target from direction `d` (target → eye), as a session
+  // file's saved view gives it.
+  lookFrom(d) {
+    const [x, y, z] = normalize(d);
+    this.pitch = Math.max(-1.5, Math.min(1.5, Math.asin(Math.max(-1, Math.min(1, y)))));
+    this.yaw = Math.atan2(x, z);
+  }
   orbit(dx, dy) {
     this.yaw -= dx * 0.008;
     this.pitch = Math.max(-1.5, Math.min(1.5, this.pitch + dy * 0.008));
