@@ -23,7 +23,8 @@ pub(crate) struct Args {
     pub(crate) input: Option<PathBuf>,
     /// Replay a session file of `trilux view` instead (its object and
     /// edits, exactly as `trilux view --replay` does, refined as the page
-    /// refines when idle); the picture is the page's export of it.
+    /// refines when idle); the picture is the page's export of it, from
+    /// the camera the page saved unless --view is given.
     #[cfg(feature = "view")]
     #[arg(long, value_name = "SESSION.json", conflicts_with_all = [
         "input", "material", "unit_mm", "light", "envmap", "cut", "relax_cut", "paint", "fracture",
