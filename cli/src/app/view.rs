@@ -12,7 +12,7 @@ use trilux::view::protocol::ExportKind;
 use trilux::view::session_file::EnvFiles;
 
 use super::args::Material;
-use super::ops::object::{check_volume, default_light, diagonal, read_volume};
+use super::ops::object::{check_volume, diagonal, read_volume};
 use super::{Context, Result, arg_error, file_error};
 
 #[derive(Debug, clap::Args)]
@@ -132,7 +132,7 @@ pub(crate) fn load(
 
 fn add_default_light(object: &mut Object) -> Result<()> {
     object
-        .add_light(default_light())
+        .add_light(trilux::view::builtin::default_light())
         .map_err(|e| super::invalid(e.to_string()))?;
     Ok(())
 }

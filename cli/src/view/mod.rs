@@ -297,8 +297,14 @@ fn white_point(session: &Session) -> f64 {
         .max(1e-12)
 }
 
+/// The body of a request without the token or with a wrong one: still a
+/// 404 (the token stays unguessable and is not revealed), but one that
+/// tells a user who typed or bookmarked a shortened address what to do.
+pub const NEEDS_TOKEN: &str = "trilux view: this address needs the full URL trilux printed when it \
+started (it holds a secret token); copy that URL, or restart trilux view for a new one\n";
+
 async fn not_found() -> Response {
-    (StatusCode::NOT_FOUND, "not found").into_response()
+    (StatusCode::NOT_FOUND, NEEDS_TOKEN).into_response()
 }
 
 /// Equal in constant time (the token must not leak through timing).
@@ -313,7 +319,7 @@ fn same(a: &str, b: &str) -> bool {
 /// The token, `Host` and `Origin` checks every request passes.
 fn check(s: &Shared, token: &str, headers: &HeaderMap) -> Result<(), (StatusCode, &'static str)> {
     if !same(token, &s.token) {
-        return Err((StatusCode::NOT_FOUND, "not found"));
+        return Err((StatusCode::NOT_FOUND, NEEDS_TOKEN));
     }
     let host = headers
         .get(header::HOST)

@@ -660,3 +660,33 @@ fn diffuse_warns_when_a_cut_plane_misses_the_object() {
     assert!(hit.status.success());
     assert!(!common::stderr(&hit).contains("misses"));
 }
+
+#[test]
+fn diffuse_warns_that_an_open_surface_is_not_closed_and_a_closed_one_passes_quietly() {
+    // `trilux view` reads its mesh through the same code as `diffuse`.
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let closed = blob(d);
+    let mut open = TriMesh::read(&closed).unwrap();
+    open.indices.remove(0);
+    open.objects.clear();
+    open.write(d.join("open.obj")).unwrap();
+    let out = run(
+        d,
+        &["diffuse", "open.obj", "--size", "32", "-o", "open.png"],
+    );
+    let err = common::stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: open.obj: not a closed surface (1 hole, 3 boundary edges)"),
+        "{err}"
+    );
+    assert!(err.contains("trilux tetra open.obj --spacing S"), "{err}");
+    let out = run(
+        d,
+        &["diffuse", "blob.obj", "--size", "32", "-o", "closed.png"],
+    );
+    let err = common::stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("closed surface"), "{err}");
+}

@@ -109,6 +109,17 @@ async fn the_page_cuts_paints_relights_undoes_and_redoes_in_chromium() {
     assert_eq!(done("redo"), ["cut", "paint"]);
     assert_ne!(step("undo")["mean"], step("light")["mean"]);
     assert_eq!(v["help_visible"], true);
+    // No console error (the favicon request was a 404 on every load).
+    assert_eq!(v["console_errors"], json!([]), "{v:#}");
+    // The HUD names the result in words, not the protocol's op names, and
+    // the exposure slider shows its value.
+    let hud = load["hud"].as_str().unwrap();
+    assert!(
+        ["loaded", "refined"].iter().any(|w| hud.starts_with(w)),
+        "{hud}"
+    );
+    assert!(!hud.contains("hello") && !hud.contains("refine:"), "{hud}");
+    assert_eq!(load["ev"], "+0.0 EV");
     // Exposure from the covered pixels (as the CLI's PNGs), not the
     // surface vertices: measured, with part of the drawing covered.
     assert_eq!(load["white_from"], "pixels", "{load}");

@@ -196,11 +196,26 @@ async fn http_needs_the_token_and_this_servers_host_and_origin() {
             "{f}"
         );
     }
-    // No token, a wrong one, a path outside the binary's files.
-    assert_eq!(get(&r, "/", &host, None).await.0, 404);
-    assert_eq!(get(&r, "/app.js", &host, None).await.0, 404);
+    // No token, a wrong one: 404 (the token stays secret), with a body
+    // that says what to do instead of a bare "not found".
     let wrong = "0".repeat(t.len());
-    assert_eq!(get(&r, &format!("/{wrong}/"), &host, None).await.0, 404);
+    for path in [
+        "/".to_string(),
+        "/app.js".into(),
+        "/favicon.ico".into(),
+        format!("/{wrong}/"),
+        format!("/{wrong}/app.js"),
+        format!("/{wrong}"),
+    ] {
+        let (code, body) = get(&r, &path, &host, None).await;
+        assert_eq!(code, 404, "{path}");
+        assert!(
+            body.contains("needs the full URL trilux printed when it started"),
+            "{path}: {body}"
+        );
+        assert!(!body.contains(&t), "{path}: the body reveals the token");
+    }
+    // A path outside the binary's files.
     assert_eq!(
         get(&r, &format!("/{t}/../Cargo.toml"), &host, None).await.0,
         404

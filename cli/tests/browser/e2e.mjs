@@ -12,11 +12,12 @@ const browser = await chromium.launch({
     '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
 });
 const out = { steps: {} };
+const consoleErrors = [];
 try {
   // The page's CSP forbids eval, which Playwright's argument passing needs.
   const page = await browser.newPage({ viewport: { width: 800, height: 600 }, bypassCSP: true });
   const logs = [];
-  page.on('console', (m) => logs.push(m.text()));
+  page.on('console', (m) => { logs.push(m.text()); if (m.type() === 'error') consoleErrors.push(m.text()); });
   page.on('pageerror', (e) => logs.push('pageerror: ' + e.message));
   const t0 = Date.now();
   await page.goto(url);
@@ -51,7 +52,9 @@ try {
   const waitEdit = async (name, before) => page.waitForFunction(([n, b]) => window.trilux.answered.length > b && window.trilux.answered[window.trilux.answered.length - 1] === n && window.trilux.pending.size === 0, [name, before], { timeout: 120000 });
   // Auto exposure measures the covered pixels after the first frame.
   await page.waitForFunction(() => window.trilux.whiteFrom === 'pixels', null, { timeout: 60000 });
-  out.steps.load = { ...(await stats()), ...(await pixels()) };
+  out.steps.load = { ...(await stats()), ...(await pixels()),
+    hud: await page.evaluate(() => document.getElementById('status').textContent),
+    ev: await page.evaluate(() => document.getElementById('evval').textContent) };
   await page.screenshot({ path: dir + '/1-load.png' });
   // Orbit: drag in orbit mode; the picture changes, no server round trip.
   const beforeOrbit = await pixels();
@@ -111,6 +114,7 @@ try {
   out.help_visible = await page.evaluate(() => !document.getElementById('helpbox').hidden);
   await page.screenshot({ path: dir + '/4-help.png' });
   out.logs = logs;
+  out.console_errors = consoleErrors;
 } catch (e) {
   if (e !== null) out.error = String(e && e.stack || e);
 } finally {

@@ -73,11 +73,33 @@ pub(crate) fn read_volume(context: &mut Context, input: &Path, with_vtu: bool) -
         return Ok((tet.positions, tet.tets, dropped));
     }
     let surface = crate::app::read_mesh(context, input)?;
+    // The help asks for a closed surface; an open one is stuffed all the
+    // same (inside by the winding number), which may or may not be what
+    // the user meant: said, not silent.
+    let shape = trilux::mesh::shape(&surface);
+    if shape.boundary_edges > 0 {
+        eprintln!("warning: {}", open_surface(input, &shape));
+    }
     let (stuffed, _) = context.step("tetrahedralizing", || {
         stuff(&surface, input, Spacing::Default, false)
     })?;
     let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
     Ok((out.positions, out.tets, None))
+}
+
+/// The warning for a surface with holes that is tetrahedralized anyway.
+fn open_surface(input: &Path, shape: &trilux::mesh::Shape) -> String {
+    let plural =
+        |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+    format!(
+        "{}: not a closed surface ({}, {}); its inside is guessed from the \
+         winding number: check the result, or tetrahedralize it yourself with \
+         `trilux tetra {} --spacing S -o OUT.node` and pass OUT.node",
+        input.display(),
+        plural(shape.holes, "hole", "holes"),
+        plural(shape.boundary_edges, "boundary edge", "boundary edges"),
+        input.display(),
+    )
 }
 
 /// The length of the bounding box's diagonal.

@@ -8,7 +8,9 @@ const $ = (id) => document.getElementById(id);
 const canvas = $('view'), overlay = $('overlay'), brush = $('brush');
 const state = {
   mode: 'orbit', hello: null, status: null, camera: null, eta: 1.3, white: 1,
-  lightDir: [0.4, 1, 0.7], pending: new Map(), errors: [], probes: [], exports: [],
+  // The server's default light (`view::builtin::DEFAULT_LIGHT`), replaced
+  // by the lights hello carries.
+  lightDir: [-0.801, 0.570, -0.184], pending: new Map(), errors: [], probes: [], exports: [],
   radianceFrames: 0, surfaceFrames: 0, answered: [], lastRadianceFinal: false, firstFrameAt: null,
   // The exposure's white: the server's first estimate (surface vertices),
   // then measured from the covered pixels as the CLI's PNGs are exposed.
@@ -92,12 +94,21 @@ function onFrame(f) {
   if (state.status && state.status.offsets) state.status.offsets.forEach((o, k) => { if (renderer.pieces[k]) renderer.pieces[k].offset = o; });
 }
 
-function showStatus(m) {
-  const solves = m.solves.map((s) => `${s.levels} levels, ${s.iterations.join('/')} it`).join('; ');
+// The HUD names what happened in words, not the protocol's op names; a
+// coarse solve is the edit's first result (a refinement follows).
+const EDIT_LABELS = {
+  hello: 'loaded', refine: 'refined', cut: 'cut', fracture: 'fractured', paint: 'painted',
+  material: 'material filled', lights: 'relit', move: 'moved', recombine: 'recombined',
+  undo: 'undone', redo: 'redone',
+};
+function statusText(m) {
+  const solves = m.solves.map((s) => `${s.levels} levels, ${s.iterations.join('/')} iterations`).join('; ');
   const tets = m.tets.reduce((a, b) => a + b, 0);
-  $('status').textContent = `${m.edit}${m.coarse ? ' (coarse)' : ''}: ${m.wall_ms.toFixed(0)} ms wall, ${m.cpu_ms.toFixed(0)} ms CPU` +
-    (solves ? `, ${solves}` : '') + ` | ${tets} tets, ${m.pieces} piece${m.pieces > 1 ? 's' : ''}`;
+  const label = EDIT_LABELS[m.edit] || m.edit;
+  return `${label}${m.coarse ? ' (first result)' : ''}: ${m.wall_ms.toFixed(0)} ms wall, ${m.cpu_ms.toFixed(0)} ms CPU` +
+    (solves ? `; solve ${solves}` : '') + ` | ${tets} tets, ${m.pieces} piece${m.pieces > 1 ? 's' : ''}`;
 }
+function showStatus(m) { $('status').textContent = statusText(m); }
 
 function showHistory(h) {
   const ol = $('history');
@@ -133,6 +144,13 @@ function frame() {
   requestAnimationFrame(frame);
 }
 const reexpose = () => { state.measureWanted = true; };
+// The exposure slider's value beside its label, as photographers read it.
+function showEv() {
+  const v = +$('ev').value;
+  $('evval').textContent = `${v < 0 ? '−' : '+'}${Math.abs(v).toFixed(Number.isInteger(v * 2) ? 1 : 2)} EV`;
+}
+$('ev').addEventListener('input', showEv);
+showEv();
 requestAnimationFrame(frame);
 
 // Modes.
