@@ -6,13 +6,14 @@ use tet_diffusion::glam::DVec3;
 use tet_diffusion::{Error, Light, Medium, Object, TetMesh, kuhn_ball};
 
 /// The direction toward `trilux view`'s default light, in the world frame:
-/// normalize(-0.6, 0.8, 0.4) in the frame of the page's starting camera
-/// (right, up, away from the viewer) — from above, to the left and a bit
-/// behind, so the lit side is bright and the shadow side shows the light
-/// diffused through the object. A light from the camera (as before) lit
-/// the ball evenly: a flat white disc that did not read as translucent.
-/// The page starts with the same direction (`state.lightDir` in app.js).
-pub const DEFAULT_LIGHT: [f64; 3] = [-0.801, 0.570, -0.184];
+/// normalize(-0.6, 0.6, -0.5) in the frame of the page's starting camera
+/// (right, up, away from the viewer) — from above, to the left and in
+/// front, so most of what the camera sees is lit and the terminator,
+/// where light diffuses into the shadow, crosses the ball. A light from
+/// the camera lit the ball evenly (a flat white disc that did not read as
+/// translucent); one from behind left most of it black. The page starts
+/// with the same direction (`state.lightDir` in app.js).
+pub const DEFAULT_LIGHT: [f64; 3] = [-0.351, 0.746, 0.565];
 
 /// `trilux view`'s light when it is given none: directional, from
 /// [`DEFAULT_LIGHT`], irradiance 1.

@@ -10,7 +10,7 @@ const state = {
   mode: 'orbit', hello: null, status: null, camera: null, eta: 1.3, white: 1,
   // The server's default light (`view::builtin::DEFAULT_LIGHT`), replaced
   // by the lights hello carries.
-  lightDir: [-0.801, 0.570, -0.184], pending: new Map(), errors: [], probes: [], exports: [],
+  lightDir: [-0.351, 0.746, 0.565], pending: new Map(), errors: [], probes: [], exports: [],
   radianceFrames: 0, surfaceFrames: 0, answered: [], lastRadianceFinal: false, firstFrameAt: null,
   // The exposure's white: the server's first estimate (surface vertices),
   // then measured from the covered pixels as the CLI's PNGs are exposed.
