@@ -200,6 +200,13 @@ impl From<mesh_sampling::Error> for Failure {
                     "for method='exact' or method='rejection'",
                 ))
             }
+            // The crate's message names `Options::max_pieces`, which
+            // Python does not expose.
+            E::TooManyPieces { needed, budget } => Self::input(format!(
+                "density: this mesh needs at least {needed} pieces (one per triangle), more \
+                 than the density sampler's budget of {budget}; with a density texture, \
+                 method='rejection' needs no pieces, else sample a mesh with fewer triangles"
+            )),
             _ => Self::input(chain(&e)),
         }
     }
@@ -340,4 +347,23 @@ pub(crate) fn guarded<T>(f: impl FnOnce() -> Result<T>) -> Result<T> {
             message: format!("internal error (a bug in trilux, please report it): {what}"),
         })
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A Python user cannot set Rust's `Options`: the piece budget's
+    /// message names what they can change instead.
+    #[test]
+    fn too_many_pieces_names_python_remedies() {
+        let f = Failure::from(mesh_sampling::Error::TooManyPieces {
+            needed: 5_000_000,
+            budget: 4_194_304,
+        });
+        assert_eq!(f.kind, Kind::Input);
+        assert!(f.message.contains("5000000 pieces"), "{}", f.message);
+        assert!(f.message.contains("method='rejection'"), "{}", f.message);
+        assert!(!f.message.contains("Options::"), "{}", f.message);
+    }
 }
