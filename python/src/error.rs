@@ -366,4 +366,26 @@ mod tests {
         assert!(f.message.contains("method='rejection'"), "{}", f.message);
         assert!(!f.message.contains("Options::"), "{}", f.message);
     }
+
+    /// The rejection steps' messages say `method=`, not "the approximate
+    /// mode" or "the exact mode".
+    #[test]
+    fn rejection_messages_name_the_method_argument() {
+        let errors = [
+            mesh_sampling::Error::AcceptanceTooLow {
+                acceptance: 1e-12,
+                minimum: 1e-9,
+            },
+            mesh_sampling::Error::IntegrationTooLarge {
+                cells: 1e12,
+                budget: 1 << 30,
+            },
+        ];
+        for e in errors {
+            let f = Failure::from(e);
+            assert_eq!(f.kind, Kind::Input);
+            assert!(f.message.contains("method='subdivision'"), "{}", f.message);
+            assert!(!f.message.contains(" mode"), "{}", f.message);
+        }
+    }
 }
