@@ -8,6 +8,7 @@ use rand::distr::Distribution;
 
 use crate::parallel::{BLOCK, check_points, for_each_chunk, unit};
 use crate::point::{Frame, uniform_barycentric};
+use crate::prefetch::prefetch;
 use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 
 /// Draws points uniformly over a mesh's surface: density `1 / A` for a
@@ -207,9 +208,18 @@ impl SurfaceSampler for UniformSampler<'_> {
 }
 
 impl UniformSampler<'_> {
-    /// Fills `out` with `make(face, barycentrics)` for blocks of draws:
-    /// the block's triangles first, by the guide table's batch search (one
-    /// `u64` each), then the points (two `u64` each).
+    /// Fills `out` with `make(face, barycentrics)` for blocks of draws,
+    /// as a software pipeline of [`DEPTH`] blocks: each turn draws a new
+    /// block's triangles (the guide table's batch search, one `u64` each)
+    /// and its variates (two `u64` per point) and prefetches their frames
+    /// (and corner indices, for shading normals); prefetches the corners'
+    /// normals of the block before it; and computes the points of the
+    /// oldest block, whose lines have arrived meanwhile. A triangle's
+    /// frame is a random line of a table that outgrows the cache on a
+    /// large mesh (4.4 MB on the bunny): without the pipeline each point
+    /// waited for its own miss. The random numbers are drawn in the order
+    /// of the plain blockwise loop (a block's triangles, then its points'
+    /// variates), so the points are the same bit for bit.
     #[inline]
     fn blocks<R: rand::Rng + ?Sized, T>(
         &self,
@@ -217,13 +227,114 @@ impl UniformSampler<'_> {
         out: &mut [T],
         make: impl Fn(u32, [f32; 3]) -> T,
     ) {
-        let mut faces = [0usize; BLOCK];
-        for block in out.chunks_mut(BLOCK) {
-            let faces = &mut faces[..block.len()];
-            self.triangles.sample_into(rng, faces);
-            for (slot, &face) in block.iter_mut().zip(faces.iter()) {
-                let u0 = unit(rng.next_u64());
-                *slot = make(face as u32, uniform_barycentric(u0, unit(rng.next_u64())));
+        let blocks = out.len().div_ceil(BLOCK);
+        let mut ring = [Ahead::EMPTY; DEPTH];
+        let normals = self.mesh.normals;
+        for t in 0..blocks + DEPTH - 1 {
+            if t < blocks {
+                let s = &mut ring[t % DEPTH];
+                s.len = (out.len() - t * BLOCK).min(BLOCK);
+                self.triangles.sample_into(rng, &mut s.face[..s.len]);
+                for xi in &mut s.xi[..s.len] {
+                    *xi = [rng.next_u64(), rng.next_u64()];
+                }
+                for &f in &s.face[..s.len] {
+                    prefetch(&self.frames, f);
+                    if normals.is_some() {
+                        prefetch(self.mesh.indices, f);
+                    }
+                }
+            }
+            if let (Some(n), Some(b)) = (normals, t.checked_sub(1).filter(|&b| b < blocks)) {
+                let s = &ring[b % DEPTH];
+                for &f in &s.face[..s.len] {
+                    for i in self.mesh.indices[f] {
+                        prefetch(n, i as usize);
+                    }
+                }
+            }
+            if let Some(b) = t.checked_sub(DEPTH - 1).filter(|&b| b < blocks) {
+                let s = &ring[b % DEPTH];
+                let block = &mut out[b * BLOCK..][..s.len];
+                for ((slot, &face), &[x1, x2]) in block.iter_mut().zip(&s.face).zip(&s.xi) {
+                    *slot = make(face as u32, uniform_barycentric(unit(x1), unit(x2)));
+                }
+            }
+        }
+    }
+}
+
+/// Blocks in flight in [`UniformSampler::blocks`]: one drawing its
+/// triangles and fetching their frames, one fetching its normals, one
+/// computing its points.
+const DEPTH: usize = 3;
+
+/// One block of [`UniformSampler::blocks`]' pipeline.
+#[derive(Clone, Copy)]
+struct Ahead {
+    len: usize,
+    face: [usize; BLOCK],
+    /// The two `u64` of each point in its triangle.
+    xi: [[u64; 2]; BLOCK],
+}
+
+impl Ahead {
+    const EMPTY: Self = Self {
+        len: 0,
+        face: [0; BLOCK],
+        xi: [[0; 2]; BLOCK],
+    };
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use rand::SeedableRng;
+
+    use super::*;
+
+    /// The pipeline gives the plain blockwise loop's points: a block's
+    /// triangles, then its points' variates, block after block.
+    #[test]
+    fn the_pipeline_draws_the_blockwise_loops_points() {
+        let n = 12u32;
+        let positions: Vec<Vec3> = (0..n * n)
+            .map(|k| Vec3::new((k % n) as f32, (k / n) as f32, ((k * 7) % 5) as f32 * 0.3))
+            .collect();
+        let normals: Vec<Vec3> = (0..n * n)
+            .map(|k| Vec3::new(0.1 * (k % 3) as f32, 0.2, 1.0).normalize())
+            .collect();
+        let mut indices = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let a = j * n + i;
+                indices.push([a, a + 1, a + n]);
+                indices.push([a + 1, a + n + 1, a + n]);
+            }
+        }
+        let with_normals = MeshRef {
+            normals: Some(&normals),
+            ..MeshRef::new(&positions, &indices)
+        };
+        for mesh in [MeshRef::new(&positions, &indices), with_normals] {
+            let sampler = UniformSampler::new(mesh).unwrap();
+            // Whole blocks, a partial last block, and fewer than one.
+            for count in [3 * BLOCK, 5 * BLOCK + 17, BLOCK - 1, 1, 0] {
+                let mut got = vec![SurfacePoint::default(); count];
+                sampler.sample_into(&mut rand_pcg::Pcg64Mcg::seed_from_u64(5), &mut got);
+                let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(5);
+                let mut want = Vec::new();
+                let mut faces = [0usize; BLOCK];
+                for start in (0..count).step_by(BLOCK) {
+                    let len = (count - start).min(BLOCK);
+                    sampler.faces_into(&mut rng, &mut faces[..len]);
+                    for &face in &faces[..len] {
+                        let u0 = unit(rng.next_u64());
+                        let bary = uniform_barycentric(u0, unit(rng.next_u64()));
+                        want.push(sampler.point(face as u32, bary));
+                    }
+                }
+                assert_eq!(got, want, "{count} points");
             }
         }
     }
