@@ -334,6 +334,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             "warning: listening on {}: other machines that can reach it may open the page (with its token)",
             args.host
         );
+        // The printed URL holds the unspecified address, which only works
+        // on this machine.
+        if args.host.is_unspecified() {
+            eprintln!(
+                "note: from another machine, use this machine's IP address in place of {} in the URL",
+                args.host
+            );
+        }
     }
     let options = trilux::view::Options {
         host: args.host,
