@@ -32,8 +32,10 @@ pub(crate) struct Args {
     /// under 5 units, as for scans in metres; 1 otherwise).
     #[arg(long, value_name = "X", allow_negative_numbers = true, value_parser = super::args::unit_mm)]
     pub(crate) unit_mm: Option<f64>,
-    /// Port (default: a free one).
-    #[arg(long, default_value_t = 0)]
+    /// Port (default: a free one; the URL printed names it).
+    // 0 asks the system for a free port; clap's "[default: 0]" would read
+    // as a port number.
+    #[arg(long, default_value_t = 0, hide_default_value = true)]
     pub(crate) port: u16,
     /// Address to listen on; anything but 127.0.0.1 exposes the object to
     /// the network (the token still guards it).

@@ -196,7 +196,20 @@ pub async fn start(
         .map_err(|e| e.to_string())??;
     let listener = tokio::net::TcpListener::bind((options.host, options.port))
         .await
-        .map_err(|e| format!("{}:{}: {e}", options.host, options.port))?;
+        .map_err(|e| {
+            let why = match e.kind() {
+                // Most often a trilux view still running from before.
+                std::io::ErrorKind::AddrInUse => format!(
+                    "port {} is in use (another trilux view?); choose another --port, or leave --port out for a free one",
+                    options.port
+                ),
+                std::io::ErrorKind::AddrNotAvailable => {
+                    "not an address of this machine (--host)".to_string()
+                }
+                _ => e.to_string(),
+            };
+            format!("{}:{}: {why}", options.host, options.port)
+        })?;
     let addr = listener.local_addr().map_err(|e| e.to_string())?;
     let hosts = allowed_hosts(options.host, addr);
     let (requests, receiver) = mpsc::channel();
