@@ -15,6 +15,8 @@ const state = {
   // The exposure's white: the server's first estimate (surface vertices),
   // then measured from the covered pixels as the CLI's PNGs are exposed.
   whiteFrom: 'vertices', covered: 0, measureWanted: false,
+  // Environment maps: the server's stored name → the picked file's name.
+  envNames: {}, uploadName: null,
 };
 window.trilux = state;
 
@@ -60,7 +62,10 @@ function onText(m) {
     showHistory(m.history);
     const env = (m.lights || []).find((l) => l.kind === 'env');
     state.environment = env ? env.file : null;
-    $('envname').textContent = env ? `Environment: ${env.file}` : 'No environment map';
+    // The server stores an upload under a name of its own (its content's
+    // hash); the user recognises the name of the file they picked.
+    if (env && state.uploadName && !state.envNames[env.file]) { state.envNames[env.file] = state.uploadName; state.uploadName = null; }
+    $('envname').textContent = env ? `Environment: ${state.envNames[env.file] || env.file}` : 'No environment map';
   } else if (m.type === 'error') {
     state.errors.push(m);
     if (m.seq != null) state.pending.delete(m.seq);
@@ -352,6 +357,7 @@ async function loadEnvironment(file) {
   const limit = state.hello ? state.hello.max_upload : 40 << 20;
   if (file && file.size + 16 > limit) { $('status').textContent = `${file.name}: ${file.size} bytes; at most ${limit - 16} may be uploaded`; return; }
   const bytes = file ? new Uint8Array(await file.arrayBuffer()) : new Uint8Array(0);
+  state.uploadName = file ? file.name : null;
   state.pending.set(conn.upload(bytes), performance.now());
 }
 state.loadEnvironment = loadEnvironment;
