@@ -69,7 +69,14 @@ function onText(m) {
   } else if (m.type === 'error') {
     state.errors.push(m);
     if (m.seq != null) state.pending.delete(m.seq);
+    // A refused upload must not lend its name to the next environment.
+    state.uploadName = null;
     if (m.exists && confirm(`${m.message}\nReplace it?`)) exportFile(state.lastExport, true);
+    // Declining to replace a file is the user's choice, not an error; and
+    // "op" (the edit itself, e.g. nothing to undo) names no field a user
+    // set on the page.
+    else if (m.exists) $('status').textContent = `not written (kept the existing file): ${m.message}`;
+    else if (m.field === 'op') $('status').textContent = m.message;
     else $('status').textContent = `error in ${m.field}: ${m.message}`;
   } else if (m.type === 'probe') {
     state.probes.push(m);
