@@ -36,6 +36,7 @@ try {
     answered: window.trilux.answered.length,
     white: window.trilux.white, white_from: window.trilux.whiteFrom, covered: window.trilux.covered,
     environment: window.trilux.environment || null,
+    light_dir: window.trilux.lightDir, sun: document.getElementById('sun') !== null,
   }));
   // The mean colour of the canvas's centre and how much of it is lit.
   const pixels = () => page.evaluate(() => {

@@ -51,6 +51,7 @@ function onText(m) {
     if (!sel.options.length) for (const name of m.materials) sel.add(new Option(name, name, name === 'ketchup', name === 'ketchup'));
     const d = m.lights.find((l) => l.kind === 'dir');
     if (d) state.lightDir = d.dir;
+    drawLight();
   } else if (m.type === 'status') {
     state.status = m;
     // The edits answered, in order (a refinement's status follows its edit's).
@@ -60,6 +61,11 @@ function onText(m) {
     renderer.dropPiecesFrom(m.pieces);
     showStatus(m);
     showHistory(m.history);
+    // The server's light after an undo, a redo or another tab's edit; the
+    // page's own while it still has edits in flight (a drag's earlier
+    // steps must not pull the light back).
+    const dl = (m.lights || []).find((l) => l.kind === 'dir');
+    if (dl && state.pending.size === 0 && !(drag && drag.kind === 'light')) { state.lightDir = dl.dir; drawLight(); }
     const env = (m.lights || []).find((l) => l.kind === 'env');
     state.environment = env ? env.file : null;
     // The server stores an upload under a name of its own (its content's
@@ -173,6 +179,22 @@ function setMode(mode) {
   brush.style.display = 'none';
   overlay.innerHTML = '';
   if (mode === 'plane') drawPlane();
+  if (mode === 'light') drawLight();
+}
+
+// Where the directional light is, in light mode: a sun at the point of
+// the view a drag to it would put the light (filled in front of the
+// object, hollow behind it), joined to the centre. Without it a user
+// drags blind: a translucent object's shading changes only softly.
+function drawLight() {
+  if (state.mode !== 'light' || !state.camera) return;
+  const [w, h] = size();
+  const ld = normalize(state.lightDir);
+  const { f, r, u } = state.camera.basis();
+  const x = (dot(ld, r) + 1) / 2 * w, y = (1 - dot(ld, u)) / 2 * h;
+  const fill = dot(ld, f) <= 0 ? '#fc6' : 'none';
+  overlay.innerHTML = `<line x1="${w / 2}" y1="${h / 2}" x2="${x}" y2="${y}" stroke="#fc6" stroke-width="1" stroke-dasharray="4 4"/>` +
+    `<circle id="sun" cx="${x}" cy="${y}" r="9" fill="${fill}" stroke="#fc6" stroke-width="2"/>`;
 }
 for (const b of document.querySelectorAll('#modes button')) b.onclick = () => setMode(b.dataset.mode);
 setMode('orbit');
@@ -265,6 +287,8 @@ canvas.addEventListener('pointermove', (e) => {
       if (now - lastSend > 30) { send('move', { piece: drag.piece, offset: drag.start }); lastSend = now; }
     } break;
   }
+  // The light moved, or the view orbited under it (middle or Alt drag).
+  if (state.mode === 'light') drawLight();
 });
 canvas.addEventListener('pointerup', (e) => {
   pointers.delete(e.pointerId);
