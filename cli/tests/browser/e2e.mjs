@@ -110,6 +110,10 @@ try {
   await page.waitForFunction(() => window.trilux.environment !== null && window.trilux.environment !== undefined, null, { timeout: 60000 });
   out.steps.env = { ...(await stats()), ...(await pixels()) };
   await page.screenshot({ path: dir + '/5-environment.png' });
+  // Shortcuts with Ctrl are the browser's: copy and save neither switch
+  // the mode nor toggle specular (Ctrl+R, reload, is not pressed here).
+  await page.keyboard.press('Control+c'); await page.keyboard.press('Control+s');
+  out.modifier_keys = await page.evaluate(() => ({ mode: window.trilux.mode, specular: document.getElementById('specular').checked }));
   // The help overlay.
   await page.keyboard.press('?');
   out.help_visible = await page.evaluate(() => !document.getElementById('helpbox').hidden);

@@ -417,13 +417,17 @@ window.addEventListener('keydown', (e) => {
   const k = e.key.toLowerCase();
   if ((e.ctrlKey || e.metaKey) && k === 'z') { e.preventDefault(); send(e.shiftKey ? 'redo' : 'undo'); return; }
   if ((e.ctrlKey || e.metaKey) && k === 'y') { e.preventDefault(); send('redo'); return; }
+  // The letter shortcuts are for the plain keys: Ctrl+C (copy) must not
+  // switch to cut, nor Ctrl+R (reload) recombine the pieces. ? [ ] may
+  // need AltGr or Option on some keyboards, so they are not filtered.
+  const plain = !(e.ctrlKey || e.metaKey || e.altKey);
   const modes = { o: 'orbit', c: 'cut', x: 'plane', p: 'paint', l: 'light', f: 'fracture', m: 'move' };
-  if (modes[k]) setMode(modes[k]);
+  if (plain && modes[k]) setMode(modes[k]);
   else if (e.key === '?') $('helpbox').hidden = !$('helpbox').hidden;
   else if (e.key === 'Escape') $('helpbox').hidden = true;
-  else if (k === 's') { $('specular').checked = !$('specular').checked; reexpose(); }
-  else if (k === 'r') recombine();
-  else if (k === 'e') exportFile('png');
+  else if (plain && k === 's') { $('specular').checked = !$('specular').checked; reexpose(); }
+  else if (plain && k === 'r') recombine();
+  else if (plain && k === 'e') exportFile('png');
   else if (e.key === '[') $('radius').value = +$('radius').value * 0.8;
   else if (e.key === ']') $('radius').value = +$('radius').value * 1.25;
 });
