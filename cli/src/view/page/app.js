@@ -24,7 +24,12 @@ let renderer;
 try { renderer = new Renderer(canvas); } catch (e) { $('status').textContent = String(e); throw e; }
 state.renderer = renderer;
 
-const conn = new Connection(onText, onFrame, (s) => { $('status').textContent = s; if (s === 'connected') conn.send('hello'); });
+// On a new connection, edits sent on the old one get no answer: the
+// hello's status shows what the server has.
+const conn = new Connection(onText, onFrame, (s) => {
+  $('status').textContent = s;
+  if (s === 'connected') { state.pending.clear(); conn.send('hello'); }
+});
 state.conn = conn;
 // The id of the drag in progress (a paint stroke, a light or piece drag):
 // its many messages carry it, and the server undoes them as one step.
@@ -34,6 +39,7 @@ const GESTURE_OPS = new Set(['paint', 'lights', 'move']);
 function send(op, fields) {
   if (gesture !== null && GESTURE_OPS.has(op)) fields = { ...fields, gesture };
   const seq = conn.send(op, fields);
+  if (seq === null) { $('status').textContent = 'not connected to trilux view: that edit was not sent'; return null; }
   state.pending.set(seq, performance.now());
   return seq;
 }
@@ -389,7 +395,9 @@ async function loadEnvironment(file) {
   if (file && file.size + 16 > limit) { $('status').textContent = `${file.name}: ${file.size} bytes; at most ${limit - 16} may be uploaded`; return; }
   const bytes = file ? new Uint8Array(await file.arrayBuffer()) : new Uint8Array(0);
   state.uploadName = file ? file.name : null;
-  state.pending.set(conn.upload(bytes), performance.now());
+  const seq = conn.upload(bytes);
+  if (seq === null) { $('status').textContent = 'not connected to trilux view: the environment map was not sent'; return; }
+  state.pending.set(seq, performance.now());
 }
 state.loadEnvironment = loadEnvironment;
 $('envmap').onchange = (e) => { if (e.target.files[0]) loadEnvironment(e.target.files[0]); e.target.value = ''; };
