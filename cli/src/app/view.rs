@@ -45,7 +45,9 @@ pub(crate) struct Args {
     #[arg(long)]
     pub(crate) open: bool,
     /// Start from a session file the page exported (its source and edits).
-    #[arg(long, value_name = "SESSION.json")]
+    // The file names its own mesh, material and unit: given beside it they
+    // would be ignored, so they are refused (as `diffuse --session` does).
+    #[arg(long, value_name = "SESSION.json", conflicts_with_all = ["input", "material", "unit_mm"])]
     pub(crate) replay: Option<PathBuf>,
     /// Folder the page's exports are written to.
     #[arg(long, value_name = "DIR", default_value = ".")]
