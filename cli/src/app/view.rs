@@ -80,6 +80,19 @@ fn replay(context: &mut Context, path: &Path) -> Result<(Object, Value, Log, Env
         ));
     }
     let view = trilux::view::session_file::saved_view(&source).map_err(|e| file_error(path, e))?;
+    // The user named only the session file: a mesh it names that is gone
+    // (moved, or a relative path from another folder) is an error in it.
+    if let Some(m) = &mesh
+        && !m.exists()
+    {
+        return Err(file_error(
+            path,
+            format!(
+                "source.mesh {:?}: no such file (a relative path is taken from the current folder)",
+                m.display().to_string()
+            ),
+        ));
+    }
     let (object, mut loaded) = load(context, mesh.as_deref(), material.as_ref(), unit)?;
     // The camera it was saved with: the page starts there.
     if let (Some(v), Some(o)) = (view, loaded.as_object_mut()) {
