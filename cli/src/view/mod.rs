@@ -190,10 +190,8 @@ pub async fn start(
         Some(t) => t,
         None => random_token().map_err(|e| format!("no random token: {e}"))?,
     };
-    let session_options = options.session;
-    let session = tokio::task::spawn_blocking(move || open_session(object, session_options, log))
-        .await
-        .map_err(|e| e.to_string())??;
+    // Bound before the first solve, so that a port in use is reported at
+    // once, not after a large mesh's solve.
     let listener = tokio::net::TcpListener::bind((options.host, options.port))
         .await
         .map_err(|e| {
@@ -210,6 +208,10 @@ pub async fn start(
             };
             format!("{}:{}: {why}", options.host, options.port)
         })?;
+    let session_options = options.session;
+    let session = tokio::task::spawn_blocking(move || open_session(object, session_options, log))
+        .await
+        .map_err(|e| e.to_string())??;
     let addr = listener.local_addr().map_err(|e| e.to_string())?;
     let hosts = allowed_hosts(options.host, addr);
     let (requests, receiver) = mpsc::channel();
