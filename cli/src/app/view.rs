@@ -32,8 +32,10 @@ pub(crate) struct Args {
     /// under 5 units, as for scans in metres; 1 otherwise).
     #[arg(long, value_name = "X", allow_negative_numbers = true, value_parser = super::args::unit_mm)]
     pub(crate) unit_mm: Option<f64>,
-    /// Port (default: a free one).
-    #[arg(long, default_value_t = 0)]
+    /// Port (default: a free one; the URL printed names it).
+    // 0 asks the system for a free port; clap's "[default: 0]" would read
+    // as a port number.
+    #[arg(long, default_value_t = 0, hide_default_value = true)]
     pub(crate) port: u16,
     /// Address to listen on; anything but 127.0.0.1 exposes the object to
     /// the network (the token still guards it).
@@ -43,7 +45,9 @@ pub(crate) struct Args {
     #[arg(long)]
     pub(crate) open: bool,
     /// Start from a session file the page exported (its source and edits).
-    #[arg(long, value_name = "SESSION.json")]
+    // The file names its own mesh, material and unit: given beside it they
+    // would be ignored, so they are refused (as `diffuse --session` does).
+    #[arg(long, value_name = "SESSION.json", conflicts_with_all = ["input", "material", "unit_mm"])]
     pub(crate) replay: Option<PathBuf>,
     /// Folder the page's exports are written to.
     #[arg(long, value_name = "DIR", default_value = ".")]
@@ -76,6 +80,19 @@ fn replay(context: &mut Context, path: &Path) -> Result<(Object, Value, Log, Env
         ));
     }
     let view = trilux::view::session_file::saved_view(&source).map_err(|e| file_error(path, e))?;
+    // The user named only the session file: a mesh it names that is gone
+    // (moved, or a relative path from another folder) is an error in it.
+    if let Some(m) = &mesh
+        && !m.exists()
+    {
+        return Err(file_error(
+            path,
+            format!(
+                "source.mesh {:?}: no such file (a relative path is taken from the current folder)",
+                m.display().to_string()
+            ),
+        ));
+    }
     let (object, mut loaded) = load(context, mesh.as_deref(), material.as_ref(), unit)?;
     // The camera it was saved with: the page starts there.
     if let (Some(v), Some(o)) = (view, loaded.as_object_mut()) {
@@ -334,6 +351,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             "warning: listening on {}: other machines that can reach it may open the page (with its token)",
             args.host
         );
+        // The printed URL holds the unspecified address, which only works
+        // on this machine.
+        if args.host.is_unspecified() {
+            eprintln!(
+                "note: from another machine, use this machine's IP address in place of {} in the URL",
+                args.host
+            );
+        }
     }
     let options = trilux::view::Options {
         host: args.host,

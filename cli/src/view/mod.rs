@@ -150,6 +150,12 @@ struct Shared {
     token: Arc<str>,
     /// `host:port` values a request's Host may have.
     hosts: Arc<Vec<String>>,
+    /// Bound to every interface (0.0.0.0 or ::): the port with which any
+    /// IP-literal Host is also accepted, since a user on another machine
+    /// types one of this machine's addresses, which the server does not
+    /// list. A DNS-rebinding page always sends a host *name*, so this
+    /// does not let one in.
+    any_ip_port: Option<u16>,
     requests: mpsc::Sender<(u64, Request)>,
     cancel: Arc<AtomicBool>,
     out: broadcast::Sender<Out>,
@@ -184,13 +190,28 @@ pub async fn start(
         Some(t) => t,
         None => random_token().map_err(|e| format!("no random token: {e}"))?,
     };
+    // Bound before the first solve, so that a port in use is reported at
+    // once, not after a large mesh's solve.
+    let listener = tokio::net::TcpListener::bind((options.host, options.port))
+        .await
+        .map_err(|e| {
+            let why = match e.kind() {
+                // Most often a trilux view still running from before.
+                std::io::ErrorKind::AddrInUse => format!(
+                    "port {} is in use (another trilux view?); choose another --port, or leave --port out for a free one",
+                    options.port
+                ),
+                std::io::ErrorKind::AddrNotAvailable => {
+                    "not an address of this machine (--host)".to_string()
+                }
+                _ => e.to_string(),
+            };
+            format!("{}:{}: {why}", options.host, options.port)
+        })?;
     let session_options = options.session;
     let session = tokio::task::spawn_blocking(move || open_session(object, session_options, log))
         .await
         .map_err(|e| e.to_string())??;
-    let listener = tokio::net::TcpListener::bind((options.host, options.port))
-        .await
-        .map_err(|e| format!("{}:{}: {e}", options.host, options.port))?;
     let addr = listener.local_addr().map_err(|e| e.to_string())?;
     let hosts = allowed_hosts(options.host, addr);
     let (requests, receiver) = mpsc::channel();
@@ -218,6 +239,7 @@ pub async fn start(
     let shared = Shared {
         token: token.clone().into(),
         hosts: Arc::new(hosts),
+        any_ip_port: options.host.is_unspecified().then_some(addr.port()),
         requests,
         cancel,
         out,
@@ -260,7 +282,8 @@ fn open_session(
 /// sends its own host name, which is never in this list).
 fn allowed_hosts(host: IpAddr, addr: SocketAddr) -> Vec<String> {
     let mut hosts = vec![addr.to_string()];
-    if host.is_loopback() {
+    // On every interface the loopback names reach it too.
+    if host.is_loopback() || host.is_unspecified() {
         hosts.push(format!("localhost:{}", addr.port()));
         hosts.push(format!("127.0.0.1:{}", addr.port()));
         hosts.push(format!("[::1]:{}", addr.port()));
@@ -316,6 +339,20 @@ fn same(a: &str, b: &str) -> bool {
             == 0
 }
 
+/// The body of a 403 for a foreign `Host`: what a user who reached the
+/// server by a host name (not an address) should do.
+pub const WRONG_HOST: &str = "trilux view: wrong Host header; open the page by the address \
+trilux printed (or, when it listens on every interface, by one of this machine's IP addresses), \
+not by a host name\n";
+
+/// Whether `host` (`host:port`, from a `Host` or `Origin` header) names
+/// this server.
+fn allowed_host(s: &Shared, host: &str) -> bool {
+    s.hosts.iter().any(|h| h == host)
+        || s.any_ip_port
+            .is_some_and(|port| host.parse::<SocketAddr>().is_ok_and(|a| a.port() == port))
+}
+
 /// The token, `Host` and `Origin` checks every request passes.
 fn check(s: &Shared, token: &str, headers: &HeaderMap) -> Result<(), (StatusCode, &'static str)> {
     if !same(token, &s.token) {
@@ -325,15 +362,15 @@ fn check(s: &Shared, token: &str, headers: &HeaderMap) -> Result<(), (StatusCode
         .get(header::HOST)
         .and_then(|h| h.to_str().ok())
         .unwrap_or_default();
-    if !s.hosts.iter().any(|h| h == host) {
-        return Err((StatusCode::FORBIDDEN, "wrong Host header"));
+    if !allowed_host(s, host) {
+        return Err((StatusCode::FORBIDDEN, WRONG_HOST));
     }
     if let Some(origin) = headers.get(header::ORIGIN) {
         let ok = origin
             .to_str()
             .ok()
             .and_then(|o| o.strip_prefix("http://"))
-            .is_some_and(|o| s.hosts.iter().any(|h| h == o));
+            .is_some_and(|o| allowed_host(s, o));
         if !ok {
             return Err((StatusCode::FORBIDDEN, "foreign Origin"));
         }

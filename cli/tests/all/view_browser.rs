@@ -108,6 +108,16 @@ async fn the_page_cuts_paints_relights_undoes_and_redoes_in_chromium() {
     assert_eq!(step("undo")["history"]["redo"], json!(["paint", "lights"]));
     assert_eq!(done("redo"), ["cut", "paint"]);
     assert_ne!(step("undo")["mean"], step("light")["mean"]);
+    // Light mode shows where the light is; undoing the drag puts the
+    // page's light (its specular term and that sun) back with the server's.
+    assert_eq!(step("light")["sun"], true);
+    assert_eq!(step("load")["sun"], false);
+    assert_ne!(step("light")["light_dir"], load["light_dir"]);
+    assert_eq!(step("undo")["light_dir"], load["light_dir"]);
+    assert_eq!(
+        v["modifier_keys"],
+        json!({"mode": "light", "specular": true})
+    );
     assert_eq!(v["help_visible"], true);
     // No console error (the favicon request was a 404 on every load).
     assert_eq!(v["console_errors"], json!([]), "{v:#}");

@@ -48,6 +48,10 @@ impl Exporter for Plain {
 }
 
 async fn server(dir: &std::path::Path) -> Running {
+    server_on(dir, Options::default().host).await
+}
+
+async fn server_on(dir: &std::path::Path, host: std::net::IpAddr) -> Running {
     let mut object = builtin::object(6).unwrap();
     object
         .add_light(Light::Directional {
@@ -56,6 +60,7 @@ async fn server(dir: &std::path::Path) -> Running {
         })
         .unwrap();
     let options = Options {
+        host,
         export_dir: dir.to_path_buf(),
         ..Options::default()
     };
@@ -168,7 +173,12 @@ async fn send_raw(s: &mut Socket, text: String) -> Result<(), tungstenite::Error
 
 /// A raw HTTP/1.1 GET; returns the status code and body.
 async fn get(r: &Running, path: &str, host: &str, origin: Option<&str>) -> (u16, String) {
-    let mut c = tokio::net::TcpStream::connect(r.addr).await.unwrap();
+    // A server on every interface (0.0.0.0) is reached through loopback.
+    let mut to = r.addr;
+    if to.ip().is_unspecified() {
+        to.set_ip(std::net::Ipv4Addr::LOCALHOST.into());
+    }
+    let mut c = tokio::net::TcpStream::connect(to).await.unwrap();
     let origin = origin.map_or(String::new(), |o| format!("Origin: {o}\r\n"));
     let req = format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n{origin}Connection: close\r\n\r\n");
     c.write_all(req.as_bytes()).await.unwrap();
@@ -240,6 +250,44 @@ async fn http_needs_the_token_and_this_servers_host_and_origin() {
             .0,
         200
     );
+    r.stop().await.unwrap();
+}
+
+// `--host 0.0.0.0` is for opening the page from another machine, by one
+// of this machine's addresses (which the server does not know): every
+// IP-literal Host with the server's port passes, a host name does not.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn on_every_interface_any_address_of_this_machine_may_open_the_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = server_on(dir.path(), std::net::Ipv4Addr::UNSPECIFIED.into()).await;
+    let (t, port) = (r.token.clone(), r.addr.port());
+    for host in [
+        format!("0.0.0.0:{port}"),
+        format!("127.0.0.1:{port}"),
+        format!("localhost:{port}"),
+        format!("192.0.2.7:{port}"),
+        format!("[2001:db8::7]:{port}"),
+    ] {
+        let origin = format!("http://{host}");
+        let (code, _) = get(&r, &format!("/{t}/"), &host, Some(&origin)).await;
+        assert_eq!(code, 200, "{host}");
+    }
+    for host in [
+        format!("evil.example:{port}"),
+        format!("192.0.2.7:{}", port.wrapping_add(1)),
+    ] {
+        let (code, body) = get(&r, &format!("/{t}/"), &host, None).await;
+        assert_eq!(code, 403, "{host}");
+        assert!(body.contains("wrong Host header"), "{host}: {body}");
+    }
+    let (code, _) = get(
+        &r,
+        &format!("/{t}/"),
+        &format!("192.0.2.7:{port}"),
+        Some("http://evil.example"),
+    )
+    .await;
+    assert_eq!(code, 403);
     r.stop().await.unwrap();
 }
 

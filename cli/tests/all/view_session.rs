@@ -257,3 +257,25 @@ fn a_bad_session_file_is_an_error_naming_the_file_and_the_entry() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+// A port already taken (most often by a trilux view still running) is an
+// error that names the address and says what to do, not the bare OS text.
+#[test]
+fn a_port_in_use_is_an_error_that_says_what_to_do() {
+    let dir = tempfile::tempdir().unwrap();
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = taken.local_addr().unwrap().port().to_string();
+    let out = trilux()
+        .args(["view", "--export-dir"])
+        .arg(dir.path())
+        .args(["--port", &port])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains(&format!("error: 127.0.0.1:{port}: port {port} is in use")),
+        "{stderr}"
+    );
+    assert!(stderr.contains("leave --port out"), "{stderr}");
+}

@@ -36,6 +36,7 @@ try {
     answered: window.trilux.answered.length,
     white: window.trilux.white, white_from: window.trilux.whiteFrom, covered: window.trilux.covered,
     environment: window.trilux.environment || null,
+    light_dir: window.trilux.lightDir, sun: document.getElementById('sun') !== null,
   }));
   // The mean colour of the canvas's centre and how much of it is lit.
   const pixels = () => page.evaluate(() => {
@@ -109,6 +110,10 @@ try {
   await page.waitForFunction(() => window.trilux.environment !== null && window.trilux.environment !== undefined, null, { timeout: 60000 });
   out.steps.env = { ...(await stats()), ...(await pixels()) };
   await page.screenshot({ path: dir + '/5-environment.png' });
+  // Shortcuts with Ctrl are the browser's: copy and save neither switch
+  // the mode nor toggle specular (Ctrl+R, reload, is not pressed here).
+  await page.keyboard.press('Control+c'); await page.keyboard.press('Control+s');
+  out.modifier_keys = await page.evaluate(() => ({ mode: window.trilux.mode, specular: document.getElementById('specular').checked }));
   // The help overlay.
   await page.keyboard.press('?');
   out.help_visible = await page.evaluate(() => !document.getElementById('helpbox').hidden);

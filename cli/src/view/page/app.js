@@ -15,6 +15,8 @@ const state = {
   // The exposure's white: the server's first estimate (surface vertices),
   // then measured from the covered pixels as the CLI's PNGs are exposed.
   whiteFrom: 'vertices', covered: 0, measureWanted: false,
+  // Environment maps: the server's stored name → the picked file's name.
+  envNames: {}, uploadName: null,
 };
 window.trilux = state;
 
@@ -22,7 +24,12 @@ let renderer;
 try { renderer = new Renderer(canvas); } catch (e) { $('status').textContent = String(e); throw e; }
 state.renderer = renderer;
 
-const conn = new Connection(onText, onFrame, (s) => { $('status').textContent = s; if (s === 'connected') conn.send('hello'); });
+// On a new connection, edits sent on the old one get no answer: the
+// hello's status shows what the server has.
+const conn = new Connection(onText, onFrame, (s) => {
+  $('status').textContent = s;
+  if (s === 'connected') { state.pending.clear(); conn.send('hello'); }
+});
 state.conn = conn;
 // The id of the drag in progress (a paint stroke, a light or piece drag):
 // its many messages carry it, and the server undoes them as one step.
@@ -32,6 +39,7 @@ const GESTURE_OPS = new Set(['paint', 'lights', 'move']);
 function send(op, fields) {
   if (gesture !== null && GESTURE_OPS.has(op)) fields = { ...fields, gesture };
   const seq = conn.send(op, fields);
+  if (seq === null) { $('status').textContent = 'not connected to trilux view: that edit was not sent'; return null; }
   state.pending.set(seq, performance.now());
   return seq;
 }
@@ -49,6 +57,7 @@ function onText(m) {
     if (!sel.options.length) for (const name of m.materials) sel.add(new Option(name, name, name === 'ketchup', name === 'ketchup'));
     const d = m.lights.find((l) => l.kind === 'dir');
     if (d) state.lightDir = d.dir;
+    drawLight();
   } else if (m.type === 'status') {
     state.status = m;
     // The edits answered, in order (a refinement's status follows its edit's).
@@ -58,13 +67,28 @@ function onText(m) {
     renderer.dropPiecesFrom(m.pieces);
     showStatus(m);
     showHistory(m.history);
+    // The server's light after an undo, a redo or another tab's edit; the
+    // page's own while it still has edits in flight (a drag's earlier
+    // steps must not pull the light back).
+    const dl = (m.lights || []).find((l) => l.kind === 'dir');
+    if (dl && state.pending.size === 0 && !(drag && drag.kind === 'light')) { state.lightDir = dl.dir; drawLight(); }
     const env = (m.lights || []).find((l) => l.kind === 'env');
     state.environment = env ? env.file : null;
-    $('envname').textContent = env ? `Environment: ${env.file}` : 'No environment map';
+    // The server stores an upload under a name of its own (its content's
+    // hash); the user recognises the name of the file they picked.
+    if (env && state.uploadName && !state.envNames[env.file]) { state.envNames[env.file] = state.uploadName; state.uploadName = null; }
+    $('envname').textContent = env ? `Environment: ${state.envNames[env.file] || env.file}` : 'No environment map';
   } else if (m.type === 'error') {
     state.errors.push(m);
     if (m.seq != null) state.pending.delete(m.seq);
+    // A refused upload must not lend its name to the next environment.
+    state.uploadName = null;
     if (m.exists && confirm(`${m.message}\nReplace it?`)) exportFile(state.lastExport, true);
+    // Declining to replace a file is the user's choice, not an error; and
+    // "op" (the edit itself, e.g. nothing to undo) names no field a user
+    // set on the page.
+    else if (m.exists) $('status').textContent = `not written (kept the existing file): ${m.message}`;
+    else if (m.field === 'op') $('status').textContent = m.message;
     else $('status').textContent = `error in ${m.field}: ${m.message}`;
   } else if (m.type === 'probe') {
     state.probes.push(m);
@@ -161,6 +185,22 @@ function setMode(mode) {
   brush.style.display = 'none';
   overlay.innerHTML = '';
   if (mode === 'plane') drawPlane();
+  if (mode === 'light') drawLight();
+}
+
+// Where the directional light is, in light mode: a sun at the point of
+// the view a drag to it would put the light (filled in front of the
+// object, hollow behind it), joined to the centre. Without it a user
+// drags blind: a translucent object's shading changes only softly.
+function drawLight() {
+  if (state.mode !== 'light' || !state.camera) return;
+  const [w, h] = size();
+  const ld = normalize(state.lightDir);
+  const { f, r, u } = state.camera.basis();
+  const x = (dot(ld, r) + 1) / 2 * w, y = (1 - dot(ld, u)) / 2 * h;
+  const fill = dot(ld, f) <= 0 ? '#fc6' : 'none';
+  overlay.innerHTML = `<line x1="${w / 2}" y1="${h / 2}" x2="${x}" y2="${y}" stroke="#fc6" stroke-width="1" stroke-dasharray="4 4"/>` +
+    `<circle id="sun" cx="${x}" cy="${y}" r="9" fill="${fill}" stroke="#fc6" stroke-width="2"/>`;
 }
 for (const b of document.querySelectorAll('#modes button')) b.onclick = () => setMode(b.dataset.mode);
 setMode('orbit');
@@ -253,6 +293,8 @@ canvas.addEventListener('pointermove', (e) => {
       if (now - lastSend > 30) { send('move', { piece: drag.piece, offset: drag.start }); lastSend = now; }
     } break;
   }
+  // The light moved, or the view orbited under it (middle or Alt drag).
+  if (state.mode === 'light') drawLight();
 });
 canvas.addEventListener('pointerup', (e) => {
   pointers.delete(e.pointerId);
@@ -352,7 +394,10 @@ async function loadEnvironment(file) {
   const limit = state.hello ? state.hello.max_upload : 40 << 20;
   if (file && file.size + 16 > limit) { $('status').textContent = `${file.name}: ${file.size} bytes; at most ${limit - 16} may be uploaded`; return; }
   const bytes = file ? new Uint8Array(await file.arrayBuffer()) : new Uint8Array(0);
-  state.pending.set(conn.upload(bytes), performance.now());
+  state.uploadName = file ? file.name : null;
+  const seq = conn.upload(bytes);
+  if (seq === null) { $('status').textContent = 'not connected to trilux view: the environment map was not sent'; return; }
+  state.pending.set(seq, performance.now());
 }
 state.loadEnvironment = loadEnvironment;
 $('envmap').onchange = (e) => { if (e.target.files[0]) loadEnvironment(e.target.files[0]); e.target.value = ''; };
@@ -380,13 +425,17 @@ window.addEventListener('keydown', (e) => {
   const k = e.key.toLowerCase();
   if ((e.ctrlKey || e.metaKey) && k === 'z') { e.preventDefault(); send(e.shiftKey ? 'redo' : 'undo'); return; }
   if ((e.ctrlKey || e.metaKey) && k === 'y') { e.preventDefault(); send('redo'); return; }
+  // The letter shortcuts are for the plain keys: Ctrl+C (copy) must not
+  // switch to cut, nor Ctrl+R (reload) recombine the pieces. ? [ ] may
+  // need AltGr or Option on some keyboards, so they are not filtered.
+  const plain = !(e.ctrlKey || e.metaKey || e.altKey);
   const modes = { o: 'orbit', c: 'cut', x: 'plane', p: 'paint', l: 'light', f: 'fracture', m: 'move' };
-  if (modes[k]) setMode(modes[k]);
+  if (plain && modes[k]) setMode(modes[k]);
   else if (e.key === '?') $('helpbox').hidden = !$('helpbox').hidden;
   else if (e.key === 'Escape') $('helpbox').hidden = true;
-  else if (k === 's') { $('specular').checked = !$('specular').checked; reexpose(); }
-  else if (k === 'r') recombine();
-  else if (k === 'e') exportFile('png');
+  else if (plain && k === 's') { $('specular').checked = !$('specular').checked; reexpose(); }
+  else if (plain && k === 'r') recombine();
+  else if (plain && k === 'e') exportFile('png');
   else if (e.key === '[') $('radius').value = +$('radius').value * 0.8;
   else if (e.key === ']') $('radius').value = +$('radius').value * 1.25;
 });

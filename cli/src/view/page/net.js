@@ -29,28 +29,40 @@ export class Connection {
     const url = location.href.replace(/^http/, 'ws').replace(/[^/]*$/, '') + 'ws';
     const ws = new WebSocket(url);
     ws.binaryType = 'arraybuffer';
-    ws.onopen = () => this.onState('connected');
-    ws.onclose = () => { this.onState('disconnected; reconnecting…'); setTimeout(() => this.open(), 1000); };
+    ws.onopen = () => { this.failures = 0; this.onState('connected'); };
+    // A server stopped with Ctrl+C never comes back under this token:
+    // after a few failed tries, say so rather than "reconnecting" forever.
+    ws.onclose = () => {
+      this.failures = (this.failures || 0) + 1;
+      this.onState(this.failures > 3
+        ? 'trilux view is not answering (stopped?): start it again and open the URL it prints; retrying…'
+        : 'disconnected; reconnecting…');
+      setTimeout(() => this.open(), 1000);
+    };
     ws.onmessage = (e) => {
       if (typeof e.data === 'string') this.onText(JSON.parse(e.data));
       else this.onFrame(parseFrame(e.data));
     };
     this.ws = ws;
   }
+  // The edit's sequence number, or null when there is no connection (the
+  // edit is not sent, so no answer will come).
   send(op, fields = {}) {
+    if (this.ws.readyState !== WebSocket.OPEN) return null;
     const seq = ++this.seq;
-    if (this.ws.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify({ seq, op, ...fields }));
+    this.ws.send(JSON.stringify({ seq, op, ...fields }));
     return seq;
   }
   // An environment-map upload: the 16-byte header (TLXU, version 1, kind
   // 1, the seq as u64) and the .hdr file's bytes (none: remove the map).
   upload(bytes) {
+    if (this.ws.readyState !== WebSocket.OPEN) return null;
     const seq = ++this.seq;
     const m = new Uint8Array(16 + bytes.length);
     m.set([0x54, 0x4c, 0x58, 0x55, 1, 1, 0, 0]);
     new DataView(m.buffer).setBigUint64(8, BigInt(seq), true);
     m.set(bytes, 16);
-    if (this.ws.readyState === WebSocket.OPEN) this.ws.send(m);
+    this.ws.send(m);
     return seq;
   }
 }
