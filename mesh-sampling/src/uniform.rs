@@ -190,7 +190,7 @@ impl SurfaceSampler for UniformSampler<'_> {
     /// repeated [`sample`](Distribution::sample) calls, which interleave
     /// the variates.
     fn sample_into<R: rand::Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
-        self.blocks(rng, out, |face, bary| self.point(face, bary));
+        self.blocks(rng, out, true, |face, bary| self.point(face, bary));
     }
 
     /// The positions of [`sample_n`](SurfaceSampler::sample_n)'s points,
@@ -199,7 +199,7 @@ impl SurfaceSampler for UniformSampler<'_> {
         check_points(n as f64)?;
         let mut out = vec![[0.0f32; 3]; n];
         for_each_chunk(seed, &mut out, |rng, chunk| {
-            self.blocks(rng, chunk, |face, [_, w1, w2]| {
+            self.blocks(rng, chunk, false, |face, [_, w1, w2]| {
                 self.frames[face as usize].at(w1, w2).to_array()
             });
         });
@@ -219,17 +219,20 @@ impl UniformSampler<'_> {
     /// large mesh (4.4 MB on the bunny): without the pipeline each point
     /// waited for its own miss. The random numbers are drawn in the order
     /// of the plain blockwise loop (a block's triangles, then its points'
-    /// variates), so the points are the same bit for bit.
+    /// variates), so the points are the same bit for bit. `shading`: the
+    /// points read the mesh's shading normals (their lines are fetched).
     #[inline]
     fn blocks<R: rand::Rng + ?Sized, T>(
         &self,
         rng: &mut R,
         out: &mut [T],
+        shading: bool,
         make: impl Fn(u32, [f32; 3]) -> T,
     ) {
         let blocks = out.len().div_ceil(BLOCK);
         let mut ring = [Ahead::EMPTY; DEPTH];
-        let normals = self.mesh.normals;
+        // Positions alone (`shading` false) read no normals: none to fetch.
+        let normals = self.mesh.normals.filter(|_| shading);
         for t in 0..blocks + DEPTH - 1 {
             if t < blocks {
                 let s = &mut ring[t % DEPTH];

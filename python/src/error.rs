@@ -203,9 +203,10 @@ impl From<mesh_sampling::Error> for Failure {
             // The crate's message names `Options::max_pieces`, which
             // Python does not expose.
             E::TooManyPieces { needed, budget } => Self::input(format!(
-                "density: this mesh needs at least {needed} pieces (one per triangle), more \
-                 than the density sampler's budget of {budget}; with a density texture, \
-                 method='rejection' needs no pieces, else sample a mesh with fewer triangles"
+                "density: this mesh needs at least {needed} pieces (one or more per \
+                 triangle), more than the density sampler's budget of {budget}; with a density \
+                 texture, method='rejection' needs no pieces, else sample a mesh with fewer \
+                 triangles"
             )),
             _ => Self::input(chain(&e)),
         }

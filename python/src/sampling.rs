@@ -29,10 +29,10 @@ pub(crate) struct Want {
 /// The arrays of a batch of points: numpy arrays, allocated by numpy
 /// under the GIL and filled without it. numpy asks the kernel for huge
 /// pages for large arrays (`madvise(MADV_HUGEPAGE)`), so the first writes
-/// to a 10⁷-point result (320 MB) fault 2 MB pages, not 4 KB ones: on a
+/// to a 10⁷-point result (320 MB) fault 2 MB pages, not 80 000 pages of
+/// 4 KB as a `Vec` filled first and then handed to numpy did, on a
 /// machine whose transparent huge pages are `madvise` (the default of
-/// Ubuntu and Debian), a `Vec` filled first and then handed to numpy made
-/// 10⁷ points about 3× slower than 10 × 10⁶.
+/// Debian and Ubuntu).
 pub(crate) struct Points<'py> {
     positions: Bound<'py, PyArray2<f64>>,
     faces: Bound<'py, PyArray1<i64>>,
