@@ -702,3 +702,77 @@ pub(crate) fn check_acceptance(acceptance: f64) -> Result<(), Error> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::{Vec2, Vec3};
+    use rand::SeedableRng;
+
+    use super::*;
+
+    /// The alias pipeline gives the plain blockwise loop's points (a
+    /// block's pieces, then its points' variates, block after block), for
+    /// a texture with and without shading normals and for per-vertex
+    /// weights (which read the corner indices).
+    #[test]
+    fn the_alias_pipeline_draws_the_blockwise_loops_points() {
+        let n = 12u32;
+        let positions: Vec<Vec3> = (0..n * n)
+            .map(|k| Vec3::new((k % n) as f32, (k / n) as f32, ((k * 7) % 5) as f32 * 0.3))
+            .collect();
+        let uvs: Vec<Vec2> = positions.iter().map(|p| p.truncate() / n as f32).collect();
+        let normals: Vec<Vec3> = (0..n * n)
+            .map(|k| Vec3::new(0.1 * (k % 3) as f32, 0.2, 1.0).normalize())
+            .collect();
+        let mut indices = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let a = j * n + i;
+                indices.push([a, a + 1, a + n]);
+                indices.push([a + 1, a + n + 1, a + n]);
+            }
+        }
+        let texels: Vec<f32> = (0..64 * 64).map(|k| ((k * 37) % 11) as f32).collect();
+        let texture = DensityTexture::new(64, 64, texels).unwrap();
+        let weights: Vec<f32> = (0..n * n).map(|k| (k % 4) as f32).collect();
+        let plain = MeshRef {
+            uvs: Some(&uvs),
+            ..MeshRef::new(&positions, &indices)
+        };
+        let shaded = MeshRef {
+            normals: Some(&normals),
+            ..plain
+        };
+        let cases = [
+            (plain, Density::Texture(&texture)),
+            (shaded, Density::Texture(&texture)),
+            (shaded, Density::PerVertex(&weights)),
+        ];
+        for (mesh, density) in cases {
+            let sampler = DensitySampler::new(mesh, density).unwrap();
+            let Table::Alias(alias) = &sampler.table else {
+                panic!("the default layout is the alias table")
+            };
+            assert!(sampler.pieces() > 4 * BLOCK, "{} pieces", sampler.pieces());
+            // Whole blocks, a partial last block, fewer than the pipeline
+            // holds, and fewer than one block.
+            for count in [7 * BLOCK, 9 * BLOCK + 17, 3 * BLOCK + 5, BLOCK - 1, 1, 0] {
+                let mut got = vec![SurfacePoint::default(); count];
+                sampler.sample_into(&mut rand_pcg::Pcg64Mcg::seed_from_u64(5), &mut got);
+                let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(5);
+                let mut want = Vec::new();
+                for start in (0..count).step_by(BLOCK) {
+                    let len = (count - start).min(BLOCK);
+                    let pieces: Vec<Piece> =
+                        (0..len).map(|_| alias.piece(rng.next_u64())).collect();
+                    for piece in pieces {
+                        let xi1 = unit(rng.next_u64());
+                        let bary = sampler.place(piece, xi1, unit(rng.next_u64()));
+                        want.push(sampler.point(piece, bary, sampler.value(piece, bary)));
+                    }
+                }
+                assert_eq!(got, want, "{count} points");
+            }
+        }
+    }
+}
