@@ -7,7 +7,7 @@
 //!
 //! ```text
 //! cargo run --release -p mesh-sampling --example paper -- [--json] [--mesh FILE]
-//!     [--density D[,D…]] [--threads T] [--no-peers] [--no-tiled] [--tiled-only]
+//!     [--density D[,D…]] [--threads T] [--no-peers] [--no-tiled] [--tiled-only] [--bar]
 //! ```
 //!
 //! Meshes: every mesh in `$TRILUX_DATA/meshes` (those without UVs get
@@ -24,7 +24,12 @@
 //! random reads of 16-byte records from a table of as many records, one at
 //! a time and in the sampler's blocks), and the summary gives each density
 //! rate as a fraction of that probe, beside its ratio to the uniform
-//! texture's rate (Sec. 5.2) and to the uniform sampler's.
+//! texture's rate (Sec. 5.2) and to the uniform sampler's. The ratio to
+//! the uniform texture is the median of nine pairs of back-to-back runs of
+//! the two samplers, so that a neighbour's load on a shared host falls on
+//! both sides of each pair; `--bar` measures only that ratio (the alias
+//! layout on every mesh and density), in a few minutes instead of the
+//! whole table's hour.
 
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -45,6 +50,8 @@ mod probe;
 
 const SIZE: usize = 1024;
 const RUNS: usize = 5;
+/// Back-to-back pairs of runs for a ratio of two samplers' rates.
+const PAIRS: usize = 9;
 const BUILDS: usize = 3;
 const TARGET_S: f64 = 0.1;
 const PEER_N: usize = 10_000_000;
@@ -56,6 +63,9 @@ struct Args {
     threads: Vec<usize>,
     peers: bool,
     tiled: bool,
+    /// Only what the bar of Sec. 5.2 needs: the alias layout, paired with
+    /// the uniform texture.
+    bar: bool,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -66,6 +76,7 @@ fn parse_args() -> Result<Args, String> {
         threads: vec![1, 2],
         peers: true,
         tiled: true,
+        bar: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -74,6 +85,11 @@ fn parse_args() -> Result<Args, String> {
             "--json" => args.json = true,
             "--no-peers" => args.peers = false,
             "--no-tiled" => args.tiled = false,
+            "--bar" => {
+                args.bar = true;
+                args.tiled = false;
+                args.peers = false;
+            }
             "--tiled-only" => {
                 args.tiled = true;
                 args.peers = false;
@@ -92,7 +108,7 @@ fn parse_args() -> Result<Args, String> {
             }
             "-h" | "--help" => {
                 return Err(
-                    "usage: paper [--json] [--mesh FILE] [--density D[,D...]] [--threads T] [--no-peers] [--no-tiled] [--tiled-only]"
+                    "usage: paper [--json] [--mesh FILE] [--density D[,D...]] [--threads T] [--no-peers] [--no-tiled] [--tiled-only] [--bar]"
                         .into(),
                 );
             }
@@ -414,6 +430,9 @@ struct Row {
     max_over_mean: f64,
     acceptance: f64,
     pieces: usize,
+    /// The alias layout's rate over the uniform texture's, the median of
+    /// [`PAIRS`] back-to-back pairs of runs (`subdivision` rows).
+    paired: Option<f64>,
 }
 
 impl Row {
@@ -421,7 +440,7 @@ impl Row {
         format!(
             "{{\"mesh\": \"{}\", \"density\": \"{}\", \"method\": \"{}\", \"msamples_per_s\": {:.3}, \
              \"preprocess_ms\": {:.2}, \"memory_mb\": {:.2}, \"threads\": {}, \"max_over_mean\": {:.3}, \
-             \"triangles\": {}, \"acceptance\": {:.4}, \"pieces\": {}}}",
+             \"triangles\": {}, \"acceptance\": {:.4}, \"pieces\": {}, \"vs_uniform_texture\": {}}}",
             self.mesh,
             self.density,
             self.method,
@@ -432,7 +451,8 @@ impl Row {
             self.max_over_mean,
             self.triangles,
             self.acceptance,
-            self.pieces
+            self.pieces,
+            self.paired.map_or("null".into(), |x| format!("{x:.4}"))
         )
     }
 }
@@ -445,15 +465,47 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// Million points per second of `sample` (streamed), median of [`RUNS`]
 /// runs sized to about [`TARGET_S`] each.
 fn rate(sampler: &impl SurfaceSampler) -> f64 {
-    let run = |n: usize| {
-        let start = Instant::now();
-        sampler.sample_stream(1, n, |_, chunk| {
-            let s: f32 = chunk.iter().map(|p| p.position.x + p.pdf).sum();
-            black_box(s);
-        });
-        start.elapsed().as_secs_f64()
-    };
-    measure(run)
+    measure(|n| timed_stream(sampler, n))
+}
+
+/// Seconds for `n` points of `sampler`, streamed and summed.
+fn timed_stream(sampler: &impl SurfaceSampler, n: usize) -> f64 {
+    let start = Instant::now();
+    sampler.sample_stream(1, n, |_, chunk| {
+        let s: f32 = chunk.iter().map(|p| p.position.x + p.pdf).sum();
+        black_box(s);
+    });
+    start.elapsed().as_secs_f64()
+}
+
+/// The rates (M points/s) of `a` and `b` and the median of `a`'s over
+/// `b`'s in [`PAIRS`] pairs of runs of the same count (about
+/// [`TARGET_S`] of `a`), the order alternating from pair to pair. On a
+/// host whose neighbours come and go, two samplers measured seconds apart
+/// can see different machines; a pair's two runs see nearly the same.
+fn paired_rates(a: &impl SurfaceSampler, b: &impl SurfaceSampler) -> (f64, f64, f64) {
+    let mut n = 1 << 10;
+    let mut t = timed_stream(a, n);
+    while t < TARGET_S / 8.0 {
+        n *= 4;
+        t = timed_stream(a, n);
+    }
+    let n = ((n as f64 * TARGET_S / t) as usize).max(1 << 10);
+    let (mut ta, mut tb, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
+    for k in 0..PAIRS {
+        let (x, y) = if k % 2 == 0 {
+            let x = timed_stream(a, n);
+            (x, timed_stream(b, n))
+        } else {
+            let y = timed_stream(b, n);
+            (timed_stream(a, n), y)
+        };
+        ta.push(x);
+        tb.push(y);
+        ratio.push(y / x);
+    }
+    let rate = |t: Vec<f64>| n as f64 / median(t) / 1e6;
+    (rate(ta), rate(tb), median(ratio))
 }
 
 /// Million triples of `u64` per second from the chunked generators the
@@ -522,10 +574,13 @@ fn measure_pair(
     name: &str,
     texture: &DensityTexture,
     threads: usize,
+    bar: bool,
 ) -> Result<Vec<Row>, String> {
     let mesh = m.mesh();
     let texture_mb = texture.memory_bytes() as f64 / 1e6;
-    let (reject_ms, rejection) = build(|| RejectionSampler::new(mesh, texture));
+    let (reject_ms, rejection) = build_n(if bar { 1 } else { BUILDS }, || {
+        RejectionSampler::new(mesh, texture)
+    });
     let rejection = rejection.map_err(|e| format!("{}, {name}: {e}", m.name))?;
     let area = UniformSampler::new(mesh)
         .map_err(|e| e.to_string())?
@@ -543,7 +598,35 @@ fn measure_pair(
         max_over_mean,
         acceptance,
         pieces,
+        paired: None,
     };
+    let density = Density::Texture(texture);
+    // The uniform texture (Sec. 5.2): one piece per face, value 1.
+    let flat_texture = DensityTexture::new(1, 1, vec![1.0]).map_err(|e| e.to_string())?;
+    let flat =
+        DensitySampler::new(mesh, Density::Texture(&flat_texture)).map_err(|e| e.to_string())?;
+    let (ms, alias) = build_n(if bar { 1 } else { BUILDS }, || {
+        DensitySampler::new(mesh, density)
+    });
+    let alias = alias.map_err(|e| e.to_string())?;
+    let (alias_rate, _, paired) = paired_rates(&alias, &flat);
+    let alias_row = Row {
+        paired: Some(paired),
+        ..row(
+            "subdivision",
+            alias_rate,
+            ms,
+            alias.memory_bytes() as f64 / 1e6,
+            1.0,
+            alias.pieces(),
+        )
+    };
+    let table_mb = alias.table_bytes() as f64 / 1e6;
+    let pieces = alias.pieces();
+    drop(alias);
+    if bar {
+        return Ok(vec![alias_row]);
+    }
     let mut rows = vec![row(
         "rejection",
         rate(&rejection),
@@ -552,7 +635,6 @@ fn measure_pair(
         rejection.acceptance(),
         m.indices.len(),
     )];
-    let density = Density::Texture(texture);
     let inversion = Options {
         layout: Layout::Inversion,
         ..Options::default()
@@ -584,20 +666,7 @@ fn measure_pair(
         table.pieces(),
     ));
     drop(table);
-    let (ms, alias) = build(|| DensitySampler::new(mesh, density));
-    let alias = alias.map_err(|e| e.to_string())?;
-    let bytes = alias.memory_bytes();
-    rows.push(row(
-        "subdivision",
-        rate(&alias),
-        ms,
-        bytes as f64 / 1e6,
-        1.0,
-        alias.pieces(),
-    ));
-    let table_mb = alias.table_bytes() as f64 / 1e6;
-    let pieces = alias.pieces();
-    drop(alias);
+    rows.push(alias_row);
     // The limit for a table of this size, on this pool.
     let limit = probe::probe(pieces, 1 << 22, RUNS);
     rows.push(row(
@@ -669,7 +738,7 @@ fn print_summary(rows: &[Row]) {
     };
     println!("\n## Density rate / uniform sampler rate (same mesh, same threads)\n");
     println!(
-        "Beside it, the alias layout's rate against the uniform texture's (the density sampler with a constant texture, Sec. 5.2) and as a fraction of the probe: random 16-byte reads from a table of as many records, in the sampler's blocks (and the probe's one-at-a-time rate).\n"
+        "Beside it, the alias layout's rate against the uniform texture's (the density sampler with a constant texture, Sec. 5.2; the median of 9 back-to-back pairs of runs) and as a fraction of the probe: random 16-byte reads from a table of as many records, in the sampler's blocks (and the probe's one-at-a-time rate).\n"
     );
     println!(
         "| mesh | density | threads | alias layout | inversion layout | speed-up over rejection | alias / uniform texture | alias / probe batch | probe M reads/s: latency / batch |"
@@ -686,8 +755,11 @@ fn print_summary(rows: &[Row]) {
             .map(|i| i.msamples_per_s / u.msamples_per_s);
         let rejection = find(&r.mesh, &r.density, "rejection", r.threads)
             .map(|j| r.msamples_per_s / j.msamples_per_s);
-        let flat = find(&r.mesh, "uniform", "subdivision", r.threads)
-            .map(|f| r.msamples_per_s / f.msamples_per_s);
+        // Paired runs where measured, else this run's two rows.
+        let flat = r.paired.or_else(|| {
+            find(&r.mesh, "uniform", "subdivision", r.threads)
+                .map(|f| r.msamples_per_s / f.msamples_per_s)
+        });
         let batch = find(&r.mesh, &r.density, "probe-batch", r.threads);
         let latency = find(&r.mesh, &r.density, "probe-latency", r.threads);
         let percent = |x: Option<f64>| x.map_or("-".into(), |x| format!("{:.0}%", 100.0 * x));
@@ -949,6 +1021,7 @@ fn run() -> Result<(), String> {
             max_over_mean: 1.0,
             acceptance: 1.0,
             pieces: 0,
+            paired: None,
         };
         if args.json {
             println!("{}", rng_row.json());
@@ -972,6 +1045,7 @@ fn run() -> Result<(), String> {
                 max_over_mean: 1.0,
                 acceptance: 1.0,
                 pieces: m.indices.len(),
+                paired: None,
             };
             if args.json {
                 println!("{}", row.json());
@@ -981,7 +1055,7 @@ fn run() -> Result<(), String> {
         for (name, texture) in &textures {
             for &t in &args.threads {
                 eprintln!("{} / {name} / {t} thread(s)…", m.name);
-                let measured = pool(t)?.install(|| measure_pair(m, name, texture, t))?;
+                let measured = pool(t)?.install(|| measure_pair(m, name, texture, t, args.bar))?;
                 if args.json {
                     for r in &measured {
                         println!("{}", r.json());
