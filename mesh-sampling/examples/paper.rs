@@ -168,11 +168,17 @@ fn load_meshes(filter: Option<&str>) -> Result<Vec<TestMesh>, String> {
             files
         }
         (_, None) => {
-            let built_in = [icosphere(5), torus(192, 96)];
-            return Ok(built_in
+            let built_in: Vec<TestMesh> = [icosphere(5), torus(192, 96)]
                 .into_iter()
                 .filter(|m| filter.is_none_or(|f| m.name == f))
-                .collect());
+                .collect();
+            if built_in.is_empty() {
+                return Err(format!(
+                    "--mesh {}: not a file, and without TRILUX_DATA the meshes are the built-in icosphere and torus",
+                    filter.unwrap_or_default()
+                ));
+            }
+            return Ok(built_in);
         }
     };
     for file in files {

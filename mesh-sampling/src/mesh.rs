@@ -94,3 +94,25 @@ impl<'a> MeshRef<'a> {
         })
     }
 }
+
+/// A test mesh: an `n × n` grid of vertices with uneven heights, two
+/// triangles per cell, and per-vertex shading normals that vary.
+#[cfg(test)]
+pub(crate) fn test_grid(n: u32) -> (Vec<glam::Vec3>, Vec<glam::Vec3>, Vec<[u32; 3]>) {
+    use glam::Vec3;
+    let positions = (0..n * n)
+        .map(|k| Vec3::new((k % n) as f32, (k / n) as f32, ((k * 7) % 5) as f32 * 0.3))
+        .collect();
+    let normals = (0..n * n)
+        .map(|k| Vec3::new(0.1 * (k % 3) as f32, 0.2, 1.0).normalize())
+        .collect();
+    let mut indices = Vec::new();
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = j * n + i;
+            indices.push([a, a + 1, a + n]);
+            indices.push([a + 1, a + n + 1, a + n]);
+        }
+    }
+    (positions, normals, indices)
+}

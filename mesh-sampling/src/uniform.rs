@@ -291,7 +291,6 @@ impl Ahead {
 
 #[cfg(test)]
 mod tests {
-    use glam::Vec3;
     use rand::SeedableRng;
 
     use super::*;
@@ -301,20 +300,7 @@ mod tests {
     #[test]
     fn the_pipeline_draws_the_blockwise_loops_points() {
         let n = 12u32;
-        let positions: Vec<Vec3> = (0..n * n)
-            .map(|k| Vec3::new((k % n) as f32, (k / n) as f32, ((k * 7) % 5) as f32 * 0.3))
-            .collect();
-        let normals: Vec<Vec3> = (0..n * n)
-            .map(|k| Vec3::new(0.1 * (k % 3) as f32, 0.2, 1.0).normalize())
-            .collect();
-        let mut indices = Vec::new();
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                let a = j * n + i;
-                indices.push([a, a + 1, a + n]);
-                indices.push([a + 1, a + n + 1, a + n]);
-            }
-        }
+        let (positions, normals, indices) = crate::mesh::test_grid(n);
         let with_normals = MeshRef {
             normals: Some(&normals),
             ..MeshRef::new(&positions, &indices)

@@ -705,7 +705,7 @@ pub(crate) fn check_acceptance(acceptance: f64) -> Result<(), Error> {
 
 #[cfg(test)]
 mod tests {
-    use glam::{Vec2, Vec3};
+    use glam::Vec2;
     use rand::SeedableRng;
 
     use super::*;
@@ -717,21 +717,8 @@ mod tests {
     #[test]
     fn the_alias_pipeline_draws_the_blockwise_loops_points() {
         let n = 12u32;
-        let positions: Vec<Vec3> = (0..n * n)
-            .map(|k| Vec3::new((k % n) as f32, (k / n) as f32, ((k * 7) % 5) as f32 * 0.3))
-            .collect();
+        let (positions, normals, indices) = crate::mesh::test_grid(n);
         let uvs: Vec<Vec2> = positions.iter().map(|p| p.truncate() / n as f32).collect();
-        let normals: Vec<Vec3> = (0..n * n)
-            .map(|k| Vec3::new(0.1 * (k % 3) as f32, 0.2, 1.0).normalize())
-            .collect();
-        let mut indices = Vec::new();
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                let a = j * n + i;
-                indices.push([a, a + 1, a + n]);
-                indices.push([a + 1, a + n + 1, a + n]);
-            }
-        }
         let texels: Vec<f32> = (0..64 * 64).map(|k| ((k * 37) % 11) as f32).collect();
         let texture = DensityTexture::new(64, 64, texels).unwrap();
         let weights: Vec<f32> = (0..n * n).map(|k| (k % 4) as f32).collect();
