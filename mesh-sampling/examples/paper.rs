@@ -490,13 +490,8 @@ fn timed_stream(sampler: &impl SurfaceSampler, n: usize) -> f64 {
 /// host whose neighbours come and go, two samplers measured seconds apart
 /// can see different machines; a pair's two runs see nearly the same.
 fn paired_rates(a: &impl SurfaceSampler, b: &impl SurfaceSampler) -> (f64, f64, f64) {
-    let mut n = 1 << 10;
-    let mut t = timed_stream(a, n);
-    while t < TARGET_S / 8.0 {
-        n *= 4;
-        t = timed_stream(a, n);
-    }
-    let n = ((n as f64 * TARGET_S / t) as usize).max(1 << 10);
+    // A sampler too slow to calibrate is measured at the first count.
+    let n = calibrate(|n| timed_stream(a, n)).unwrap_or(1 << 10);
     let (mut ta, mut tb, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
     for k in 0..PAIRS {
         let (x, y) = if k % 2 == 0 {
@@ -543,18 +538,27 @@ fn rng_rate() -> f64 {
 /// 1,024 points (one chunk, so one thread) takes over [`TARGET_S`]
 /// (rejection at an acceptance of 1e-5) is reported from that one run.
 fn measure(run: impl Fn(usize) -> f64) -> f64 {
+    let n = match calibrate(&run) {
+        Ok(n) => n,
+        Err(rate) => return rate,
+    };
+    let times: Vec<f64> = (0..RUNS).map(|_| run(n)).collect();
+    n as f64 / median(times) / 1e6
+}
+
+/// The count that makes one `run` take about [`TARGET_S`], or `Err` with
+/// the rate (M items/s) of a first run of 1,024 that already takes longer.
+fn calibrate(run: impl Fn(usize) -> f64) -> Result<usize, f64> {
     let mut n = 1 << 10;
     let mut t = run(n);
     if t > TARGET_S {
-        return n as f64 / t / 1e6;
+        return Err(n as f64 / t / 1e6);
     }
     while t < TARGET_S / 8.0 {
         n *= 4;
         t = run(n);
     }
-    let n = ((n as f64 * TARGET_S / t) as usize).max(1 << 10);
-    let times: Vec<f64> = (0..RUNS).map(|_| run(n)).collect();
-    n as f64 / median(times) / 1e6
+    Ok(((n as f64 * TARGET_S / t) as usize).max(1 << 10))
 }
 
 /// Median build time (ms) of [`BUILDS`] builds, and the last build.
