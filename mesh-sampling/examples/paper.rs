@@ -439,6 +439,9 @@ struct Row {
     /// The alias layout's rate over the uniform texture's, the median of
     /// [`PAIRS`] back-to-back pairs of runs (`subdivision` rows).
     paired: Option<f64>,
+    /// The largest relative change of a piece's value to fit the alias
+    /// columns ([`DensitySampler::value_tolerance`]; 0 elsewhere).
+    value_tolerance: f64,
 }
 
 impl Row {
@@ -446,7 +449,7 @@ impl Row {
         format!(
             "{{\"mesh\": \"{}\", \"density\": \"{}\", \"method\": \"{}\", \"msamples_per_s\": {:.3}, \
              \"preprocess_ms\": {:.2}, \"memory_mb\": {:.2}, \"threads\": {}, \"max_over_mean\": {:.3}, \
-             \"triangles\": {}, \"acceptance\": {:.4}, \"pieces\": {}, \"vs_uniform_texture\": {}}}",
+             \"triangles\": {}, \"acceptance\": {:.4}, \"pieces\": {}, \"vs_uniform_texture\": {}, \"value_tolerance\": {:e}}}",
             self.mesh,
             self.density,
             self.method,
@@ -458,7 +461,8 @@ impl Row {
             self.triangles,
             self.acceptance,
             self.pieces,
-            self.paired.map_or("null".into(), |x| format!("{x:.4}"))
+            self.paired.map_or("null".into(), |x| format!("{x:.4}")),
+            self.value_tolerance
         )
     }
 }
@@ -609,6 +613,7 @@ fn measure_pair(
         acceptance,
         pieces,
         paired: None,
+        value_tolerance: 0.0,
     };
     let density = Density::Texture(texture);
     // The uniform texture (Sec. 5.2): one piece per face, value 1.
@@ -622,6 +627,7 @@ fn measure_pair(
     let (alias_rate, _, paired) = paired_rates(&alias, &flat);
     let alias_row = Row {
         paired: Some(paired),
+        value_tolerance: alias.value_tolerance(),
         ..row(
             "subdivision",
             alias_rate,
@@ -810,6 +816,17 @@ fn print_summary(rows: &[Row]) {
             r.density,
             r.threads
         );
+    }
+    let rounded = rows
+        .iter()
+        .filter(|r| r.value_tolerance > 0.0)
+        .max_by(|a, b| a.value_tolerance.total_cmp(&b.value_tolerance));
+    match rounded {
+        Some(r) => println!(
+            "- Values rounded to fit the alias columns: by at most {:.1e} (relative; {}, {})",
+            r.value_tolerance, r.mesh, r.density
+        ),
+        None => println!("- Values rounded to fit the alias columns: none (every value exact)"),
     }
     for (name, w) in ["alias", "inversion"].iter().zip(worst) {
         if let Some((ratio, r)) = w {
@@ -1032,6 +1049,7 @@ fn run() -> Result<(), String> {
             acceptance: 1.0,
             pieces: 0,
             paired: None,
+            value_tolerance: 0.0,
         };
         if args.json {
             println!("{}", rng_row.json());
@@ -1056,6 +1074,7 @@ fn run() -> Result<(), String> {
                 acceptance: 1.0,
                 pieces: m.indices.len(),
                 paired: None,
+                value_tolerance: 0.0,
             };
             if args.json {
                 println!("{}", row.json());

@@ -21,8 +21,8 @@
 //!   [`Mode::Exact`] goes beyond the paper and samples Eq. 1 itself.
 //!   [`RejectionSampler`] is the paper's Sec. 3.2 baseline.
 //!   Pieces are drawn from an alias table whose 16-byte columns are the
-//!   pieces' records ([`Layout::Alias`], one column a draw, two when it
-//!   takes the alias side) or, order-preserving,
+//!   pieces' records, each with its alias's ([`Layout::Alias`], one
+//!   column a draw) or, order-preserving,
 //!   by the paper's lookup-table CDF ([`Layout::Inversion`]). A density
 //!   constant over a triangle's UV footprint is one piece, found in O(1)
 //!   from the texture's tables, so tiled UVs stay cheap, and
@@ -112,7 +112,7 @@ pub use density::{
     DEFAULT_MAX_PIECES, Density, DensitySampler, Depth, MIN_ACCEPTANCE, Mode, Options,
 };
 pub use error::Error;
-pub use layout::{Layout, MIN_THRESHOLD_BITS};
+pub use layout::{Layout, MAX_VALUE_SHIFT, MIN_THRESHOLD_BITS};
 pub use mesh::MeshRef;
 pub use multi::{MeshPoint, MultiDensitySampler, MultiMeshSampler};
 pub use naive::NaiveSampler;

@@ -12,7 +12,7 @@ use glam::DVec2;
 use rand::Rng;
 use rand::distr::Distribution;
 
-use crate::layout::{Piece, PieceAlias};
+use crate::layout::{Format, Piece, PieceAlias};
 use crate::parallel::{BLOCK, unit};
 use crate::point::Frame;
 use crate::prefetch::prefetch;
@@ -65,8 +65,8 @@ impl<S> Table<S> {
 /// A sub-triangle costs its triangle, a code of its level and position
 /// (Fig. 4, decoded in O(1)) and its value, plus its share of the table it
 /// is drawn from ([`Layout`]): by default an alias table whose 16-byte
-/// columns are the records themselves (one column per draw, two when the
-/// alias side is taken). With
+/// columns are the records themselves, a column holding both of its
+/// sides (one column read per draw). With
 /// [`Layout::Inversion`], `S` is the 1D sampler over the CDF that picks a
 /// sub-triangle: the guide table by default,
 /// [`CdfBisection`](discrete_sampling::CdfBisection) for the paper's
@@ -112,6 +112,8 @@ pub struct DensitySampler<'a, S = GuideTable> {
     norm: f64,
     /// Expected fraction of proposals accepted (1 without rejection).
     acceptance: f64,
+    /// See [`DensitySampler::value_tolerance`].
+    value_tolerance: f64,
 }
 
 impl<'a> DensitySampler<'a, GuideTable> {
@@ -179,7 +181,7 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         // that, waking them costs more than the work (a constant density
         // builds as fast as the uniform sampler's table).
         let many = faces >= PARALLEL_FACES;
-        let (pieces, face_start, face_level, exact_mass) = match density {
+        let (mut pieces, face_start, face_level, exact_mass) = match density {
             Density::Texture(texture) => {
                 let uvs = texture_uvs(&mesh)?;
                 // Per face: its level, and its value if the density is
@@ -230,6 +232,17 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         if pieces.len() > u32::MAX as usize {
             return Err(Error::TooLarge(pieces.len()));
         }
+        // The alias layout's columns when they can be packed (see
+        // `Layout::Alias`), otherwise the inversion method. The columns
+        // may store the values with fewer bits: rounded first, so that
+        // the masses are those of the values drawn and reported.
+        let format = match options.layout {
+            Layout::Alias => Format::fit(&pieces, faces, exact_mass.is_some()),
+            Layout::Inversion => None,
+        };
+        if let Some(format) = format {
+            format.round_values(&mut pieces);
+        }
         let areas: Vec<f64> = map_faces(many, faces, |f| mesh.area(f));
         let masses: Vec<f64> = pieces
             .iter()
@@ -237,12 +250,8 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
             .collect();
         let proposal_mass: f64 = masses.iter().sum();
         let zero = Error::ZeroDensity { triangles: faces };
-        // The alias layout when its columns can be packed (see
-        // `Layout::Alias`), otherwise the inversion method.
-        let alias = match options.layout {
-            Layout::Alias => PieceAlias::new(&pieces, &masses, faces),
-            Layout::Inversion => None,
-        };
+        let alias = format.and_then(|f| PieceAlias::new(&pieces, &masses, f));
+        let table_format = format.filter(|_| alias.is_some());
         let table = match alias {
             Some(alias) => Table::Alias(alias),
             None => Table::Inversion {
@@ -270,6 +279,10 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
             frames: Frame::all(&mesh),
             norm: 1.0 / mass,
             acceptance: (mass / proposal_mass).min(1.0),
+            value_tolerance: match &table_format {
+                Some(f) => f.value_tolerance(),
+                None => 0.0,
+            },
         })
     }
 
@@ -313,6 +326,15 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
             Table::Alias(_) => Layout::Alias,
             Table::Inversion { .. } => Layout::Inversion,
         }
+    }
+
+    /// The largest relative change the table made to a piece's value to
+    /// store it: 0 when the values are exact (the inversion layout, and
+    /// the alias layout where the values' range fits its columns), at most
+    /// `2⁻¹³` (see [`Layout::Alias`]). The density drawn and reported
+    /// (`p′`, or exact mode's bounds) is the one with the changed values.
+    pub fn value_tolerance(&self) -> f64 {
+        self.value_tolerance
     }
 
     /// Heap memory of the table the pieces are drawn from (with the
@@ -534,6 +556,7 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         let mut ring = [Stage::EMPTY; DEPTH];
         let needs_indices =
             self.mesh.normals.is_some() || matches!(self.density, Density::PerVertex(_));
+        let inline = alias.inline();
         for t in 0..blocks + DEPTH - 1 {
             if t < blocks {
                 let s = &mut ring[t % DEPTH];
@@ -548,26 +571,38 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
                     alias.prefetch(c);
                 }
             }
-            if let Some(b) = t.checked_sub(1).filter(|&b| b < blocks) {
-                let s = &mut ring[b % DEPTH];
-                for (c, &f) in s.column[..s.len].iter_mut().zip(&s.frac[..s.len]) {
-                    *c = alias.side(*c, f);
-                }
-                for &c in &s.column[..s.len] {
-                    alias.prefetch(c);
-                }
-            }
-            if let Some(b) = t.checked_sub(2).filter(|&b| b < blocks) {
-                let s = &mut ring[b % DEPTH];
-                for (p, &c) in s.piece[..s.len].iter_mut().zip(&s.column[..s.len]) {
-                    *p = alias.get(c);
-                }
+            // An inline table has the records a turn early: the alias's
+            // column is not read.
+            let records = |s: &mut Stage| {
                 for p in &s.piece[..s.len] {
                     prefetch(&self.frames, p.face as usize);
                     if needs_indices {
                         prefetch(self.mesh.indices, p.face as usize);
                     }
                 }
+            };
+            if let Some(b) = t.checked_sub(1).filter(|&b| b < blocks) {
+                let s = &mut ring[b % DEPTH];
+                if inline {
+                    for ((p, &c), &f) in s.piece.iter_mut().zip(&s.column[..s.len]).zip(&s.frac) {
+                        *p = alias.pick(c, f);
+                    }
+                    records(s);
+                } else {
+                    for (c, &f) in s.column[..s.len].iter_mut().zip(&s.frac[..s.len]) {
+                        *c = alias.side(*c, f);
+                    }
+                    for &c in &s.column[..s.len] {
+                        alias.prefetch(c);
+                    }
+                }
+            }
+            if let Some(b) = t.checked_sub(2).filter(|&b| b < blocks && !inline) {
+                let s = &mut ring[b % DEPTH];
+                for (p, &c) in s.piece[..s.len].iter_mut().zip(&s.column[..s.len]) {
+                    *p = alias.get(c);
+                }
+                records(s);
             }
             if let Some(b) = t.checked_sub(DEPTH - 1).filter(|&b| b < blocks) {
                 let s = &ring[b % DEPTH];
@@ -713,7 +748,8 @@ mod tests {
     /// The alias pipeline gives the plain blockwise loop's points (a
     /// block's pieces, then its points' variates, block after block), for
     /// a texture with and without shading normals and for per-vertex
-    /// weights (which read the corner indices).
+    /// weights (which read the corner indices), with the columns inline
+    /// and linked.
     #[test]
     fn the_alias_pipeline_draws_the_blockwise_loops_points() {
         let n = 12u32;
@@ -735,11 +771,15 @@ mod tests {
             (shaded, Density::Texture(&texture)),
             (shaded, Density::PerVertex(&weights)),
         ];
-        for (mesh, density) in cases {
-            let sampler = DensitySampler::new(mesh, density).unwrap();
+        for ((mesh, density), linked) in cases.into_iter().flat_map(|c| [(c, false), (c, true)]) {
+            crate::layout::FORCE_LINKED.with(|f| f.set(linked));
+            let sampler = DensitySampler::new(mesh, density);
+            crate::layout::FORCE_LINKED.with(|f| f.set(false));
+            let sampler = sampler.unwrap();
             let Table::Alias(alias) = &sampler.table else {
                 panic!("the default layout is the alias table")
             };
+            assert_eq!(alias.inline(), !linked);
             assert!(sampler.pieces() > 4 * BLOCK, "{} pieces", sampler.pieces());
             // Whole blocks, a partial last block, fewer than the pipeline
             // holds, and fewer than one block.

@@ -599,6 +599,88 @@ fn pdfs_agree_with_the_samples_and_integrate_to_one() {
     assert_eq!(samplers[0].pdf(m.2.len(), [1.0, 0.0, 0.0]), 0.0);
 }
 
+/// A mesh whose deep faces and many constant ones leave the alias
+/// columns too few bits for all of a value's mantissa over a density
+/// spanning forty binades: the values are rounded, and the table draws
+/// and reports the rounded ones, within `value_tolerance` of the exact
+/// ones (which the inversion layout keeps).
+#[test]
+fn rounded_values_are_drawn_and_reported_alike() {
+    // Left half constant; right half 2^±20 (Nearest, so the left half's
+    // faces are one piece each).
+    let size = 1024;
+    let texels: Vec<f32> = (0..size * size)
+        .map(|i| {
+            let (x, y) = (i % size, i / size);
+            if x < size / 2 {
+                1.0
+            } else {
+                (20.0 * ((x as f32 * 0.05).sin() * (y as f32 * 0.03).cos())).exp2()
+            }
+        })
+        .collect();
+    let t = DensityTexture::new(size, size, texels)
+        .unwrap()
+        .with_filter(Filter::Nearest);
+    // u⁶ crowds most faces into the constant half; the last columns
+    // stretch over the varying half and are subdivided deep.
+    let m = grid(64, |uv| Vec2::new(uv.x.powi(6), uv.y));
+    let mesh = mesh_ref(&m);
+    for mode in [Mode::Approximate, Mode::Exact] {
+        let options = |layout| Options {
+            mode,
+            layout,
+            ..Options::default()
+        };
+        let alias =
+            DensitySampler::with_options(mesh, Density::Texture(&t), &options(Layout::Alias))
+                .unwrap();
+        let exact_values =
+            DensitySampler::with_options(mesh, Density::Texture(&t), &options(Layout::Inversion))
+                .unwrap();
+        let tolerance = alias.value_tolerance();
+        assert_eq!(alias.layout(), Layout::Alias);
+        assert!(
+            tolerance > 0.0 && tolerance <= 2f64.powi(-13),
+            "{mode:?}: tolerance {tolerance}, {} pieces, deepest {}",
+            alias.pieces(),
+            (0..m.2.len()).map(|f| alias.level(f)).max().unwrap()
+        );
+        assert_eq!(exact_values.value_tolerance(), 0.0);
+        assert_eq!(alias.pieces(), exact_values.pieces());
+        let mass = alias.total_mass() / exact_values.total_mass();
+        assert!(
+            (mass - 1.0).abs() <= 2.0 * tolerance,
+            "{mode:?}: mass ratio {mass}"
+        );
+        for p in alias.sample_n(3, 20_000).unwrap() {
+            // What is drawn is what is reported, …
+            let q = alias.pdf(p.face as usize, p.barycentric);
+            assert!((q - p.pdf).abs() <= 1e-6 * q, "{mode:?}: {q} vs {}", p.pdf);
+            // … within the tolerance of the exact values (exact mode:
+            // the filtered density, whatever the bounds).
+            let e = f64::from(exact_values.pdf(p.face as usize, p.barycentric));
+            let bound = if mode == Mode::Exact {
+                1e-6
+            } else {
+                3.0 * tolerance
+            };
+            assert!(
+                (f64::from(p.pdf) - e).abs() <= bound * e,
+                "{mode:?}: {} vs exact {e}",
+                p.pdf
+            );
+        }
+        // The two layouts sample one distribution (the difference, at
+        // most the tolerance, is far below what 10⁶ points resolve).
+        let faces = m.2.len();
+        let a = face_counts(faces, &alias.sample_n(4, N).unwrap());
+        let b = face_counts(faces, &exact_values.sample_n(5, N).unwrap());
+        let p = two_sample_p(&a, &b);
+        assert!(p > 1e-3, "{mode:?}: alias vs inversion p = {p:.2e}");
+    }
+}
+
 #[test]
 fn merging_keeps_one_piece_per_face_for_a_constant_density() {
     let t = DensityTexture::new(64, 64, vec![3.0; 64 * 64]).unwrap();
