@@ -538,12 +538,13 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
     /// The batch path of the alias layout (not in exact mode): a software
     /// pipeline over blocks of [`BLOCK`] draws, [`DEPTH`] blocks in
     /// flight. Each turn draws a new block's random numbers and prefetches
-    /// its columns, picks the sides of the block before it (whose columns
-    /// have arrived meanwhile) and prefetches the picked columns, reads
-    /// the records of the block before that and prefetches its frames, and
+    /// its columns, picks the records of the block before it from its
+    /// columns (arrived meanwhile) and prefetches their frames, and
     /// computes the points of the oldest block: every miss of a draw is
     /// asked for a turn before its use, and overlaps a block's
-    /// computation. The random numbers are drawn in the order of the
+    /// computation. In a linked table (columns holding their alias's
+    /// index) the second stage picks the sides and prefetches the picked
+    /// columns, and a third reads their records. The random numbers are drawn in the order of the
     /// blockwise loop (a block's `u64` for the pieces, then its two per
     /// point), so the points are the same bit for bit.
     fn sample_alias<R: Rng + ?Sized>(
@@ -631,8 +632,9 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
 }
 
 /// Blocks in flight in [`DensitySampler::sample_alias`]'s pipeline: one
-/// drawing its columns, one picking its sides, one reading its records,
-/// one computing its points.
+/// drawing its columns, one picking its records (linked tables: its
+/// sides), one waiting (linked: reading its records), one computing its
+/// points.
 const DEPTH: usize = 4;
 
 /// One block of [`DensitySampler::sample_alias`]'s pipeline.
@@ -662,8 +664,9 @@ impl Stage {
 impl<S: DiscreteSampler + Sync> SurfaceSampler for DensitySampler<'_, S> {
     /// Computed in blocks, like
     /// [`UniformSampler`](crate::UniformSampler)'s: the block's pieces by
-    /// the table's batch search (with the alias layout: the columns, then
-    /// the aliases' columns), then their faces' records, then the points;
+    /// the table's batch search (with the alias layout: the columns, and
+    /// in a linked table the aliases' columns), then their faces'
+    /// records, then the points;
     /// in exact mode, blocks of proposals of which the accepted are kept.
     fn sample_into<R: Rng + ?Sized>(&self, rng: &mut R, out: &mut [SurfacePoint]) {
         let mut pieces = [Piece::default(); BLOCK];
