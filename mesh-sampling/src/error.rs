@@ -56,7 +56,9 @@ pub enum Error {
         count: usize,
     },
     /// A point density that is negative, NaN or infinite.
-    #[error("points per unit area must be finite and >= 0, got {0}")]
+    #[error(
+        "a point rate (points per unit area, or per unit mass of a density) must be finite and >= 0, got {0}"
+    )]
     InvalidDensity(f64),
     /// The mesh has more triangles than a sampler can index.
     #[error("{0} triangles is more than a sampler can index")]
@@ -64,6 +66,14 @@ pub enum Error {
     /// A density texture of width or height 0.
     #[error("the density texture is {width}×{height}: it has no texels")]
     EmptyTexture {
+        /// Its width.
+        width: usize,
+        /// Its height.
+        height: usize,
+    },
+    /// A texture whose `width × height` overflows `usize`.
+    #[error("the density texture is {width}×{height}: more texels than can be indexed")]
+    TextureTooLarge {
         /// Its width.
         width: usize,
         /// Its height.
@@ -105,7 +115,7 @@ pub enum Error {
         vertex: usize,
     },
     /// Per-face or per-vertex weights of the wrong length.
-    #[error("{what} weights: {len} given for {expected} {what}s")]
+    #[error("{what} weights: {len} given for {expected} {}", plural(.what))]
     WeightLength {
         /// "face" or "vertex".
         what: &'static str,
@@ -148,8 +158,8 @@ pub enum Error {
     },
     /// A call would return more points than [`MAX_POINTS`](crate::MAX_POINTS).
     #[error(
-        "{requested} points is too large a count: at most {budget} points are returned at \
-         once (use sample_stream for more, or a lower rate)"
+        "{} points is too large a count: at most {budget} points are returned at \
+         once (use sample_stream for more, or a lower rate)", count(.requested)
     )]
     TooManyPoints {
         /// The number of points asked for (or an upper bound of it).
@@ -192,4 +202,24 @@ pub enum Error {
         /// The number of triangles.
         count: usize,
     },
+}
+
+/// The plural of "face" or "vertex", for messages.
+fn plural(what: &str) -> &str {
+    match what {
+        "vertex" => "vertices",
+        "face" => "faces",
+        other => other,
+    }
+}
+
+/// A count that may be an upper bound computed in `f64`: the integer when
+/// `f64` holds it exactly, else about so much.
+fn count(n: &f64) -> String {
+    let n = *n;
+    if n.is_finite() && n.abs() < 2f64.powi(53) {
+        format!("{n:.0}")
+    } else {
+        format!("about {n:.3e}")
+    }
 }

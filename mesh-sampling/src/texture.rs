@@ -88,7 +88,9 @@ impl DensityTexture {
     /// A texture of `width × height` values, row by row.
     ///
     /// # Errors
-    /// [`Error::EmptyTexture`] for a size of 0, [`Error::TextureSize`] when
+    /// [`Error::EmptyTexture`] for a size of 0,
+    /// [`Error::TextureTooLarge`] when `width × height` overflows,
+    /// [`Error::TextureSize`] when
     /// `texels` does not hold `width · height` values,
     /// [`Error::InvalidTexel`] naming the first negative, NaN or infinite
     /// value.
@@ -96,10 +98,9 @@ impl DensityTexture {
         if width == 0 || height == 0 {
             return Err(Error::EmptyTexture { width, height });
         }
-        let expected = width.checked_mul(height).ok_or(Error::TextureSize {
-            expected: usize::MAX,
-            len: texels.len(),
-        })?;
+        let expected = width
+            .checked_mul(height)
+            .ok_or(Error::TextureTooLarge { width, height })?;
         if texels.len() != expected {
             return Err(Error::TextureSize {
                 expected,

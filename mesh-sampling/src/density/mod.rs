@@ -363,15 +363,18 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
     /// draws from, at barycentrics `barycentric` of triangle `face`: what a
     /// path tracer needs for multiple importance sampling when a ray hits
     /// the mesh. 0 for a triangle that does not exist, a zero-area
-    /// triangle, or barycentrics that are NaN or infinite.
+    /// triangle, or barycentrics that are NaN or infinite (or all zero).
+    /// Barycentrics outside the triangle (a negative weight, or a sum
+    /// away from 1) are first moved onto it: negative weights to 0, then
+    /// all divided by their sum; a ray's hit, inside up to rounding, is
+    /// taken as it is.
     pub fn pdf(&self, face: usize, barycentric: [f32; 3]) -> f32 {
         let Some(range) = self.face_range(face) else {
             return 0.0;
         };
-        if !barycentric.iter().all(|b| b.is_finite()) {
+        let Some([b0, b1, b2]) = onto_triangle(barycentric) else {
             return 0.0;
-        }
-        let [b0, b1, b2] = barycentric.map(f64::from);
+        };
         let value = match self.density {
             Density::PerFace(w) => {
                 if range.is_empty() {
@@ -722,6 +725,24 @@ impl<S: DiscreteSampler + Sync> Distribution<SurfacePoint> for DensitySampler<'_
             }
         }
     }
+}
+
+/// `b` in `f64`, unchanged when it is a point of the triangle up to
+/// rounding (weights ≥ 0 summing to 1 within `10⁻⁶`), else with negative
+/// weights set to 0 and divided by the sum; `None` for weights that are
+/// not finite or sum to 0.
+fn onto_triangle(b: [f32; 3]) -> Option<[f64; 3]> {
+    if !b.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let b = b.map(f64::from);
+    let sum: f64 = b.iter().sum();
+    if b.iter().all(|&x| x >= 0.0) && (sum - 1.0).abs() <= 1e-6 {
+        return Some(b);
+    }
+    let b = b.map(|x| x.max(0.0));
+    let sum: f64 = b.iter().sum();
+    (sum > 0.0).then(|| b.map(|x| x / sum))
 }
 
 /// The lowest expected acceptance a rejection step may have: 10⁻⁹ (a

@@ -334,7 +334,10 @@ impl Linked {
 /// The layout of a table's columns.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Format {
+    /// Both sides' records in the column: one read a draw.
     Inline(Inline),
+    /// The piece's record and its alias's index: two reads when the alias
+    /// side is taken.
     Linked(Linked),
 }
 

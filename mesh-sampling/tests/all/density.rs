@@ -597,6 +597,21 @@ fn pdfs_agree_with_the_samples_and_integrate_to_one() {
         "a tolerance merges more"
     );
     assert_eq!(samplers[0].pdf(m.2.len(), [1.0, 0.0, 0.0]), 0.0);
+    // Barycentrics outside the triangle are moved onto it; a point of it
+    // is taken as it is.
+    for s in &samplers {
+        for f in [0, 7] {
+            assert_eq!(s.pdf(f, [5.0, -3.0, -1.0]), s.pdf(f, [1.0, 0.0, 0.0]));
+            let (a, b) = (
+                s.pdf(f, [1.0, 2.0, -0.5]),
+                s.pdf(f, [1.0 / 3.0, 2.0 / 3.0, 0.0]),
+            );
+            assert!((a - b).abs() <= 1e-6 * b, "{a} vs {b}");
+            assert_eq!(s.pdf(f, [0.0; 3]), 0.0);
+            assert_eq!(s.pdf(f, [-1.0, -1.0, -1.0]), 0.0);
+            assert!(s.pdf(f, [0.2, 0.3, 0.5]) >= 0.0);
+        }
+    }
 }
 
 /// A mesh whose deep faces and many constant ones leave the alias
@@ -823,6 +838,15 @@ fn bad_input_is_an_error() {
             len: 3
         })
     ));
+    let huge = DensityTexture::new(usize::MAX, 2, vec![1.0]).unwrap_err();
+    assert_eq!(
+        huge,
+        Error::TextureTooLarge {
+            width: usize::MAX,
+            height: 2
+        }
+    );
+    assert!(huge.to_string().contains("more texels than"), "{huge}");
     let zero = DensityTexture::new(4, 4, vec![0.0; 16]).unwrap();
     for options in [Options::default(), exact()] {
         assert!(matches!(
@@ -857,6 +881,8 @@ fn bad_input_is_an_error() {
             expected: 8
         }
     );
+    let short = DensitySampler::new(mesh, Density::PerVertex(&[1.0; 3])).unwrap_err();
+    assert_eq!(short.to_string(), "vertex weights: 3 given for 9 vertices");
     let mut w = vec![1.0; 9];
     w[4] = -1.0;
     assert_eq!(

@@ -37,6 +37,19 @@ fn regression_sampling_huge_density() {
         "{err:?}"
     );
     assert!(err.to_string().contains("too large"), "{err}");
+    // A count f64 holds exactly is printed as the integer.
+    let err = uniform.sample_n(1, usize::MAX).unwrap_err();
+    assert!(
+        err.to_string().starts_with("about 1.845e19 points")
+            || err.to_string().starts_with("18446744073709551615 points"),
+        "{err}"
+    );
+    let err = uniform.sample_n(1, MAX_POINTS + 1).unwrap_err();
+    assert!(
+        err.to_string()
+            .starts_with(&format!("{} points", MAX_POINTS + 1)),
+        "{err}"
+    );
     // The same through a density, and the right count below the budget.
     let weights = vec![1.0f32; square.indices.len()];
     let density = DensitySampler::new(mesh, Density::PerFace(&weights)).unwrap();
