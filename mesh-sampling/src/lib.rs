@@ -27,6 +27,8 @@
 //!   constant over a triangle's UV footprint is one piece, found in O(1)
 //!   from the texture's tables, so tiled UVs stay cheap, and
 //!   [`Options::max_pieces`] bounds the subdivision before it is built.
+//!   A mesh without texture coordinates gets spherical ones from
+//!   [`spherical_uvs`] (vertices split along the seam).
 //! - **Blue noise** ([`blue_noise`], feature `blue-noise`): Poisson-disk
 //!   points that keep their distance, following any sampler's density, by
 //!   weighted sample elimination (Yuksel 2015).

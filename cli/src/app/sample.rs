@@ -229,13 +229,15 @@ fn method(args: &Args) -> Result<Method> {
 /// channel, or none.
 fn source(context: &mut Context, args: &Args, mesh: &TriMesh, channel: Channel) -> Result<Source> {
     let source = if let Some(path) = &args.density {
+        // The image first: a wrong path is the first thing to tell.
+        let image = super::read_image(context, path, true)?;
         if mesh.uvs.is_none() {
             return Err(file_error(
                 &args.mesh,
-                "a density texture is looked up at texture coordinates, and the mesh has none",
+                "a density texture is looked up at texture coordinates, and the mesh has none \
+                 (give the mesh UVs, or use --face-weights or --density-meshcolors)",
             ));
         }
-        let image = super::read_image(context, path, true)?;
         let wrap = mesh
             .materials
             .first()
