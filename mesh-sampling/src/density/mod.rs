@@ -112,8 +112,6 @@ pub struct DensitySampler<'a, S = GuideTable> {
     norm: f64,
     /// Expected fraction of proposals accepted (1 without rejection).
     acceptance: f64,
-    /// See [`DensitySampler::value_tolerance`].
-    value_tolerance: f64,
 }
 
 impl<'a> DensitySampler<'a, GuideTable> {
@@ -250,9 +248,7 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
             .collect();
         let proposal_mass: f64 = masses.iter().sum();
         let zero = Error::ZeroDensity { triangles: faces };
-        let alias = format.and_then(|f| PieceAlias::new(&pieces, &masses, f));
-        let table_format = format.filter(|_| alias.is_some());
-        let table = match alias {
+        let table = match format.and_then(|f| PieceAlias::new(&pieces, &masses, f)) {
             Some(alias) => Table::Alias(alias),
             None => Table::Inversion {
                 sampler: S::from_weights(&masses).map_err(|_| zero)?,
@@ -279,10 +275,6 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
             frames: Frame::all(&mesh),
             norm: 1.0 / mass,
             acceptance: (mass / proposal_mass).min(1.0),
-            value_tolerance: match &table_format {
-                Some(f) => f.value_tolerance(),
-                None => 0.0,
-            },
         })
     }
 
@@ -334,7 +326,10 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
     /// `2⁻¹³` (see [`Layout::Alias`]). The density drawn and reported
     /// (`p′`, or exact mode's bounds) is the one with the changed values.
     pub fn value_tolerance(&self) -> f64 {
-        self.value_tolerance
+        match &self.table {
+            Table::Alias(alias) => alias.value_tolerance(),
+            Table::Inversion { .. } => 0.0,
+        }
     }
 
     /// Heap memory of the table the pieces are drawn from (with the
@@ -547,9 +542,10 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
     /// asked for a turn before its use, and overlaps a block's
     /// computation. In a linked table (columns holding their alias's
     /// index) the second stage picks the sides and prefetches the picked
-    /// columns, and a third reads their records. The random numbers are drawn in the order of the
-    /// blockwise loop (a block's `u64` for the pieces, then its two per
-    /// point), so the points are the same bit for bit.
+    /// columns, and a third reads their records. The random numbers are
+    /// drawn in the order of the blockwise loop (a block's `u64` for the
+    /// pieces, then its two per point), so the points are the same bit
+    /// for bit.
     fn sample_alias<R: Rng + ?Sized>(
         &self,
         alias: &PieceAlias,

@@ -28,7 +28,7 @@ pub(super) struct Column(pub(super) u128);
 pub const MAX_VALUE_SHIFT: u32 = 11;
 
 /// Bits needed for the values `0..n` (0 for `n ≤ 1`).
-pub(super) fn bits_for(n: usize) -> u32 {
+fn bits_for(n: usize) -> u32 {
     usize::BITS - n.saturating_sub(1).leading_zeros()
 }
 

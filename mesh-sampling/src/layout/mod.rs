@@ -112,6 +112,11 @@ impl PieceAlias {
         self.columns.len()
     }
 
+    /// See [`Format::value_tolerance`].
+    pub(crate) fn value_tolerance(&self) -> f64 {
+        self.format.value_tolerance()
+    }
+
     /// Whether a column holds its alias's record (a draw reads one
     /// column) rather than its index (two when the alias side is taken).
     pub(crate) fn inline(&self) -> bool {
