@@ -412,6 +412,17 @@ pub fn write(path: impl AsRef<Path>, image: &Image) -> Result<()> {
 /// size; codec and I/O errors.
 pub fn write_png(path: impl AsRef<Path>, image: &Image, depth: PngDepth) -> Result<()> {
     let path = path.as_ref();
+    let bytes = encode_png(image, depth, path)?;
+    std::fs::write(path, bytes).map_err(|e| Error::io(path, e))
+}
+
+/// The PNG file [`write_png`] writes, in memory (`path` names the image
+/// in errors): what a glTF writer embeds.
+///
+/// # Errors
+/// As for [`write_png`], without I/O.
+pub fn encode_png(image: &Image, depth: PngDepth, path: impl AsRef<Path>) -> Result<Vec<u8>> {
+    let path = path.as_ref();
     image.check(path)?;
     // sRGB-encode colour, keep alpha linear; image's conversion to 8 or
     // 16 bits then clamps to [0, 1], scales and rounds.
@@ -434,9 +445,11 @@ pub fn write_png(path: impl AsRef<Path>, image: &Image, depth: PngDepth) -> Resu
         PngDepth::Eight => DynamicImage::ImageRgba8(float.to_rgba8()),
         PngDepth::Sixteen => DynamicImage::ImageRgba16(float.to_rgba16()),
     };
+    let mut bytes = std::io::Cursor::new(Vec::new());
     dynamic
-        .save_with_format(path, ImageFormat::Png)
-        .map_err(|e| codec_error(path, ImageFormat::Png, e))
+        .write_to(&mut bytes, ImageFormat::Png)
+        .map_err(|e| codec_error(path, ImageFormat::Png, e))?;
+    Ok(bytes.into_inner())
 }
 
 /// Writes an OpenEXR file: linear RGBA, f32 or f16 samples.

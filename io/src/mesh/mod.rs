@@ -265,9 +265,11 @@ impl TriMesh {
     }
 
     /// Writes the mesh, choosing the format by extension: `.obj` (with its
-    /// `.mtl` and textures, see [`obj::write`]) or `.ply` (binary
+    /// `.mtl` and textures, see [`obj::write`]), `.ply` (binary
     /// little-endian with normals and UVs; objects and materials are not
-    /// part of PLY and are not written, see [`ply::write`]).
+    /// part of PLY and are not written, see [`ply::write`]), or `.glb` /
+    /// `.gltf` (with objects, materials and embedded textures, see
+    /// [`gltf::write`]).
     ///
     /// # Errors
     /// [`ErrorKind::UnknownExtension`] for other extensions; the writer's
@@ -276,6 +278,7 @@ impl TriMesh {
         let path = path.as_ref();
         match crate::error::extension(path).as_str() {
             "obj" => obj::write(path, self),
+            "gltf" | "glb" => gltf::write(path, self),
             "ply" => {
                 // A texture file is named as MeshLab does, when the first
                 // material has one inside the file's folder.
@@ -300,9 +303,66 @@ impl TriMesh {
             }
             other => Err(Error::new(
                 path,
-                ErrorKind::UnknownExtension(other.to_string(), ".obj, .ply"),
+                ErrorKind::UnknownExtension(other.to_string(), ".obj, .ply, .glb, .gltf"),
             )),
         }
+    }
+
+    /// Checks what every writer needs of the layout: attribute arrays of
+    /// the vertex count, indices in range, objects that cover the
+    /// triangles in order with materials that exist, a finite origin.
+    ///
+    /// # Errors
+    /// [`ErrorKind::InvalidInput`] naming `path`, the element and the
+    /// problem.
+    pub(crate) fn check_layout(&self, path: &Path) -> Result<()> {
+        let invalid = |what: String| Error::new(path, ErrorKind::InvalidInput(what));
+        let n = self.positions.len();
+        let arrays = [
+            ("UVs", self.uvs.as_ref().map(Vec::len)),
+            ("second UVs", self.uvs1.as_ref().map(Vec::len)),
+            ("normals", self.normals.as_ref().map(Vec::len)),
+        ];
+        for (what, len) in arrays {
+            if let Some(len) = len.filter(|&l| l != n) {
+                return Err(invalid(format!("{len} {what} for {n} positions")));
+            }
+        }
+        if let Some((t, _)) = self
+            .indices
+            .iter()
+            .enumerate()
+            .find(|(_, tri)| tri.iter().any(|&i| i as usize >= n))
+        {
+            return Err(invalid(format!("triangle {t} references a missing vertex")));
+        }
+        let mut end = 0;
+        for o in &self.objects {
+            if o.triangles.start != end || o.triangles.end < o.triangles.start {
+                return Err(invalid(format!(
+                    "object {:?} does not continue at triangle {end}",
+                    o.name
+                )));
+            }
+            end = o.triangles.end;
+            if let Some(m) = o.material.filter(|&m| m >= self.materials.len()) {
+                return Err(invalid(format!(
+                    "object {:?} uses material {m}, but there are {}",
+                    o.name,
+                    self.materials.len()
+                )));
+            }
+        }
+        if !self.objects.is_empty() && end != self.indices.len() {
+            return Err(invalid(format!(
+                "the objects cover {end} of {} triangles",
+                self.indices.len()
+            )));
+        }
+        if !self.origin.is_finite() {
+            return Err(invalid(format!("origin {} is not finite", self.origin)));
+        }
+        Ok(())
     }
 
     /// The total surface area, in the square of the mesh's unit (summed in

@@ -854,58 +854,12 @@ fn texture_map<'a>(at: &At<'_>, mut rest: &'a str) -> Result<TextureMap<'a>> {
 /// break would cut; an I/O error.
 pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
     let path = path.as_ref();
-    let invalid = |what: String| Error::new(path, ErrorKind::InvalidInput(what));
-    let n = mesh.positions.len();
-    let bad_len = |len: Option<usize>| len.is_some_and(|l| l != n);
-    if bad_len(mesh.uvs.as_ref().map(Vec::len)) {
-        return Err(invalid(format!(
-            "{} UVs for {n} positions",
-            mesh.uvs.as_ref().map_or(0, Vec::len)
-        )));
-    }
-    if bad_len(mesh.normals.as_ref().map(Vec::len)) {
-        return Err(invalid(format!(
-            "{} normals for {n} positions",
-            mesh.normals.as_ref().map_or(0, Vec::len)
-        )));
-    }
-    if let Some((t, _)) = mesh
-        .indices
-        .iter()
-        .enumerate()
-        .find(|(_, tri)| tri.iter().any(|&i| i as usize >= n))
-    {
-        return Err(invalid(format!("triangle {t} references a missing vertex")));
-    }
-    let mut end = 0;
+    mesh.check_layout(path)?;
     for o in &mesh.objects {
-        if o.triangles.start != end || o.triangles.end < o.triangles.start {
-            return Err(invalid(format!(
-                "object {:?} does not continue at triangle {end}",
-                o.name
-            )));
-        }
-        end = o.triangles.end;
-        if let Some(m) = o.material.filter(|&m| m >= mesh.materials.len()) {
-            return Err(invalid(format!(
-                "object {:?} uses material {m}, but there are {}",
-                o.name,
-                mesh.materials.len()
-            )));
-        }
         check_name(path, "object", &o.name)?;
     }
-    if !mesh.objects.is_empty() && end != mesh.indices.len() {
-        return Err(invalid(format!(
-            "the objects cover {end} of {} triangles",
-            mesh.indices.len()
-        )));
-    }
-    if !mesh.origin.is_finite() {
-        return Err(invalid(format!("origin {} is not finite", mesh.origin)));
-    }
     let names = material_names(path, mesh)?;
-    let mut out = String::with_capacity(40 * n + 30 * mesh.indices.len());
+    let mut out = String::with_capacity(40 * mesh.positions.len() + 30 * mesh.indices.len());
     out.push_str("# written by trilux-io\n");
     if !mesh.materials.is_empty() {
         let library = path.with_extension("mtl");

@@ -5,6 +5,7 @@ mod support;
 
 mod fuzz_regressions;
 mod gltf;
+mod gltf_roundtrip;
 mod images;
 mod images_second;
 mod meshes;

@@ -1,23 +1,4 @@
-//! glTF 2.0 (`.gltf` with external or `data:` buffers, and binary `.glb`):
-//! every triangle primitive of the default scene with its node transforms
-//! applied; POSITION, NORMAL, the base-colour texture's `TEXCOORD_n` (and
-//! `TEXCOORD_1` as [`TriMesh::uvs1`]) and indices; base-colour factor and
-//! texture (embedded or external, decoded), with its wrap modes.
-//!
-//! One decoder reads every accessor (glTF 2.0 Sec. 3.6.2): float and
-//! integer component types, normalized integers mapped to `[0, 1]` or
-//! `[-1, 1]` (Sec. 3.11), non-normalized integers as their values
-//! (`KHR_mesh_quantization`), and sparse substitution over a buffer view
-//! or over zeros. `KHR_texture_transform` on the base-colour texture is
-//! applied to the UVs. A file that requires any other extension is refused
-//! with an error naming it: a silently wrong mesh is worse than none.
-//!
-//! The `gltf` crate parses the JSON and GLB container (its headers checked
-//! here first); buffers and images
-//! are resolved here, so that a file cannot make the reader open anything
-//! outside its own folder: absolute paths, `..` and remote schemes are
-//! refused unless [`Options::allow_outside_folder`] is set. Every accessor
-//! is checked against its buffer before it is read.
+//! Reading glTF: the triangles (and points) of the default scene.
 
 use std::path::{Component, Path, PathBuf};
 
@@ -27,9 +8,10 @@ use gltf::accessor::{Accessor, DataType, Dimensions};
 use gltf::mesh::Mode;
 use gltf::texture::WrappingMode;
 
-use super::{Material, Object, TriMesh, Wrap};
+use super::{Attribute, AttributeValues, Points, Scene, VertexData};
 use crate::error::{Error, ErrorKind, Result};
 use crate::image::{self, ReadOptions};
+use crate::mesh::{Material, Object, TriMesh, Wrap};
 use crate::warning::Warning;
 
 /// How to read a glTF file.
@@ -58,8 +40,27 @@ pub fn read(path: impl AsRef<Path>) -> Result<TriMesh> {
 /// As for [`read`].
 pub fn read_with(path: impl AsRef<Path>, options: Options) -> Result<TriMesh> {
     let path = path.as_ref();
+    Ok(read_scene_with(path, options)?.into_mesh(path))
+}
+
+/// Reads everything [`read`] does and what a [`TriMesh`] has no place
+/// for: vertex colours and `_NAME` attributes of the triangles, and the
+/// `POINTS` primitives (see [`Scene`]).
+///
+/// # Errors
+/// As for [`read`].
+pub fn read_scene(path: impl AsRef<Path>) -> Result<Scene> {
+    read_scene_with(path, Options::default())
+}
+
+/// As [`read_scene`], with [`Options`].
+///
+/// # Errors
+/// As for [`read`].
+pub fn read_scene_with(path: impl AsRef<Path>, options: Options) -> Result<Scene> {
+    let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    from_bytes(&bytes, path, options)
+    scene_from_bytes(&bytes, path, options)
 }
 
 /// Parses glTF JSON or GLB bytes; external URIs resolve against the
@@ -68,6 +69,15 @@ pub fn read_with(path: impl AsRef<Path>, options: Options) -> Result<TriMesh> {
 /// # Errors
 /// As for [`read`].
 pub fn from_bytes(bytes: &[u8], path: impl AsRef<Path>, options: Options) -> Result<TriMesh> {
+    let path = path.as_ref();
+    Ok(scene_from_bytes(bytes, path, options)?.into_mesh(path))
+}
+
+/// Parses glTF JSON or GLB bytes into a [`Scene`], as [`from_bytes`].
+///
+/// # Errors
+/// As for [`read`].
+pub fn scene_from_bytes(bytes: &[u8], path: impl AsRef<Path>, options: Options) -> Result<Scene> {
     let path = path.as_ref();
     let folder = path.parent().unwrap_or(Path::new("."));
     Reader {
@@ -156,7 +166,7 @@ impl Reader<'_> {
         }
     }
 
-    fn read(&self, bytes: &[u8]) -> Result<TriMesh> {
+    fn read(&self, bytes: &[u8]) -> Result<Scene> {
         let codec = |e: gltf::Error| {
             self.error(ErrorKind::Codec {
                 format: "glTF",
@@ -166,8 +176,8 @@ impl Reader<'_> {
         // The gltf crate's GLB split subtracts before it compares (an
         // overflow on a total length below 12, found by fuzzing), so the
         // container is checked here first.
-        if super::glb::is_glb(bytes) {
-            super::glb::check(bytes, self.path)?;
+        if crate::mesh::glb::is_glb(bytes) {
+            crate::mesh::glb::check(bytes, self.path)?;
         }
         // The gltf crate's validation indexes the arrays a file references
         // without bounds checks (found by fuzzing: a primitive naming an
@@ -219,9 +229,13 @@ impl Reader<'_> {
         let scene = document
             .default_scene()
             .or_else(|| document.scenes().next());
+        // Depth first in the file's order (the stack pops the last pushed,
+        // so siblings go on reversed): objects come out as the file lists
+        // them.
         let mut stack: Vec<(gltf::Node<'_>, Mat4)> = scene
             .map(|s| s.nodes().map(|n| (n, Mat4::IDENTITY)).collect())
             .unwrap_or_default();
+        stack.reverse();
         let mut visited = 0usize;
         while let Some((node, parent)) = stack.pop() {
             visited += 1;
@@ -229,7 +243,9 @@ impl Reader<'_> {
                 return Err(self.invalid("a node hierarchy with a cycle".into()));
             }
             let global = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+            let first_child = stack.len();
             stack.extend(node.children().map(|c| (c, global)));
+            stack[first_child..].reverse();
             let Some(gmesh) = node.mesh() else { continue };
             for primitive in gmesh.primitives() {
                 let name = gmesh.name().or(node.name()).unwrap_or("").to_string();
@@ -394,17 +410,20 @@ impl Reader<'_> {
         name: String,
         material_map: &mut [Option<usize>],
     ) -> Result<()> {
-        if !matches!(
-            primitive.mode(),
-            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-        ) {
-            // Points and lines have no surface; said, not skipped in
-            // silence.
+        let is_points = primitive.mode() == Mode::Points;
+        if !is_points
+            && !matches!(
+                primitive.mode(),
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            )
+        {
+            // Lines have no surface; said, not skipped in silence.
             parts.mesh.warnings.push(Warning::new(
                 self.path,
                 None,
                 format!(
-                    "primitive {} of mesh {:?} is drawn as {:?}, not triangles; it is not read",
+                    "primitive {} of mesh {:?} is drawn as {:?}, not triangles or points; it \
+                     is not read",
                     primitive.index(),
                     name,
                     primitive.mode()
@@ -412,7 +431,117 @@ impl Reader<'_> {
             ));
             return Ok(());
         }
-        use DataType::{F32, I8, I16, U8, U16, U32};
+        if is_points && primitive.indices().is_some() {
+            parts.mesh.warnings.push(Warning::new(
+                self.path,
+                None,
+                format!(
+                    "the indices of points primitive {} of mesh {:?} are not applied; every \
+                     vertex is read as a point",
+                    primitive.index(),
+                    name
+                ),
+            ));
+        }
+        let Parts {
+            mesh,
+            surface,
+            points,
+        } = parts;
+        let vertices = if is_points { points } else { surface };
+        // Primitives that share their vertex accessors (one mesh split by
+        // material) share their vertices.
+        let key = VertexKey::of(primitive, global, is_points);
+        let (base, count) = match key.as_ref().and_then(|k| vertices.shared.get(k)) {
+            Some(&found) => found,
+            None => {
+                let found = self.vertices(primitive, global, buffers, vertices)?;
+                if let Some(key) = key {
+                    vertices.shared.insert(key, found);
+                }
+                found
+            }
+        };
+        use DataType::{U8, U16, U32};
+        if is_points {
+            return Ok(());
+        }
+
+        if let Some(a) = primitive.indices().filter(|a| a.normalized()) {
+            return Err(self.invalid(format!("index accessor {} marked normalized", a.index())));
+        }
+        let raw: Vec<u32> = match primitive.indices() {
+            Some(a) => self
+                .decode(&a, buffers, "indices", Dimensions::Scalar, &[U8, U16, U32])?
+                .into_iter()
+                .map(|i| i as u32)
+                .collect(),
+            None => (0..count as u32).collect(),
+        };
+        let triangles: Vec<[u32; 3]> = match primitive.mode() {
+            Mode::TriangleStrip => (2..raw.len())
+                .map(|k| {
+                    if k % 2 == 0 {
+                        [raw[k - 2], raw[k - 1], raw[k]]
+                    } else {
+                        [raw[k - 1], raw[k - 2], raw[k]]
+                    }
+                })
+                .collect(),
+            Mode::TriangleFan => (2..raw.len())
+                .map(|k| [raw[0], raw[k - 1], raw[k]])
+                .collect(),
+            _ => raw.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        };
+        let mirrored = global.determinant() < 0.0;
+        let start = mesh.indices.len();
+        for (t, tri) in triangles.into_iter().enumerate() {
+            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= count) {
+                return Err(self.error(ErrorKind::ReferenceOutOfRange(Box::new(
+                    crate::error::Reference {
+                        what: "vertex",
+                        reference: i64::from(bad),
+                        element: "triangle",
+                        index: start + t,
+                        count,
+                        records: "vertices in its primitive",
+                    },
+                ))));
+            }
+            let [a, b, c] = tri.map(|i| i + base as u32);
+            mesh.indices
+                .push(if mirrored { [a, c, b] } else { [a, b, c] });
+        }
+        let material = match primitive.material().index() {
+            Some(i) => Some(match material_map[i] {
+                Some(m) => m,
+                None => {
+                    let m = self.material(&primitive.material(), buffers, &mut mesh.warnings)?;
+                    mesh.materials.push(m);
+                    material_map[i] = Some(mesh.materials.len() - 1);
+                    mesh.materials.len() - 1
+                }
+            }),
+            None => None,
+        };
+        mesh.objects.push(Object {
+            name,
+            triangles: start..mesh.indices.len(),
+            material,
+        });
+        Ok(())
+    }
+
+    /// Decodes the vertices of `primitive` into `vertices`: their first
+    /// index there and their count.
+    fn vertices(
+        &self,
+        primitive: &gltf::Primitive<'_>,
+        global: Mat4,
+        buffers: &[Vec<u8>],
+        vertices: &mut Vertices,
+    ) -> Result<(usize, usize)> {
+        use DataType::{F32, I8, I16, U8, U16};
         let positions = primitive
             .get(&gltf::Semantic::Positions)
             .ok_or_else(|| self.invalid("a primitive without POSITION".into()))?;
@@ -426,7 +555,7 @@ impl Reader<'_> {
             &[F32, I8, U8, I16, U16],
         )?;
         let count = positions.len() / 3;
-        let base = parts.points.len();
+        let base = vertices.positions.len();
         let normal_matrix = Mat3::from_mat4(global).inverse().transpose();
         // In f64, so that a node translation far from the origin (a
         // georeferenced tile) keeps the precision of the vertices; the
@@ -442,7 +571,7 @@ impl Reader<'_> {
                     value,
                 }));
             }
-            parts.points.push(q);
+            vertices.positions.push(q);
         }
         let length_error = |what: &str, n: usize| {
             self.invalid(format!(
@@ -456,12 +585,12 @@ impl Reader<'_> {
                 if values.len() != 3 * count {
                     return Err(length_error("NORMAL", values.len() / 3));
                 }
-                parts.normals.extend(values.chunks_exact(3).map(|n| {
+                vertices.normals.extend(values.chunks_exact(3).map(|n| {
                     let n = Vec3::new(n[0] as f32, n[1] as f32, n[2] as f32);
                     Some((normal_matrix * n).normalize_or_zero())
                 }));
             }
-            None => parts.normals.extend(std::iter::repeat_n(None, count)),
+            None => vertices.normals.extend(std::iter::repeat_n(None, count)),
         }
 
         let material = primitive.material();
@@ -524,77 +653,104 @@ impl Reader<'_> {
             )));
         }
         match uvs {
-            Some(uvs) => parts.uvs.extend(uvs.into_iter().map(Some)),
-            None => parts.uvs.extend(std::iter::repeat_n(None, count)),
+            Some(uvs) => vertices.uvs.extend(uvs.into_iter().map(Some)),
+            None => vertices.uvs.extend(std::iter::repeat_n(None, count)),
         }
         match read_set(1)? {
-            Some(uvs1) => parts.uvs1.extend(uvs1.into_iter().map(Some)),
-            None => parts.uvs1.extend(std::iter::repeat_n(None, count)),
+            Some(uvs1) => vertices.uvs1.extend(uvs1.into_iter().map(Some)),
+            None => vertices.uvs1.extend(std::iter::repeat_n(None, count)),
         }
 
-        if let Some(a) = primitive.indices().filter(|a| a.normalized()) {
-            return Err(self.invalid(format!("index accessor {} marked normalized", a.index())));
-        }
-        let raw: Vec<u32> = match primitive.indices() {
-            Some(a) => self
-                .decode(&a, buffers, "indices", Dimensions::Scalar, &[U8, U16, U32])?
-                .into_iter()
-                .map(|i| i as u32)
-                .collect(),
-            None => (0..count as u32).collect(),
+        self.colors_and_attributes(primitive, buffers, vertices, count)?;
+        Ok((base, count))
+    }
+
+    /// Reads `COLOR_0` and the `_NAME` attributes of a primitive with
+    /// `count` vertices into `vertices`, padding the attributes it lacks
+    /// (and the earlier vertices of one it brings first) with zeros.
+    fn colors_and_attributes(
+        &self,
+        primitive: &gltf::Primitive<'_>,
+        buffers: &[Vec<u8>],
+        vertices: &mut Vertices,
+        count: usize,
+    ) -> Result<()> {
+        use DataType::{F32, I8, I16, U8, U16};
+        let length_error = |what: &str, n: usize| {
+            self.invalid(format!(
+                "a primitive with {count} positions but {n} {what} values"
+            ))
         };
-        let triangles: Vec<[u32; 3]> = match primitive.mode() {
-            Mode::TriangleStrip => (2..raw.len())
-                .map(|k| {
-                    if k % 2 == 0 {
-                        [raw[k - 2], raw[k - 1], raw[k]]
-                    } else {
-                        [raw[k - 1], raw[k - 2], raw[k]]
+        match primitive.get(&gltf::Semantic::Colors(0)) {
+            Some(a) => {
+                let dimensions = a.dimensions();
+                let n = match dimensions {
+                    Dimensions::Vec3 => 3,
+                    Dimensions::Vec4 => 4,
+                    other => {
+                        return Err(self.invalid(format!(
+                            "COLOR_0 accessor {} of type {other:?} (VEC3 or VEC4 expected)",
+                            a.index()
+                        )));
                     }
-                })
-                .collect(),
-            Mode::TriangleFan => (2..raw.len())
-                .map(|k| [raw[0], raw[k - 1], raw[k]])
-                .collect(),
-            _ => raw.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
-        };
-        let mirrored = global.determinant() < 0.0;
-        let mesh = &mut parts.mesh;
-        let start = mesh.indices.len();
-        for (t, tri) in triangles.into_iter().enumerate() {
-            if let Some(&bad) = tri.iter().find(|&&i| i as usize >= count) {
-                return Err(self.error(ErrorKind::ReferenceOutOfRange(Box::new(
-                    crate::error::Reference {
-                        what: "vertex",
-                        reference: i64::from(bad),
-                        element: "triangle",
-                        index: start + t,
-                        count,
-                        records: "vertices in its primitive",
-                    },
-                ))));
-            }
-            let [a, b, c] = tri.map(|i| i + base as u32);
-            mesh.indices
-                .push(if mirrored { [a, c, b] } else { [a, b, c] });
-        }
-        let material = match primitive.material().index() {
-            Some(i) => Some(match material_map[i] {
-                Some(m) => m,
-                None => {
-                    let m = self.material(&primitive.material(), buffers, &mut mesh.warnings)?;
-                    mesh.materials.push(m);
-                    material_map[i] = Some(mesh.materials.len() - 1);
-                    mesh.materials.len() - 1
+                };
+                let values = self.decode(&a, buffers, "COLOR_0", dimensions, &[F32, U8, U16])?;
+                if values.len() != n * count {
+                    return Err(length_error("COLOR_0", values.len() / n));
                 }
-            }),
-            None => None,
-        };
-        mesh.objects.push(Object {
-            name,
-            triangles: start..mesh.indices.len(),
-            material,
-        });
+                vertices.colors.extend(values.chunks_exact(n).map(|c| {
+                    let alpha = if n == 4 { c[3] as f32 } else { 1.0 };
+                    Some([c[0] as f32, c[1] as f32, c[2] as f32, alpha])
+                }));
+            }
+            None => vertices.colors.extend(std::iter::repeat_n(None, count)),
+        }
+        let before = vertices.positions.len() - count;
+        let mut seen = Vec::new();
+        for (semantic, a) in primitive.attributes() {
+            let gltf::Semantic::Extras(name) = semantic else {
+                continue;
+            };
+            let dimensions = a.dimensions();
+            let n = components(dimensions);
+            if !matches!(
+                dimensions,
+                Dimensions::Scalar | Dimensions::Vec2 | Dimensions::Vec3 | Dimensions::Vec4
+            ) {
+                return Err(self.invalid(format!(
+                    "attribute _{name} (accessor {}) of type {dimensions:?}; SCALAR or VEC2-4 \
+                     are read",
+                    a.index()
+                )));
+            }
+            let what = format!("_{name}");
+            let values = self.decode(&a, buffers, &what, dimensions, &[F32, I8, U8, I16, U16])?;
+            if values.len() != n * count {
+                return Err(length_error(&what, values.len() / n));
+            }
+            let column = match vertices.attributes.iter().position(|(m, ..)| *m == name) {
+                Some(k) => &mut vertices.attributes[k],
+                None => {
+                    vertices
+                        .attributes
+                        .push((name.clone(), n, vec![0.0; n * before]));
+                    vertices.attributes.last_mut().expect("just pushed")
+                }
+            };
+            if column.1 != n {
+                return Err(self.invalid(format!(
+                    "attribute _{name} has {n} components here and {} in an earlier primitive",
+                    column.1
+                )));
+            }
+            column.2.extend(values.into_iter().map(|v| v as f32));
+            seen.push(name);
+        }
+        for (name, n, values) in &mut vertices.attributes {
+            if !seen.contains(name) {
+                values.resize(*n * vertices.positions.len(), 0.0);
+            }
+        }
         Ok(())
     }
 
@@ -682,47 +838,161 @@ impl Reader<'_> {
     }
 }
 
-/// The mesh under construction: per-vertex attributes that some
-/// primitives may lack.
+/// The scene under construction: the surface's and the points' vertices,
+/// with attributes that some primitives may lack.
 #[derive(Default)]
 struct Parts {
     mesh: TriMesh,
+    surface: Vertices,
+    points: Vertices,
+}
+
+/// Per-vertex values of the primitives read so far.
+#[derive(Default)]
+struct Vertices {
     /// Positions with the node transforms applied, in f64 until the
     /// global shift is known.
-    points: Vec<DVec3>,
+    positions: Vec<DVec3>,
     normals: Vec<Option<Vec3>>,
     uvs: Vec<Option<Vec2>>,
     uvs1: Vec<Option<Vec2>>,
+    colors: Vec<Option<[f32; 4]>>,
+    /// `_NAME` attributes by name (without the underscore): components
+    /// per element and the values, zeros for the vertices of primitives
+    /// without it. Each holds `components · positions.len()` values
+    /// between primitives.
+    attributes: Vec<(String, usize, Vec<f32>)>,
+    /// The first vertex and count of each set of vertex accessors read.
+    shared: std::collections::HashMap<VertexKey, (usize, usize)>,
 }
 
-impl Parts {
-    /// The mesh, with an attribute when any primitive has it (zeros for
-    /// the vertices of those that do not), positions relative to the
-    /// global shift.
-    fn finish(self, path: &Path) -> Result<TriMesh> {
-        fn fill<T: Copy + Default>(values: Vec<Option<T>>) -> Option<Vec<T>> {
-            values
-                .iter()
-                .any(Option::is_some)
-                .then(|| values.into_iter().map(Option::unwrap_or_default).collect())
+/// What decides a primitive's vertices: its attribute accessors, the node
+/// transform applied to them, and points or surface.
+#[derive(PartialEq, Eq, Hash)]
+struct VertexKey {
+    transform: [u32; 16],
+    attributes: Vec<(String, usize)>,
+    points: bool,
+    uv_set: u32,
+}
+
+impl VertexKey {
+    /// The key, or `None` when a texture transform makes the decoded UVs
+    /// depend on the material too (such primitives are read alone).
+    fn of(primitive: &gltf::Primitive<'_>, global: Mat4, points: bool) -> Option<Self> {
+        let texture = primitive
+            .material()
+            .pbr_metallic_roughness()
+            .base_color_texture();
+        if texture
+            .as_ref()
+            .is_some_and(|t| t.texture_transform().is_some())
+        {
+            return None;
         }
-        let (origin, positions) = super::recenter(&self.points);
+        let mut attributes: Vec<(String, usize)> = primitive
+            .attributes()
+            .map(|(semantic, a)| (semantic.to_string(), a.index()))
+            .collect();
+        attributes.sort();
+        Some(VertexKey {
+            transform: global.to_cols_array().map(f32::to_bits),
+            attributes,
+            points,
+            uv_set: texture.map_or(0, |t| t.tex_coord()),
+        })
+    }
+}
+
+/// An attribute when any primitive has it (zeros for the vertices of
+/// those that do not).
+fn fill<T: Copy + Default>(values: Vec<Option<T>>) -> Option<Vec<T>> {
+    values
+        .iter()
+        .any(Option::is_some)
+        .then(|| values.into_iter().map(Option::unwrap_or_default).collect())
+}
+
+impl Vertices {
+    /// Positions relative to the global shift of these vertices.
+    fn recentered(&self, path: &Path) -> Result<(DVec3, Vec<Vec3>)> {
+        let (origin, positions) = crate::mesh::recenter(&self.positions);
         if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
             return Err(Error::new(
                 path,
                 ErrorKind::OutOfRange(format!(
                     "vertex {i} at {} is too far from the others for f32 positions",
-                    self.points[i]
+                    self.positions[i]
                 )),
             ));
         }
-        Ok(TriMesh {
+        Ok((origin, positions))
+    }
+
+    /// The colours and custom attributes, as [`VertexData`].
+    fn vertex_data(
+        colors: Vec<Option<[f32; 4]>>,
+        attributes: Vec<(String, usize, Vec<f32>)>,
+    ) -> VertexData {
+        VertexData {
+            colors: fill(colors),
+            attributes: attributes
+                .into_iter()
+                .map(|(name, components, values)| Attribute {
+                    name,
+                    values: AttributeValues::from_components(components, values),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The `_FACE` attribute as face ids, taken out of `data`, when every
+/// value is a non-negative integer below 2^24 (what the writer stores).
+fn take_faces(data: &mut VertexData) -> Option<Vec<u32>> {
+    let k = data
+        .attributes
+        .iter()
+        .position(|a| a.name == super::FACE_ATTRIBUTE)?;
+    let AttributeValues::Scalar(values) = &data.attributes[k].values else {
+        return None;
+    };
+    let exact = |v: f32| v >= 0.0 && v < super::EXACT_F32_INTEGERS as f32 && v.fract() == 0.0;
+    if !values.iter().all(|&v| exact(v)) {
+        return None;
+    }
+    let faces = values.iter().map(|&v| v as u32).collect();
+    data.attributes.remove(k);
+    Some(faces)
+}
+
+impl Parts {
+    /// The scene, positions relative to their global shifts.
+    fn finish(self, path: &Path) -> Result<Scene> {
+        let (origin, positions) = self.surface.recentered(path)?;
+        let mesh = TriMesh {
             positions,
             origin,
-            normals: fill(self.normals),
-            uvs: fill(self.uvs),
-            uvs1: fill(self.uvs1),
+            normals: fill(self.surface.normals),
+            uvs: fill(self.surface.uvs),
+            uvs1: fill(self.surface.uvs1),
             ..self.mesh
+        };
+        let vertex_data = Vertices::vertex_data(self.surface.colors, self.surface.attributes);
+        let (origin, positions) = self.points.recentered(path)?;
+        let mut point_data = Vertices::vertex_data(self.points.colors, self.points.attributes);
+        let faces = take_faces(&mut point_data);
+        Ok(Scene {
+            mesh,
+            vertex_data,
+            points: Points {
+                positions,
+                origin,
+                normals: fill(self.points.normals),
+                uvs: fill(self.points.uvs),
+                faces,
+                vertex_data: point_data,
+            },
         })
     }
 }

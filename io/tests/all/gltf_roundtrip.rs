@@ -1,0 +1,433 @@
+//! Property tests of the glTF writer over random data: every mesh, point
+//! cloud and attribute written reads back through the crate's own reader
+//! with the same counts and values, in both containers (`.glb`, `.gltf` +
+//! `.bin`), with 16- and 32-bit indices, objects, materials with embedded
+//! textures, and far-from-origin shifts. Each file also goes through the
+//! Khronos glTF-Validator (`test_support::gltf::validate`).
+
+use glam::{DVec3, Vec2, Vec3};
+use test_support::SplitMix64 as Rng;
+use trilux_io::image::{Image, srgb_to_linear};
+use trilux_io::mesh::gltf::{self, Attribute, AttributeValues, Points, VertexData};
+use trilux_io::mesh::ply::PlyData;
+use trilux_io::mesh::{Material, Object, TriMesh, Wrap};
+
+use crate::support::scratch;
+
+fn unit(rng: &mut Rng) -> Vec3 {
+    loop {
+        let v = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 2.0 - 1.0;
+        if let Some(u) = v.try_normalize().filter(|_| v.length() > 0.1) {
+            return u;
+        }
+    }
+}
+
+fn vec2s(rng: &mut Rng, n: usize) -> Vec<Vec2> {
+    (0..n)
+        .map(|_| Vec2::new(rng.f32() * 4.0 - 2.0, rng.f32()))
+        .collect()
+}
+
+/// An image whose linear values come from 8-bit sRGB codes, so that the
+/// writer's 8-bit PNG holds them exactly.
+fn image(rng: &mut Rng) -> Image {
+    let (width, height) = (1 + rng.below(9) as u32, 1 + rng.below(9) as u32);
+    let code = |rng: &mut Rng| srgb_to_linear(rng.below(256) as f32 / 255.0);
+    let pixels = (0..width * height)
+        .map(|_| {
+            [
+                code(rng),
+                code(rng),
+                code(rng),
+                rng.below(256) as f32 / 255.0,
+            ]
+        })
+        .collect();
+    Image {
+        width,
+        height,
+        pixels,
+    }
+}
+
+fn attributes(rng: &mut Rng, n: usize) -> Vec<Attribute> {
+    let names = ["PHI", "RADIANCE", "PDF", "W_2"];
+    let k = rng.below(names.len() as u64 + 1) as usize;
+    names[..k]
+        .iter()
+        .map(|name| {
+            let kind = rng.below(4);
+            let mut f = || rng.f32() * 200.0 - 100.0;
+            let values = match kind {
+                0 => AttributeValues::Scalar((0..n).map(|_| f()).collect()),
+                1 => AttributeValues::Vec2((0..n).map(|_| Vec2::new(f(), f())).collect()),
+                2 => AttributeValues::Vec3((0..n).map(|_| Vec3::new(f(), f(), f())).collect()),
+                _ => AttributeValues::Vec4((0..n).map(|_| [f(), f(), f(), f()]).collect()),
+            };
+            Attribute {
+                name: name.to_string(),
+                values,
+            }
+        })
+        .collect()
+}
+
+fn colors(rng: &mut Rng, n: usize, opaque: bool) -> Vec<[f32; 4]> {
+    (0..n)
+        .map(|_| {
+            let a = if opaque { 1.0 } else { rng.f32() };
+            [rng.f32(), rng.f32(), rng.f32(), a]
+        })
+        .collect()
+}
+
+/// A far shift sometimes, as a georeferenced scan has.
+fn origin(rng: &mut Rng) -> DVec3 {
+    match rng.below(3) {
+        0 => DVec3::new(412_345.0, 4_612_345.0, 120.0),
+        _ => DVec3::ZERO,
+    }
+}
+
+/// A random mesh of `n` vertices: objects with materials (every material
+/// used, in order, as the reader numbers them by first use).
+fn random_mesh(rng: &mut Rng, n: usize) -> TriMesh {
+    let triangles = 1 + rng.below(2 * n as u64 + 1) as usize;
+    let indices = (0..triangles)
+        .map(|_| [0; 3].map(|_: u32| rng.below(n as u64) as u32))
+        .collect::<Vec<_>>();
+    let positions = (0..n)
+        .map(|_| Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 10.0 - 5.0)
+        .collect();
+    let uvs = (rng.below(3) > 0).then(|| vec2s(rng, n));
+    let mut mesh = TriMesh {
+        positions,
+        origin: origin(rng),
+        normals: (rng.below(2) == 0).then(|| (0..n).map(|_| unit(rng)).collect()),
+        uvs1: (uvs.is_some() && rng.below(3) == 0).then(|| vec2s(rng, n)),
+        indices,
+        ..TriMesh::default()
+    };
+    if uvs.is_some() && rng.below(2) == 0 {
+        // Objects over the triangles, each with its own material.
+        let cuts = 1 + rng.below(3.min(triangles as u64)) as usize;
+        let mut start = 0;
+        for k in 0..cuts {
+            let end = if k + 1 == cuts {
+                triangles
+            } else {
+                start + 1 + rng.below((triangles - start - (cuts - k)) as u64 + 1) as usize
+            };
+            let wraps = [Wrap::Repeat, Wrap::MirroredRepeat, Wrap::ClampToEdge];
+            mesh.materials.push(Material {
+                name: format!("m{k}"),
+                diffuse: [rng.f32(), rng.f32(), rng.f32()],
+                diffuse_texture: None,
+                diffuse_image: (rng.below(2) == 0).then(|| image(rng)),
+                wrap: [0, 1].map(|_| wraps[rng.below(3) as usize]),
+            });
+            mesh.objects.push(Object {
+                name: format!("part {k}"),
+                triangles: start..end,
+                material: Some(k),
+            });
+            start = end;
+        }
+    }
+    mesh.uvs = uvs;
+    mesh
+}
+
+fn assert_positions(written: &[Vec3], origin: DVec3, read: &TriMeshLike) {
+    assert_eq!(read.positions.len(), written.len());
+    for (i, (p, q)) in written.iter().zip(read.positions.iter()).enumerate() {
+        let a = origin + p.as_dvec3();
+        let b = read.origin + q.as_dvec3();
+        // Exact without a shift; within the f32 steps of the shift and
+        // of a 10-unit mesh otherwise.
+        let tol = if origin == DVec3::ZERO {
+            0.0
+        } else {
+            2e-6 * 16.0
+        };
+        assert!((a - b).abs().max_element() <= tol, "vertex {i}: {a} vs {b}");
+    }
+}
+
+/// Positions and shift of what was read.
+struct TriMeshLike<'a> {
+    positions: &'a [Vec3],
+    origin: DVec3,
+}
+
+fn assert_normals(written: Option<&Vec<Vec3>>, read: Option<&Vec<Vec3>>) {
+    assert_eq!(written.is_some(), read.is_some());
+    for (a, b) in written
+        .into_iter()
+        .flatten()
+        .zip(read.into_iter().flatten())
+    {
+        assert!((*a - *b).abs().max_element() < 1e-6, "normal {a} vs {b}");
+    }
+}
+
+/// glTF keeps attributes by name: they come back in name order.
+fn sorted(mut data: VertexData) -> VertexData {
+    data.attributes.sort_by(|a, b| a.name.cmp(&b.name));
+    data
+}
+
+fn extension(rng: &mut Rng) -> &'static str {
+    if rng.below(2) == 0 { "glb" } else { "gltf" }
+}
+
+#[test]
+fn random_meshes_with_colours_and_attributes_read_back_as_written() {
+    let mut rng = Rng(0x617c_f00d);
+    let dir = scratch("gltf-roundtrip-meshes");
+    for case in 0..60 {
+        // Mostly small; one mesh past 65 535 vertices for 32-bit indices.
+        let n = if case == 7 {
+            70_000
+        } else {
+            1 + rng.below(300) as usize
+        };
+        let mesh = random_mesh(&mut rng, n);
+        let opaque = rng.below(2) == 0;
+        let data = VertexData {
+            colors: (rng.below(2) == 0).then(|| colors(&mut rng, n, opaque)),
+            attributes: attributes(&mut rng, n),
+        };
+        let path = dir.join(format!("mesh{case}.{}", extension(&mut rng)));
+        gltf::write_with(&path, &mesh, &data).unwrap();
+        test_support::gltf::validate(&path);
+        let scene = gltf::read_scene(&path).unwrap();
+        let read = &scene.mesh;
+        assert!(read.warnings.is_empty(), "{:?}", read.warnings);
+        assert_eq!(read.indices, mesh.indices, "case {case}");
+        assert_positions(
+            &mesh.positions,
+            mesh.origin,
+            &TriMeshLike {
+                positions: &read.positions,
+                origin: read.origin,
+            },
+        );
+        assert_normals(mesh.normals.as_ref(), read.normals.as_ref());
+        assert_eq!(read.uvs, mesh.uvs, "case {case}");
+        assert_eq!(read.uvs1, mesh.uvs1, "case {case}");
+        assert!(
+            scene.vertex_data == sorted(data),
+            "case {case}: vertex data differ"
+        );
+        assert!(scene.points.positions.is_empty());
+        if mesh.objects.is_empty() {
+            assert_eq!(read.objects.len(), 1);
+            assert_eq!(read.objects[0].triangles, 0..mesh.indices.len());
+        } else {
+            assert_eq!(read.objects, mesh.objects, "case {case}");
+        }
+        assert_eq!(read.materials.len(), mesh.materials.len());
+        for (a, b) in mesh.materials.iter().zip(&read.materials) {
+            assert_eq!((&a.name, a.diffuse), (&b.name, b.diffuse));
+            // Wrap modes belong to a texture's sampler.
+            if a.diffuse_image.is_some() {
+                assert_eq!(a.wrap, b.wrap);
+            }
+            assert_eq!(a.diffuse_image, b.diffuse_image, "case {case}");
+        }
+        // TriMesh::write picks glTF by extension too, and read() agrees.
+        let again = dir.join(format!("again{case}.glb"));
+        mesh.write(&again).unwrap();
+        assert_eq!(trilux_io::mesh::read(&again).unwrap().indices, mesh.indices);
+    }
+}
+
+#[test]
+fn random_point_clouds_read_back_as_written() {
+    let mut rng = Rng(0x0090_1375);
+    let dir = scratch("gltf-roundtrip-points");
+    for case in 0..40 {
+        let n = 1 + rng.below(500) as usize;
+        let ply = PlyData {
+            positions: (0..n)
+                .map(|_| Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 2.0 - 1.0)
+                .collect(),
+            origin: origin(&mut rng),
+            normals: (rng.below(2) == 0).then(|| (0..n).map(|_| unit(&mut rng)).collect()),
+            colors: (rng.below(2) == 0).then(|| {
+                (0..n)
+                    .map(|_| [0; 4].map(|_: u8| rng.below(256) as u8))
+                    .collect()
+            }),
+            uvs: (rng.below(2) == 0).then(|| vec2s(&mut rng, n)),
+            face_ids: (rng.below(2) == 0).then(|| {
+                (0..n)
+                    .map(|_| rng.below(1 << 24) as u32)
+                    .collect::<Vec<_>>()
+            }),
+            scalars: (0..rng.below(3))
+                .map(|k| (format!("s{k}"), (0..n).map(|_| rng.f32()).collect()))
+                .collect(),
+            ..PlyData::default()
+        };
+        let points = Points::from(&ply);
+        let path = dir.join(format!("points{case}.{}", extension(&mut rng)));
+        gltf::write_points(&path, &points).unwrap();
+        test_support::gltf::validate(&path);
+        let scene = gltf::read_scene(&path).unwrap();
+        assert!(scene.mesh.indices.is_empty());
+        let read = &scene.points;
+        assert_positions(
+            &points.positions,
+            points.origin,
+            &TriMeshLike {
+                positions: &read.positions,
+                origin: read.origin,
+            },
+        );
+        assert_normals(points.normals.as_ref(), read.normals.as_ref());
+        assert_eq!(read.uvs, points.uvs, "case {case}");
+        assert_eq!(read.faces, ply.face_ids, "case {case}");
+        assert!(
+            read.vertex_data == sorted(points.vertex_data.clone()),
+            "case {case}"
+        );
+        // The 8-bit colours come back exactly.
+        let bytes = read.vertex_data.colors.as_ref().map(|c| {
+            c.iter()
+                .map(|p| p.map(|v| (v * 255.0).round() as u8))
+                .collect::<Vec<_>>()
+        });
+        assert_eq!(bytes, ply.colors);
+        // read() keeps the triangles only, and says so.
+        let mesh = gltf::read(&path).unwrap();
+        assert!(
+            mesh.warnings
+                .iter()
+                .any(|w| w.to_string().contains("points"))
+        );
+    }
+}
+
+#[test]
+fn a_texture_file_is_embedded_as_it_is() {
+    let dir = scratch("gltf-texture-file");
+    let texture = dir.join("checker.png");
+    let checker = Image {
+        width: 2,
+        height: 2,
+        pixels: vec![
+            [1.0, 0.0, 0.0, 1.0],
+            [0.0, 1.0, 0.0, 1.0],
+            [0.0, 0.0, 1.0, 1.0],
+            [1.0, 1.0, 1.0, 1.0],
+        ],
+    };
+    trilux_io::image::write(&texture, &checker).unwrap();
+    let mesh = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices: vec![[0, 1, 2]],
+        uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::Y]),
+        objects: vec![Object {
+            name: "quad".into(),
+            triangles: 0..1,
+            material: Some(0),
+        }],
+        materials: vec![Material {
+            name: "checker".into(),
+            diffuse: [1.0; 3],
+            diffuse_texture: Some(texture.clone()),
+            diffuse_image: None,
+            wrap: [Wrap::ClampToEdge; 2],
+        }],
+        ..TriMesh::default()
+    };
+    let path = dir.join("textured.glb");
+    mesh.write(&path).unwrap();
+    test_support::gltf::validate(&path);
+    let read = gltf::read(&path).unwrap();
+    assert_eq!(read.materials[0].diffuse_image.as_ref(), Some(&checker));
+    // A texture that is not there is an error naming it, not a mesh
+    // without its texture.
+    let mut missing = mesh.clone();
+    missing.materials[0].diffuse_texture = Some(dir.join("gone.png"));
+    let err = missing.write(dir.join("missing.glb")).unwrap_err();
+    assert!(err.to_string().contains("gone.png"), "{err}");
+}
+
+#[test]
+fn bad_input_is_refused_naming_the_problem() {
+    let dir = scratch("gltf-bad-input");
+    let mesh = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices: vec![[0, 1, 2]],
+        ..TriMesh::default()
+    };
+    let write = |data: &VertexData| {
+        gltf::write_with(dir.join("bad.glb"), &mesh, data)
+            .unwrap_err()
+            .to_string()
+    };
+    let scalar = |name: &str, values: Vec<f32>| VertexData {
+        attributes: vec![Attribute {
+            name: name.into(),
+            values: AttributeValues::Scalar(values),
+        }],
+        ..VertexData::default()
+    };
+    assert!(write(&scalar("PHI", vec![1.0])).contains("1 values for 3 vertices"));
+    assert!(write(&scalar("PHI", vec![1.0, f32::NAN, 0.0])).contains("not finite at vertex 1"));
+    assert!(write(&scalar("no space", vec![0.0; 3])).contains("letters, digits"));
+    let colors = VertexData {
+        colors: Some(vec![[0.0, 2.0, 0.0, 1.0]; 3]),
+        ..VertexData::default()
+    };
+    assert!(write(&colors).contains("not in [0, 1]"));
+    let mut broken = mesh.clone();
+    broken.indices[0][2] = 3;
+    let err = broken
+        .write(dir.join("broken.glb"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("triangle 0 references a missing vertex"),
+        "{err}"
+    );
+    let err = mesh.write(dir.join("mesh.stl")).unwrap_err().to_string();
+    assert!(err.contains(".glb"), "{err}");
+    let far = Points {
+        positions: vec![Vec3::ZERO],
+        faces: Some(vec![1 << 24]),
+        ..Points::default()
+    };
+    let err = gltf::write_points(dir.join("far.glb"), &far)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("2^24"), "{err}");
+    // Nothing was left behind by the refused writes.
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+}
+
+#[test]
+fn zero_normals_become_face_normals() {
+    let dir = scratch("gltf-zero-normals");
+    let mesh = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
+        indices: vec![[0, 1, 2]],
+        normals: Some(vec![
+            Vec3::ZERO,
+            Vec3::new(0.0, 0.0, 2.0),
+            Vec3::NAN,
+            Vec3::ZERO,
+        ]),
+        ..TriMesh::default()
+    };
+    let path = dir.join("normals.gltf");
+    mesh.write(&path).unwrap();
+    test_support::gltf::validate(&path);
+    let read = gltf::read(&path).unwrap();
+    assert_eq!(read.normals.unwrap(), vec![Vec3::Z; 4]);
+    assert!(dir.join("normals.bin").is_file());
+}
