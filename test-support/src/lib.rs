@@ -1,13 +1,15 @@
 //! Helpers shared by the tests of the trilux workspace, one copy each
 //! instead of files included by `#[path]` across crates: where the real
 //! data is ([`data`]), Pearson's chi-square test with an exact p-value
-//! ([`stats`]), and a small seeded generator ([`SplitMix64`]).
+//! ([`stats`]), the Khronos glTF-Validator on written glTF files
+//! ([`gltf`]), and a small seeded generator ([`SplitMix64`]).
 //!
 //! A path-only dev-dependency (`test-support = { workspace = true }` with
 //! no version): `cargo package` strips it from a published crate's
 //! manifest, so it is never published and never needed by users.
 
 pub mod data;
+pub mod gltf;
 pub mod stats;
 
 /// SplitMix64 (Steele, Lea and Flood 2014, as in Vigna's reference

@@ -5,6 +5,7 @@ mod common;
 
 mod cli;
 mod cmd;
+mod gltf_clients;
 mod help;
 mod info_warnings;
 mod tet_cli;
