@@ -1,10 +1,11 @@
 //! `trilux-io`: the files trilux users already have, in and out.
 //!
 //! - **Triangle meshes** ([`mesh`]): OBJ (with MTL), glTF/GLB and PLY in;
-//!   OBJ (with MTL and textures) and PLY out, chosen by extension
-//!   ([`mesh::read`], [`mesh::TriMesh::write`]); PLY point clouds for
-//!   sampled points. One index stream, materials with decoded glTF
-//!   textures.
+//!   OBJ (with MTL and textures), PLY and glTF/GLB (textures embedded) out,
+//!   chosen by extension ([`mesh::read`], [`mesh::TriMesh::write`]); PLY
+//!   or glTF point clouds for sampled points, glTF vertex colours and
+//!   custom attributes for per-vertex results ([`mesh::gltf`]). One index
+//!   stream, materials with decoded glTF textures.
 //! - **Images** ([`image`]): PNG, JPEG, Radiance HDR, OpenEXR in as linear
 //!   `f32` RGBA; PNG (8/16 bit) and EXR (f32/f16) out.
 //! - **Tetrahedral meshes** ([`tet`]): TetGen `.node`/`.ele` (+ `.face`),
