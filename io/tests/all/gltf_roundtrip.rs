@@ -218,17 +218,27 @@ fn random_meshes_with_colours_and_attributes_read_back_as_written() {
         assert_eq!(read.uvs, mesh.uvs, "case {case}");
         assert_eq!(read.uvs1, mesh.uvs1, "case {case}");
         assert!(
-            scene.vertex_data == sorted(data),
+            scene.vertex_data == sorted(data.clone()),
             "case {case}: vertex data differ"
         );
         assert!(scene.points.positions.is_empty());
+        // Triangles without a material come back with the writer's
+        // fallback (glTF's own default is a black-looking metal).
+        let fallback = if data.colors.is_some() {
+            gltf::UNLIT_MATERIAL
+        } else {
+            gltf::DEFAULT_MATERIAL
+        };
         if mesh.objects.is_empty() {
             assert_eq!(read.objects.len(), 1);
             assert_eq!(read.objects[0].triangles, 0..mesh.indices.len());
+            assert_eq!(read.materials.len(), 1);
+            assert_eq!(read.materials[0].name, fallback);
+            assert_eq!(read.materials[0].diffuse, [1.0; 3]);
         } else {
             assert_eq!(read.objects, mesh.objects, "case {case}");
+            assert_eq!(read.materials.len(), mesh.materials.len());
         }
-        assert_eq!(read.materials.len(), mesh.materials.len());
         for (a, b) in mesh.materials.iter().zip(&read.materials) {
             assert_eq!((&a.name, a.diffuse), (&b.name, b.diffuse));
             // Wrap modes belong to a texture's sampler.
@@ -294,10 +304,14 @@ fn random_point_clouds_read_back_as_written() {
             read.vertex_data == sorted(points.vertex_data.clone()),
             "case {case}"
         );
-        // The 8-bit colours come back exactly.
+        // The 8-bit colours (sRGB-decoded on the way in) come back exactly.
         let bytes = read.vertex_data.colors.as_ref().map(|c| {
             c.iter()
-                .map(|p| p.map(|v| (v * 255.0).round() as u8))
+                .map(|&[r, g, b, a]| {
+                    let code = |v: f32| (v * 255.0).round() as u8;
+                    let encode = trilux_io::image::linear_to_srgb;
+                    [code(encode(r)), code(encode(g)), code(encode(b)), code(a)]
+                })
                 .collect::<Vec<_>>()
         });
         assert_eq!(bytes, ply.colors);

@@ -71,7 +71,7 @@ pub use read::{
     MAX_ACCESSOR_VALUES, MAX_ZERO_FILLED_ELEMENTS, Options, from_bytes, read, read_scene,
     read_scene_with, read_with, scene_from_bytes,
 };
-pub use write::{write, write_points, write_with};
+pub use write::{DEFAULT_MATERIAL, UNLIT_MATERIAL, write, write_points, write_with};
 
 /// Per-vertex values beyond positions, normals and UVs that glTF carries:
 /// vertex colours and application-specific attributes. Every array has
@@ -210,7 +210,9 @@ pub(crate) const EXACT_F32_INTEGERS: u32 = 1 << 24;
 
 impl From<&super::ply::PlyData> for Points {
     /// The points of PLY data: positions, origin, normals, UVs and face
-    /// ids as they are; RGBA 8-bit colours as linear `[0, 1]` (`c / 255`);
+    /// ids as they are; RGBA 8-bit colours as linear `[0, 1]`, RGB decoded
+    /// from sRGB (PLY colours are display values, as 8-bit images are;
+    /// viewers then show them as other tools do) and alpha as `c / 255`;
     /// other scalars as attributes under their names. Triangles, if any,
     /// are not part of a point cloud and are left out.
     fn from(ply: &super::ply::PlyData) -> Self {
@@ -221,10 +223,15 @@ impl From<&super::ply::PlyData> for Points {
             uvs: ply.uvs.clone(),
             faces: ply.face_ids.clone(),
             vertex_data: VertexData {
-                colors: ply
-                    .colors
-                    .as_ref()
-                    .map(|c| c.iter().map(|p| p.map(|v| f32::from(v) / 255.0)).collect()),
+                colors: ply.colors.as_ref().map(|c| {
+                    c.iter()
+                        .map(|p| {
+                            let [r, g, b, a] = p.map(|v| f32::from(v) / 255.0);
+                            let decode = crate::image::srgb_to_linear;
+                            [decode(r), decode(g), decode(b), a]
+                        })
+                        .collect()
+                }),
                 attributes: ply
                     .scalars
                     .iter()

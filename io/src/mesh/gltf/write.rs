@@ -49,6 +49,12 @@ pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
 /// mesh where the file it came from did; glTF stores it in `f32`, and
 /// what `f32` cannot hold of it is added to the vertices.
 ///
+/// Triangles without a material get [`UNLIT_MATERIAL`] when there are
+/// vertex colours (shown as they are, as a radiance or baked result
+/// means), else [`DEFAULT_MATERIAL`]: glTF's own default is a metal that
+/// viewers draw nearly black. Reading the file back gives them that
+/// material.
+///
 /// Normals are written normalised; a zero or non-finite one is replaced
 /// by the normalised sum of its triangles' normals (`+z` for a vertex on
 /// no triangle), as viewers need unit normals.
@@ -164,6 +170,14 @@ pub fn write_points(path: impl AsRef<Path>, points: &Points) -> Result<()> {
     }
     doc.save(container)
 }
+
+/// The name of the material given to triangles without one when the mesh
+/// has vertex colours: unlit (`KHR_materials_unlit`), white, double-sided.
+pub const UNLIT_MATERIAL: &str = "vertex colours (unlit)";
+
+/// The name of the material given to triangles without one otherwise:
+/// white, metallic 0, roughness 1, double-sided.
+pub const DEFAULT_MATERIAL: &str = "default";
 
 /// `.glb` or `.gltf`.
 #[derive(Clone, Copy)]
@@ -351,7 +365,12 @@ impl<'a> Document<'a> {
             &mesh.objects[..]
         };
         let origin = mesh.origin.as_vec3();
+        let mut fallback = None;
         for object in objects.iter().filter(|o| !o.triangles.is_empty()) {
+            let material = match object.material {
+                Some(m) => materials[m],
+                None => *fallback.get_or_insert_with(|| self.fallback_material(data)),
+            };
             let indices = self.indices(
                 &mesh.indices[object.triangles.clone()],
                 mesh.positions.len(),
@@ -361,7 +380,7 @@ impl<'a> Document<'a> {
                 extensions: None,
                 extras: Default::default(),
                 indices: Some(indices),
-                material: object.material.map(|m| materials[m]),
+                material: Some(material),
                 mode: Valid(Mode::Triangles),
                 targets: None,
             };
@@ -552,6 +571,40 @@ impl<'a> Document<'a> {
             normalized: false,
             sparse: None,
         })
+    }
+
+    /// The material of triangles without one: glTF's default is metallic
+    /// and single-sided, which viewers draw nearly black (and not at all
+    /// from behind). With vertex colours, an unlit one
+    /// (`KHR_materials_unlit`) that shows them as they are (a radiance
+    /// result is the final colour); otherwise a white dielectric.
+    fn fallback_material(&mut self, data: &VertexData) -> Index<json::Material> {
+        let unlit = data.colors.is_some();
+        let mut material = json::Material {
+            name: Some(
+                if unlit {
+                    UNLIT_MATERIAL
+                } else {
+                    DEFAULT_MATERIAL
+                }
+                .into(),
+            ),
+            pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+                metallic_factor: json::material::StrengthFactor(0.0),
+                roughness_factor: json::material::StrengthFactor(1.0),
+                ..Default::default()
+            },
+            double_sided: true,
+            ..Default::default()
+        };
+        if unlit {
+            material.extensions = Some(json::extensions::material::Material {
+                unlit: Some(json::extensions::material::Unlit {}),
+                ..Default::default()
+            });
+            self.root.extensions_used.push("KHR_materials_unlit".into());
+        }
+        self.root.push(material)
     }
 
     /// A metallic-roughness material for `m`, with its texture embedded.
