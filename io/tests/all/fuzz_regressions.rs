@@ -105,8 +105,18 @@ fn replay(target: &str, data: &[u8]) -> Option<()> {
         }
         "gltf" => {
             let path = Path::new("/nonexistent-trilux-fuzz/asset.gltf");
-            if let Ok(mesh) = gltf::from_bytes(data, path, gltf::Options::default()) {
-                check_tri(&mesh);
+            if let Ok(scene) = gltf::scene_from_bytes(data, path, gltf::Options::default()) {
+                check_tri(&scene.mesh);
+                let check_data = |data: &gltf::VertexData, n: usize| {
+                    assert!(data.colors.as_ref().is_none_or(|c| c.len() == n));
+                    assert!(data.attributes.iter().all(|a| a.values.len() == n));
+                };
+                check_data(&scene.vertex_data, scene.mesh.positions.len());
+                let points = &scene.points;
+                let m = points.positions.len();
+                assert!(points.positions.iter().all(|p| p.is_finite()));
+                assert!(points.faces.as_ref().is_none_or(|f| f.len() == m));
+                check_data(&points.vertex_data, m);
             }
         }
         "image" => {
