@@ -1,4 +1,6 @@
-//! Sampled points → a PLY point cloud.
+//! Sampled points → a point cloud: PLY data, which
+//! `trilux_io::mesh::gltf::Points::from` turns into a glTF `POINTS`
+//! primitive.
 
 use mesh_sampling::SurfacePoint;
 use rayon::prelude::*;

@@ -12,31 +12,35 @@ pub fn positions_f64(mesh: &TetMesh) -> Vec<[f64; 3]> {
 }
 
 /// The boundary of a tetrahedral mesh as a triangle mesh (outward
-/// triangles, `f32` positions, only the boundary's vertices), for previews
-/// and sampling.
+/// triangles, only the boundary's vertices), for previews, sampling and
+/// glTF. Its `f32` positions are relative to an origin chosen as the
+/// readers choose one ([`trilux_io::mesh::recenter`]): zero unless the
+/// coordinates are far from it, so a far-away mesh keeps its precision.
 pub fn surface(mesh: &TetMesh) -> TriMesh {
     let boundary = mesh.boundary();
     let mut map = vec![u32::MAX; mesh.positions.len()];
-    let mut positions = Vec::new();
+    let mut used = Vec::new();
     let indices: Vec<[u32; 3]> = boundary
         .iter()
         .map(|t| {
             t.map(|v| {
                 let slot = &mut map[v as usize];
                 if *slot == u32::MAX {
-                    *slot = positions.len() as u32;
-                    positions.push(mesh.positions[v as usize].as_vec3());
+                    *slot = used.len() as u32;
+                    used.push(mesh.positions[v as usize]);
                 }
                 *slot
             })
         })
         .collect();
+    let (origin, positions) = trilux_io::mesh::recenter(&used);
     TriMesh {
         objects: vec![Object {
             name: String::new(),
             triangles: 0..indices.len(),
             material: None,
         }],
+        origin,
         positions,
         indices,
         ..TriMesh::default()

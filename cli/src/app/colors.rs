@@ -44,15 +44,17 @@ pub(crate) struct ConvertArgs {
 
 #[derive(Debug, clap::Args)]
 #[command(
-    about = "Bake mesh colours to a texture atlas: an OBJ with UVs, its .mtl and a PNG",
-    after_help = "Example:\n  trilux colors bake ../shared/data/meshes/spot.obj spot.meshcolors -o spot_atlas.obj"
+    about = "Bake mesh colours to a texture atlas: an OBJ with UVs, its .mtl and a PNG, or one glTF file with the atlas embedded",
+    after_help = "Examples:\n  trilux colors bake ../shared/data/meshes/spot.obj spot.meshcolors -o spot_atlas.obj\n  trilux colors bake ../shared/data/meshes/spot.obj spot.meshcolors -o spot_atlas.glb"
 )]
 pub(crate) struct BakeArgs {
     /// The mesh the colours were made for.
     pub(crate) mesh: PathBuf,
     /// The mesh colours.
     pub(crate) colors: PathBuf,
-    /// The OBJ to write; the atlas goes beside it as NAME_0.png and NAME.mtl.
+    /// The mesh to write: .obj (the atlas goes beside it as NAME_0.png
+    /// and NAME.mtl), .glb (one file, the atlas embedded) or .gltf (with
+    /// NAME.bin beside it, the atlas inside).
     #[arg(short, long, value_name = "OUT.obj")]
     pub(crate) output: PathBuf,
     /// MIP-safe packing for this many MIP levels (0: compact packing).
@@ -196,14 +198,7 @@ fn convert_summary(
 }
 
 fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
-    let ext = super::extension(&args.output);
-    if ext == "gltf" || ext == "glb" {
-        return Err(super::output_error(
-            &args.output,
-            "trilux-io writes no glTF yet (write .obj, with .mtl and .png beside it)",
-        ));
-    }
-    super::check_output(context, &args.output, &["obj"])?;
+    super::check_output(context, &args.output, &["obj", "glb", "gltf"])?;
     let mesh = super::read_mesh(context, &args.mesh)?;
     let (surface, colors) = context.step("reading the mesh colours", || {
         load_for(&mesh, &args.mesh, &args.colors)
@@ -220,12 +215,19 @@ fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
         })
         .map_err(|e| super::at(args.colors.display(), e))?;
     // No texture file named: the OBJ writer writes the atlas image
-    // beside the .obj and .mtl as NAME_atlas.png.
+    // beside the .obj and .mtl as NAME_0.png; the glTF writer embeds
+    // it as a PNG.
     let (baked, image) = trilux::atlas_mesh(&surface, &atlas, None);
     let force = context.force;
-    let files = context.step("writing OBJ, MTL and PNG", || {
-        trilux::output::write_atomic_files(&args.output, force, |tmp| Ok(baked.write(tmp)?))
-    })?;
+    let files = if super::extension(&args.output) == "obj" {
+        context.step("writing OBJ, MTL and PNG", || {
+            trilux::output::write_atomic_files(&args.output, force, |tmp| Ok(baked.write(tmp)?))
+        })?
+    } else {
+        context.step("writing glTF", || {
+            super::write_gltf(&args.output, force, |tmp| baked.write(tmp))
+        })?
+    };
     let text = format!(
         "{} faces baked to a {}×{} atlas{}: {}\n",
         colors.face_count(),

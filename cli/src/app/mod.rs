@@ -385,6 +385,45 @@ pub(crate) fn write_image(
     })
 }
 
+/// Writes a glTF output by extension, atomically, refusing to overwrite
+/// without `--force`: `.glb` as one file, `.gltf` with its `.bin` beside
+/// it (both or neither). `write` writes to a temporary path; its errors
+/// name `path` (and the `.bin` beside it), not the temporary files.
+/// Returns the files written.
+pub(crate) fn write_gltf(
+    path: &Path,
+    force: bool,
+    write: impl FnOnce(&Path) -> trilux_io::Result<()>,
+) -> Result<Vec<std::path::PathBuf>> {
+    if extension(path) == "gltf" {
+        let mut files = trilux::output::write_atomic_files(path, force, |tmp| {
+            write(tmp).map_err(|e| at_output(e, tmp, path))
+        })?;
+        files.sort();
+        Ok(files)
+    } else {
+        trilux::output::write_atomic(path, force, |tmp| {
+            write(tmp).map_err(|e| at_output(e, tmp, path))
+        })?;
+        Ok(vec![path.to_path_buf()])
+    }
+}
+
+/// A writer's error about the temporary file `tmp` (or a file beside it
+/// in the temporary folder of a set of files) as one about `path`.
+fn at_output(mut e: trilux_io::Error, tmp: &Path, path: &Path) -> Error {
+    if e.path == tmp {
+        e.path = path.to_path_buf();
+    } else if tmp.file_name() == path.file_name()
+        && let Some(name) = e.path.file_name()
+        && e.path.parent() == tmp.parent()
+    {
+        // A set of files: `tmp` is `path`'s name in a temporary folder.
+        e.path = path.with_file_name(name);
+    }
+    Error::from(e)
+}
+
 /// The lowercased extension.
 pub(crate) fn extension(path: &Path) -> String {
     path.extension()
@@ -393,8 +432,9 @@ pub(crate) fn extension(path: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// Checks that an output's folder exists and the extension is one of
-/// `allowed`, before any long computation.
+/// Checks that an output's folder exists, the extension is one of
+/// `allowed` and the file (and a `.gltf`'s `.bin`) is new or `--force`
+/// was given, before any long computation.
 pub(crate) fn check_output(context: &Context, path: &Path, allowed: &[&str]) -> Result<()> {
     let ext = extension(path);
     if !allowed.contains(&ext.as_str()) {
@@ -418,7 +458,12 @@ pub(crate) fn check_output(context: &Context, path: &Path, allowed: &[&str]) -> 
             format!("the folder {} does not exist", dir.display()),
         ));
     }
-    trilux::output::check_new(path, context.force)
+    trilux::output::check_new(path, context.force)?;
+    if ext == "gltf" {
+        // The glTF writer puts NAME.bin beside NAME.gltf.
+        trilux::output::check_new(&path.with_extension("bin"), context.force)?;
+    }
+    Ok(())
 }
 
 /// Runs `f` on `threads` threads (all when `None`).

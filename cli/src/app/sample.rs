@@ -1,12 +1,12 @@
 //! `trilux sample`: random points on a mesh, uniform or with a density
 //! (texture, per-face weights, or a mesh-colours channel), to a PLY point
-//! cloud.
+//! cloud or a glTF `POINTS` primitive.
 
 use std::path::PathBuf;
 
 use mesh_sampling::{BlueNoiseTarget, Channel, Packing, SurfacePoint};
 use trilux_io::mesh::TriMesh;
-use trilux_io::mesh::ply;
+use trilux_io::mesh::{gltf, ply};
 
 use super::ops::sample::{
     ChannelArg, MAX_POINTS, Method, Points, Source, draw_points, meshcolors_source, preview,
@@ -16,8 +16,8 @@ use super::{Context, Result, arg_error, file_cause, file_error};
 
 #[derive(Debug, clap::Args)]
 #[command(
-    about = "Scatter random points on a mesh (uniform or with a density) and write a PLY point cloud",
-    after_help = "Examples:\n  trilux sample ../shared/data/meshes/spot.obj -n 1000000 \\\n      --density ../shared/data/textures/spot_texture.png -o spot.ply --preview spot.png\n  trilux sample ../shared/data/meshes/spot.obj --blue-noise --radius 0.01 -o spot_blue.ply"
+    about = "Scatter random points on a mesh (uniform or with a density) and write a PLY or glTF point cloud",
+    after_help = "Examples:\n  trilux sample ../shared/data/meshes/spot.obj -n 1000000 \\\n      --density ../shared/data/textures/spot_texture.png -o spot.ply --preview spot.png\n  trilux sample ../shared/data/meshes/spot.obj --blue-noise --radius 0.01 -o spot_blue.ply\n  trilux sample ../shared/data/meshes/spot.obj -n 100000 -o spot_points.glb"
 )]
 pub(crate) struct Args {
     /// The mesh: .obj, .gltf, .glb or .ply.
@@ -82,10 +82,13 @@ pub(crate) struct Args {
     /// Threads to use (all by default).
     #[arg(long)]
     pub(crate) threads: Option<usize>,
-    /// The PLY file to write (positions, normals, UVs, face ids).
+    /// The point cloud to write, with normals, UVs (when the mesh has them)
+    /// and face ids: .ply, or .glb / .gltf (+ .bin) as a POINTS primitive
+    /// with the face ids as the _FACE attribute (meshes of at most 2^24
+    /// triangles).
     #[arg(short, long, value_name = "OUT.ply")]
     pub(crate) output: PathBuf,
-    /// Write ASCII PLY instead of binary.
+    /// Write ASCII PLY instead of binary (PLY only).
     #[arg(long)]
     pub(crate) ascii: bool,
     /// Also render a PNG (or EXR) picture of the points on the mesh.
@@ -119,11 +122,24 @@ impl PackingArg {
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let wanted = wanted(&args)?;
     let channel = args.channel.unwrap_or(ChannelArg::Luminance).channel();
-    super::check_output(context, &args.output, &["ply"])?;
+    super::check_output(context, &args.output, &["ply", "glb", "gltf"])?;
+    let gltf = super::extension(&args.output) != "ply";
+    if gltf && args.ascii {
+        return Err(arg_error(
+            "--ascii",
+            format!(
+                "ASCII is a PLY encoding, and {} is glTF (write .ply, or leave out --ascii)",
+                args.output.display()
+            ),
+        ));
+    }
     if let Some(p) = &args.preview {
         super::check_output(context, p, &["png", "exr"])?;
     }
     let mesh = super::read_mesh(context, &args.mesh)?;
+    if gltf {
+        check_gltf_faces(&args.output, mesh.indices.len())?;
+    }
     let method = method(&args)?;
     let source = source(context, &args, &mesh, channel)?;
     let points = super::with_threads(args.threads, || {
@@ -139,8 +155,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             super::at(args.mesh.display(), e)
         }
     })?;
-    write(context, &args, &mesh, &points)?;
-    report(context, &args, &mesh, &points, method);
+    let files = write(context, &args, &mesh, &points)?;
+    report(context, &args, (&mesh, &points), method, &files);
     Ok(())
 }
 
@@ -260,13 +276,34 @@ fn source(context: &mut Context, args: &Args, mesh: &TriMesh, channel: Channel) 
     Ok(source)
 }
 
-/// The PLY file, and the preview when asked for.
+/// Refuses a glTF output for a mesh of more than 2^24 triangles, before
+/// sampling: glTF stores each point's face id as an `f32` attribute,
+/// exact below 2^24 only.
+fn check_gltf_faces(output: &std::path::Path, triangles: usize) -> Result<()> {
+    if triangles > GLTF_MAX_FACES {
+        return Err(file_error(
+            output,
+            format!(
+                "the mesh has {triangles} triangles, and glTF stores each point's face id as a \
+                 32-bit float, exact only for the first 2^24 ({GLTF_MAX_FACES}) triangles \
+                 (write .ply for larger meshes)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Face ids glTF's `f32` `_FACE` attribute holds exactly: 0 to 2^24 − 1.
+const GLTF_MAX_FACES: usize = 1 << 24;
+
+/// The point cloud (PLY or glTF by extension), and the preview when
+/// asked for.
 fn write(
     context: &mut Context,
     args: &Args,
     mesh: &TriMesh,
     points: &[SurfacePoint],
-) -> Result<()> {
+) -> Result<Vec<PathBuf>> {
     let cloud = context.step("building the point cloud", || {
         trilux::point_cloud(mesh, points)
     });
@@ -276,20 +313,35 @@ fn write(
         ply::Format::BinaryLittleEndian
     };
     let force = context.force;
-    context.step("writing the PLY file", || {
-        trilux::output::write_atomic(&args.output, force, |tmp| {
-            Ok(ply::write(tmp, &cloud, format)?)
-        })
-    })?;
+    let files = if super::extension(&args.output) == "ply" {
+        context.step("writing the PLY file", || {
+            trilux::output::write_atomic(&args.output, force, |tmp| {
+                Ok(ply::write(tmp, &cloud, format)?)
+            })
+        })?;
+        vec![args.output.clone()]
+    } else {
+        let points = gltf::Points::from(&cloud);
+        context.step("writing the glTF file", || {
+            super::write_gltf(&args.output, force, |tmp| gltf::write_points(tmp, &points))
+        })?
+    };
     if let Some(path) = &args.preview {
         let image = context.step("rendering the preview", || preview(mesh, points, 768, 768));
         super::write_image(context, path, &image)?;
     }
-    Ok(())
+    Ok(files)
 }
 
-/// The summary line, or the JSON object.
-fn report(context: &Context, args: &Args, mesh: &TriMesh, points: &[SurfacePoint], method: Method) {
+/// The summary line, or the JSON object; `files` are the point cloud's
+/// (a `.gltf` and its `.bin`, or one file).
+fn report(
+    context: &Context,
+    args: &Args,
+    (mesh, points): (&TriMesh, &[SurfacePoint]),
+    method: Method,
+    files: &[PathBuf],
+) {
     let packing = args.packing.unwrap_or(PackingArg::Elimination);
     let kind = if args.blue_noise {
         format!("{}, blue noise by {}", method.name(), packing.name())
@@ -302,7 +354,11 @@ fn report(context: &Context, args: &Args, mesh: &TriMesh, points: &[SurfacePoint
         if points.len() == 1 { "" } else { "s" },
         args.mesh.display(),
         mesh.indices.len(),
-        args.output.display(),
+        files
+            .iter()
+            .map(|f| f.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
         args.preview
             .as_ref()
             .map(|p| format!(", preview {}", p.display()))
@@ -318,8 +374,52 @@ fn report(context: &Context, args: &Args, mesh: &TriMesh, points: &[SurfacePoint
         "packing": args.blue_noise.then_some(packing.name()),
         "seed": args.seed,
         "output": super::shown(&args.output),
+        "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
         "preview": args.preview.as_deref().map(super::shown),
         "seconds": context.timings_json(),
     });
     context.report(&text, json);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trilux_io::glam::Vec3;
+
+    /// A face id of 2^24 or more, which glTF's `f32` `_FACE` cannot hold:
+    /// the writer's error, naming the output (not its temporary name), and
+    /// nothing left behind; a mesh with that many triangles is refused
+    /// before sampling.
+    #[test]
+    fn a_face_id_gltf_cannot_hold_is_an_error_naming_the_output() {
+        let dir = tempfile::tempdir().unwrap();
+        let cloud = ply::PlyData {
+            positions: vec![Vec3::ZERO, Vec3::X],
+            face_ids: Some(vec![0, GLTF_MAX_FACES as u32]),
+            ..ply::PlyData::default()
+        };
+        let points = gltf::Points::from(&cloud);
+        for name in ["far.glb", "far.gltf"] {
+            let out = dir.path().join(name);
+            let e = super::super::write_gltf(&out, false, |tmp| gltf::write_points(tmp, &points))
+                .unwrap_err();
+            let text = e.to_string();
+            assert!(
+                text.starts_with(&format!("{}: ", out.display()))
+                    && text.contains("point 1 lies on face 16777216")
+                    && text.contains("2^24"),
+                "{text}"
+            );
+            assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        }
+        let out = dir.path().join("big.glb");
+        assert!(check_gltf_faces(&out, GLTF_MAX_FACES).is_ok());
+        let e = check_gltf_faces(&out, GLTF_MAX_FACES + 1).unwrap_err();
+        assert_eq!(e.place(), Some(out.display().to_string()));
+        let why = std::error::Error::source(&e).unwrap().to_string();
+        assert!(
+            why.contains("16777217 triangles") && why.contains(".ply"),
+            "{why}"
+        );
+    }
 }

@@ -10,7 +10,7 @@ use super::ops::stuff::{Spacing, number, stuff};
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Tetrahedralize a surface by isosurface stuffing (bounded dihedral angles); writes TetGen, MEDIT or VTU",
-    after_help = "Example:\n  trilux tetra ../shared/data/meshes/stanford-bunny.obj --spacing 0.003 -o bunny.node --preview bunny_tets.png"
+    after_help = "Examples:\n  trilux tetra ../shared/data/meshes/stanford-bunny.obj --spacing 0.003 -o bunny.node --preview bunny_tets.png\n  trilux tetra ../shared/data/meshes/stanford-bunny.obj -o bunny.node --glb bunny_boundary.glb"
 )]
 pub(crate) struct Args {
     /// The surface: .obj, .gltf, .glb or .ply (holes and overlaps are fine:
@@ -33,12 +33,19 @@ pub(crate) struct Args {
     /// Also render the boundary to a PNG.
     #[arg(long, value_name = "OUT.png")]
     pub(crate) preview: Option<PathBuf>,
+    /// Also write the boundary of the tetrahedra (a closed surface,
+    /// triangles facing out) as glTF: .glb, or .gltf with a .bin beside it.
+    #[arg(long, value_name = "OUT.glb")]
+    pub(crate) glb: Option<PathBuf>,
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     super::check_output(context, &args.output, &["node", "ele", "mesh", "vtu"])?;
     if let Some(p) = &args.preview {
         super::check_output(context, p, &["png", "exr"])?;
+    }
+    if let Some(p) = &args.glb {
+        super::check_output(context, p, &["glb", "gltf"])?;
     }
     let spacing = match (args.spacing, args.size) {
         (None, Some(h)) => {
@@ -66,8 +73,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             Ok(trilux_io::tet::write(tmp, &out)?)
         })
     })?;
-    if let Some(p) = &args.preview {
-        let surface = trilux::tet::surface(&out);
+    let surface = (args.preview.is_some() || args.glb.is_some())
+        .then(|| context.step("finding the boundary", || trilux::tet::surface(&out)));
+    if let (Some(p), Some(surface)) = (&args.glb, &surface) {
+        files.extend(context.step("writing the boundary", || {
+            super::write_gltf(p, force, |tmp| trilux_io::mesh::gltf::write(tmp, surface))
+        })?);
+    }
+    if let (Some(p), Some(surface)) = (&args.preview, &surface) {
         let image = context.step("rendering the preview", || {
             trilux::preview::render_mesh(&surface.positions, &surface.indices, 768, 768)
         });

@@ -6,6 +6,7 @@ mod common;
 mod cli;
 mod cmd;
 mod gltf_clients;
+mod gltf_out;
 mod help;
 mod info_warnings;
 mod tet_cli;
