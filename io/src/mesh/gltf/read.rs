@@ -188,6 +188,11 @@ impl Reader<'_> {
         if let Some(broken) = first_dangling_reference(document.as_json()) {
             return Err(self.invalid(broken));
         }
+        // The gltf crate unwraps these when asked for an image's source
+        // (found by fuzzing), so they are checked here first.
+        if let Some(problem) = first_image_without_source(document.as_json()) {
+            return Err(self.invalid(problem));
+        }
         let mut json = document.into_json();
         if let Some(missing) = json
             .extensions_required
@@ -1168,6 +1173,20 @@ fn first_dangling_reference(root: &gltf::json::Root) -> Option<String> {
         }
     }
     problems.pop().map(|p| format!("a reference to {p}"))
+}
+
+/// The first image whose data cannot be found as the specification
+/// says (a `bufferView` with its `mimeType`, or a `uri`), described.
+fn first_image_without_source(root: &gltf::json::Root) -> Option<String> {
+    root.images.iter().enumerate().find_map(|(i, image)| {
+        match (&image.buffer_view, &image.mime_type, &image.uri) {
+            (Some(_), None, _) => Some(format!(
+                "image {i} in a buffer view without the mimeType the specification requires"
+            )),
+            (None, _, None) => Some(format!("image {i} with neither a uri nor a buffer view")),
+            _ => None,
+        }
+    })
 }
 
 /// Decodes `%XX` escapes; `None` for a malformed escape or non-UTF-8.
