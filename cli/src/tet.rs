@@ -1,8 +1,10 @@
-//! trilux-io tetrahedral meshes → solver positions, surfaces, quality.
+//! trilux-io tetrahedral meshes → solver positions, surfaces, quality;
+//! solved objects → pictures and glTF surfaces with their radiance.
 
 use glam::{DVec3, Vec3};
 use tet_diffusion::Light;
-use trilux_io::mesh::{Object, TriMesh};
+use trilux_io::mesh::gltf::{Attribute, AttributeValues, VertexData};
+use trilux_io::mesh::{Material, Object, TriMesh};
 use trilux_io::tet::TetMesh;
 
 /// The node positions as `[x, y, z]` rows, the form multires'
@@ -316,6 +318,178 @@ fn display_normals(o: &tet_diffusion::Object) -> Vec<Vec3> {
         .collect()
 }
 
+/// The boundary triangles of `mesh` numbered by their place in
+/// [`boundary_vertices`](tet_diffusion::TetMesh::boundary_vertices): the
+/// numbering of [`Object::radiance`](tet_diffusion::Object::radiance) and
+/// [`Object::boundary_flux`](tet_diffusion::Object::boundary_flux), so a
+/// surface of the boundary vertices alone takes them as they are (what
+/// `trilux view` sends the page, and [`radiance_surface`] writes).
+pub fn boundary_triangles(mesh: &tet_diffusion::TetMesh) -> Vec<[u32; 3]> {
+    mesh.boundary()
+        .iter()
+        // Every corner of a boundary triangle is a boundary vertex.
+        .map(|t| t.map(|v| mesh.boundary_index(v as usize).unwrap_or(0) as u32))
+        .collect()
+}
+
+/// The name of each piece in [`radiance_surface`]'s mesh (its glTF node
+/// and mesh): `piece K`, K from 0 as the pieces are given.
+pub fn piece_name(k: usize) -> String {
+    format!("piece {k}")
+}
+
+/// The boundary surfaces of solved objects (the pieces of a session, or
+/// of a fracture) as one triangle mesh with per-vertex data, one
+/// [`Object`] range per piece (named by [`piece_name`]): what
+/// [`write_radiance_gltf`] writes.
+///
+/// - Positions: the boundary vertices of each piece in the display frame
+///   ([`Object::display_positions`](tet_diffusion::Object::display_positions):
+///   fractured pieces where they were moved, as the pictures show them),
+///   in the mesh's own unit (as the VTU and TetGen exports; glTF viewers
+///   take them as metres), relative to a global shift for coordinates far
+///   from zero ([`trilux_io::mesh::recenter`], written as the node's
+///   translation). Normals: the outward vertex normals, turned likewise.
+///   Triangles: [`boundary_triangles`], outward.
+/// - `COLOR_0` ([`VertexData::colors`]): the linear outgoing radiance at
+///   normal exitance ([`Object::radiance`](tet_diffusion::Object::radiance)`(None)`),
+///   divided by `white` and clamped to `[0, 1]`, alpha 1. Pass the
+///   picture's [`exposure_white`] (as `trilux diffuse` and `trilux view`'s
+///   export do), and a viewer that shows the vertex colours unlit shows
+///   the PNG's exposure: the brightest 1 % of the picture at white, the
+///   rest linear below it (the PNG's pixels also carry the view-dependent
+///   Fresnel factor and the specular highlight, which per-vertex colours
+///   cannot).
+/// - `_RADIANCE` (VEC3): the same radiance unscaled and unclamped, linear
+///   RGB in W/(mm² sr).
+/// - `_PHI` (VEC3): the fluence φ at each boundary vertex, one value per
+///   colour channel (the diffusion is solved per channel), as
+///   [`Object::fluence`](tet_diffusion::Object::fluence).
+///
+/// # Errors
+/// [`Error::Invalid`](crate::Error::Invalid) for no objects, a `white`
+/// that is not a positive finite number, or a radiance or φ that is not
+/// finite (naming the piece and the vertex).
+pub fn radiance_surface(
+    objects: &[tet_diffusion::Object],
+    white: f32,
+) -> crate::Result<(TriMesh, VertexData)> {
+    use crate::Error::Invalid;
+    if objects.is_empty() {
+        return Err(Invalid(
+            "no objects: a radiance surface needs at least one".into(),
+        ));
+    }
+    if !(white.is_finite() && white > 0.0) {
+        return Err(Invalid(format!(
+            "the exposure's white {white}: must be a positive finite radiance"
+        )));
+    }
+    let mut absolute = Vec::new();
+    let mut normals = Vec::new();
+    let mut indices = Vec::new();
+    let mut parts = Vec::new();
+    let mut colors = Vec::new();
+    let mut radiance = Vec::new();
+    let mut phi = Vec::new();
+    for (k, o) in objects.iter().enumerate() {
+        let m = o.mesh();
+        let bv = m.boundary_vertices();
+        let base = absolute.len() as u32;
+        let first = indices.len();
+        let display = o.display_positions();
+        let turned = display_normals(o);
+        absolute.extend(bv.iter().map(|&v| display[v as usize]));
+        normals.extend(bv.iter().map(|&v| turned[v as usize]));
+        indices.extend(
+            boundary_triangles(m)
+                .into_iter()
+                .map(|t| t.map(|i| i + base)),
+        );
+        parts.push(Object {
+            name: piece_name(k),
+            triangles: first..indices.len(),
+            material: Some(0),
+        });
+        let fluence = o.fluence();
+        for (i, (&v, l)) in bv.iter().zip(o.radiance(None)).enumerate() {
+            let f = fluence[v as usize];
+            if !l.iter().chain(&f).all(|x| x.is_finite()) {
+                return Err(Invalid(format!(
+                    "{} (boundary vertex {i}, node {v}): the radiance {l:?} or φ {f:?} is not \
+                     finite (is the object solved?)",
+                    piece_name(k)
+                )));
+            }
+            let l = Vec3::from_array(l.map(|x| x as f32));
+            let c = (l / white).clamp(Vec3::ZERO, Vec3::ONE);
+            colors.push([c.x, c.y, c.z, 1.0]);
+            radiance.push(l);
+            phi.push(Vec3::from_array(f.map(|x| x as f32)));
+        }
+    }
+    let (origin, positions) = trilux_io::mesh::recenter(&absolute);
+    let mesh = TriMesh {
+        positions,
+        origin,
+        indices,
+        normals: Some(normals),
+        objects: parts,
+        materials: vec![Material {
+            name: "radiance".into(),
+            // White: the vertex colours are the whole colour.
+            diffuse: [1.0; 3],
+            diffuse_texture: None,
+            diffuse_image: None,
+            wrap: Default::default(),
+        }],
+        ..TriMesh::default()
+    };
+    let data = VertexData {
+        colors: Some(colors),
+        attributes: vec![
+            Attribute {
+                name: "RADIANCE".into(),
+                values: AttributeValues::Vec3(radiance),
+            },
+            Attribute {
+                name: "PHI".into(),
+                values: AttributeValues::Vec3(phi),
+            },
+        ],
+    };
+    Ok((mesh, data))
+}
+
+/// Writes [`radiance_surface`]`(objects, white)` as glTF by extension:
+/// `.glb`, or `.gltf` with its `.bin` beside it. Atomic: written under
+/// temporary names in the same folder and renamed into place; an existing
+/// file (the `.bin` too) is refused unless `overwrite`.
+///
+/// # Errors
+/// [`radiance_surface`]'s, [`Error::Exists`](crate::Error::Exists), and
+/// the writer's (an extension other than `.glb` or `.gltf`, I/O).
+pub fn write_radiance_gltf(
+    path: &std::path::Path,
+    objects: &[tet_diffusion::Object],
+    white: f32,
+    overwrite: bool,
+) -> crate::Result<()> {
+    let (mesh, data) = radiance_surface(objects, white)?;
+    crate::output::write_atomic_files(path, overwrite, |tmp| {
+        Ok(trilux_io::mesh::gltf::write_with(tmp, &mesh, &data)?)
+    })?;
+    Ok(())
+}
+
+/// The picture of a session as `trilux view` exports it: every piece, lit
+/// by the first piece's lights (all pieces share them), seen from `view`
+/// ([`render`]).
+pub fn render_session(session: &tet_diffusion::Session, size: u32, view: Option<Vec3>) -> Picture {
+    let lights = session.pieces()[0].lights();
+    render(session.pieces(), &lights, size, view)
+}
+
 /// The radiance in air toward the eye at a fragment: the hemispherical
 /// flux `J⁺` meeting the boundary from inside (interpolated from the
 /// vertices, [`Object::boundary_flux`](tet_diffusion::Object::boundary_flux)) times `F_t(n·v) / (π η²)`
@@ -422,6 +596,202 @@ mod tests {
                 assert!((stuffing[e] - diffusion[d]).abs() < 1e-8, "{p:?} edge {e}");
             }
         }
+    }
+
+    /// A marble ball of radius 1 (10 mm) lit from +x, solved, broken in two
+    /// by the plane x = 0.1; the second piece moved far from the origin
+    /// (so the file needs a global shift).
+    fn two_lit_pieces() -> [tet_diffusion::Object; 2] {
+        let (p, t) = tet_diffusion::kuhn_ball(6, 1.0);
+        let mesh = tet_diffusion::TetMesh::new(&p, &t).unwrap();
+        let marble = tet_diffusion::Medium::measured("marble").unwrap();
+        let mut o = tet_diffusion::Object::homogeneous(mesh, 10.0, marble, 1.3).unwrap();
+        o.add_light(Light::Directional {
+            to_light: DVec3::X,
+            irradiance: [1.0; 3],
+        })
+        .unwrap();
+        let [mut a, mut b] = o.fracture(DVec3::new(0.1, 0.0, 0.0), DVec3::X).unwrap();
+        let far = DVec3::new(2.0e6, -3.0, 0.5);
+        a.set_transform(glam::DAffine3::from_translation(far));
+        b.set_transform(glam::DAffine3::from_translation(far + 0.3 * DVec3::X));
+        a.solve().unwrap();
+        b.solve().unwrap();
+        [a, b]
+    }
+
+    /// The median luminance of the pieces' radiance: about half the
+    /// vertices clamp at it.
+    fn median_white(pieces: &[tet_diffusion::Object]) -> f32 {
+        let mut lum: Vec<f32> = pieces
+            .iter()
+            .flat_map(|o| o.radiance(None))
+            .map(|l| trilux_io::image::luminance(l.map(|x| x as f32)))
+            .collect();
+        lum.sort_by(f32::total_cmp);
+        lum[lum.len() / 2]
+    }
+
+    #[test]
+    fn a_radiance_surface_is_each_pieces_boundary_with_its_radiance_and_phi() {
+        let pieces = two_lit_pieces();
+        let white = median_white(&pieces);
+        let (mesh, data) = radiance_surface(&pieces, white).unwrap();
+        assert_eq!(mesh.objects.len(), 2);
+        assert!(mesh.origin.x > 1.9e6, "{}", mesh.origin);
+        let colors = data.colors.as_ref().unwrap();
+        let radiance = match data.attribute("RADIANCE") {
+            Some(AttributeValues::Vec3(v)) => v,
+            other => panic!("{other:?}"),
+        };
+        let phi = match data.attribute("PHI") {
+            Some(AttributeValues::Vec3(v)) => v,
+            other => panic!("{other:?}"),
+        };
+        let normals = mesh.normals.as_ref().unwrap();
+        let (mut base, mut clamped) = (0usize, 0);
+        for (k, o) in pieces.iter().enumerate() {
+            let m = o.mesh();
+            let bv = m.boundary_vertices();
+            let part = &mesh.objects[k];
+            assert_eq!(part.name, format!("piece {k}"));
+            assert_eq!(part.triangles.len(), m.boundary().len());
+            // The same triangles, in the boundary vertices' numbering.
+            for (t, b) in mesh.indices[part.triangles.clone()]
+                .iter()
+                .zip(m.boundary())
+            {
+                assert_eq!(t.map(|i| bv[i as usize - base]), *b);
+            }
+            let display = o.display_positions();
+            let l = o.radiance(None);
+            let f = o.fluence();
+            for (i, &v) in bv.iter().enumerate() {
+                let j = base + i;
+                let p = mesh.origin + mesh.positions[j].as_dvec3();
+                assert!(p.distance(display[v as usize]) < 1e-6, "{p} {k} {i}");
+                let n = (o.transform().matrix3 * m.vertex_normals()[v as usize]).as_vec3();
+                assert!(normals[j].distance(n) < 1e-6);
+                let expected = Vec3::from_array(l[i].map(|x| x as f32));
+                assert_eq!(radiance[j], expected);
+                assert_eq!(phi[j], Vec3::from_array(f[v as usize].map(|x| x as f32)));
+                for c in 0..3 {
+                    let shown = (expected[c] / white).min(1.0);
+                    assert_eq!(colors[j][c], shown);
+                }
+                assert_eq!(colors[j][3], 1.0);
+                clamped += usize::from(expected.max_element() > white);
+            }
+            base += bv.len();
+        }
+        assert_eq!(base, mesh.positions.len());
+        // The white matters: some clamp, some do not.
+        assert!(clamped > base / 4 && clamped < base, "{clamped} of {base}");
+        // The side facing the light (+x) is brighter than the far side.
+        let local_x: Vec<f64> = pieces
+            .iter()
+            .flat_map(|o| {
+                let p = o.mesh().positions();
+                o.mesh()
+                    .boundary_vertices()
+                    .iter()
+                    .map(|&v| p[v as usize].x)
+            })
+            .collect();
+        let side = |lit: bool| {
+            let js: Vec<usize> = (0..base)
+                .filter(|&j| {
+                    if lit {
+                        local_x[j] > 0.5
+                    } else {
+                        local_x[j] < -0.5
+                    }
+                })
+                .collect();
+            js.iter().map(|&j| radiance[j].x).sum::<f32>() / js.len() as f32
+        };
+        let (lit, dark) = (side(true), side(false));
+        assert!(lit > 2.0 * dark && dark > 0.0, "{lit} {dark}");
+    }
+
+    #[test]
+    fn a_radiance_gltf_reads_back_validates_and_is_not_overwritten_silently() {
+        let pieces = two_lit_pieces();
+        let dir = tempfile::tempdir().unwrap();
+        let white = median_white(&pieces);
+        let (mesh, data) = radiance_surface(&pieces, white).unwrap();
+        for name in ["r.glb", "r.gltf"] {
+            let path = dir.path().join(name);
+            write_radiance_gltf(&path, &pieces, white, false).unwrap();
+            test_support::gltf::validate(&path);
+            let scene = trilux_io::mesh::gltf::read_scene(&path).unwrap();
+            let back = &scene.vertex_data;
+            assert!(back.colors == data.colors, "{name}: the colours differ");
+            for a in &data.attributes {
+                let got = back.attribute(&a.name);
+                assert!(got == Some(&a.values), "{name}: {} differs", a.name);
+            }
+            assert_eq!(back.attributes.len(), 2);
+            assert_eq!(scene.mesh.indices, mesh.indices);
+            let names: Vec<&str> = scene.mesh.objects.iter().map(|o| o.name.as_str()).collect();
+            assert_eq!(names, ["piece 0", "piece 1"]);
+            let far = mesh.absolute_positions();
+            for (a, b) in scene.mesh.absolute_positions().iter().zip(&far) {
+                assert!(a.distance(*b) < 1e-3, "{a} {b}");
+            }
+            // Refused without overwrite, kept as it was; replaced with it
+            // (the colours are in the .bin of a .gltf).
+            let bytes = || {
+                let mut b = std::fs::read(&path).unwrap();
+                if name.ends_with("gltf") {
+                    b.extend(std::fs::read(path.with_extension("bin")).unwrap());
+                }
+                b
+            };
+            let before = bytes();
+            let e = write_radiance_gltf(&path, &pieces, 2.0 * white, false).unwrap_err();
+            assert!(matches!(e, crate::Error::Exists(_)), "{e}");
+            assert!(bytes() == before, "{name}: changed");
+            write_radiance_gltf(&path, &pieces, 2.0 * white, true).unwrap();
+            assert!(bytes() != before, "{name}: not replaced");
+        }
+        // A .gltf's .bin in the way is refused too, and nothing is moved.
+        let lone = dir.path().join("lone.gltf");
+        std::fs::write(dir.path().join("lone.bin"), "keep").unwrap();
+        let e = write_radiance_gltf(&lone, &pieces, white, false).unwrap_err();
+        assert!(e.to_string().contains("lone.bin"), "{e}");
+        assert!(!lone.exists());
+        // No temporary files left behind.
+        let mut names: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["lone.bin", "r.bin", "r.glb", "r.gltf"]);
+    }
+
+    #[test]
+    fn a_radiance_surface_refuses_what_it_cannot_show() {
+        let pieces = two_lit_pieces();
+        for white in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+            let e = radiance_surface(&pieces, white).unwrap_err().to_string();
+            assert!(e.contains("the exposure's white"), "{e}");
+        }
+        let e = radiance_surface(&[], 1.0).unwrap_err().to_string();
+        assert!(e.starts_with("no objects"), "{e}");
+        let [mut a, _] = pieces;
+        let n = a.mesh().vertex_count();
+        let mut phi = vec![1.0; n];
+        let v = a.mesh().boundary_vertices()[3] as usize;
+        phi[v] = f64::NAN;
+        a.set_phi([phi, vec![1.0; n], vec![1.0; n]]).unwrap();
+        let e = radiance_surface(std::slice::from_ref(&a), 1.0)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&format!("piece 0 (boundary vertex 3, node {v})")),
+            "{e}"
+        );
     }
 
     #[test]

@@ -73,6 +73,12 @@ pub(crate) struct Args {
     /// Also φ and the radiance per node as VTU, for ParaView.
     #[arg(long, value_name = "OUT.vtu")]
     pub(crate) vtu: Option<PathBuf>,
+    /// Also the surface as glTF (.glb, or .gltf + .bin) for 3D viewers:
+    /// the radiance as vertex colours at the picture's exposure, and as
+    /// attributes the radiance unclamped (_RADIANCE) and φ (_PHI); one
+    /// object per piece.
+    #[arg(long, value_name = "OUT.glb")]
+    pub(crate) glb: Option<PathBuf>,
 }
 
 /// Sweeps of TransCut's relaxation of the cross-section after a
@@ -167,7 +173,7 @@ fn paint(args: &Args, object: &mut Object) -> Result<Vec<usize>> {
 }
 
 /// `--session`: the view's session replayed, and its picture (and EXR,
-/// VTU) written as the page's exports write them — byte for byte.
+/// VTU, glTF) written as the page's exports write them — byte for byte.
 #[cfg(feature = "view")]
 fn run_session(context: &mut Context, args: &Args, path: &Path) -> Result<()> {
     check_outputs(context, args)?;
@@ -177,14 +183,18 @@ fn run_session(context: &mut Context, args: &Args, path: &Path) -> Result<()> {
     let view = args.picture.direction().or(saved.map(|v| v.as_vec3()));
     let size = args.picture.size;
     let force = context.force;
-    context.step("rendering", || {
-        super::view::write_picture(&session, true, &args.output, size, view, force)
-    })?;
+    let picture = context.step("rendering", || {
+        trilux::tet::render_session(&session, size, view)
+    });
+    super::view::write_picture(&picture, true, &args.output, force)?;
     if let Some(p) = &args.exr {
-        super::view::write_picture(&session, false, p, size, view, force)?;
+        super::view::write_picture(&picture, false, p, force)?;
     }
     if let Some(p) = &args.vtu {
         super::view::write_vtu(&session, p, force)?;
+    }
+    if let Some(p) = &args.glb {
+        write_glb(p, session.pieces(), &picture, force)?;
     }
     let pieces = session.pieces();
     let tets: usize = pieces.iter().map(|o| o.mesh().tets().len()).sum();
@@ -218,7 +228,26 @@ fn check_outputs(context: &Context, args: &Args) -> Result<()> {
     if let Some(p) = &args.vtu {
         super::check_output(context, p, &["vtu"])?;
     }
+    if let Some(p) = &args.glb {
+        super::check_output(context, p, &["glb", "gltf"])?;
+        // A .gltf's buffer goes beside it, under its name.
+        if super::extension(p) == "gltf" {
+            trilux::output::check_new(&p.with_extension("bin"), context.force)?;
+        }
+    }
     Ok(())
+}
+
+/// `--glb`: the pieces' surfaces with their radiance, the vertex colours
+/// at the exposure of `picture` (the PNG written beside it).
+fn write_glb(
+    path: &Path,
+    objects: &[Object],
+    picture: &trilux::tet::Picture,
+    force: bool,
+) -> Result<()> {
+    let white = trilux::tet::exposure_white(picture);
+    trilux::tet::write_radiance_gltf(path, objects, white, force)
 }
 
 /// Adds the lights (the default one when none is given) and the
@@ -302,7 +331,7 @@ fn fracture(args: &Args, object: Object, diagonal: f64) -> Result<Vec<Object>> {
     Ok(vec![a, b])
 }
 
-/// The picture, and the EXR and VTU when asked for.
+/// The picture, and the EXR, VTU and glTF when asked for.
 fn write(context: &mut Context, args: &Args, solved: &Solved) -> Result<()> {
     let image = context.step("rendering", || {
         render(
@@ -318,6 +347,9 @@ fn write(context: &mut Context, args: &Args, solved: &Solved) -> Result<()> {
     }
     if let Some(p) = &args.vtu {
         write_vtu(context, p, &solved.objects[0], solved.dropped.as_ref())?;
+    }
+    if let Some(p) = &args.glb {
+        write_glb(p, &solved.objects, &image, context.force)?;
     }
     Ok(())
 }

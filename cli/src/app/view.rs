@@ -181,60 +181,45 @@ impl trilux::view::Exporter for Cli {
     ) -> std::result::Result<(), String> {
         let view = view.map(|v| v.as_vec3());
         let written = match kind {
-            ExportKind::Png | ExportKind::Exr => write_picture(
-                session,
-                kind == ExportKind::Png,
-                path,
-                size,
-                view,
-                overwrite,
-            ),
+            ExportKind::Png | ExportKind::Exr => {
+                // A file in the way is refused before the picture is drawn.
+                trilux::output::check_new(path, overwrite).map_err(|e| e.to_string())?;
+                let picture = trilux::tet::render_session(session, size, view);
+                write_picture(&picture, kind == ExportKind::Png, path, overwrite)
+            }
             ExportKind::Vtu => write_vtu(session, path, overwrite),
             ExportKind::Tet => return write_tet(session, path, overwrite),
-            ExportKind::Session => return Err("session files are written by the server".into()),
+            ExportKind::Session | ExportKind::Glb => {
+                return Err(format!(
+                    "{} files are written by the server",
+                    kind.extension()
+                ));
+            }
         };
         written.map_err(|e| e.to_string())
     }
 }
 
-/// The picture of a session as the page's export draws it: every piece,
-/// lit by the first piece's lights (all pieces share them), from `view`.
-pub(crate) fn session_picture(
-    session: &Session,
-    size: u32,
-    view: Option<glam::Vec3>,
-) -> trilux::tet::Picture {
-    let lights = session.pieces()[0].lights();
-    trilux::tet::render(session.pieces(), &lights, size, view)
-}
-
-/// Writes the session's picture: tone-mapped 8-bit PNG (`png`) or linear
-/// EXR, atomically (an existing file only with `overwrite`).
+/// Writes a session's picture ([`trilux::tet::render_session`]):
+/// tone-mapped 8-bit PNG (`png`) or linear EXR, atomically (an existing
+/// file only with `overwrite`).
 pub(crate) fn write_picture(
-    session: &Session,
+    picture: &trilux::tet::Picture,
     png: bool,
     path: &Path,
-    size: u32,
-    view: Option<glam::Vec3>,
     overwrite: bool,
 ) -> trilux::Result<()> {
-    let picture = session_picture(session, size, view);
-    let image = if png {
-        trilux::tet::tone_map(&picture)
-    } else {
-        picture.image
-    };
     trilux::output::write_atomic(path, overwrite, |tmp| {
         if png {
             Ok(trilux_io::image::write_png(
                 tmp,
-                &image,
+                &trilux::tet::tone_map(picture),
                 trilux_io::image::PngDepth::Eight,
             )?)
         } else {
             Ok(trilux_io::image::write_exr(
                 tmp,
-                &image,
+                &picture.image,
                 trilux_io::image::ExrPrecision::F32,
             )?)
         }

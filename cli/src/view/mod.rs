@@ -53,10 +53,10 @@ pub enum Out {
     Binary(Arc<Vec<u8>>),
 }
 
-/// Writes what the page asks to export other than the session file
-/// (which the server writes itself): pictures as `trilux diffuse`
-/// renders them, VTU, tet meshes. The binary supplies it, since the
-/// renderer lives there.
+/// Writes what the page asks to export other than the session file and
+/// the glTF surface (which the server writes itself, with the library's
+/// writers): pictures as `trilux diffuse` renders them, VTU, tet meshes.
+/// The binary supplies it.
 pub trait Exporter: Send + 'static {
     /// Writes `kind` of `session` to `path` (`size` pixels, seen from
     /// `view`), atomically, refusing an existing file unless `overwrite`.

@@ -85,11 +85,13 @@ pub enum Request {
     },
     /// Write a file into the export folder.
     Export {
-        /// `png`, `exr`, `vtu`, `tet` (TetGen .node/.ele) or `session`.
+        /// `png`, `exr`, `vtu`, `glb`, `tet` (TetGen .node/.ele) or
+        /// `session`.
         kind: ExportKind,
         /// A plain file name (no folder).
         name: String,
-        /// Picture size for png/exr.
+        /// Picture size for png/exr (and the picture whose exposure a
+        /// glb's vertex colours take).
         size: u32,
         /// Replace an existing file (the page asked the user).
         overwrite: bool,
@@ -116,6 +118,10 @@ pub enum ExportKind {
     Exr,
     /// φ and radiance per node, ParaView.
     Vtu,
+    /// The boundary surface with its radiance as vertex colours (at the
+    /// PNG's exposure), the radiance and φ as attributes: binary glTF,
+    /// written by the server ([`crate::tet::write_radiance_gltf`]).
+    Glb,
     /// The tet mesh, TetGen .node (+ .ele beside it).
     Tet,
     /// The session file (`trilux view --replay`).
@@ -129,6 +135,7 @@ impl ExportKind {
             Self::Png => "png",
             Self::Exr => "exr",
             Self::Vtu => "vtu",
+            Self::Glb => "glb",
             Self::Tet => "node",
             Self::Session => "json",
         }
@@ -496,12 +503,13 @@ fn export(o: &Map<String, Value>) -> Result<Request, BadField> {
         Some("png") => ExportKind::Png,
         Some("exr") => ExportKind::Exr,
         Some("vtu") => ExportKind::Vtu,
+        Some("glb") => ExportKind::Glb,
         Some("tet") => ExportKind::Tet,
         Some("session") => ExportKind::Session,
         _ => {
             return Err(BadField::new(
                 "kind",
-                "expected png, exr, vtu, tet or session",
+                "expected png, exr, vtu, glb, tet or session",
             ));
         }
     };
@@ -607,6 +615,7 @@ mod tests {
             r#"{"seq":10,"op":"material","material":"apple"}"#,
             r#"{"seq":11,"op":"probe","piece":0,"point":[0,0,0]}"#,
             r#"{"seq":12,"op":"export","kind":"png","name":"a.png","size":256}"#,
+            r#"{"seq":12,"op":"export","kind":"glb","name":"a.GLB","size":256}"#,
             r#"{"seq":13,"op":"hello"}"#,
         ];
         for m in ok {
@@ -644,6 +653,14 @@ mod tests {
             (
                 r#"{"seq":1,"op":"export","kind":"png","name":"x.exr"}"#,
                 "name",
+            ),
+            (
+                r#"{"seq":1,"op":"export","kind":"glb","name":"x.gltf"}"#,
+                "name",
+            ),
+            (
+                r#"{"seq":1,"op":"export","kind":"gltf","name":"x.gltf"}"#,
+                "kind",
             ),
             (r#"{"seq":1,"op":"recombine","a":1,"b":1}"#, "b"),
             (

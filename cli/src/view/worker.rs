@@ -222,12 +222,15 @@ impl Worker {
                 view,
             } => {
                 let path = self.export_dir.join(&name);
-                let result = if kind == ExportKind::Session {
-                    let log = self.session.log();
-                    session_file::write(&path, &self.source, &log, &self.envs, view, overwrite)
-                } else {
-                    self.exporter
-                        .export(&self.session, kind, &path, size, view, overwrite)
+                let result = match kind {
+                    ExportKind::Session => {
+                        let log = self.session.log();
+                        session_file::write(&path, &self.source, &log, &self.envs, view, overwrite)
+                    }
+                    ExportKind::Glb => write_glb(&self.session, &path, size, view, overwrite),
+                    _ => self
+                        .exporter
+                        .export(&self.session, kind, &path, size, view, overwrite),
                 };
                 match result {
                     Ok(()) => self.send(Out::Text(
@@ -453,6 +456,25 @@ impl Worker {
     }
 }
 
+/// The export of kind `glb`: the pieces' boundary surfaces with their
+/// radiance ([`crate::tet::write_radiance_gltf`]), the vertex colours at
+/// the exposure of the PNG the page would export now (`size` pixels,
+/// seen from `view`).
+fn write_glb(
+    session: &Session,
+    path: &std::path::Path,
+    size: u32,
+    view: Option<DVec3>,
+    overwrite: bool,
+) -> Result<(), String> {
+    // A file in the way is refused before the picture is drawn.
+    crate::output::check_new(path, overwrite).map_err(|e| e.to_string())?;
+    let picture = crate::tet::render_session(session, size, view.map(|v| v.as_vec3()));
+    let white = crate::tet::exposure_white(&picture);
+    crate::tet::write_radiance_gltf(path, session.pieces(), white, overwrite)
+        .map_err(|e| e.to_string())
+}
+
 /// Sends each piece's boundary surface (positions, normals, triangles)
 /// and keeps the frames for pages that connect later.
 fn publish_surfaces(out: &broadcast::Sender<Out>, latest: &Mutex<Latest>, session: &Session) {
@@ -472,9 +494,7 @@ fn publish_surfaces(out: &broadcast::Sender<Out>, latest: &Mutex<Latest>, sessio
         );
         protocol::put_u32(
             &mut payload,
-            m.boundary()
-                .iter()
-                .flat_map(|t| t.map(|v| m.boundary_index(v as usize).unwrap_or(0) as u32)),
+            crate::tet::boundary_triangles(m).into_iter().flatten(),
         );
         protocol::frame(
             SURFACE,

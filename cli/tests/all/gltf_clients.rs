@@ -444,3 +444,85 @@ fn points_validate_and_three_js_draws_them_as_points() {
     }
     assert_pixel(&v, 9, BACKGROUND, "between the points");
 }
+
+/// The rendered pixel of probe `i`, 8-bit sRGB, opaque.
+fn pixel(v: &Value, i: usize) -> [u8; 3] {
+    let rgba: Vec<u8> = v["probes"][i]["rgba"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no probe {i} in {v:#}"))
+        .iter()
+        .map(|c| c.as_u64().unwrap() as u8)
+        .collect();
+    assert_eq!(rgba[3], 255, "probe {i}: {v:#}");
+    [rgba[0], rgba[1], rgba[2]]
+}
+
+#[test]
+fn a_diffuse_glb_lit_from_one_side_shows_its_lit_side_brighter_in_three_js() {
+    let temporary = tempfile::tempdir().unwrap();
+    let dir = out_dir(temporary.path());
+    // A unit sphere, 10 mm across per unit, of marble, lit from +x only.
+    let sphere = dir.join("sphere.obj");
+    if sphere.exists() {
+        std::fs::remove_file(&sphere).unwrap();
+    }
+    trilux::shapes::icosphere(3).write(&sphere).unwrap();
+    let glb = dir.join("sphere_diffuse.glb");
+    let out = Command::new(env!("CARGO_BIN_EXE_trilux"))
+        .current_dir(&dir)
+        .args(["--force", "diffuse", "sphere.obj", "--material", "marble"])
+        .args(["--unit-mm", "10", "--light", "dir:1,0,0", "--size", "96"])
+        .args(["-o", "sphere_diffuse.png", "--glb", "sphere_diffuse.glb"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    test_support::gltf::validate(&glb);
+    let scene = gltf::read_scene(&glb).unwrap();
+    let colours = scene.vertex_data.colors.as_ref().unwrap();
+    assert!(colours.iter().flatten().all(|c| (0.0..=1.0).contains(c)));
+    // Points on the sphere's front (+z, toward three.js's camera): the
+    // lit side, the middle, the far side; then the background.
+    let probes = [
+        Vec3::new(0.6, 0.0, 0.8),
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(-0.6, 0.0, 0.8),
+    ];
+    let mut args: Vec<String> = probes.iter().flat_map(|p| world(*p)).collect();
+    args.extend(["--at".into(), "0.005,0.005".into()]);
+    let shot = dir.join("sphere_diffuse.glb.png");
+    let Some(v) = three(&glb, &shot, &args) else {
+        return;
+    };
+    let object = &v["objects"][0];
+    assert_eq!(
+        object["gltf_attributes"],
+        serde_json::json!(["COLOR_0", "NORMAL", "POSITION", "_PHI", "_RADIANCE"]),
+        "{v:#}"
+    );
+    assert_eq!(object["material"]["vertex_colors"], true, "{v:#}");
+    // The base colour is white: the vertex colours are the whole colour.
+    let factor: Vec<f64> = object["material"]["color"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c.as_f64().unwrap())
+        .collect();
+    assert_eq!(factor, [1.0; 3], "{v:#}");
+    let lum = |p: [u8; 3]| 0.2126 * linear(p[0]) + 0.7152 * linear(p[1]) + 0.0722 * linear(p[2]);
+    let [lit, middle, dark] = [0, 1, 2].map(|i| pixel(&v, i));
+    let shown = format!(
+        "lit {lit:?}, middle {middle:?}, far {dark:?} (screenshot {}{})",
+        shot.display(),
+        keep_hint()
+    );
+    eprintln!("diffuse --glb in three.js: {shown}");
+    // Non-black where lit, and brighter toward the light.
+    assert!(lit.iter().all(|&c| c >= 64), "{shown}");
+    assert!(lum(lit) > 1.5 * lum(middle), "{shown}");
+    assert!(lum(middle) > 1.5 * lum(dark), "{shown}");
+    // Marble is translucent: light reaches the far side too.
+    assert!(lum(dark) > 0.0, "{shown}");
+    // Not a flat grey: marble's red scatters farthest.
+    assert!(dark[0] > dark[2], "{shown}");
+    assert_pixel(&v, 3, BACKGROUND, "beside the sphere");
+}

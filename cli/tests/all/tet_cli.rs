@@ -690,3 +690,80 @@ fn diffuse_warns_that_an_open_surface_is_not_closed_and_a_closed_one_passes_quie
     assert!(out.status.success(), "{err}");
     assert!(!err.contains("closed surface"), "{err}");
 }
+
+#[test]
+fn diffuse_writes_the_surface_as_gltf_one_object_per_piece_and_keeps_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    stuffed_blob(d, "0.2");
+    let broken = [
+        "diffuse",
+        "blob.node",
+        "--fracture",
+        "plane:1,0,0,0",
+        "--size",
+        "64",
+    ];
+    let report = json(
+        d,
+        &[&broken[..], &["-o", "broken.png", "--glb", "broken.glb"]].concat(),
+    );
+    assert_eq!(report["objects"], 2);
+    let glb = d.join("broken.glb");
+    test_support::gltf::validate(&glb);
+    let scene = trilux_io::mesh::gltf::read_scene(&glb).unwrap();
+    let names: Vec<&str> = scene.mesh.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["piece 0", "piece 1"]);
+    let n = scene.mesh.positions.len();
+    assert_eq!(scene.mesh.normals.as_ref().map(Vec::len), Some(n));
+    let colours = scene.vertex_data.colors.as_ref().unwrap();
+    assert!(colours.iter().flatten().all(|c| (0.0..=1.0).contains(c)));
+    // The PNG's exposure: its brightest percent at white, so some
+    // vertices clamp, and most do not.
+    let white = colours.iter().filter(|c| c[..3].contains(&1.0)).count();
+    assert!(white > 0 && white < n / 2, "{white} of {n} at white");
+    let radiance = match scene.vertex_data.attribute("RADIANCE") {
+        Some(trilux_io::mesh::gltf::AttributeValues::Vec3(r)) => r,
+        other => panic!("{other:?}"),
+    };
+    // Unclamped: the colours are the radiance over one white.
+    let (k, brightest) = radiance
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.max_element().total_cmp(&b.1.max_element()))
+        .unwrap();
+    assert!(brightest.max_element() > 0.0 && colours[k][..3].contains(&1.0));
+    let phi = scene.vertex_data.attribute("PHI").unwrap();
+    assert_eq!((phi.len(), phi.components()), (n, 3));
+    // The second piece is drawn moved apart along +x, as in the picture.
+    let x = |o: usize| {
+        let t = &scene.mesh.indices[scene.mesh.objects[o].triangles.clone()];
+        let p = scene.mesh.absolute_positions();
+        t.iter().flatten().map(|&v| p[v as usize].x).sum::<f64>() / (3 * t.len()) as f64
+    };
+    assert!(x(1) > x(0) + 0.3, "{} {}", x(0), x(1));
+
+    // .gltf: a .bin beside it; a .bin in the way is refused before the
+    // solve (no picture written), and so is an existing .glb.
+    let gltf = [&broken[..], &["-o", "b2.png", "--glb", "broken.gltf"]].concat();
+    json(d, &gltf);
+    test_support::gltf::validate(&d.join("broken.gltf"));
+    assert!(d.join("broken.bin").is_file());
+    std::fs::remove_file(d.join("broken.gltf")).unwrap();
+    let again = [&broken[..], &["-o", "b3.png", "--glb", "broken.gltf"]].concat();
+    common::fails_with(d, 1, &again, &["broken.bin", "exists", "--force"]);
+    let again = [&broken[..], &["-o", "b3.png", "--glb", "broken.glb"]].concat();
+    common::fails_with(d, 1, &again, &["broken.glb", "exists", "--force"]);
+    assert!(!d.join("b3.png").exists() && !d.join("broken.gltf").exists());
+    let before = std::fs::read(&glb).unwrap();
+    let forced = [&["--force"][..], &again].concat();
+    json(d, &forced);
+    assert!(d.join("b3.png").exists());
+    assert!(
+        std::fs::read(&glb).unwrap() == before,
+        "not the same surface"
+    );
+    // Only .glb and .gltf.
+    let obj = [&broken[..], &["-o", "b4.png", "--glb", "b4.obj"]].concat();
+    common::fails_with(d, 2, &obj, &["b4.obj", "\"obj\"", ".glb, .gltf"]);
+}

@@ -1,8 +1,9 @@
 //! `trilux view`'s page in a real browser: headless Chromium (software
 //! WebGL through SwiftShader) driven by `tests/browser/e2e.mjs` with
 //! playwright-core — load, first frame with radiance, orbit, stroke cut,
-//! paint, relight, undo, redo, screenshots — asserting on pixels, mesh
-//! counts and the server's numbers.
+//! paint, relight, undo, redo, an environment map, a GLB export,
+//! screenshots — asserting on pixels, mesh counts, the written file and
+//! the server's numbers.
 //!
 //! Needs `node`, Chromium (`TRILUX_BROWSER` names it; default
 //! `/usr/bin/chromium`) and playwright-core installed under
@@ -146,7 +147,30 @@ async fn the_page_cuts_paints_relights_undoes_and_redoes_in_chromium() {
     );
     assert_eq!(done("env").last().map(String::as_str), Some("lights"));
     assert_ne!(env["mean"], step("redo")["mean"]);
-    for s in ["load", "cut", "paint", "light", "undo", "redo", "env"] {
+    // The panel's GLB button: the server wrote the surface (its name made
+    // a file name), a valid glTF file with one object per piece.
+    let export = step("export");
+    let written = page.exports.join("page_surface.glb");
+    assert_eq!(
+        export["paths"],
+        json!([written.display().to_string()]),
+        "{export}"
+    );
+    assert!(
+        export["hud"]
+            .as_str()
+            .is_some_and(|h| h.starts_with("written ")),
+        "{export}"
+    );
+    test_support::gltf::validate(&written);
+    let scene = trilux_io::mesh::gltf::read_scene(&written).unwrap();
+    assert_eq!(scene.mesh.objects.len(), 1);
+    assert!(scene.vertex_data.colors.is_some());
+    let help = v["help_text"].as_str().unwrap();
+    assert!(help.contains("GLB"), "{help}");
+    for s in [
+        "load", "cut", "paint", "light", "undo", "redo", "env", "export",
+    ] {
         assert_eq!(step(s)["errors"], 0, "{s}: {v:#}");
     }
 }

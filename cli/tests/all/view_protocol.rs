@@ -479,6 +479,62 @@ async fn every_edit_through_the_protocol() {
     // The stroke's gesture is kept (a replay undoes it as one step).
     let gestures: Vec<Option<u64>> = log.edits.iter().map(|l| l.gesture).collect();
     assert_eq!(gestures, [Some(42), None, None, None, None]);
+    // The glTF surface is written by the server itself (not the
+    // exporter): broken in two, one object per piece, each piece's surface
+    // vertices with the radiance as colours and attributes.
+    send(
+        &mut s,
+        json!({"seq": 36, "op": "fracture", "piece": 0, "point": [0, 0, 0], "normal": [0, 1, 0]}),
+    )
+    .await;
+    let st = loop {
+        let st = until(&mut s, "status", &mut seen).await;
+        if st["seqs"].as_array().unwrap().contains(&json!(36)) {
+            break st;
+        }
+    };
+    assert_eq!(st["pieces"], 2);
+    let glb = dir.path().join("surface.glb");
+    send(
+        &mut s,
+        json!({"seq": 37, "op": "export", "kind": "glb", "name": "surface.glb", "size": 64,
+               "view": [0, 0, 1]}),
+    )
+    .await;
+    let written = until(&mut s, "export", &mut seen).await;
+    assert_eq!(written["seq"], 37);
+    test_support::gltf::validate(&glb);
+    let scene = trilux_io::mesh::gltf::read_scene(&glb).unwrap();
+    let names: Vec<&str> = scene.mesh.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["piece 0", "piece 1"]);
+    let vertices: u64 = st["surface_vertices"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(scene.mesh.positions.len() as u64, vertices);
+    let colours = scene.vertex_data.colors.as_ref().unwrap();
+    assert!(colours.iter().flatten().all(|c| (0.0..=1.0).contains(c)));
+    // The exposure puts the brightest percent of the picture at white.
+    assert!(colours.iter().any(|c| c[..3].contains(&1.0)));
+    for (name, components) in [("RADIANCE", 3), ("PHI", 3)] {
+        let a = scene.vertex_data.attribute(name).unwrap();
+        assert_eq!((a.len(), a.components()), (vertices as usize, components));
+    }
+    // Not over an existing file unless the page asks.
+    let before = std::fs::read(&glb).unwrap();
+    send(
+        &mut s,
+        json!({"seq": 38, "op": "export", "kind": "glb", "name": "surface.glb", "size": 32}),
+    )
+    .await;
+    let e = until(&mut s, "error", &mut seen).await;
+    assert_eq!(
+        (e["seq"].clone(), e["exists"].clone()),
+        (json!(38), json!(true))
+    );
+    assert_eq!(std::fs::read(&glb).unwrap(), before);
     // No temporary files left behind.
     let left: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()

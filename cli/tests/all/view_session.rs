@@ -1,7 +1,7 @@
 //! A session of `trilux view` saved from its page and replayed: by
 //! `trilux view --replay` and by `trilux diffuse --session`, whose
-//! picture and VTU are byte for byte the page's exports of the live
-//! session; and a bad session file is an error naming the file and the
+//! picture, VTU and glTF surface are byte for byte the page's exports of
+//! the live session; and a bad session file is an error naming the file and the
 //! entry.
 #![cfg(feature = "view")]
 
@@ -92,11 +92,11 @@ fn status_of(seq: u64) -> impl Fn(&Value) -> bool {
     }
 }
 
-/// Exports the picture, VTU (and the session file, when `session`) of
+/// Exports the picture, VTU, GLB (and the session file, when `session`) of
 /// the server's session once it is refined.
 async fn export(s: &mut Socket, prefix: &str, session: bool) {
     let mut seq = 100;
-    let mut kinds = vec![("png", "png"), ("vtu", "vtu")];
+    let mut kinds = vec![("png", "png"), ("vtu", "vtu"), ("glb", "glb")];
     if session {
         kinds.push(("session", "json"));
     }
@@ -148,6 +148,7 @@ fn a_view_session_replays_in_diffuse_as_the_page_exports_it_byte_for_byte() {
         .current_dir(d)
         .args(["diffuse", "--session", "live.json", "--view", "0.5,1,2"])
         .args(["--size", "96", "-o", "diffuse.png", "--vtu", "diffuse.vtu"])
+        .args(["--glb", "diffuse.glb"])
         .output()
         .unwrap();
     assert!(out.status.success(), "{out:?}");
@@ -156,6 +157,9 @@ fn a_view_session_replays_in_diffuse_as_the_page_exports_it_byte_for_byte() {
     let read = |name: &str| std::fs::read(d.join(name)).unwrap();
     assert!(read("diffuse.png") == read("live.png"), "the PNGs differ");
     assert!(read("diffuse.vtu") == read("live.vtu"), "the VTUs differ");
+    // The glTF surface too: the same surface, radiance and exposure.
+    test_support::gltf::validate(&d.join("live.glb"));
+    assert!(read("diffuse.glb") == read("live.glb"), "the GLBs differ");
     // The file keeps the page's camera; without --view, diffuse renders
     // from there.
     let saved: Value = serde_json::from_str(&text).unwrap();
@@ -200,6 +204,7 @@ fn a_view_session_replays_in_diffuse_as_the_page_exports_it_byte_for_byte() {
     replay.wait().unwrap();
     assert!(read("replay.png") == read("live.png"), "the PNGs differ");
     assert!(read("replay.vtu") == read("live.vtu"), "the VTUs differ");
+    assert!(read("replay.glb") == read("live.glb"), "the GLBs differ");
 }
 
 #[test]

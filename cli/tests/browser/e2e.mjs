@@ -1,6 +1,6 @@
 // End-to-end test of trilux view's page in headless Chromium: load, first
-// frame with radiance, orbit, stroke cut, paint, relight, undo, redo,
-// screenshot. Prints one JSON object with what it saw; the Rust test
+// frame with radiance, orbit, stroke cut, paint, relight, undo, redo, an
+// environment map, a GLB export, screenshot. Prints one JSON object with what it saw; the Rust test
 // asserts on it. Usage: node e2e.mjs URL SCREENSHOT_DIR [first-frame]
 // (first-frame: only load the page and time its first frame with radiance).
 import { chromium } from 'playwright-core';
@@ -110,6 +110,14 @@ try {
   await page.waitForFunction(() => window.trilux.environment !== null && window.trilux.environment !== undefined, null, { timeout: 60000 });
   out.steps.env = { ...(await stats()), ...(await pixels()) };
   await page.screenshot({ path: dir + '/5-environment.png' });
+  // Export the surface as GLB from the panel's button (the server writes
+  // it into the export folder and answers with its path).
+  await page.fill('#size', '64');
+  await page.fill('#ename', 'page surface');
+  await page.click('[data-export="glb"]');
+  await page.waitForFunction(() => window.trilux.exports.length > 0 || window.trilux.errors.length > 0, null, { timeout: 60000 });
+  out.steps.export = { ...(await stats()), paths: await page.evaluate(() => window.trilux.exports.map((e) => e.path)),
+    hud: await page.evaluate(() => document.getElementById('status').textContent) };
   // Shortcuts with Ctrl are the browser's: copy and save neither switch
   // the mode nor toggle specular (Ctrl+R, reload, is not pressed here).
   await page.keyboard.press('Control+c'); await page.keyboard.press('Control+s');
@@ -117,6 +125,7 @@ try {
   // The help overlay.
   await page.keyboard.press('?');
   out.help_visible = await page.evaluate(() => !document.getElementById('helpbox').hidden);
+  out.help_text = await page.evaluate(() => document.getElementById('helpbox').innerText);
   await page.screenshot({ path: dir + '/4-help.png' });
   out.logs = logs;
   out.console_errors = consoleErrors;

@@ -406,7 +406,7 @@ canvas.addEventListener('dragover', (e) => e.preventDefault());
 canvas.addEventListener('drop', (e) => { e.preventDefault(); const f = e.dataTransfer.files[0]; if (f) loadEnvironment(f); });
 
 function exportFile(kind, overwrite = false) {
-  const ext = { png: 'png', exr: 'exr', vtu: 'vtu', tet: 'node', session: 'json' }[kind];
+  const ext = { png: 'png', exr: 'exr', vtu: 'vtu', glb: 'glb', tet: 'node', session: 'json' }[kind];
   const name = $('ename').value.replace(/[^A-Za-z0-9_.-]/g, '_').replace(/^\.+/, '') + '.' + ext;
   state.lastExport = kind;
   const view = state.camera ? normalize(state.camera.eye().map((v, i) => v - state.camera.target[i])) : undefined;
