@@ -4,11 +4,11 @@
 //!
 //! | Python | Rust |
 //! |---|---|
-//! | `load`, `save`, `Mesh` | trilux-io meshes ([`mesh`]) |
+//! | `load`, `save`, `Mesh` | trilux-io meshes ([`mesh`]); glTF colours and attributes ([`gltf`]) |
 //! | `sample_surface`, `blue_noise`, `sample_surface_even` | mesh-sampling ([`sampling`]) |
 //! | `Distribution1D`, `Distribution2D` | discrete-sampling ([`discrete`]) |
 //! | `MeshColors` | mesh-colors via `trilux::to_mesh_colors` ([`colors`]) |
-//! | `tetrahedralize`, `load_tets`, `save_tets`, `save_points` | stuffing, trilux-io ([`tets`]) |
+//! | `tetrahedralize`, `load_tets`, `save_tets`, `save_points` | stuffing, trilux-io ([`tets`]), PLY or glTF points |
 //! | `Object`, `render`, `media` | tet-diffusion ([`transcut`]) |
 //! | `Error`, `InputError`, `FileError`, `InternalError` | every crate's error, message unchanged ([`error`]) |
 //!
@@ -26,6 +26,7 @@ pub mod arrays;
 pub mod colors;
 pub mod discrete;
 pub mod error;
+pub mod gltf;
 pub mod mesh;
 pub mod sampling;
 pub mod tets;

@@ -407,15 +407,36 @@ pub(crate) fn load(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Mesh> {
 }
 
 /// Writes a triangle mesh (a `trilux.Mesh`, a `trimesh.Trimesh` or a
-/// `(vertices, faces)` pair) as OBJ (with MTL and textures) or PLY, by
-/// extension. An existing file is replaced.
+/// `(vertices, faces)` pair) by extension: OBJ (with MTL and textures),
+/// PLY, or glTF (`.glb`, one file; `.gltf` with a `.bin` of the same name
+/// beside it), with the mesh's normals, UVs and materials (textures
+/// embedded). An existing file is replaced.
+///
+/// glTF files also keep, per vertex, `colors` (`COLOR_0`): `(n, 3)` or
+/// `(n, 4)` floats in [0, 1], linear as glTF says, or `uint8` taken as
+/// 8-bit sRGB (trimesh's `visual.vertex_colors`) and decoded; and
+/// `attributes`: a dict of names to `(n,)` or `(n, k)` arrays (k from 1
+/// to 4, stored as float32), written as glTF's `_NAME` attributes
+/// (three.js's `geometry.attributes._name`, Blender's attributes); a
+/// name may be given with or without the underscore. With another
+/// extension they raise `trilux.InputError`, as does a colour outside
+/// [0, 1], a wrong number of rows, a non-finite value or a name that is
+/// not ASCII letters, digits and `_`.
 #[pyfunction]
+#[pyo3(signature = (path, mesh, *, colors = None, attributes = None))]
 pub(crate) fn save(
     py: Python<'_>,
     path: &Bound<'_, PyAny>,
     mesh: &Bound<'_, PyAny>,
+    colors: Option<&Bound<'_, PyAny>>,
+    attributes: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<()> {
     let path = path_arg(path, "path")?;
     let mesh = mesh_arg(mesh, None)?;
-    detached(py, || Ok(mesh.write(&path)?))
+    let n = mesh.positions.len();
+    let data = crate::gltf::vertex_data(&path, colors, attributes, n, ("vertex", "vertices"))?;
+    detached(py, || match &data {
+        Some(data) => Ok(trilux_io::mesh::gltf::write_with(&path, &mesh, data)?),
+        None => Ok(mesh.write(&path)?),
+    })
 }

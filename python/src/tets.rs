@@ -144,19 +144,43 @@ pub(crate) fn save_tets(
     detached(py, || Ok(trilux_io::tet::write(&path, &mesh)?))
 }
 
-/// Writes a point cloud as PLY (binary little-endian): `points` `(n, 3)`,
-/// optional `normals` `(n, 3)` and `face_index` `(n,)` (PLY `face_id`),
-/// as `trilux sample` writes them.
+/// Writes a point cloud by extension: PLY (binary little-endian, as
+/// `trilux sample` writes it) or glTF (`.glb`, or `.gltf` with its `.bin`:
+/// a `POINTS` primitive). `points` `(n, 3)`, optional `normals` `(n, 3)`
+/// and `face_index` `(n,)` (PLY `face_id`, glTF `_FACE`, which keeps ids
+/// below 2**24).
+///
+/// glTF files also keep `colors` and `attributes` per point, as
+/// `trilux.save` writes them per vertex (with another extension they
+/// raise `trilux.InputError`; `FACE` is `face_index`'s name there). An
+/// existing file is replaced.
 #[pyfunction]
-#[pyo3(signature = (path, points, *, normals = None, face_index = None))]
+#[pyo3(signature = (path, points, *, normals = None, face_index = None, colors = None, attributes = None))]
 pub(crate) fn save_points(
     py: Python<'_>,
     path: &Bound<'_, PyAny>,
     points: &Bound<'_, PyAny>,
     normals: Option<&Bound<'_, PyAny>>,
     face_index: Option<&Bound<'_, PyAny>>,
+    colors: Option<&Bound<'_, PyAny>>,
+    attributes: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<()> {
     let path = path_arg(path, "path")?;
+    let gltf = crate::gltf::is_gltf(&path);
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if !gltf && ext != "ply" {
+        return Err(Failure {
+            kind: crate::error::Kind::File,
+            message: format!(
+                "{}: unknown extension {ext:?} for points (write .ply, .glb or .gltf)",
+                path.display()
+            ),
+        }
+        .into());
+    }
     let p = arrays::rows_f64::<3>(points, "points")?;
     let absolute: Vec<DVec3> = p.into_iter().map(DVec3::from_array).collect();
     let (origin, positions) = trilux_io::mesh::recenter(&absolute);
@@ -195,6 +219,40 @@ pub(crate) fn save_points(
                 .collect::<PyResult<Vec<u32>>>()
         })
         .transpose()?;
+    let data = crate::gltf::vertex_data(&path, colors, attributes, n, ("point", "points"))?;
+    if gltf {
+        if let Some((i, f)) = face_ids
+            .iter()
+            .flatten()
+            .enumerate()
+            .find(|(_, f)| **f >= 1 << 24)
+        {
+            return Err(Failure::input(format!(
+                "face_index: entry {i} is {f}; glTF stores face ids as float32, exact below \
+                 2**24 = 16777216 (write .ply for meshes with more triangles)"
+            ))
+            .into());
+        }
+        let vertex_data = data.unwrap_or_default();
+        let face = trilux_io::mesh::gltf::FACE_ATTRIBUTE;
+        if face_ids.is_some() && vertex_data.attribute(face).is_some() {
+            return Err(Failure::input(format!(
+                "attributes: {face} is where face_index goes in a glTF file; rename it"
+            ))
+            .into());
+        }
+        let cloud = trilux_io::mesh::gltf::Points {
+            positions,
+            origin,
+            normals,
+            uvs: None,
+            faces: face_ids,
+            vertex_data,
+        };
+        return detached(py, || {
+            Ok(trilux_io::mesh::gltf::write_points(&path, &cloud)?)
+        });
+    }
     let data = trilux_io::mesh::ply::PlyData {
         positions,
         origin,

@@ -61,6 +61,8 @@ def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     colors = trilux.MeshColors.from_texture(mesh, np.ones((2, 2, 3)))
     rgb: npt.NDArray[np.float32] = colors.lookup(faces, np.ones((len(faces), 3)) / 3)
     baked, atlas = colors.bake()
+    trilux.save(path + ".glb", mesh, colors=np.ones((len(vertices), 3)), attributes={"PHI": vertices[:, 0]})
+    trilux.save_points(path + ".glb", points, face_index=faces, attributes={"DEPTH": points[:, 2]})
     try:
         trilux.load("missing.obj")
     except trilux.FileError as e:

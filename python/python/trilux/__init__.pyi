@@ -3,7 +3,7 @@
 # and an overload per value of every `return_*` flag, plus a plain-`bool`
 # fallback), and checked by `mypy --strict` on tests/typing_usage.py.
 import os
-from typing import Any, Literal, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Literal, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -59,7 +59,16 @@ class Mesh:
     def warnings(self) -> list[str]: ...
 
 def load(path: PathLike) -> Mesh: ...
-def save(path: PathLike, mesh: MeshLike) -> None: ...
+# save / save_points: colors and attributes go into glTF files (.glb, .gltf)
+# only: colors (n, 3) or (n, 4), floats in [0, 1] (linear) or uint8 (sRGB);
+# attributes {name: (n,) or (n, k) array, k from 1 to 4}, written as _NAME.
+def save(
+    path: PathLike,
+    mesh: MeshLike,
+    *,
+    colors: Optional[ArrayLike] = None,
+    attributes: Optional[Mapping[str, ArrayLike]] = None,
+) -> None: ...
 
 # sample_surface / blue_noise return (points, face_index) and then, in this
 # order, barycentric, pdf and normals for each flag that is True: all float64,
@@ -483,6 +492,8 @@ def save_points(
     *,
     normals: Optional[ArrayLike] = None,
     face_index: Optional[ArrayLike] = None,
+    colors: Optional[ArrayLike] = None,
+    attributes: Optional[Mapping[str, ArrayLike]] = None,
 ) -> None: ...
 def media() -> list[str]: ...
 
