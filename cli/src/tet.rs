@@ -4,7 +4,7 @@
 use glam::{DVec3, Vec3};
 use tet_diffusion::Light;
 use trilux_io::mesh::gltf::{Attribute, AttributeValues, VertexData};
-use trilux_io::mesh::{Material, Object, TriMesh};
+use trilux_io::mesh::{Object, TriMesh};
 use trilux_io::tet::TetMesh;
 
 /// The node positions as `[x, y, z]` rows, the form multires'
@@ -351,6 +351,9 @@ pub fn piece_name(k: usize) -> String {
 ///   from zero ([`trilux_io::mesh::recenter`], written as the node's
 ///   translation). Normals: the outward vertex normals, turned likewise.
 ///   Triangles: [`boundary_triangles`], outward.
+/// - Material: none of its own, so the writer gives the pieces its unlit
+///   one ([`trilux_io::mesh::gltf::UNLIT_MATERIAL`]): the vertex colours
+///   are the final colour, which a lit material would shade again.
 /// - `COLOR_0` ([`VertexData::colors`]): the linear outgoing radiance at
 ///   normal exitance ([`Object::radiance`](tet_diffusion::Object::radiance)`(None)`),
 ///   divided by `white` and clamped to `[0, 1]`, alpha 1. Pass the
@@ -409,7 +412,9 @@ pub fn radiance_surface(
         parts.push(Object {
             name: piece_name(k),
             triangles: first..indices.len(),
-            material: Some(0),
+            // The writer's unlit material: the radiance is the whole
+            // colour, which a lit material would shade a second time.
+            material: None,
         });
         let fluence = o.fluence();
         for (i, (&v, l)) in bv.iter().zip(o.radiance(None)).enumerate() {
@@ -435,14 +440,6 @@ pub fn radiance_surface(
         indices,
         normals: Some(normals),
         objects: parts,
-        materials: vec![Material {
-            name: "radiance".into(),
-            // White: the vertex colours are the whole colour.
-            diffuse: [1.0; 3],
-            diffuse_texture: None,
-            diffuse_image: None,
-            wrap: Default::default(),
-        }],
         ..TriMesh::default()
     };
     let data = VertexData {

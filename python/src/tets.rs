@@ -225,7 +225,7 @@ pub(crate) fn save_points(
             .iter()
             .flatten()
             .enumerate()
-            .find(|(_, f)| **f >= 1 << 24)
+            .find(|(_, f)| **f >= trilux_io::mesh::gltf::FACE_ID_LIMIT)
         {
             return Err(Failure::input(format!(
                 "face_index: entry {i} is {f}; glTF stores face ids as float32, exact below \

@@ -294,7 +294,7 @@ fn check_gltf_faces(output: &std::path::Path, triangles: usize) -> Result<()> {
 }
 
 /// Face ids glTF's `f32` `_FACE` attribute holds exactly: 0 to 2^24 − 1.
-const GLTF_MAX_FACES: usize = 1 << 24;
+const GLTF_MAX_FACES: usize = gltf::FACE_ID_LIMIT as usize;
 
 /// The point cloud (PLY or glTF by extension), and the preview when
 /// asked for.

@@ -205,8 +205,10 @@ pub struct Points {
 /// The name of the attribute that holds each sampled point's triangle.
 pub const FACE_ATTRIBUTE: &str = "FACE";
 
-/// Integers below this are exact in `f32`.
-pub(crate) const EXACT_F32_INTEGERS: u32 = 1 << 24;
+/// Face ids below this (2^24) are exact in the `f32` `_FACE` attribute
+/// ([`write_points`] refuses larger ones; glTF attributes may not be
+/// 32-bit integers).
+pub const FACE_ID_LIMIT: u32 = 1 << 24;
 
 impl From<&super::ply::PlyData> for Points {
     /// The points of PLY data: positions, origin, normals, UVs and face

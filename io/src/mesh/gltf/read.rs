@@ -962,7 +962,7 @@ fn take_faces(data: &mut VertexData) -> Option<Vec<u32>> {
     let AttributeValues::Scalar(values) = &data.attributes[k].values else {
         return None;
     };
-    let exact = |v: f32| v >= 0.0 && v < super::EXACT_F32_INTEGERS as f32 && v.fract() == 0.0;
+    let exact = |v: f32| v >= 0.0 && v < super::FACE_ID_LIMIT as f32 && v.fract() == 0.0;
     if !values.iter().all(|&v| exact(v)) {
         return None;
     }

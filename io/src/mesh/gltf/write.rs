@@ -20,7 +20,7 @@ use gltf::json::mesh::{Mode, Semantic};
 use gltf::json::validation::{Checked, Checked::Valid, USize64};
 use gltf::json::{self, Index};
 
-use super::{AttributeValues, EXACT_F32_INTEGERS, FACE_ATTRIBUTE, Points, VertexData};
+use super::{AttributeValues, FACE_ATTRIBUTE, FACE_ID_LIMIT, Points, VertexData};
 use crate::error::{Error, ErrorKind, Result};
 use crate::image::{self, PngDepth};
 use crate::mesh::{Material, TriMesh, Wrap};
@@ -124,11 +124,7 @@ pub fn write_points(path: impl AsRef<Path>, points: &Points) -> Result<()> {
                 format!("an attribute named {FACE_ATTRIBUTE} beside the face ids"),
             ));
         }
-        if let Some((i, f)) = faces
-            .iter()
-            .enumerate()
-            .find(|(_, f)| **f >= EXACT_F32_INTEGERS)
-        {
+        if let Some((i, f)) = faces.iter().enumerate().find(|(_, f)| **f >= FACE_ID_LIMIT) {
             return Err(invalid(
                 path,
                 format!(
