@@ -308,6 +308,20 @@ impl TriMesh {
         }
     }
 
+    /// The objects, or one unnamed object of every triangle without a
+    /// material when the mesh has none: what a writer writes as groups.
+    pub(crate) fn objects_or_whole(&self) -> std::borrow::Cow<'_, [Object]> {
+        if self.objects.is_empty() {
+            std::borrow::Cow::Owned(vec![Object {
+                name: String::new(),
+                triangles: 0..self.indices.len(),
+                material: None,
+            }])
+        } else {
+            std::borrow::Cow::Borrowed(&self.objects)
+        }
+    }
+
     /// Checks what every writer needs of the layout: attribute arrays of
     /// the vertex count, indices in range, objects that cover the
     /// triangles in order with materials that exist, a finite origin.

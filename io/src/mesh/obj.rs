@@ -894,17 +894,7 @@ pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
             (true, true) => write!(out, " {i}/{i}/{i}"),
         };
     };
-    let whole = [Object {
-        name: String::new(),
-        triangles: 0..mesh.indices.len(),
-        material: None,
-    }];
-    let objects = if mesh.objects.is_empty() {
-        &whole[..]
-    } else {
-        &mesh.objects[..]
-    };
-    for object in objects {
+    for object in mesh.objects_or_whole().iter() {
         if !object.name.is_empty() {
             let _ = writeln!(out, "o {}", object.name);
         }

@@ -350,16 +350,7 @@ impl<'a> Document<'a> {
             .iter()
             .map(|m| self.material(m))
             .collect::<Result<Vec<_>>>()?;
-        let whole = [crate::mesh::Object {
-            name: String::new(),
-            triangles: 0..mesh.indices.len(),
-            material: None,
-        }];
-        let objects = if mesh.objects.is_empty() {
-            &whole[..]
-        } else {
-            &mesh.objects[..]
-        };
+        let objects = mesh.objects_or_whole();
         let origin = mesh.origin.as_vec3();
         let mut fallback = None;
         for object in objects.iter().filter(|o| !o.triangles.is_empty()) {
