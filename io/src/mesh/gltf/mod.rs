@@ -28,7 +28,7 @@
 //!
 //! # Writing
 //!
-//! [`write`] (also [`TriMesh::write`] with `.glb` or `.gltf`), [`write_with`]
+//! [`write()`] (also [`TriMesh::write`] with `.glb` or `.gltf`), [`write_with`]
 //! (vertex colours and `_NAME` attributes beside the mesh) and
 //! [`write_points`] (a `POINTS` primitive) serialise through the gltf-rs
 //! project's own JSON types (`gltf-json`). What [`read_scene`] returns
