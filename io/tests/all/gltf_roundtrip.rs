@@ -445,3 +445,98 @@ fn zero_normals_become_face_normals() {
     assert_eq!(read.normals.unwrap(), vec![Vec3::Z; 4]);
     assert!(dir.join("normals.bin").is_file());
 }
+
+/// Pieces over consecutive runs of vertices (a fracture's, meshes put one
+/// after the other) get vertex accessors of their own, so each loads
+/// alone; they read back as written.
+#[test]
+fn pieces_over_their_own_vertices_have_their_own_accessors() {
+    let mut rng = Rng(0x5eed_0f_9ec5);
+    let dir = scratch("gltf-pieces");
+    for case in 0..20 {
+        let pieces = 2 + rng.below(3) as usize;
+        let mut mesh = TriMesh::default();
+        let mut colours = Vec::new();
+        for k in 0..pieces {
+            let first = mesh.positions.len() as u32;
+            let n = 3 + rng.below(40) as u32;
+            mesh.positions
+                .extend((0..n).map(|_| Vec3::new(rng.f32(), rng.f32(), k as f32)));
+            let start = mesh.indices.len();
+            // Every vertex of the run used, the first and last included.
+            mesh.indices.push([first, first + 1, first + n - 1]);
+            for _ in 0..rng.below(2 * u64::from(n)) {
+                mesh.indices
+                    .push([0; 3].map(|_: u32| first + rng.below(u64::from(n)) as u32));
+            }
+            mesh.objects.push(Object {
+                name: format!("piece {k}"),
+                triangles: start..mesh.indices.len(),
+                material: None,
+            });
+            colours.extend((0..n).map(|_| [rng.f32(), rng.f32(), rng.f32(), 1.0]));
+        }
+        let data = VertexData {
+            colors: Some(colours),
+            attributes: attributes(&mut rng, mesh.positions.len()),
+        };
+        let path = dir.join(format!("pieces{case}.gltf"));
+        gltf::write_with(&path, &mesh, &data).unwrap();
+        test_support::gltf::validate(&path);
+        let json = std::fs::read_to_string(&path).unwrap();
+        let own = json.matches("\"POSITION\":").count();
+        assert_eq!(own, pieces, "one POSITION accessor per piece");
+        let scene = gltf::read_scene(&path).unwrap();
+        assert_eq!(scene.mesh.positions, mesh.positions, "case {case}");
+        assert_eq!(scene.mesh.indices, mesh.indices, "case {case}");
+        let names: Vec<_> = scene.mesh.objects.iter().map(|o| &o.name).collect();
+        assert_eq!(
+            names,
+            mesh.objects.iter().map(|o| &o.name).collect::<Vec<_>>()
+        );
+        assert!(scene.vertex_data == sorted(data), "case {case}");
+    }
+    // Pieces that share a vertex share the accessors.
+    let mut shared = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
+        indices: vec![[0, 1, 2], [1, 2, 3]],
+        ..TriMesh::default()
+    };
+    shared.objects = (0..2)
+        .map(|k| Object {
+            name: format!("part {k}"),
+            triangles: k..k + 1,
+            material: None,
+        })
+        .collect();
+    let path = dir.join("shared.gltf");
+    shared.write(&path).unwrap();
+    let json = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(json.matches("\"POSITION\":0").count(), 2);
+    assert_eq!(gltf::read(&path).unwrap().positions, shared.positions);
+}
+
+#[test]
+fn colour_rounding_just_outside_zero_to_one_is_clamped_and_more_is_refused() {
+    let dir = scratch("gltf-colour-slack");
+    let mesh = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices: vec![[0, 1, 2]],
+        ..TriMesh::default()
+    };
+    let with = |c: [f32; 4]| VertexData {
+        colors: Some(vec![c, [0.5; 4], [0.5; 4]]),
+        ..VertexData::default()
+    };
+    let path = dir.join("slack.glb");
+    gltf::write_with(&path, &mesh, &with([1.000_000_1, -1e-7, 0.25, 1.0])).unwrap();
+    let back = gltf::read_scene(&path).unwrap().vertex_data.colors.unwrap();
+    assert_eq!(back[0], [1.0, 0.0, 0.25, 1.0]);
+    let refused = |c: [f32; 4]| {
+        gltf::write_with(dir.join("refused.glb"), &mesh, &with(c))
+            .unwrap_err()
+            .to_string()
+    };
+    assert!(refused([1.01, 0.0, 0.0, 1.0]).contains("is not in [0, 1]"));
+    assert!(refused([f32::NAN, 0.0, 0.0, 1.0]).contains("is not finite"));
+}

@@ -11,6 +11,7 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
+use std::ops::Range;
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
@@ -23,7 +24,7 @@ use gltf::json::{self, Index};
 use super::{AttributeValues, FACE_ATTRIBUTE, FACE_ID_LIMIT, Points, VertexData};
 use crate::error::{Error, ErrorKind, Result};
 use crate::image::{self, PngDepth};
-use crate::mesh::{Material, TriMesh, Wrap};
+use crate::mesh::{Material, Object, TriMesh, Wrap};
 
 /// Writes `mesh` as glTF, choosing the container by extension: `.glb`
 /// (binary, one file) or `.gltf` (JSON beside a `.bin` of the same name).
@@ -38,9 +39,11 @@ pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
 /// Writes `mesh` with per-vertex colours (`COLOR_0`) and custom
 /// attributes (`_NAME`) as glTF (`.glb` or `.gltf` + `.bin`).
 ///
-/// One glTF mesh and node per [`Object`](crate::mesh::Object) (named as
-/// it; all share one set of vertex accessors), or one for the whole mesh
-/// when it has no objects. Each material becomes a metallic-roughness
+/// One glTF mesh and node per [`Object`] (named as it), or one for the
+/// whole mesh when it has no objects. Objects whose triangles use
+/// consecutive, disjoint runs of the vertices (the pieces of a fracture,
+/// meshes put one after the other) have vertex accessors of their own, so
+/// that each loads alone in any viewer; otherwise all share one set. Each material becomes a metallic-roughness
 /// material (metallic 0, roughness 1, double-sided) with the base colour
 /// as its factor and its texture embedded: the decoded image as an 8-bit
 /// sRGB PNG, or the file it names (PNG and JPEG as they are, other
@@ -65,7 +68,7 @@ pub fn write(path: impl AsRef<Path>, mesh: &TriMesh) -> Result<()> {
 /// the vertex count, an index out of range, objects that do not cover the
 /// triangles in order, a material out of range, vertices without
 /// triangles, second UVs without first ones, a non-finite position, UV or attribute value, a colour
-/// outside `[0, 1]`, an attribute name that is not `[A-Za-z0-9_]+` or
+/// more than 10^-5 outside `[0, 1]` (closer ones are clamped into it), an attribute name that is not `[A-Za-z0-9_]+` or
 /// appears twice, a texture file that does not exist or decode, or a GLB
 /// over 4 GiB; an I/O error.
 pub fn write_with(path: impl AsRef<Path>, mesh: &TriMesh, data: &VertexData) -> Result<()> {
@@ -199,6 +202,11 @@ fn invalid(path: &Path, what: String) -> Error {
     Error::new(path, ErrorKind::InvalidInput(what))
 }
 
+/// How far outside `[0, 1]` a colour may be and still be written (clamped
+/// into it): the rounding of a filter or a conversion that should have
+/// stayed inside (a texture lookup giving 1.0000001).
+pub(crate) const COLOR_SLACK: f32 = 1e-5;
+
 /// Checks colours and attributes against `n` vertices.
 fn check_vertex_data(path: &Path, data: &VertexData, n: usize) -> Result<()> {
     if let Some(colors) = &data.colors {
@@ -208,11 +216,17 @@ fn check_vertex_data(path: &Path, data: &VertexData, n: usize) -> Result<()> {
                 format!("{} colours for {n} vertices", colors.len()),
             ));
         }
-        let bad = |c: &[f32; 4]| c.iter().any(|v| !(0.0..=1.0).contains(v));
+        let range = -COLOR_SLACK..=1.0 + COLOR_SLACK;
+        let bad = |c: &[f32; 4]| c.iter().any(|v| !range.contains(v));
         if let Some((i, c)) = colors.iter().enumerate().find(|(_, c)| bad(c)) {
+            let problem = if c.iter().all(|v| v.is_finite()) {
+                "is not in [0, 1] (scale or clamp it)"
+            } else {
+                "is not finite"
+            };
             return Err(invalid(
                 path,
-                format!("the colour of vertex {i}, {c:?}, is not in [0, 1] (scale or clamp it)"),
+                format!("the colour of vertex {i}, {c:?}, {problem}"),
             ));
         }
     }
@@ -286,6 +300,51 @@ fn unit_normals(
     Ok(out.into_iter().flatten().collect())
 }
 
+/// The vertex run of each object when the objects' triangles use
+/// consecutive, disjoint runs of vertices that together are all of them
+/// (object k's indices within run k); `None` otherwise, or for a single
+/// object.
+fn vertex_runs(mesh: &TriMesh, objects: &[&Object]) -> Option<Vec<Range<usize>>> {
+    if objects.len() < 2 {
+        return None;
+    }
+    let mut runs = Vec::with_capacity(objects.len());
+    let mut next = 0;
+    for object in objects {
+        let triangles = mesh.indices[object.triangles.clone()].iter().flatten();
+        let (lo, hi) = triangles.fold((u32::MAX, 0), |(lo, hi), &i| (lo.min(i), hi.max(i)));
+        if lo as usize != next {
+            return None;
+        }
+        next = hi as usize + 1;
+        runs.push(lo as usize..next);
+    }
+    (next == mesh.positions.len()).then_some(runs)
+}
+
+impl VertexData {
+    /// The colours and attributes of the vertices in `run`.
+    fn slice(&self, run: Range<usize>) -> VertexData {
+        let values = |v: &AttributeValues| match v {
+            AttributeValues::Scalar(x) => AttributeValues::Scalar(x[run.clone()].to_vec()),
+            AttributeValues::Vec2(x) => AttributeValues::Vec2(x[run.clone()].to_vec()),
+            AttributeValues::Vec3(x) => AttributeValues::Vec3(x[run.clone()].to_vec()),
+            AttributeValues::Vec4(x) => AttributeValues::Vec4(x[run.clone()].to_vec()),
+        };
+        VertexData {
+            colors: self.colors.as_ref().map(|c| c[run.clone()].to_vec()),
+            attributes: self
+                .attributes
+                .iter()
+                .map(|a| super::Attribute {
+                    name: a.name.clone(),
+                    values: values(&a.values),
+                })
+                .collect(),
+        }
+    }
+}
+
 /// The per-vertex arrays of one set of vertex accessors.
 struct Vertices<'a> {
     positions: &'a [Vec3],
@@ -294,6 +353,26 @@ struct Vertices<'a> {
     uvs: Option<&'a [glam::Vec2]>,
     uvs1: Option<&'a [glam::Vec2]>,
     data: &'a VertexData,
+}
+
+impl<'a> Vertices<'a> {
+    /// The vertices of `mesh` in `run` (with `normals`, made unit length),
+    /// with `data` for them.
+    fn run(
+        mesh: &'a TriMesh,
+        normals: Option<&'a [Vec3]>,
+        run: Range<usize>,
+        data: &'a VertexData,
+    ) -> Self {
+        Vertices {
+            positions: &mesh.positions[run.clone()],
+            origin: mesh.origin,
+            normals: normals.map(|n| &n[run.clone()]),
+            uvs: mesh.uvs.as_deref().map(|t| &t[run.clone()]),
+            uvs1: mesh.uvs1.as_deref().map(|t| &t[run.clone()]),
+            data,
+        }
+    }
 }
 
 /// The JSON under construction and the one binary buffer it refers to.
@@ -337,33 +416,50 @@ impl<'a> Document<'a> {
             )?),
             None => None,
         };
-        let attributes = self.vertices(&Vertices {
-            positions: &mesh.positions,
-            origin: mesh.origin,
-            normals: normals.as_deref(),
-            uvs: mesh.uvs.as_deref(),
-            uvs1: mesh.uvs1.as_deref(),
-            data,
-        })?;
+        let all = 0..mesh.positions.len();
+        let normals = normals.as_deref();
         let materials = mesh
             .materials
             .iter()
             .map(|m| self.material(m))
             .collect::<Result<Vec<_>>>()?;
         let objects = mesh.objects_or_whole();
+        let live: Vec<&Object> = objects.iter().filter(|o| !o.triangles.is_empty()).collect();
+        // Objects over consecutive runs of vertices (the pieces of a
+        // fracture, concatenated meshes) get accessors of their own, so
+        // each loads alone; others share one set.
+        let runs = vertex_runs(mesh, &live);
+        let shared = match runs {
+            Some(_) => None,
+            None => Some(self.vertices(&Vertices::run(mesh, normals, all, data))?),
+        };
         let origin = mesh.origin.as_vec3();
         let mut fallback = None;
-        for object in objects.iter().filter(|o| !o.triangles.is_empty()) {
+        for (k, object) in live.iter().enumerate() {
             let material = match object.material {
                 Some(m) => materials[m],
                 None => *fallback.get_or_insert_with(|| self.fallback_material(data)),
             };
-            let indices = self.indices(
-                &mesh.indices[object.triangles.clone()],
-                mesh.positions.len(),
-            );
+            let triangles = &mesh.indices[object.triangles.clone()];
+            let (attributes, indices) = match (&shared, &runs) {
+                (Some(attributes), _) => (
+                    attributes.clone(),
+                    self.indices(triangles, mesh.positions.len()),
+                ),
+                (None, Some(runs)) => {
+                    let run = runs[k].clone();
+                    let own = data.slice(run.clone());
+                    let attributes =
+                        self.vertices(&Vertices::run(mesh, normals, run.clone(), &own))?;
+                    let first = run.start as u32;
+                    let local: Vec<[u32; 3]> =
+                        triangles.iter().map(|t| t.map(|i| i - first)).collect();
+                    (attributes, self.indices(&local, run.len()))
+                }
+                (None, None) => unreachable!("one of the two is set"),
+            };
             let primitive = json::mesh::Primitive {
-                attributes: attributes.clone(),
+                attributes,
                 extensions: None,
                 extras: Default::default(),
                 indices: Some(indices),
@@ -453,6 +549,11 @@ impl<'a> Document<'a> {
             );
         }
         if let Some(colors) = &v.data.colors {
+            // Within COLOR_SLACK of [0, 1] (checked): into it.
+            let colors: Vec<[f32; 4]> = colors
+                .iter()
+                .map(|c| c.map(|v| v.clamp(0.0, 1.0)))
+                .collect();
             let opaque = colors.iter().all(|c| c[3] == 1.0);
             let (flat, type_): (Vec<f32>, _) = if opaque {
                 let flat = colors.iter().flat_map(|c| [c[0], c[1], c[2]]).collect();
