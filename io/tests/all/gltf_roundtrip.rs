@@ -451,7 +451,7 @@ fn zero_normals_become_face_normals() {
 /// alone; they read back as written.
 #[test]
 fn pieces_over_their_own_vertices_have_their_own_accessors() {
-    let mut rng = Rng(0x5eed_0f_9ec5);
+    let mut rng = Rng(0x005e_ed0f_9ec5);
     let dir = scratch("gltf-pieces");
     for case in 0..20 {
         let pieces = 2 + rng.below(3) as usize;
