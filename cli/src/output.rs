@@ -22,11 +22,18 @@ pub fn temporary_name(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.partial-{}{ext}", std::process::id()))
 }
 
-/// Refuses an existing `path` unless `force`.
+/// Refuses an existing `path` unless `force`, and a folder at `path`
+/// even with `force` (a file cannot replace it).
 ///
 /// # Errors
-/// [`Error::Exists`].
+/// [`Error::Exists`], or [`Error::Invalid`] naming the folder.
 pub fn check_new(path: &Path, force: bool) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::Invalid(format!(
+            "{}: a folder is in the way of this output (remove it, or write to another name)",
+            path.display()
+        )));
+    }
     if !force && path.exists() {
         return Err(Error::Exists(path.to_path_buf()));
     }
@@ -59,15 +66,19 @@ pub fn write_atomic(
 }
 
 /// Writes a set of files that belong together (an OBJ, its `.mtl` and
-/// its textures): `write(path in a temporary folder beside path)` writes
-/// them all into a hidden folder next to `path`, then each is renamed
-/// into place. Nothing is moved if one of them exists (unless `force`) or
-/// the writing fails; the temporary folder is removed either way. Returns
-/// the paths written.
+/// its textures; a `.gltf` and its `.bin`): `write(path in a temporary
+/// folder beside path)` writes them all into a hidden folder next to
+/// `path`, then each is renamed into place, `path` itself last (a failed
+/// rename never leaves a new `path` referring to files that did not
+/// arrive). Nothing is moved if one of them exists (unless `force`), if
+/// one of them is a folder (even with `force`), or if the writing fails;
+/// the temporary folder is removed either way. Returns the paths written,
+/// sorted.
 ///
 /// # Errors
-/// [`Error::Exists`] naming the first file in the way, `write`'s error,
-/// or a rename's.
+/// [`Error::Exists`] naming the first file in the way, [`Error::Invalid`]
+/// naming a folder in the way (and what was being written), `write`'s
+/// error, or a rename's.
 pub fn write_atomic_files(
     path: &Path,
     force: bool,
@@ -97,16 +108,47 @@ pub fn write_atomic_files(
                 Some(d) => d.join(entry.file_name()),
                 None => PathBuf::from(entry.file_name()),
             };
-            check_new(&target, force)?;
             files.push((entry.path(), target));
+        }
+        // `path` last, the others in a stable order.
+        files.sort_by_key(|(_, to)| (to.as_path() == path, to.clone()));
+        // Every target checked before any is replaced: a refusal leaves
+        // nothing half-written.
+        for (_, to) in &files {
+            if to.is_dir() {
+                return Err(Error::Invalid(format!(
+                    "{}: a folder is in the way of writing {}; nothing was moved into place \
+                     (remove the folder, or write to another name)",
+                    to.display(),
+                    described(path, &files)
+                )));
+            }
+            check_new(to, force)?;
         }
         for (from, to) in &files {
             std::fs::rename(from, to).map_err(file_error(to))?;
         }
-        Ok(files.into_iter().map(|(_, to)| to).collect())
+        let mut written: Vec<PathBuf> = files.into_iter().map(|(_, to)| to).collect();
+        written.sort();
+        Ok(written)
     })();
     let _ = std::fs::remove_dir_all(&tmp);
     result
+}
+
+/// What a set of files is: `out.gltf with out.bin`, `out.obj with
+/// out.mtl and out_0.png`.
+fn described(path: &Path, files: &[(PathBuf, PathBuf)]) -> String {
+    let others: Vec<String> = files
+        .iter()
+        .filter(|(_, to)| to != path)
+        .map(|(_, to)| to.display().to_string())
+        .collect();
+    match others.split_last() {
+        None => path.display().to_string(),
+        Some((last, [])) => format!("{} with {last}", path.display()),
+        Some((last, rest)) => format!("{} with {} and {last}", path.display(), rest.join(", ")),
+    }
 }
 
 #[cfg(test)]
@@ -140,6 +182,88 @@ mod tests {
         })
         .unwrap();
         assert_eq!(std::fs::read_to_string(&out).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// Writes `out.gltf` and `out.bin` into the temporary folder, as the
+    /// glTF writer does.
+    fn gltf_and_bin(tmp: &Path) -> Result<()> {
+        let write = |p: &Path, text: &str| {
+            std::fs::write(p, text).map_err(|source| Error::File {
+                path: p.into(),
+                source,
+            })
+        };
+        write(tmp, "new gltf")?;
+        write(&tmp.with_extension("bin"), "new bin")
+    }
+
+    #[test]
+    fn a_folder_in_the_way_of_a_set_of_files_is_refused_before_anything_is_moved() {
+        let dir = tempfile::tempdir().unwrap();
+        let gltf = dir.path().join("x.gltf");
+        let bin = dir.path().join("x.bin");
+        std::fs::create_dir(&bin).unwrap();
+        // With --force, and without an old x.gltf ...
+        let e = write_atomic_files(&gltf, true, gltf_and_bin).unwrap_err();
+        let text = e.to_string();
+        assert!(matches!(e, Error::Invalid(_)), "{e:?}");
+        assert!(
+            text.starts_with(&format!("{}: a folder is in the way", bin.display())),
+            "{text}"
+        );
+        assert!(
+            text.contains(&format!(
+                "writing {} with {}",
+                gltf.display(),
+                bin.display()
+            )),
+            "{text}"
+        );
+        assert!(text.contains("nothing was moved"), "{text}");
+        assert!(!gltf.exists(), "a .gltf without its .bin");
+        // ... and with one, which is kept as it was.
+        std::fs::write(&gltf, "old gltf").unwrap();
+        write_atomic_files(&gltf, true, gltf_and_bin).unwrap_err();
+        assert_eq!(std::fs::read_to_string(&gltf).unwrap(), "old gltf");
+        assert!(bin.is_dir());
+        // No temporary folder or file left.
+        let mut names: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["x.bin", "x.gltf"]);
+        // Once the folder is gone, both are written, the paths sorted.
+        std::fs::remove_dir(&bin).unwrap();
+        let files = write_atomic_files(&gltf, true, gltf_and_bin).unwrap();
+        assert_eq!(files, [bin.clone(), gltf.clone()]);
+        assert_eq!(std::fs::read_to_string(&bin).unwrap(), "new bin");
+        assert_eq!(std::fs::read_to_string(&gltf).unwrap(), "new gltf");
+    }
+
+    #[test]
+    fn a_folder_where_the_output_goes_is_refused_even_with_force() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out.png");
+        std::fs::create_dir(&out).unwrap();
+        for force in [false, true] {
+            let mut called = false;
+            let e = write_atomic(&out, force, |_| {
+                called = true;
+                Ok(())
+            })
+            .unwrap_err();
+            assert!(!called, "written before the check");
+            let text = e.to_string();
+            assert!(
+                text.starts_with(&format!("{}: a folder is in the way", out.display())),
+                "{text}"
+            );
+            let e = write_atomic_files(&out, force, |_| Ok(())).unwrap_err();
+            assert!(matches!(e, Error::Invalid(_)), "{e:?}");
+        }
+        assert!(out.is_dir());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 }

@@ -150,9 +150,9 @@ fn check_convert(context: &Context, args: &ConvertArgs) -> Result<()> {
     if args.budget == Some(0) {
         return Err(arg_error("--budget 0", "at least one sample is needed"));
     }
-    super::check_output(context, &args.output, &["meshcolors"])?;
+    super::check_output(context, "-o", &args.output, &["meshcolors"])?;
     if let Some(p) = &args.preview {
-        super::check_output(context, p, &["png", "exr"])?;
+        super::check_output(context, "--preview", p, &["png", "exr"])?;
     }
     Ok(())
 }
@@ -198,7 +198,7 @@ fn convert_summary(
 }
 
 fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
-    super::check_output(context, &args.output, &["obj", "glb", "gltf"])?;
+    super::check_output(context, "-o", &args.output, &["obj", "glb", "gltf"])?;
     let mesh = super::read_mesh(context, &args.mesh)?;
     let (surface, colors) = context.step("reading the mesh colours", || {
         load_for(&mesh, &args.mesh, &args.colors)
@@ -258,7 +258,7 @@ fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
 }
 
 fn render(context: &mut Context, args: RenderArgs) -> Result<()> {
-    super::check_output(context, &args.output, &["png", "exr"])?;
+    super::check_output(context, "-o", &args.output, &["png", "exr"])?;
     let (size, view) = (args.picture.size, args.picture.direction());
     let mesh = super::read_mesh(context, &args.mesh)?;
     let (surface, colors) = context.step("reading the mesh colours", || {

@@ -142,8 +142,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         painted,
         dropped,
     };
-    write(context, &args, &solved)?;
-    report(context, &args, input, &solved);
+    let files = write(context, &args, &solved)?;
+    report(context, &args, input, &solved, &files);
     Ok(())
 }
 
@@ -187,24 +187,27 @@ fn run_session(context: &mut Context, args: &Args, path: &Path) -> Result<()> {
         trilux::tet::render_session(&session, size, view)
     });
     super::view::write_picture(&picture, true, &args.output, force)?;
+    let mut files = vec![args.output.clone()];
     if let Some(p) = &args.exr {
         super::view::write_picture(&picture, false, p, force)?;
+        files.push(p.clone());
     }
     if let Some(p) = &args.vtu {
         super::view::write_vtu(&session, p, force)?;
+        files.push(p.clone());
     }
     if let Some(p) = &args.glb {
-        write_glb(p, session.pieces(), &picture, force)?;
+        files.extend(write_glb(p, session.pieces(), &picture, force)?);
     }
     let pieces = session.pieces();
     let tets: usize = pieces.iter().map(|o| o.mesh().tets().len()).sum();
     let edits = session.log().edits.len();
     let text = format!(
-        "{tets} tetrahedra ({} object{}), session {} replayed ({edits} edits); picture written to {}\n",
+        "{tets} tetrahedra ({} object{}), session {} replayed ({edits} edits); written to {}\n",
         pieces.len(),
         if pieces.len() > 1 { "s" } else { "" },
         path.display(),
-        args.output.display()
+        listed(&files)
     );
     let json = serde_json::json!({
         "command": "diffuse",
@@ -213,6 +216,7 @@ fn run_session(context: &mut Context, args: &Args, path: &Path) -> Result<()> {
         "tetrahedra": tets,
         "objects": pieces.len(),
         "output": super::shown(&args.output),
+        "files": shown_all(&files),
         "seconds": context.timings_json(),
     });
     context.report(&text, json);
@@ -221,33 +225,49 @@ fn run_session(context: &mut Context, args: &Args, path: &Path) -> Result<()> {
 
 /// The outputs' names, before any long step.
 fn check_outputs(context: &Context, args: &Args) -> Result<()> {
-    super::check_output(context, &args.output, &["png"])?;
+    super::check_output(context, "-o", &args.output, &["png"])?;
     if let Some(p) = &args.exr {
-        super::check_output(context, p, &["exr"])?;
+        super::check_output(context, "--exr", p, &["exr"])?;
     }
     if let Some(p) = &args.vtu {
-        super::check_output(context, p, &["vtu"])?;
+        super::check_output(context, "--vtu", p, &["vtu"])?;
     }
     if let Some(p) = &args.glb {
-        super::check_output(context, p, &["glb", "gltf"])?;
-        // A .gltf's buffer goes beside it, under its name.
-        if super::extension(p) == "gltf" {
-            trilux::output::check_new(&p.with_extension("bin"), context.force)?;
-        }
+        // A .gltf's .bin beside it too.
+        super::check_output(context, "--glb", p, &["glb", "gltf"])?;
     }
     Ok(())
 }
 
 /// `--glb`: the pieces' surfaces with their radiance, the vertex colours
-/// at the exposure of `picture` (the PNG written beside it).
+/// at the exposure of `picture` (the PNG written beside it), as
+/// `trilux::tet::write_radiance_gltf` writes them (the view's export);
+/// returns the files written (a `.gltf` and its `.bin`, or the `.glb`).
 fn write_glb(
     path: &Path,
     objects: &[Object],
     picture: &trilux::tet::Picture,
     force: bool,
-) -> Result<()> {
+) -> Result<Vec<PathBuf>> {
     let white = trilux::tet::exposure_white(picture);
-    trilux::tet::write_radiance_gltf(path, objects, white, force)
+    let (mesh, data) = trilux::tet::radiance_surface(objects, white)?;
+    super::write_gltf(path, force, |tmp| {
+        trilux_io::mesh::gltf::write_with(tmp, &mesh, &data)
+    })
+}
+
+/// The files as the summary line lists them.
+fn listed(files: &[PathBuf]) -> String {
+    files
+        .iter()
+        .map(|f| f.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The files as the JSON lists them.
+fn shown_all(files: &[PathBuf]) -> Vec<String> {
+    files.iter().map(|f| super::shown(f)).collect()
 }
 
 /// Adds the lights (the default one when none is given) and the
@@ -331,8 +351,9 @@ fn fracture(args: &Args, object: Object, diagonal: f64) -> Result<Vec<Object>> {
     Ok(vec![a, b])
 }
 
-/// The picture, and the EXR, VTU and glTF when asked for.
-fn write(context: &mut Context, args: &Args, solved: &Solved) -> Result<()> {
+/// The picture, and the EXR, VTU and glTF when asked for; returns the
+/// files written, in that order.
+fn write(context: &mut Context, args: &Args, solved: &Solved) -> Result<Vec<PathBuf>> {
     let image = context.step("rendering", || {
         render(
             &solved.objects,
@@ -342,16 +363,19 @@ fn write(context: &mut Context, args: &Args, solved: &Solved) -> Result<()> {
         )
     });
     super::write_image(context, &args.output, &tone_map(&image))?;
+    let mut files = vec![args.output.clone()];
     if let Some(p) = &args.exr {
         super::write_image(context, p, &image.image)?;
+        files.push(p.clone());
     }
     if let Some(p) = &args.vtu {
         write_vtu(context, p, &solved.objects[0], solved.dropped.as_ref())?;
+        files.push(p.clone());
     }
     if let Some(p) = &args.glb {
-        write_glb(p, &solved.objects, &image, context.force)?;
+        files.extend(write_glb(p, &solved.objects, &image, context.force)?);
     }
-    Ok(())
+    Ok(files)
 }
 
 /// φ per colour channel and the boundary's luminance per node of `o`.
@@ -402,13 +426,13 @@ fn write_vtu(
     })
 }
 
-/// The summary line, or the JSON object.
-fn report(context: &Context, args: &Args, input: &Path, solved: &Solved) {
+/// The summary line, or the JSON object; `files` are every file written.
+fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: &[PathBuf]) {
     let objects = &solved.objects;
     let tets: usize = objects.iter().map(|o| o.mesh().tets().len()).sum();
     let painted = &solved.painted;
     let text = format!(
-        "{} tetrahedra ({} object{}), {} mm per unit{}, solved ({} level{}); picture written to {}\n",
+        "{} tetrahedra ({} object{}), {} mm per unit{}, solved ({} level{}); written to {}\n",
         tets,
         objects.len(),
         if objects.len() > 1 { "s" } else { "" },
@@ -427,7 +451,7 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved) {
         },
         solved.levels,
         if solved.levels == 1 { "" } else { "s" },
-        args.output.display()
+        listed(files)
     );
     let json = serde_json::json!({
         "command": "diffuse",
@@ -443,6 +467,7 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved) {
             .map(|(spec, n)| serde_json::json!({"spec": spec.spec, "tetrahedra": n}))
             .collect::<Vec<_>>(),
         "output": super::shown(&args.output),
+        "files": shown_all(files),
         "seconds": context.timings_json(),
     });
     context.report(&text, json);

@@ -23,7 +23,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let path = &args.file;
     super::check_input(path)?;
     let (text, json) = match super::extension(path).as_str() {
-        "obj" | "gltf" | "glb" => mesh_info(context, path)?,
+        "obj" => mesh_info(context, path)?,
+        "gltf" | "glb" => gltf_info(context, path)?,
         "ply" => ply_info(context, path)?,
         "node" | "ele" | "msh" | "mesh" => tet_info(context, path)?,
         "face" => face_info(context, path)?,
@@ -67,6 +68,182 @@ fn mesh_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     Ok(describe_mesh(context, path, "triangle mesh", &mesh))
 }
 
+/// A glTF file: its triangles as [`describe_mesh`] does, with their
+/// vertex colours and `_NAME` attributes, and its `POINTS` primitives
+/// (a point cloud, as a PLY one is reported, when there are no
+/// triangles).
+fn gltf_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
+    use trilux_io::mesh::gltf;
+    let scene = context.step("reading the glTF file", || gltf::read_scene(path))?;
+    let points = &scene.points;
+    if scene.mesh.indices.is_empty() && !points.positions.is_empty() {
+        let mut text = format!("{}: point cloud\n", path.display());
+        let mut json = json!({"file": super::shown(path), "kind": "point cloud"});
+        describe_points(&mut text, &mut json, points, "");
+        add_warnings(&mut text, &mut json, &scene.mesh.warnings);
+        return Ok((text, json));
+    }
+    let mut extra = String::new();
+    let mut more = json!({});
+    describe_vertex_data(&mut extra, &mut more, &scene.vertex_data);
+    if !points.positions.is_empty() {
+        // Points beside the triangles: their own lines, and an object
+        // of their own in the JSON.
+        let _ = writeln!(extra, "  point cloud (POINTS primitives):");
+        let mut cloud = json!({});
+        describe_points(&mut extra, &mut cloud, points, "  ");
+        if let Some(object) = more.as_object_mut() {
+            object.insert("point_cloud".into(), cloud);
+        }
+    }
+    let (text, json) =
+        describe_mesh_with(context, path, "triangle mesh", &scene.mesh, (&extra, more));
+    Ok((text, json))
+}
+
+/// The lines and JSON keys of glTF points: count, bounds, and what each
+/// point carries (`attributes`, named as for a PLY point cloud, a `_NAME`
+/// attribute with its components), the UVs' and face ids' ranges, and
+/// the JSON keys of [`describe_vertex_data`]; `indent` goes before each
+/// line's own two spaces.
+fn describe_points(
+    text: &mut String,
+    json: &mut Value,
+    points: &trilux_io::mesh::gltf::Points,
+    indent: &str,
+) {
+    let n = points.positions.len();
+    let (lo, hi) = trilux::preview::bounds(&points.positions).unwrap_or_default();
+    // In the file's coordinates: the reader shifts far-away points by
+    // `origin` to keep f32 precision (then shown in f64).
+    let (bounds, bounds_json) = if points.origin == glam::DVec3::ZERO {
+        (format!("{lo} .. {hi}"), json!([v3(lo), v3(hi)]))
+    } else {
+        let (lo, hi) = (lo.as_dvec3() + points.origin, hi.as_dvec3() + points.origin);
+        (
+            format!("{lo} .. {hi}"),
+            json!([lo.to_array(), hi.to_array()]),
+        )
+    };
+    let _ = writeln!(text, "{indent}  points: {n}");
+    let _ = writeln!(text, "{indent}  bounds: {bounds}");
+    let mut attributes = Vec::new();
+    let mut shown = Vec::new();
+    let mut add = |name: String, detail: String| {
+        shown.push(format!("{name}{detail}"));
+        attributes.push(name);
+    };
+    if points.normals.is_some() {
+        add("normals".into(), String::new());
+    }
+    if points.uvs.is_some() {
+        add("uvs".into(), String::new());
+    }
+    if let Some(colors) = &points.vertex_data.colors {
+        add("colors".into(), format!(" ({})", color_kind(colors)));
+    }
+    if points.faces.is_some() {
+        add("face ids".into(), " (_FACE)".into());
+    }
+    for a in &points.vertex_data.attributes {
+        add(format!("_{}", a.name), components(a.values.components()));
+    }
+    let _ = writeln!(
+        text,
+        "{indent}  attributes: {}",
+        if shown.is_empty() {
+            "none".to_string()
+        } else {
+            shown.join(", ")
+        }
+    );
+    let faces = points.faces.as_ref().map(|f| {
+        let lo = f.iter().copied().min().unwrap_or(0);
+        let hi = f.iter().copied().max().unwrap_or(0);
+        let _ = writeln!(text, "{indent}  face ids: {lo} .. {hi}");
+        json!([lo, hi])
+    });
+    let uvs = points.uvs.as_ref().map(|uvs| {
+        let mut line = String::new();
+        let range = describe_uvs(&mut line, Some(uvs));
+        text.push_str(indent);
+        text.push_str(&line);
+        range
+    });
+    let mut data = json!({});
+    describe_vertex_data(&mut String::new(), &mut data, &points.vertex_data);
+    if let Some(object) = json.as_object_mut() {
+        object.insert("points".into(), json!(n));
+        object.insert("bounds".into(), bounds_json);
+        object.insert("attributes".into(), json!(attributes));
+        object.insert("normals".into(), json!(points.normals.is_some()));
+        object.insert("uvs".into(), uvs.unwrap_or(Value::Null));
+        object.insert("face_ids".into(), faces.unwrap_or(Value::Null));
+        if let Value::Object(data) = data {
+            object.extend(data);
+        }
+    }
+}
+
+/// ` (3 components)`, ` (1 component)`.
+fn components(n: usize) -> String {
+    format!(" ({n} component{})", if n == 1 { "" } else { "s" })
+}
+
+/// `RGB`, or `RGBA` when some alpha is below 1 (glTF's writer stores
+/// opaque colours as `VEC3`).
+fn color_kind(colors: &[[f32; 4]]) -> &'static str {
+    if colors.iter().any(|c| c[3] != 1.0) {
+        "RGBA"
+    } else {
+        "RGB"
+    }
+}
+
+/// glTF's `COLOR_0` and `_NAME` attributes as lines and as the JSON keys `colors` (`"RGB"`,
+/// `"RGBA"` or null) and `custom_attributes` (the name and components
+/// of each, in the order of the file).
+fn describe_vertex_data(
+    text: &mut String,
+    json: &mut Value,
+    data: &trilux_io::mesh::gltf::VertexData,
+) {
+    let colors = data.colors.as_deref().map(color_kind);
+    let _ = writeln!(
+        text,
+        "  vertex colours (COLOR_0): {}",
+        colors.unwrap_or("none")
+    );
+    let custom: Vec<(String, usize)> = data
+        .attributes
+        .iter()
+        .map(|a| (format!("_{}", a.name), a.values.components()))
+        .collect();
+    let _ = writeln!(
+        text,
+        "  custom attributes: {}",
+        if custom.is_empty() {
+            "none".to_string()
+        } else {
+            custom
+                .iter()
+                .map(|(name, n)| format!("{name}{}", components(*n)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
+    );
+    if let Some(object) = json.as_object_mut() {
+        object.insert("colors".into(), json!(colors));
+        object.insert(
+            "custom_attributes".into(),
+            custom
+                .iter()
+                .map(|(name, n)| json!({"name": name, "components": n}))
+                .collect(),
+        );
+    }
+}
+
 fn ply_info(context: &mut Context, path: &Path) -> Result<(String, Value)> {
     let ply = context.step("reading the PLY file", || trilux_io::mesh::ply::read(path))?;
     if !ply.triangles.is_empty() {
@@ -106,6 +283,18 @@ fn describe_mesh(
     path: &Path,
     kind: &str,
     mesh: &trilux_io::mesh::TriMesh,
+) -> (String, Value) {
+    describe_mesh_with(context, path, kind, mesh, ("", json!({})))
+}
+
+/// As [`describe_mesh`], with `extra` lines and JSON keys (a glTF file's
+/// vertex colours and attributes) before the warnings.
+fn describe_mesh_with(
+    context: &mut Context,
+    path: &Path,
+    kind: &str,
+    mesh: &trilux_io::mesh::TriMesh,
+    (extra_text, extra_json): (&str, Value),
 ) -> (String, Value) {
     let shape = context.step("checking the topology", || trilux::mesh::shape(mesh));
     // A file without faces (empty, or points only) has no surface: no
@@ -170,6 +359,10 @@ fn describe_mesh(
         "objects": mesh.objects.len(),
         "materials": materials,
     });
+    text.push_str(extra_text);
+    if let (Some(object), Value::Object(extra)) = (json.as_object_mut(), extra_json) {
+        object.extend(extra);
+    }
     add_warnings(&mut text, &mut json, &mesh.warnings);
     (text, json)
 }
@@ -546,4 +739,54 @@ fn meshcolors_info(context: &mut Context, path: &Path) -> Result<(String, Value)
                "resolutions": histogram.iter().map(|(r, n)| (r.to_string(), json!(n))).collect::<serde_json::Map<_, _>>(),
                "mip": mip.is_some()}),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trilux_io::mesh::gltf::{Attribute, AttributeValues, Points, VertexData};
+
+    #[test]
+    fn glb_points_list_their_colours_and_custom_attributes_far_from_the_origin() {
+        let points = Points {
+            positions: vec![glam::Vec3::ZERO, glam::Vec3::ONE],
+            origin: glam::DVec3::new(1e6, 0.0, 0.0),
+            vertex_data: VertexData {
+                colors: Some(vec![[1.0, 0.0, 0.0, 0.5], [0.0, 1.0, 0.0, 1.0]]),
+                attributes: vec![
+                    Attribute {
+                        name: "W".into(),
+                        values: AttributeValues::Scalar(vec![1.0, 2.0]),
+                    },
+                    Attribute {
+                        name: "DIR".into(),
+                        values: AttributeValues::Vec3(vec![glam::Vec3::X; 2]),
+                    },
+                ],
+            },
+            ..Default::default()
+        };
+        let (mut text, mut json) = (String::new(), json!({}));
+        describe_points(&mut text, &mut json, &points, "");
+        assert_eq!(
+            text,
+            "  points: 2\n  bounds: [1000000, 0, 0] .. [1000001, 1, 1]\n  attributes: colors (RGBA), \
+             _W (1 component), _DIR (3 components)\n"
+        );
+        assert_eq!(json["points"], 2);
+        assert_eq!(
+            json["bounds"],
+            json!([[1e6, 0.0, 0.0], [1e6 + 1.0, 1.0, 1.0]])
+        );
+        assert_eq!(json["attributes"], json!(["colors", "_W", "_DIR"]));
+        assert_eq!(json["colors"], "RGBA");
+        assert_eq!(
+            json["custom_attributes"],
+            json!([{"name": "_W", "components": 1}, {"name": "_DIR", "components": 3}])
+        );
+        assert_eq!(
+            (&json["normals"], &json["uvs"], &json["face_ids"]),
+            (&json!(false), &Value::Null, &Value::Null)
+        );
+    }
 }

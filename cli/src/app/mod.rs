@@ -432,38 +432,99 @@ pub(crate) fn extension(path: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// Checks that an output's folder exists, the extension is one of
-/// `allowed` and the file (and a `.gltf`'s `.bin`) is new or `--force`
-/// was given, before any long computation.
-pub(crate) fn check_output(context: &Context, path: &Path, allowed: &[&str]) -> Result<()> {
-    let ext = extension(path);
-    if !allowed.contains(&ext.as_str()) {
-        return Err(output_error(
-            path,
-            format!(
-                "unknown output extension {ext:?} (expected {})",
-                allowed
-                    .iter()
-                    .map(|e| format!(".{e}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
+/// Checks an output, given as `option` (`-o`, `--glb`), before any long
+/// computation: a file name (not a folder) with one of the `allowed`
+/// extensions, in a folder that exists, new or `--force` given (and so
+/// for a `.gltf`'s `.bin`). A wrong name is a usage error naming the
+/// option as typed (`--glb b.ply: expected .glb or .gltf`); a missing
+/// folder or a file in the way is the file's.
+pub(crate) fn check_output(
+    context: &Context,
+    option: &str,
+    path: &Path,
+    allowed: &[&str],
+) -> Result<()> {
+    let typed = format!("{option} {}", path.display());
+    let expected = one_of(allowed);
+    if path.is_dir() {
+        return Err(arg_error(
+            typed,
+            format!("a folder, not a file (expected a file name ending in {expected})"),
         ));
+    }
+    let ext = extension(path);
+    if ext.is_empty() {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        // `.glb` is a hidden file's name, not an extension.
+        let hidden = name.strip_prefix('.').filter(|rest| !rest.is_empty());
+        let (hint, example) = match hidden {
+            Some(rest) if allowed.contains(&rest.to_ascii_lowercase().as_str()) => (
+                "a name starting with a dot is a hidden file's name; ",
+                format!("out{name}"),
+            ),
+            _ => (
+                "",
+                format!(
+                    "{}.{}",
+                    name.trim_end_matches('.'),
+                    allowed.first().copied().unwrap_or_default()
+                ),
+            ),
+        };
+        return Err(arg_error(
+            typed,
+            format!("the file name has no extension ({hint}expected {expected}, as in {example})"),
+        ));
+    }
+    if !allowed.contains(&ext.as_str()) {
+        return Err(arg_error(typed, format!("expected {expected}")));
     }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
         && !dir.is_dir()
     {
-        return Err(file_error(
-            path,
-            format!("the folder {} does not exist", dir.display()),
-        ));
+        // The first part of the path that exists: a file where a folder
+        // is needed, or a folder the rest is missing from.
+        let problem = match dir
+            .ancestors()
+            .find(|a| !a.as_os_str().is_empty() && a.exists())
+        {
+            Some(file) if !file.is_dir() => {
+                format!("{} is a file, not a folder", file.display())
+            }
+            _ => format!("the folder {} does not exist", dir.display()),
+        };
+        return Err(file_error(path, problem));
     }
     trilux::output::check_new(path, context.force)?;
     if ext == "gltf" {
         // The glTF writer puts NAME.bin beside NAME.gltf.
-        trilux::output::check_new(&path.with_extension("bin"), context.force)?;
+        let bin = path.with_extension("bin");
+        if bin.is_dir() {
+            return Err(file_error(
+                &bin,
+                format!(
+                    "a folder is in the way of the .bin written beside {} (remove it, or write \
+                     to another name)",
+                    path.display()
+                ),
+            ));
+        }
+        trilux::output::check_new(&bin, context.force)?;
     }
     Ok(())
+}
+
+/// `.png`, `.glb or .gltf`, `.node, .ele, .mesh or .vtu`.
+fn one_of(allowed: &[&str]) -> String {
+    let dotted: Vec<String> = allowed.iter().map(|e| format!(".{e}")).collect();
+    match dotted.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    }
 }
 
 /// Runs `f` on `threads` threads (all when `None`).

@@ -122,7 +122,7 @@ impl PackingArg {
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let wanted = wanted(&args)?;
     let channel = args.channel.unwrap_or(ChannelArg::Luminance).channel();
-    super::check_output(context, &args.output, &["ply", "glb", "gltf"])?;
+    super::check_output(context, "-o", &args.output, &["ply", "glb", "gltf"])?;
     let gltf = super::extension(&args.output) != "ply";
     if gltf && args.ascii {
         return Err(arg_error(
@@ -134,7 +134,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         ));
     }
     if let Some(p) = &args.preview {
-        super::check_output(context, p, &["png", "exr"])?;
+        super::check_output(context, "--preview", p, &["png", "exr"])?;
     }
     let mesh = super::read_mesh(context, &args.mesh)?;
     if gltf {

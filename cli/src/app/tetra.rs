@@ -40,12 +40,12 @@ pub(crate) struct Args {
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
-    super::check_output(context, &args.output, &["node", "ele", "mesh", "vtu"])?;
+    super::check_output(context, "-o", &args.output, &["node", "ele", "mesh", "vtu"])?;
     if let Some(p) = &args.preview {
-        super::check_output(context, p, &["png", "exr"])?;
+        super::check_output(context, "--preview", p, &["png", "exr"])?;
     }
     if let Some(p) = &args.glb {
-        super::check_output(context, p, &["glb", "gltf"])?;
+        super::check_output(context, "--glb", p, &["glb", "gltf"])?;
     }
     let spacing = match (args.spacing, args.size) {
         (None, Some(h)) => {

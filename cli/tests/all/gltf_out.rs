@@ -3,8 +3,10 @@
 //! no warning) and reads back with `trilux_io::mesh::gltf::read_scene`
 //! holding what the command made (the atlas and its triangles, the points
 //! with their normals, UVs and faces, the closed outward boundary of the
-//! tetrahedra); outputs are not clobbered without `--force` and an
-//! extension the command does not write is refused before any work.
+//! tetrahedra); outputs are not clobbered without `--force`, an
+//! extension the command does not write or a folder in the way is refused
+//! before any work; `trilux info` reports sampled glTF points as it
+//! reports a PLY point cloud.
 
 use std::path::{Path, PathBuf};
 
@@ -425,28 +427,131 @@ fn gltf_outputs_are_not_overwritten_without_force_and_other_extensions_are_refus
         .success();
     assert!(!checked(&d.join("surface.glb")).mesh.indices.is_empty());
 
-    // Extensions the commands do not write: usage errors naming the file
-    // and what they write.
+    // Extensions the commands do not write: usage errors naming the
+    // option, the file and what they write.
     fails_with(
         d,
         2,
         &[&sample[..], &["-o", "p.fbx"]].concat(),
-        &["p.fbx", ".ply, .glb, .gltf"],
+        &["error: -o p.fbx: expected .ply, .glb or .gltf"],
     );
     fails_with(
         d,
         2,
         &[&bake[..], &["-o", "atlas.fbx"]].concat(),
-        &["atlas.fbx", ".obj, .glb, .gltf"],
+        &["error: -o atlas.fbx: expected .obj, .glb or .gltf"],
     );
     fails_with(
         d,
         2,
         &[&tetra[..], &["--glb", "surface.obj", "--force"]].concat(),
-        &["surface.obj", ".glb, .gltf"],
+        &["error: --glb surface.obj: expected .glb or .gltf"],
     );
     for name in ["p.fbx", "atlas.fbx", "surface.obj"] {
         assert!(!d.join(name).exists(), "{name}");
     }
     no_partial_files(d);
+}
+
+#[test]
+fn a_folder_in_the_way_of_a_gltf_or_its_bin_is_refused_even_with_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, _) = torus_and_noise(d);
+    let torus = torus.to_str().unwrap();
+    let sample = ["--force", "sample", torus, "-n", "10", "-o"];
+    std::fs::create_dir(d.join("x.bin")).unwrap();
+    // Before sampling: the .bin the .gltf needs is a folder.
+    let message = fails_with(
+        d,
+        1,
+        &[&sample[..], &["x.gltf"]].concat(),
+        &["error: x.bin: a folder is in the way of the .bin written beside x.gltf"],
+    );
+    assert_eq!(message.lines().count(), 1, "{message}");
+    assert!(!d.join("x.gltf").exists(), "a .gltf without its .bin");
+    assert!(d.join("x.bin").is_dir());
+    // The output itself a folder: a usage error naming the option.
+    std::fs::create_dir(d.join("y.glb")).unwrap();
+    fails_with(
+        d,
+        2,
+        &[&sample[..], &["y.glb"]].concat(),
+        &[
+            "error: -o y.glb: a folder, not a file (expected a file name ending in .ply, .glb or .gltf)",
+        ],
+    );
+    // A file where the output's folder should be.
+    std::fs::write(d.join("afile"), "").unwrap();
+    fails_with(
+        d,
+        1,
+        &[&sample[..], &["afile/x.glb"]].concat(),
+        &["error: afile/x.glb: afile is a file, not a folder"],
+    );
+    no_partial_files(d);
+}
+
+/// `trilux info FILE --json`.
+fn info(dir: &Path, file: &str) -> serde_json::Value {
+    json(dir, &["info", file])
+}
+
+/// `trilux info FILE` as text.
+fn info_text(dir: &Path, file: &str) -> String {
+    let out = trilux(dir).args(["info", file]).output().unwrap();
+    assert!(out.status.success(), "{out:?}");
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn info_reports_sampled_gltf_points_as_it_reports_a_ply_point_cloud() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, _) = torus_and_noise(d);
+    let torus = torus.to_str().unwrap();
+    let sample = |out: &str| json(d, &["sample", torus, "-n", "40", "--seed", "5", "-o", out]);
+    for out in ["p.glb", "p.gltf", "p.ply"] {
+        sample(out);
+    }
+    let ply = info(d, "p.ply");
+    for file in ["p.glb", "p.gltf"] {
+        let glb = info(d, file);
+        assert_eq!(glb["kind"], "point cloud", "{glb}");
+        assert_eq!(glb["points"], 40);
+        assert_eq!(glb["attributes"], ply["attributes"], "{glb} vs {ply}");
+        assert_eq!(
+            glb["attributes"],
+            serde_json::json!(["normals", "uvs", "face ids"])
+        );
+        assert_eq!(glb["normals"], true);
+        assert_eq!(glb["colors"], serde_json::Value::Null);
+        assert_eq!(glb["custom_attributes"], serde_json::json!([]));
+        let faces = glb["face_ids"].as_array().expect("a face id range");
+        assert!(faces[1].as_u64().unwrap() < 256, "{glb}");
+        let u = glb["uvs"]["u"].as_array().expect("a UV range");
+        assert!(u[0].as_f64().unwrap() <= u[1].as_f64().unwrap());
+        // The same points: the same bounds, to f32 precision.
+        for (a, b) in [0, 1].map(|k| (&glb["bounds"][k], &ply["bounds"][k])) {
+            for c in 0..3 {
+                let (a, b) = (a[c].as_f64().unwrap(), b[c].as_f64().unwrap());
+                assert!((a - b).abs() < 1e-5, "{glb} vs {ply}");
+            }
+        }
+        assert_eq!(glb["warnings"], serde_json::json!([]));
+        let text = info_text(d, file);
+        assert!(
+            text.starts_with(&format!("{file}: point cloud\n")),
+            "{text}"
+        );
+        for line in [
+            "  points: 40\n",
+            "  attributes: normals, uvs, face ids (_FACE)\n",
+            "  face ids: ",
+            "  UVs: u ",
+        ] {
+            assert!(text.contains(line), "{line:?} not in {text}");
+        }
+        assert!(!text.contains("triangle mesh"), "{text}");
+    }
 }

@@ -709,6 +709,11 @@ fn diffuse_writes_the_surface_as_gltf_one_object_per_piece_and_keeps_outputs() {
         &[&broken[..], &["-o", "broken.png", "--glb", "broken.glb"]].concat(),
     );
     assert_eq!(report["objects"], 2);
+    assert_eq!(report["output"], "broken.png");
+    assert_eq!(
+        report["files"],
+        serde_json::json!(["broken.png", "broken.glb"])
+    );
     let glb = d.join("broken.glb");
     test_support::gltf::validate(&glb);
     let scene = trilux_io::mesh::gltf::read_scene(&glb).unwrap();
@@ -746,7 +751,11 @@ fn diffuse_writes_the_surface_as_gltf_one_object_per_piece_and_keeps_outputs() {
     // .gltf: a .bin beside it; a .bin in the way is refused before the
     // solve (no picture written), and so is an existing .glb.
     let gltf = [&broken[..], &["-o", "b2.png", "--glb", "broken.gltf"]].concat();
-    json(d, &gltf);
+    let report = json(d, &gltf);
+    assert_eq!(
+        report["files"],
+        serde_json::json!(["b2.png", "broken.bin", "broken.gltf"])
+    );
     test_support::gltf::validate(&d.join("broken.gltf"));
     assert!(d.join("broken.bin").is_file());
     std::fs::remove_file(d.join("broken.gltf")).unwrap();
@@ -765,5 +774,66 @@ fn diffuse_writes_the_surface_as_gltf_one_object_per_piece_and_keeps_outputs() {
     );
     // Only .glb and .gltf.
     let obj = [&broken[..], &["-o", "b4.png", "--glb", "b4.obj"]].concat();
-    common::fails_with(d, 2, &obj, &["b4.obj", "\"obj\"", ".glb, .gltf"]);
+    common::fails_with(d, 2, &obj, &["error: --glb b4.obj: expected .glb or .gltf"]);
+}
+
+#[test]
+fn diffuse_lists_every_file_it_writes_and_info_shows_the_gltf_attributes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    stuffed_blob(d, "0.25");
+    let base = ["diffuse", "blob.node", "--size", "32"];
+    let all = ["-o", "a.png", "--exr", "a.exr", "--vtu", "a.vtu"];
+    let report = json(d, &[&base[..], &all, &["--glb", "a.gltf"]].concat());
+    let written = ["a.png", "a.exr", "a.vtu", "a.bin", "a.gltf"];
+    assert_eq!(report["files"], serde_json::json!(written), "{report}");
+    assert_eq!(report["output"], "a.png");
+    for f in written {
+        assert!(d.join(f).is_file(), "{f}");
+    }
+    // The summary line names them all too.
+    let out = run(
+        d,
+        &[&["--force"], &base[..], &all, &["--glb", "a.gltf"]].concat(),
+    );
+    assert!(out.status.success(), "{out:?}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.trim_end()
+            .ends_with("; written to a.png, a.exr, a.vtu, a.bin, a.gltf"),
+        "{text}"
+    );
+    let out = run(d, &[&base[..], &["-o", "b.png", "--glb", "b.glb"]].concat());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.trim_end().ends_with("; written to b.png, b.glb"),
+        "{text}"
+    );
+
+    // `info` on the surface: the triangles with their vertex colours and
+    // the radiance and φ as custom attributes.
+    for file in ["a.gltf", "b.glb"] {
+        let info = json(d, &["info", file]);
+        assert_eq!(info["kind"], "triangle mesh", "{info}");
+        assert_eq!(info["closed"], true);
+        assert_eq!(info["colors"], "RGB");
+        let mut custom = info["custom_attributes"].as_array().unwrap().clone();
+        custom.sort_by_key(|a| a["name"].as_str().unwrap().to_string());
+        assert_eq!(
+            custom,
+            [
+                serde_json::json!({"name": "_PHI", "components": 3}),
+                serde_json::json!({"name": "_RADIANCE", "components": 3}),
+            ]
+        );
+        let out = run(d, &["info", file]);
+        let text = String::from_utf8_lossy(&out.stdout);
+        for line in [
+            "  vertex colours (COLOR_0): RGB\n",
+            "_PHI (3 components)",
+            "_RADIANCE (3 components)",
+        ] {
+            assert!(text.contains(line), "{line:?} not in {text}");
+        }
+    }
 }

@@ -1,7 +1,8 @@
 //! A session of `trilux view` saved from its page and replayed: by
 //! `trilux view --replay` and by `trilux diffuse --session`, whose
 //! picture, VTU and glTF surface are byte for byte the page's exports of
-//! the live session; and a bad session file is an error naming the file and the
+//! the live session (every file written listed in the summary and the
+//! JSON); and a bad session file is an error naming the file and the
 //! entry.
 #![cfg(feature = "view")]
 
@@ -154,6 +155,10 @@ fn a_view_session_replays_in_diffuse_as_the_page_exports_it_byte_for_byte() {
     assert!(out.status.success(), "{out:?}");
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("replayed (4 edits)"), "{stdout}");
+    assert!(
+        stdout.ends_with("; written to diffuse.png, diffuse.vtu, diffuse.glb\n"),
+        "{stdout}"
+    );
     let read = |name: &str| std::fs::read(d.join(name)).unwrap();
     assert!(read("diffuse.png") == read("live.png"), "the PNGs differ");
     assert!(read("diffuse.vtu") == read("live.vtu"), "the VTUs differ");
@@ -205,6 +210,45 @@ fn a_view_session_replays_in_diffuse_as_the_page_exports_it_byte_for_byte() {
     assert!(read("replay.png") == read("live.png"), "the PNGs differ");
     assert!(read("replay.vtu") == read("live.vtu"), "the VTUs differ");
     assert!(read("replay.glb") == read("live.glb"), "the GLBs differ");
+}
+
+#[test]
+fn diffuse_session_lists_every_file_it_writes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // The built-in ball, no edits.
+    let session = json!({"format": "trilux-session", "version": 1, "refined_initially": false,
+        "source": {"mesh": null, "material": null, "unit_mm": null}, "edits": []});
+    std::fs::write(d.join("s.json"), session.to_string()).unwrap();
+    let out = trilux()
+        .current_dir(d)
+        .args(["--json", "diffuse", "--session", "s.json", "--size", "32"])
+        .args([
+            "-o", "s.png", "--exr", "s.exr", "--vtu", "s.vtu", "--glb", "s.gltf",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let written = ["s.png", "s.exr", "s.vtu", "s.bin", "s.gltf"];
+    assert_eq!(report["files"], json!(written), "{report}");
+    assert_eq!(report["output"], "s.png");
+    for f in written {
+        assert!(d.join(f).is_file(), "{f}");
+    }
+    test_support::gltf::validate(&d.join("s.gltf"));
+    let out = trilux()
+        .current_dir(d)
+        .args(["diffuse", "--session", "s.json", "--size", "32"])
+        .args(["-o", "t.png", "--glb", "t.glb"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.ends_with("replayed (0 edits); written to t.png, t.glb\n"),
+        "{stdout}"
+    );
 }
 
 #[test]
