@@ -133,9 +133,11 @@ impl MeshColors {
     }
 
     /// Writes a `.meshcolors` file (with the MIP-map, when `lookup` with
-    /// `filter='mip'` built one).
+    /// `filter='mip'` built one); a folder that does not exist raises
+    /// `trilux.FileError`.
     fn save(&self, py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<()> {
         let path = path_arg(path, "path")?;
+        crate::mesh::check_folder(&path)?;
         detached(py, || {
             Ok(mesh_colors::file::save(
                 &path,
@@ -225,13 +227,7 @@ impl MeshColors {
             let atlas = mesh_colors::atlas::bake(&self.colors, &options)?;
             Ok(trilux::atlas_mesh(&self.surface, &atlas, None))
         })?;
-        let mesh = Bound::new(
-            py,
-            Mesh {
-                inner: std::sync::Arc::new(mesh),
-            },
-        )?
-        .into_any();
+        let mesh = Bound::new(py, Mesh::plain(mesh))?.into_any();
         PyTuple::new(py, [mesh, image_to(py, &image)?])
     }
 

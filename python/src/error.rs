@@ -4,8 +4,8 @@
 //! | exception | bases | raised for |
 //! |---|---|---|
 //! | `trilux.Error` | `Exception` | the base of all below |
-//! | `trilux.InputError` | `Error`, `ValueError` | arguments and data the Rust crates refuse (bad arrays, weights, options, meshes) |
-//! | `trilux.FileError` | `Error`, `OSError` | a file that cannot be read, written or parsed (trilux-io's errors: the message names the file and line) |
+//! | `trilux.InputError` | `Error`, `ValueError` | arguments and data the Rust crates refuse (bad arrays, weights, options, meshes; data a trilux-io writer refuses) |
+//! | `trilux.FileError` | `Error`, `OSError` | a file that cannot be read, written or parsed, a path whose extension names no format or whose folder does not exist (trilux-io's errors: the message names the file and line) |
 //! | `trilux.InternalError` | `Error`, `RuntimeError` | a Rust panic (a bug): never a crash of the interpreter |
 
 use pyo3::prelude::*;
@@ -134,9 +134,18 @@ impl From<Failure> for PyErr {
 }
 
 impl From<trilux_io::Error> for Failure {
+    /// A `FileError`, except for data a writer refuses
+    /// ([`trilux_io::ErrorKind::InvalidInput`]: a field of the wrong
+    /// length, a non-finite position, a colour out of range): a problem
+    /// of the arrays given, so an `InputError` as the Python layer's own
+    /// checks raise.
     fn from(e: trilux_io::Error) -> Self {
+        let kind = match e.kind {
+            trilux_io::ErrorKind::InvalidInput(_) => Kind::Input,
+            _ => Kind::File,
+        };
         Self {
-            kind: Kind::File,
+            kind,
             message: chain(&e),
         }
     }
@@ -366,6 +375,29 @@ mod tests {
         assert!(f.message.contains("5000000 pieces"), "{}", f.message);
         assert!(f.message.contains("method='rejection'"), "{}", f.message);
         assert!(!f.message.contains("Options::"), "{}", f.message);
+    }
+
+    /// Data a trilux-io writer refuses is an `InputError`; a file that
+    /// cannot be read or written stays a `FileError`.
+    #[test]
+    fn a_writers_refusal_of_the_data_is_an_input_error() {
+        let refused = trilux_io::Error {
+            path: "a.glb".into(),
+            location: None,
+            kind: trilux_io::ErrorKind::InvalidInput("vertex 3 has a non-finite position".into()),
+        };
+        let f = Failure::from(refused);
+        assert_eq!(f.kind, Kind::Input);
+        assert_eq!(
+            f.message,
+            "a.glb: cannot write this data: vertex 3 has a non-finite position"
+        );
+        let missing = trilux_io::Error {
+            path: "a.glb".into(),
+            location: None,
+            kind: trilux_io::ErrorKind::Io(std::io::ErrorKind::NotFound.into()),
+        };
+        assert_eq!(Failure::from(missing).kind, Kind::File);
     }
 
     /// The rejection steps' messages say `method=`, not "the approximate

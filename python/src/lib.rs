@@ -4,11 +4,12 @@
 //!
 //! | Python | Rust |
 //! |---|---|
-//! | `load`, `save`, `Mesh` | trilux-io meshes ([`mesh`]); glTF colours and attributes ([`gltf`]) |
+//! | `load`, `save`, `Mesh` | trilux-io meshes ([`mesh`]); glTF colours and attributes, in and out ([`gltf`]) |
 //! | `sample_surface`, `blue_noise`, `sample_surface_even` | mesh-sampling ([`sampling`]) |
 //! | `Distribution1D`, `Distribution2D` | discrete-sampling ([`discrete`]) |
 //! | `MeshColors` | mesh-colors via `trilux::to_mesh_colors` ([`colors`]) |
 //! | `tetrahedralize`, `load_tets`, `save_tets`, `save_points` | stuffing, trilux-io ([`tets`]), PLY or glTF points |
+//! | `load_points`, `Points` | PLY or glTF points back in ([`points`]) |
 //! | `Object`, `render`, `media` | tet-diffusion ([`transcut`]) |
 //! | `Error`, `InputError`, `FileError`, `InternalError` | every crate's error, message unchanged ([`error`]) |
 //!
@@ -28,6 +29,7 @@ pub mod discrete;
 pub mod error;
 pub mod gltf;
 pub mod mesh;
+pub mod points;
 pub mod sampling;
 pub mod tets;
 pub mod transcut;
@@ -51,6 +53,8 @@ fn _trilux(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tets::load_tets, m)?)?;
     m.add_function(wrap_pyfunction!(tets::save_tets, m)?)?;
     m.add_function(wrap_pyfunction!(tets::save_points, m)?)?;
+    m.add_class::<points::Points>()?;
+    m.add_function(wrap_pyfunction!(points::load_points, m)?)?;
     m.add_class::<transcut::Object>()?;
     m.add_function(wrap_pyfunction!(transcut::render, m)?)?;
     m.add_function(wrap_pyfunction!(transcut::media, m)?)?;

@@ -9,17 +9,18 @@
 //! Inside, `TriMesh` UVs are glTF's (`v = 0` at row 0): the flip
 //! `v ↦ 1 − v` happens here, on the way in and out, and nowhere else.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{DVec3, Vec2, Vec3};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use trilux_io::image::Image;
+use trilux_io::mesh::gltf::VertexData;
 use trilux_io::mesh::{Material as IoMaterial, Object, TriMesh};
 
 use crate::arrays;
-use crate::error::{Failure, detached};
+use crate::error::{Failure, Kind, detached};
 
 /// A triangle mesh as trilux holds it: `float32` positions relative to an
 /// `origin` (kept in `float64`, so georeferenced scans keep their
@@ -29,10 +30,24 @@ use crate::error::{Failure, detached};
 /// `Mesh(vertices, faces, uv=None, normals=None)` makes one from arrays;
 /// `trilux.load(path)` reads one. A `Mesh` has `.vertices` and `.faces`
 /// like a `trimesh.Trimesh`, so it goes wherever a mesh is asked for, and
-/// `trimesh.Trimesh(m.vertices, m.faces)` turns it into one.
+/// `trimesh.Trimesh(m.vertices, m.faces)` turns it into one. A glTF
+/// file's per-vertex colours and `_NAME` attributes are `colors` and
+/// `attributes`.
 #[pyclass(module = "trilux", frozen)]
 pub(crate) struct Mesh {
     pub(crate) inner: Arc<TriMesh>,
+    /// A glTF file's `COLOR_0` and `_NAME` attributes (empty otherwise).
+    pub(crate) data: VertexData,
+}
+
+impl Mesh {
+    /// A mesh without colours or attributes.
+    pub(crate) fn plain(inner: TriMesh) -> Self {
+        Self {
+            inner: Arc::new(inner),
+            data: VertexData::default(),
+        }
+    }
 }
 
 fn flip_v(uv: [f64; 2]) -> Vec2 {
@@ -252,6 +267,83 @@ pub(crate) fn path_arg(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<PathBuf> 
         .map_err(|_| Failure::input(format!("{what}: expected a path (str or os.PathLike)")).into())
 }
 
+/// A `trilux.FileError` with `message`.
+pub(crate) fn file_error(message: String) -> PyErr {
+    Failure {
+        kind: Kind::File,
+        message,
+    }
+    .into()
+}
+
+/// The lowercased extension of `path`, `None` when it has none (or ends
+/// in a bare `.`).
+pub(crate) fn extension(path: &Path) -> Option<String> {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .filter(|e| !e.is_empty())
+}
+
+/// `.a, .b or .c`.
+fn listed(extensions: &[&str]) -> String {
+    let dotted: Vec<String> = extensions.iter().map(|e| format!(".{e}")).collect();
+    match dotted.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => dotted.concat(),
+    }
+}
+
+/// Checks that `path`'s extension is one of `extensions` (lower case),
+/// which pick the format of `what` ("a mesh", "points"), and returns it:
+/// otherwise a `trilux.FileError` naming the path and the extensions
+/// accepted, with `verb` ("write", "read") in the advice.
+pub(crate) fn check_extension(
+    path: &Path,
+    extensions: &[&str],
+    what: &str,
+    verb: &str,
+) -> PyResult<String> {
+    let accepted = listed(extensions);
+    match extension(path) {
+        None => Err(file_error(format!(
+            "{}: the path has no extension, and the extension picks the format of {what} \
+             ({verb} {accepted})",
+            path.display()
+        ))),
+        Some(ext) if !extensions.contains(&ext.as_str()) => Err(file_error(format!(
+            "{}: unknown extension {ext:?} for {what} ({verb} {accepted})",
+            path.display()
+        ))),
+        Some(ext) => Ok(ext),
+    }
+}
+
+/// Checks that the folder a file is to be written in exists: otherwise a
+/// `trilux.FileError` naming the path given and the folder (the writer's
+/// own error would name the first file it opens: the `.bin` of a
+/// `.gltf`, the `.ele` of a `.node`).
+pub(crate) fn check_folder(path: &Path) -> PyResult<()> {
+    let Some(folder) = path.parent().filter(|f| !f.as_os_str().is_empty()) else {
+        return Ok(());
+    };
+    if folder.is_dir() {
+        return Ok(());
+    }
+    let why = if folder.exists() {
+        "is not a folder"
+    } else {
+        "does not exist"
+    };
+    Err(file_error(format!(
+        "{}: the folder {} {why}",
+        path.display(),
+        folder.display()
+    )))
+}
+
+/// The extensions `save` writes a mesh to.
+const MESH_EXTENSIONS: [&str; 4] = ["obj", "ply", "glb", "gltf"];
+
 #[pymethods]
 impl Mesh {
     /// A mesh of arrays: vertices `(n, 3)` (any real dtype), faces `(m, 3)`
@@ -266,9 +358,7 @@ impl Mesh {
         uv: Option<&Bound<'_, PyAny>>,
         normals: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        Ok(Self {
-            inner: Arc::new(from_arrays(vertices, faces, uv, normals)?),
-        })
+        Ok(Self::plain(from_arrays(vertices, faces, uv, normals)?))
     }
 
     /// Vertex positions, `(n, 3)` float64, in the file's coordinates
@@ -317,6 +407,29 @@ impl Mesh {
             .transpose()
     }
 
+    /// Per-vertex colours of a glTF file (`COLOR_0`), float32 linear RGB
+    /// in `[0, 1]`: `(n, 3)`, or `(n, 4)` RGBA when an alpha is not 1; or
+    /// `None` (other formats, or a file without them). `trilux.save`
+    /// writes them back only when given:
+    /// `trilux.save(path, m, colors=m.colors, attributes=m.attributes)`.
+    #[getter]
+    fn colors<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.data
+            .colors
+            .as_ref()
+            .map(|c| crate::gltf::colours_out(py, c))
+            .transpose()
+    }
+
+    /// A glTF file's per-vertex `_NAME` attributes: a dict of names
+    /// without the underscore (`_PHI` is `"PHI"`) to float32 arrays,
+    /// `(n,)` or `(n, k)`, as `trilux.save(..., attributes=)` takes them;
+    /// empty for other formats.
+    #[getter]
+    fn attributes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        crate::gltf::attributes_out(py, &self.data.attributes)
+    }
+
     /// The global shift, `(3,)` float64: zero for ordinary files, the
     /// centre of the bounding box for coordinates far from zero.
     #[getter]
@@ -347,7 +460,8 @@ impl Mesh {
     /// What the reader skipped or replaced without refusing the file, a
     /// list of str: a missing `.mtl` or texture, `f v/vt/vn` corners
     /// without `vt` lines, PLY elements or properties it does not read, a
-    /// glTF texture whose image is only in an extension. Each names the
+    /// glTF texture whose image is only in an extension, a glTF file's
+    /// points (which `trilux.load_points` reads). Each names the
     /// file, the line or element and what was skipped (as `trilux info`
     /// prints them); empty for an intact file or a mesh made of arrays.
     #[getter]
@@ -378,8 +492,14 @@ impl Mesh {
     }
 
     fn __repr__(&self) -> String {
+        let names: Vec<&str> = self
+            .data
+            .attributes
+            .iter()
+            .map(|a| a.name.as_str())
+            .collect();
         format!(
-            "trilux.Mesh({} vertices, {} faces{}{})",
+            "trilux.Mesh({} vertices, {} faces{}{}{}{})",
             self.inner.positions.len(),
             self.inner.indices.len(),
             if self.inner.uvs.is_some() { ", uv" } else { "" },
@@ -388,6 +508,16 @@ impl Mesh {
             } else {
                 ""
             },
+            if self.data.colors.is_some() {
+                ", colors"
+            } else {
+                ""
+            },
+            if names.is_empty() {
+                String::new()
+            } else {
+                format!(", attributes {}", names.join(", "))
+            },
         )
     }
 }
@@ -395,14 +525,37 @@ impl Mesh {
 /// Reads a triangle mesh: OBJ (with its MTL and textures), glTF/GLB or
 /// PLY, by extension. Raises `trilux.FileError` naming the file and line.
 /// What the reader skipped without refusing the file (a missing texture,
-/// an element it does not read) is in the mesh's `warnings`.
+/// an element it does not read) is in the mesh's `warnings`. A glTF
+/// file's per-vertex colours and `_NAME` attributes are the mesh's
+/// `colors` and `attributes`; its points (`POINTS` primitives, as
+/// `save_points` writes them) are not part of the mesh: a warning says
+/// so, and `trilux.load_points` reads them.
 #[pyfunction]
 pub(crate) fn load(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Mesh> {
     let path = path_arg(path, "path")?;
     Failure::if_directory(&path, "a mesh file (.obj, .gltf, .glb or .ply)")?;
-    let inner = detached(py, || Ok(TriMesh::read(&path)?))?;
+    if !crate::gltf::is_gltf(&path) {
+        let inner = detached(py, || Ok(TriMesh::read(&path)?))?;
+        return Ok(Mesh::plain(inner));
+    }
+    let scene = detached(py, || Ok(trilux_io::mesh::gltf::read_scene(&path)?))?;
+    let mut inner = scene.mesh;
+    let points = scene.points.positions.len();
+    if points > 0 {
+        // trilux-io's own warning (which `read` adds, `read_scene` does
+        // not) names a Rust function; this one names the Python one.
+        inner.warnings.push(trilux_io::Warning {
+            path: path.clone(),
+            location: None,
+            message: format!(
+                "the file also holds {points} points (POINTS primitives), which a triangle mesh \
+                 does not keep; trilux.load_points(path) reads them"
+            ),
+        });
+    }
     Ok(Mesh {
         inner: Arc::new(inner),
+        data: scene.vertex_data,
     })
 }
 
@@ -410,18 +563,27 @@ pub(crate) fn load(py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<Mesh> {
 /// `(vertices, faces)` pair) by extension: OBJ (with MTL and textures),
 /// PLY, or glTF (`.glb`, one file; `.gltf` with a `.bin` of the same name
 /// beside it), with the mesh's normals, UVs and materials (textures
-/// embedded). An existing file is replaced.
+/// embedded). An existing file is replaced. A path without one of these
+/// extensions, or in a folder that does not exist, raises
+/// `trilux.FileError`; a vertex that is not finite, `trilux.InputError`.
 ///
 /// glTF files also keep, per vertex, `colors` (`COLOR_0`): `(n, 3)` or
-/// `(n, 4)` floats in [0, 1], linear as glTF says, or `uint8` taken as
+/// `(n, 4)` floats in [0, 1], linear as glTF says (values within 1e-5 of
+/// [0, 1], float32 rounding, are clamped into it), or `uint8` taken as
 /// 8-bit sRGB (trimesh's `visual.vertex_colors`) and decoded; and
 /// `attributes`: a dict of names to `(n,)` or `(n, k)` arrays (k from 1
-/// to 4, stored as float32), written as glTF's `_NAME` attributes
-/// (three.js's `geometry.attributes._name`, Blender's attributes); a
-/// name may be given with or without the underscore. With another
-/// extension they raise `trilux.InputError`, as does a colour outside
-/// [0, 1], a wrong number of rows, a non-finite value or a name that is
-/// not ASCII letters, digits and `_`.
+/// to 4), written as glTF's `_NAME` attributes: the name is prefixed
+/// with `_` (`"PHI"` is written `_PHI`, `"COLOR_0"` `_COLOR_0`; a name
+/// given with the underscore keeps its one), which three.js shows as
+/// `geometry.attributes._phi` and Blender as `_PHI`. Attributes are
+/// stored as float32, as glTF requires of them: floats are rounded to
+/// float32, and integers must be exact in it (every one up to 2**24 =
+/// 16777216 in magnitude is; give floats to accept rounding). With
+/// another extension they raise `trilux.InputError`, as does a colour
+/// outside [0, 1] (by more than 1e-5) or not finite, a wrong number of
+/// rows, a non-finite value or a name that is not ASCII letters, digits
+/// and `_`. `trilux.load` gives them back (`Mesh.colors`,
+/// `Mesh.attributes`).
 #[pyfunction]
 #[pyo3(signature = (path, mesh, *, colors = None, attributes = None))]
 pub(crate) fn save(
@@ -432,11 +594,35 @@ pub(crate) fn save(
     attributes: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<()> {
     let path = path_arg(path, "path")?;
+    check_extension(&path, &MESH_EXTENSIONS, "a mesh", "write")?;
+    check_folder(&path)?;
     let mesh = mesh_arg(mesh, None)?;
+    check_finite_vertices(&mesh)?;
     let n = mesh.positions.len();
     let data = crate::gltf::vertex_data(&path, colors, attributes, n, ("vertex", "vertices"))?;
     detached(py, || match &data {
         Some(data) => Ok(trilux_io::mesh::gltf::write_with(&path, &mesh, data)?),
         None => Ok(mesh.write(&path)?),
     })
+}
+
+/// A `trilux.InputError` naming the first vertex of `mesh` whose position
+/// is not finite (or, finite in float64, too far from the others to be
+/// held in float32 relative to the origin): every format's reader refuses
+/// such a file.
+fn check_finite_vertices(mesh: &TriMesh) -> PyResult<()> {
+    let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) else {
+        return Ok(());
+    };
+    let absolute = (mesh.origin + mesh.positions[i].as_dvec3()).to_array();
+    let why = if absolute.iter().all(|v| v.is_finite()) {
+        "is too far from the other vertices to be stored in float32"
+    } else {
+        "is not finite"
+    };
+    Err(Failure::input(format!(
+        "mesh: vertex {i} {why} ({})",
+        crate::gltf::row_text(&absolute)
+    ))
+    .into())
 }

@@ -9,7 +9,7 @@ use tet_stuffing as stuffing;
 
 use crate::arrays;
 use crate::error::{Failure, detached};
-use crate::mesh::{mesh_arg, path_arg};
+use crate::mesh::{check_extension, check_folder, mesh_arg, path_arg};
 
 /// `(nodes, tets)` as numpy: `(n, 3)` float64 and `(m, 4)` int64.
 pub(crate) fn tets_out<'py>(
@@ -126,7 +126,8 @@ pub(crate) fn load_tets<'py>(
 }
 
 /// Writes a tetrahedral mesh `(nodes (n, 3), tets (m, 4))` as TetGen
-/// `.node` + `.ele`, MEDIT `.mesh` or VTK `.vtu`, by extension.
+/// `.node` + `.ele`, MEDIT `.mesh` or VTK `.vtu`, by extension (a folder
+/// that does not exist raises `trilux.FileError`).
 #[pyfunction]
 pub(crate) fn save_tets(
     py: Python<'_>,
@@ -135,6 +136,7 @@ pub(crate) fn save_tets(
     tets: &Bound<'_, PyAny>,
 ) -> PyResult<()> {
     let path = path_arg(path, "path")?;
+    check_folder(&path)?;
     let (positions, tets) = tets_in(nodes, tets)?;
     let mesh = trilux_io::tet::TetMesh {
         positions,
@@ -144,16 +146,38 @@ pub(crate) fn save_tets(
     detached(py, || Ok(trilux_io::tet::write(&path, &mesh)?))
 }
 
+/// The extensions `save_points` writes and `load_points` reads.
+pub(crate) const POINT_EXTENSIONS: [&str; 3] = ["ply", "glb", "gltf"];
+
+/// Checks that every row of `rows` (the argument `what`) is finite: a
+/// `trilux.InputError` naming the first that is not.
+fn finite_rows(rows: &[[f64; 3]], what: &str) -> PyResult<()> {
+    match rows.iter().position(|r| !r.iter().all(|v| v.is_finite())) {
+        None => Ok(()),
+        Some(i) => Err(Failure::input(format!(
+            "{what}: row {i} is not finite ({})",
+            crate::gltf::row_text(&rows[i])
+        ))
+        .into()),
+    }
+}
+
 /// Writes a point cloud by extension: PLY (binary little-endian, as
 /// `trilux sample` writes it) or glTF (`.glb`, or `.gltf` with its `.bin`:
 /// a `POINTS` primitive). `points` `(n, 3)`, optional `normals` `(n, 3)`
 /// and `face_index` `(n,)` (PLY `face_id`, glTF `_FACE`, which keeps ids
-/// below 2**24).
+/// below 2**24). glTF stores unit normals: a normal is normalised, and a
+/// zero one becomes `(0, 0, 1)` (PLY keeps them as given). A point or
+/// normal that is not finite raises `trilux.InputError`; a path without
+/// one of these extensions, or in a folder that does not exist,
+/// `trilux.FileError`.
 ///
 /// glTF files also keep `colors` and `attributes` per point, as
-/// `trilux.save` writes them per vertex (with another extension they
-/// raise `trilux.InputError`; `FACE` is `face_index`'s name there). An
-/// existing file is replaced.
+/// `trilux.save` writes them per vertex: colours linear in [0, 1] (within
+/// 1e-5 clamped) or uint8 sRGB; attributes stored as float32 under the
+/// name prefixed with `_` (`FACE` is `face_index`'s name there). With
+/// another extension they raise `trilux.InputError`. An existing file is
+/// replaced. `trilux.load_points` reads the file back.
 #[pyfunction]
 #[pyo3(signature = (path, points, *, normals = None, face_index = None, colors = None, attributes = None))]
 pub(crate) fn save_points(
@@ -166,24 +190,20 @@ pub(crate) fn save_points(
     attributes: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<()> {
     let path = path_arg(path, "path")?;
+    check_extension(&path, &POINT_EXTENSIONS, "points", "write")?;
+    check_folder(&path)?;
     let gltf = crate::gltf::is_gltf(&path);
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
-    if !gltf && ext != "ply" {
-        return Err(Failure {
-            kind: crate::error::Kind::File,
-            message: format!(
-                "{}: unknown extension {ext:?} for points (write .ply, .glb or .gltf)",
-                path.display()
-            ),
-        }
+    let p = arrays::rows_f64::<3>(points, "points")?;
+    finite_rows(&p, "points")?;
+    let absolute: Vec<DVec3> = p.iter().copied().map(DVec3::from_array).collect();
+    let (origin, positions) = trilux_io::mesh::recenter(&absolute);
+    if let Some(i) = positions.iter().position(|q| !q.is_finite()) {
+        return Err(Failure::input(format!(
+            "points: row {i} ({}) is too far from the other points to be stored in float32",
+            crate::gltf::row_text(&p[i])
+        ))
         .into());
     }
-    let p = arrays::rows_f64::<3>(points, "points")?;
-    let absolute: Vec<DVec3> = p.into_iter().map(DVec3::from_array).collect();
-    let (origin, positions) = trilux_io::mesh::recenter(&absolute);
     let n = positions.len();
     let normals = normals
         .map(|a| {
@@ -194,6 +214,7 @@ pub(crate) fn save_points(
                     rows.len()
                 ))));
             }
+            finite_rows(&rows, "normals")?;
             Ok(rows
                 .into_iter()
                 .map(|r| DVec3::from_array(r).as_vec3())

@@ -1,7 +1,7 @@
 """A typed use of the API: `mypy --strict` checks it against the stubs
 (run by .ci/run; see test_stubs.py for the runtime side)."""
 
-from typing import Tuple
+from typing import Optional, Tuple
 
 import numpy as np
 import numpy.typing as npt
@@ -10,6 +10,7 @@ import trilux
 
 F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]
+F32 = npt.NDArray[np.float32]
 
 def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     mesh: trilux.Mesh = trilux.load(path)
@@ -63,6 +64,17 @@ def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     baked, atlas = colors.bake()
     trilux.save(path + ".glb", mesh, colors=np.ones((len(vertices), 3)), attributes={"PHI": vertices[:, 0]})
     trilux.save_points(path + ".glb", points, face_index=faces, attributes={"DEPTH": points[:, 2]})
+    cloud: trilux.Points = trilux.load_points(path + ".glb")
+    cloud_faces: Optional[I64] = cloud.face_index
+    cloud_colors: Optional[F32] = cloud.colors
+    depth: F32 = cloud.attributes["DEPTH"]
+    n_points: int = len(cloud)
+    trilux.save_points(path + ".ply", cloud.points, normals=cloud.normals, face_index=cloud.face_index)
+    trilux.save_points(path + ".glb", cloud.points, colors=cloud.colors, attributes=cloud.attributes)
+    loaded = trilux.load(path + ".glb")
+    mesh_colors: Optional[F32] = loaded.colors
+    trilux.save(path + ".glb", loaded, colors=loaded.colors, attributes=loaded.attributes)
+    del cloud_faces, cloud_colors, depth, n_points, mesh_colors
     try:
         trilux.load("missing.obj")
     except trilux.FileError as e:
