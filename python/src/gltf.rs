@@ -83,7 +83,7 @@ fn shape(obj: &Bound<'_, PyAny>) -> PyResult<Vec<usize>> {
 /// (a `MeshColors.lookup` interpolating texels of 1.0 gives 1.0000001).
 /// trilux-io's glTF writer allows the same; beyond it a colour is an
 /// `InputError`.
-pub(crate) const COLOR_TOLERANCE: f64 = 1e-5;
+pub(crate) const COLOR_TOLERANCE: f64 = trilux_io::mesh::gltf::COLOR_SLACK;
 
 /// `v` as Python prints a float (`1.0`, `nan`, `inf`, `-2e-05`, `1e+16`):
 /// the shortest digits that read back as `v` (Rust's and Python's

@@ -205,7 +205,7 @@ fn invalid(path: &Path, what: String) -> Error {
 /// How far outside `[0, 1]` a colour may be and still be written (clamped
 /// into it): the rounding of a filter or a conversion that should have
 /// stayed inside (a texture lookup giving 1.0000001).
-pub(crate) const COLOR_SLACK: f32 = 1e-5;
+pub const COLOR_SLACK: f64 = 1e-5;
 
 /// Checks colours and attributes against `n` vertices.
 fn check_vertex_data(path: &Path, data: &VertexData, n: usize) -> Result<()> {
@@ -217,7 +217,7 @@ fn check_vertex_data(path: &Path, data: &VertexData, n: usize) -> Result<()> {
             ));
         }
         let range = -COLOR_SLACK..=1.0 + COLOR_SLACK;
-        let bad = |c: &[f32; 4]| c.iter().any(|v| !range.contains(v));
+        let bad = |c: &[f32; 4]| c.iter().any(|&v| !range.contains(&f64::from(v)));
         if let Some((i, c)) = colors.iter().enumerate().find(|(_, c)| bad(c)) {
             let problem = if c.iter().all(|v| v.is_finite()) {
                 "is not in [0, 1] (scale or clamp it)"
