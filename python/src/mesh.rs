@@ -382,14 +382,8 @@ impl Mesh {
     fn uv<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.inner
             .uvs
-            .as_ref()
-            .map(|uv| {
-                let data = uv
-                    .iter()
-                    .flat_map(|t| [f64::from(t.x), 1.0 - f64::from(t.y)])
-                    .collect();
-                arrays::matrix(py, data, 2)
-            })
+            .as_deref()
+            .map(|uv| uv_out(py, uv))
             .transpose()
     }
 
@@ -625,4 +619,15 @@ fn check_finite_vertices(mesh: &TriMesh) -> PyResult<()> {
         crate::gltf::row_text(&absolute)
     ))
     .into())
+}
+
+/// Texture coordinates in trilux's convention (v down) as the `(n, 2)`
+/// float64 array Python gets, OpenGL's convention (`v = 0` at the image's
+/// bottom row, as trimesh's `visual.uv`).
+pub(crate) fn uv_out<'py>(py: Python<'py>, uv: &[Vec2]) -> PyResult<Bound<'py, PyAny>> {
+    let data = uv
+        .iter()
+        .flat_map(|t| [f64::from(t.x), 1.0 - f64::from(t.y)])
+        .collect();
+    arrays::matrix(py, data, 2)
 }

@@ -85,14 +85,8 @@ impl Points {
     fn uv<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.inner
             .uvs
-            .as_ref()
-            .map(|uv| {
-                let data = uv
-                    .iter()
-                    .flat_map(|t| [f64::from(t.x), 1.0 - f64::from(t.y)])
-                    .collect();
-                arrays::matrix(py, data, 2)
-            })
+            .as_deref()
+            .map(|uv| crate::mesh::uv_out(py, uv))
             .transpose()
     }
 
