@@ -151,6 +151,50 @@ fn described(path: &Path, files: &[(PathBuf, PathBuf)]) -> String {
     }
 }
 
+/// Writes a glTF output by extension, atomically, refusing to overwrite
+/// unless `force`: `.glb` as one file ([`write_atomic`]), `.gltf` with its
+/// `.bin` beside it ([`write_atomic_files`], both or neither). `write`
+/// writes to a temporary path; its errors name `path` (and the `.bin`
+/// beside it), not the temporary files. Returns the files written,
+/// sorted.
+///
+/// # Errors
+/// As [`write_atomic_files`].
+pub fn write_gltf(
+    path: &Path,
+    force: bool,
+    write: impl FnOnce(&Path) -> trilux_io::Result<()>,
+) -> Result<Vec<PathBuf>> {
+    let gltf = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf"));
+    if gltf {
+        write_atomic_files(path, force, |tmp| {
+            write(tmp).map_err(|e| at_output(e, tmp, path))
+        })
+    } else {
+        write_atomic(path, force, |tmp| {
+            write(tmp).map_err(|e| at_output(e, tmp, path))
+        })?;
+        Ok(vec![path.to_path_buf()])
+    }
+}
+
+/// A writer's error about the temporary file `tmp` (or a file beside it
+/// in the temporary folder of a set of files) as one about `path`.
+fn at_output(mut e: trilux_io::Error, tmp: &Path, path: &Path) -> Error {
+    if e.path == tmp {
+        e.path = path.to_path_buf();
+    } else if tmp.file_name() == path.file_name()
+        && let Some(name) = e.path.file_name()
+        && e.path.parent() == tmp.parent()
+    {
+        // A set of files: `tmp` is `path`'s name in a temporary folder.
+        e.path = path.with_file_name(name);
+    }
+    Error::from(e)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

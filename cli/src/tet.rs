@@ -459,9 +459,9 @@ pub fn radiance_surface(
 }
 
 /// Writes [`radiance_surface`]`(objects, white)` as glTF by extension:
-/// `.glb`, or `.gltf` with its `.bin` beside it. Atomic: written under
-/// temporary names in the same folder and renamed into place; an existing
-/// file (the `.bin` too) is refused unless `overwrite`.
+/// `.glb`, or `.gltf` with its `.bin` beside it
+/// ([`crate::output::write_gltf`]: atomic; an existing file, the `.bin`
+/// too, is refused unless `overwrite`). Returns the files written.
 ///
 /// # Errors
 /// [`radiance_surface`]'s, [`Error::Exists`](crate::Error::Exists), and
@@ -471,12 +471,11 @@ pub fn write_radiance_gltf(
     objects: &[tet_diffusion::Object],
     white: f32,
     overwrite: bool,
-) -> crate::Result<()> {
+) -> crate::Result<Vec<std::path::PathBuf>> {
     let (mesh, data) = radiance_surface(objects, white)?;
-    crate::output::write_atomic_files(path, overwrite, |tmp| {
-        Ok(trilux_io::mesh::gltf::write_with(tmp, &mesh, &data)?)
-    })?;
-    Ok(())
+    crate::output::write_gltf(path, overwrite, |tmp| {
+        trilux_io::mesh::gltf::write_with(tmp, &mesh, &data)
+    })
 }
 
 /// The picture of a session as `trilux view` exports it: every piece, lit

@@ -225,7 +225,7 @@ fn bake(context: &mut Context, args: BakeArgs) -> Result<()> {
         })?
     } else {
         context.step("writing glTF", || {
-            super::write_gltf(&args.output, force, |tmp| baked.write(tmp))
+            trilux::output::write_gltf(&args.output, force, |tmp| baked.write(tmp))
         })?
     };
     let text = format!(

@@ -240,9 +240,9 @@ fn check_outputs(context: &Context, args: &Args) -> Result<()> {
 }
 
 /// `--glb`: the pieces' surfaces with their radiance, the vertex colours
-/// at the exposure of `picture` (the PNG written beside it), as
-/// `trilux::tet::write_radiance_gltf` writes them (the view's export);
-/// returns the files written (a `.gltf` and its `.bin`, or the `.glb`).
+/// at the exposure of `picture` (the PNG written beside it), as the
+/// view's export writes them; returns the files written (a `.gltf` and
+/// its `.bin`, or the `.glb`).
 fn write_glb(
     path: &Path,
     objects: &[Object],
@@ -250,10 +250,7 @@ fn write_glb(
     force: bool,
 ) -> Result<Vec<PathBuf>> {
     let white = trilux::tet::exposure_white(picture);
-    let (mesh, data) = trilux::tet::radiance_surface(objects, white)?;
-    super::write_gltf(path, force, |tmp| {
-        trilux_io::mesh::gltf::write_with(tmp, &mesh, &data)
-    })
+    trilux::tet::write_radiance_gltf(path, objects, white, force)
 }
 
 /// The files as the summary line lists them.

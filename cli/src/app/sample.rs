@@ -323,7 +323,7 @@ fn write(
     } else {
         let points = gltf::Points::from(&cloud);
         context.step("writing the glTF file", || {
-            super::write_gltf(&args.output, force, |tmp| gltf::write_points(tmp, &points))
+            trilux::output::write_gltf(&args.output, force, |tmp| gltf::write_points(tmp, &points))
         })?
     };
     if let Some(path) = &args.preview {
@@ -401,7 +401,7 @@ mod tests {
         let points = gltf::Points::from(&cloud);
         for name in ["far.glb", "far.gltf"] {
             let out = dir.path().join(name);
-            let e = super::super::write_gltf(&out, false, |tmp| gltf::write_points(tmp, &points))
+            let e = trilux::output::write_gltf(&out, false, |tmp| gltf::write_points(tmp, &points))
                 .unwrap_err();
             let text = e.to_string();
             assert!(

@@ -77,7 +77,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         .then(|| context.step("finding the boundary", || trilux::tet::surface(&out)));
     if let (Some(p), Some(surface)) = (&args.glb, &surface) {
         files.extend(context.step("writing the boundary", || {
-            super::write_gltf(p, force, |tmp| trilux_io::mesh::gltf::write(tmp, surface))
+            trilux::output::write_gltf(p, force, |tmp| trilux_io::mesh::gltf::write(tmp, surface))
         })?);
     }
     if let (Some(p), Some(surface)) = (&args.preview, &surface) {

@@ -472,6 +472,7 @@ fn write_glb(
     let picture = crate::tet::render_session(session, size, view.map(|v| v.as_vec3()));
     let white = crate::tet::exposure_white(&picture);
     crate::tet::write_radiance_gltf(path, session.pieces(), white, overwrite)
+        .map(drop)
         .map_err(|e| e.to_string())
 }
 
