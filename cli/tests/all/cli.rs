@@ -6,23 +6,14 @@
 use std::path::{Path, PathBuf};
 
 use crate::common;
-use common::{data, fails, fails_with, have_data, json, run, stderr, trilux, trilux_bin};
+use common::{
+    data, fails, fails_with, have_data, json, no_partial_files, run, stderr, trilux, trilux_bin,
+};
 use trilux_io::mesh::TriMesh;
 
 /// A built-in textured torus and a noise texture written as files.
 fn inputs(dir: &Path) -> (PathBuf, PathBuf) {
-    let torus = dir.join("torus.obj");
-    trilux::shapes::torus(48, 24).write(&torus).unwrap();
-    let noise = dir.join("noise.png");
-    trilux_io::image::write(&noise, &trilux::shapes::noise(64, 64, 1)).unwrap();
-    (torus, noise)
-}
-
-fn no_partial_files(dir: &Path) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
-        assert!(!name.contains(".partial"), "left behind: {name}");
-    }
+    common::torus_and_noise(dir, [48, 24], 64)
 }
 
 #[test]

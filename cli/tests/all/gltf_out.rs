@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::common;
-use common::{fails_with, json, trilux};
+use common::{blob, fails_with, json, no_partial_files, trilux};
 use test_support::gltf::validate;
 use trilux_io::glam::{DVec3, Vec3};
 use trilux_io::mesh::TriMesh;
@@ -20,25 +20,7 @@ use trilux_io::mesh::gltf::{Scene, read_scene};
 /// A built-in textured torus (16 × 8, 256 triangles) and a noise texture
 /// written as files.
 fn torus_and_noise(dir: &Path) -> (PathBuf, PathBuf) {
-    let torus = dir.join("torus.obj");
-    trilux::shapes::torus(16, 8).write(&torus).unwrap();
-    let noise = dir.join("noise.png");
-    trilux_io::image::write(&noise, &trilux::shapes::noise(32, 32, 1)).unwrap();
-    (torus, noise)
-}
-
-/// The built-in bumpy blob (closed, about unit size) written as OBJ.
-fn blob(dir: &Path) -> PathBuf {
-    let path = dir.join("blob.obj");
-    trilux::shapes::blob(2).write(&path).unwrap();
-    path
-}
-
-fn no_partial_files(dir: &Path) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
-        assert!(!name.contains(".partial"), "left behind: {name}");
-    }
+    common::torus_and_noise(dir, [16, 8], 32)
 }
 
 /// The file names of a report's `files`.

@@ -3,19 +3,12 @@
 //! reported; bad inputs fail with a message naming the problem and the
 //! file or argument; outputs are not clobbered without `--force`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::common;
-use common::{data, fails, have_data, json, run, trilux};
+use common::{blob, data, fails, have_data, json, run, trilux};
 use glam::Vec3;
 use trilux_io::mesh::TriMesh;
-
-/// The built-in bumpy blob (closed, about unit size) written as OBJ.
-fn blob(dir: &Path) -> PathBuf {
-    let path = dir.join("blob.obj");
-    trilux::shapes::blob(2).write(&path).unwrap();
-    path
-}
 
 /// The blob tetrahedralized at spacing `size` into `blob.node` (+ `.ele`).
 fn stuffed_blob(dir: &Path, size: &str) {

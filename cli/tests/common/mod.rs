@@ -73,3 +73,34 @@ pub(crate) fn json(dir: &Path, args: &[&str]) -> serde_json::Value {
 pub(crate) fn run(dir: &Path, args: &[&str]) -> Output {
     trilux(dir).args(args).output().unwrap()
 }
+
+/// A built-in textured torus (`major` × `minor` segments) and a noise
+/// texture of `side` × `side` pixels, written as `torus.obj` and
+/// `noise.png` in `dir`.
+pub(crate) fn torus_and_noise(
+    dir: &Path,
+    [major, minor]: [u32; 2],
+    side: u32,
+) -> (PathBuf, PathBuf) {
+    let torus = dir.join("torus.obj");
+    trilux::shapes::torus(major, minor).write(&torus).unwrap();
+    let noise = dir.join("noise.png");
+    trilux_io::image::write(&noise, &trilux::shapes::noise(side, side, 1)).unwrap();
+    (torus, noise)
+}
+
+/// The built-in bumpy blob (closed, about unit size) written as
+/// `blob.obj` in `dir`.
+pub(crate) fn blob(dir: &Path) -> PathBuf {
+    let path = dir.join("blob.obj");
+    trilux::shapes::blob(2).write(&path).unwrap();
+    path
+}
+
+/// Asserts that no temporary `.partial` file or folder is left in `dir`.
+pub(crate) fn no_partial_files(dir: &Path) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(!name.contains(".partial"), "left behind: {name}");
+    }
+}
