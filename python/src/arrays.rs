@@ -257,6 +257,23 @@ pub(crate) fn matrix<'py, T: numpy::Element>(
     Ok(a.into_pyarray(py).into_any())
 }
 
+/// Unit vectors (normals) as an `(n, 3)` float64 array.
+pub(crate) fn vectors<'py>(py: Python<'py>, v: &[glam::Vec3]) -> PyResult<Bound<'py, PyAny>> {
+    let data = v.iter().flat_map(|v| v.as_dvec3().to_array()).collect();
+    matrix(py, data, 3)
+}
+
+/// Texture coordinates in trilux's convention (v down) as the `(n, 2)`
+/// float64 array Python gets, OpenGL's convention (`v = 0` at the image's
+/// bottom row, as trimesh's `visual.uv`).
+pub(crate) fn uvs<'py>(py: Python<'py>, uv: &[glam::Vec2]) -> PyResult<Bound<'py, PyAny>> {
+    let data = uv
+        .iter()
+        .flat_map(|t| [f64::from(t.x), 1.0 - f64::from(t.y)])
+        .collect();
+    matrix(py, data, 2)
+}
+
 /// Positions stored relative to `origin` (`f32`, as trilux-io's meshes
 /// hold them) as an `(n, 3)` float64 array in the file's coordinates:
 /// `origin` added back in `f64`.

@@ -383,7 +383,7 @@ impl Mesh {
         self.inner
             .uvs
             .as_deref()
-            .map(|uv| uv_out(py, uv))
+            .map(|uv| arrays::uvs(py, uv))
             .transpose()
     }
 
@@ -393,11 +393,8 @@ impl Mesh {
     fn normals<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.inner
             .normals
-            .as_ref()
-            .map(|n| {
-                let data = n.iter().flat_map(|v| v.as_dvec3().to_array()).collect();
-                arrays::matrix(py, data, 3)
-            })
+            .as_deref()
+            .map(|n| arrays::vectors(py, n))
             .transpose()
     }
 
@@ -619,15 +616,4 @@ fn check_finite_vertices(mesh: &TriMesh) -> PyResult<()> {
         crate::gltf::row_text(&absolute)
     ))
     .into())
-}
-
-/// Texture coordinates in trilux's convention (v down) as the `(n, 2)`
-/// float64 array Python gets, OpenGL's convention (`v = 0` at the image's
-/// bottom row, as trimesh's `visual.uv`).
-pub(crate) fn uv_out<'py>(py: Python<'py>, uv: &[Vec2]) -> PyResult<Bound<'py, PyAny>> {
-    let data = uv
-        .iter()
-        .flat_map(|t| [f64::from(t.x), 1.0 - f64::from(t.y)])
-        .collect();
-    arrays::matrix(py, data, 2)
 }

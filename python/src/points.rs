@@ -38,11 +38,8 @@ impl Points {
     fn normals<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.inner
             .normals
-            .as_ref()
-            .map(|n| {
-                let data = n.iter().flat_map(|v| v.as_dvec3().to_array()).collect();
-                arrays::matrix(py, data, 3)
-            })
+            .as_deref()
+            .map(|n| arrays::vectors(py, n))
             .transpose()
     }
 
@@ -86,7 +83,7 @@ impl Points {
         self.inner
             .uvs
             .as_deref()
-            .map(|uv| crate::mesh::uv_out(py, uv))
+            .map(|uv| arrays::uvs(py, uv))
             .transpose()
     }
 
