@@ -194,6 +194,37 @@ pub enum Error {
         /// The minimum, [`MIN_ACCEPTANCE`](crate::MIN_ACCEPTANCE).
         minimum: f64,
     },
+    /// An emitter's emission is zero on the whole mesh.
+    #[error("the emission is zero everywhere on the mesh ({triangles} triangles): nothing emits")]
+    NoEmission {
+        /// The number of triangles.
+        triangles: usize,
+    },
+    /// A triangle asked to be sampled alone has no area or emits nothing.
+    #[error("triangle {face} has no area or no emission: there is nothing to sample in it")]
+    DarkTriangle {
+        /// The triangle.
+        face: usize,
+    },
+    /// An emission scale that is negative, NaN or infinite.
+    #[error("the emission scale is {0}: it must be finite and >= 0")]
+    InvalidScale(f32),
+    /// Per-face radiance of the wrong length.
+    #[error("per-face radiance: {len} given for {expected} faces")]
+    RadianceLength {
+        /// Radiances given.
+        len: usize,
+        /// Faces of the mesh.
+        expected: usize,
+    },
+    /// A per-face radiance channel that is negative, NaN or infinite.
+    #[error("face {face} has a radiance channel of {value}: radiance must be finite and >= 0")]
+    InvalidRadiance {
+        /// The face.
+        face: usize,
+        /// The channel's value.
+        value: f32,
+    },
     /// A triangle index that does not exist.
     #[error("there is no triangle {face}: the mesh has {count}")]
     NoSuchFace {

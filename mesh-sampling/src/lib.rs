@@ -34,6 +34,17 @@
 //!   weighted sample elimination (Yuksel 2015).
 //! - **Weights**: [`Density::PerFace`] and [`Density::PerVertex`] (linear
 //!   over each triangle), both sampled exactly.
+//! - **Light sampling** ([`Emitter`], the paper's Sec. 5.3 application:
+//!   a luminaire that is a mesh with an HDR texture as its emission): RGB
+//!   radiance from an [`EmissionTexture`] times a scale, or per face, one-
+//!   or two-sided ([`Sides`]), sampled by area, by per-triangle power, or
+//!   by emitted power inside triangles (the subdivision's `p′`, or exactly)
+//!   behind one API ([`Strategy`]); each [`LightSample`] carries `Le` and
+//!   its pdf, [`Emitter::toward`] and [`Emitter::pdf_solid_angle`] give
+//!   the solid-angle pdf `p_A d² / |cos θ_l|` for multiple importance
+//!   sampling, evaluated from `(face, barycentric)` at a BSDF-sampled hit,
+//!   and [`Emitter::triangle_power`], [`Emitter::triangle_bounds`] and
+//!   [`Emitter::sample_in_triangle`] serve a renderer's own light tree.
 //!
 //! Conventions: texture coordinates are glTF's (v = 0 at the first image
 //! row, as `trilux-io`'s `TriMesh` holds them), [`Wrap`] has glTF's
@@ -90,6 +101,7 @@ mod batch;
 #[cfg(feature = "blue-noise")]
 mod blue_noise;
 mod density;
+mod emitter;
 mod error;
 mod layout;
 mod mesh;
@@ -112,6 +124,10 @@ pub use blue_noise::{
 };
 pub use density::{
     DEFAULT_MAX_PIECES, Density, DensitySampler, Depth, MIN_ACCEPTANCE, Mode, Options,
+};
+pub use emitter::{
+    DEFAULT_DEFENSIVE_FRACTION, Emission, EmissionTexture, Emitter, EmitterOptions, LightSample,
+    Sides, Strategy, Toward, TriangleBounds,
 };
 pub use error::Error;
 pub use layout::{Layout, MAX_VALUE_SHIFT, MIN_THRESHOLD_BITS};

@@ -395,6 +395,41 @@ impl DensityTexture {
         self.at_cell(self.to_cells(uv))
     }
 
+    /// The texels (row-major indices) the filtered value at `uv` combines,
+    /// with their weights: the four of the bilinear cell (weights summing
+    /// to 1), or the nearest texel with weight 1 (and three of weight 0).
+    /// [`eval`](Self::eval) is `Σ weight · texel`; a texture of other
+    /// values on the same grid (an emitter's RGB) is filtered the same way.
+    #[inline]
+    pub(crate) fn taps(&self, uv: DVec2) -> [(usize, f64); 4] {
+        let p = self.to_cells(uv);
+        let cell = (floor_i64(p.x), floor_i64(p.y));
+        let x0 = self.wrap_index(cell.0, self.width);
+        let row0 = self.wrap_index(cell.1, self.height) * self.width;
+        match self.filter {
+            Filter::Nearest => [
+                (row0 + x0, 1.0),
+                (row0 + x0, 0.0),
+                (row0 + x0, 0.0),
+                (row0 + x0, 0.0),
+            ],
+            Filter::Bilinear => {
+                let (fx, fy) = (
+                    (p.x - cell.0 as f64).clamp(0.0, 1.0),
+                    (p.y - cell.1 as f64).clamp(0.0, 1.0),
+                );
+                let x1 = self.wrap_index(cell.0.saturating_add(1), self.width);
+                let row1 = self.wrap_index(cell.1.saturating_add(1), self.height) * self.width;
+                [
+                    (row0 + x0, (1.0 - fx) * (1.0 - fy)),
+                    (row0 + x1, fx * (1.0 - fy)),
+                    (row1 + x0, (1.0 - fx) * fy),
+                    (row1 + x1, fx * fy),
+                ]
+            }
+        }
+    }
+
     /// The exact integral of the filtered density over the UV triangle
     /// `uv`, in UV area (the unit square has area 1).
     ///

@@ -394,10 +394,23 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
         (value * self.norm) as f32
     }
 
-    fn face_range(&self, face: usize) -> Option<std::ops::Range<usize>> {
+    /// The table indices of face `face`'s pieces (`None` for no such face).
+    pub(crate) fn face_range(&self, face: usize) -> Option<std::ops::Range<usize>> {
         let start = *self.face_start.get(face)? as usize;
         let end = *self.face_start.get(face + 1)? as usize;
         Some(start..end)
+    }
+
+    /// Piece `k` of the table, in face order.
+    #[inline]
+    pub(crate) fn piece_at(&self, k: usize) -> Piece {
+        self.table.get(k)
+    }
+
+    /// The unnormalised mass piece `piece` is drawn with: its value (the
+    /// density, or in exact mode its bound) times its area.
+    pub(crate) fn piece_mass(&self, piece: Piece) -> f64 {
+        f64::from(piece.value) * self.mesh.area(piece.face as usize) * piece_fraction(piece.part)
     }
 
     /// `p′` before normalisation at `(u, v)` of `face`: the value of the
@@ -439,7 +452,7 @@ impl<'a, S: DiscreteSampler + Sync> DensitySampler<'a, S> {
     /// Where piece `k` puts the point for variates `xi1`, `xi2`: parent
     /// barycentrics.
     #[inline]
-    fn place(&self, piece: Piece, xi1: f64, xi2: f64) -> [f32; 3] {
+    pub(crate) fn place(&self, piece: Piece, xi1: f64, xi2: f64) -> [f32; 3] {
         match piece.part.corner() {
             Some(corner) => linear_corner_barycentric(corner, xi1, xi2),
             None => {

@@ -2,6 +2,7 @@
 
 mod blue_noise;
 mod density;
+mod emitter;
 mod multi;
 mod robustness;
 mod stability;
