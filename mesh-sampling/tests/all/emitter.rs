@@ -494,6 +494,73 @@ fn pdfs_at_sampling_time_equal_pdfs_from_face_and_barycentrics() {
     }
 }
 
+/// The pdf is positive wherever the filtered emission is: on the lit
+/// square's triangles cut by its edge, the paper's `p′` alone (defensive
+/// fraction 0, the wrong twin) is 0 at lit points, the default mixture is
+/// not; the exact strategy never is. Checked on a lattice of points of
+/// every triangle.
+#[test]
+fn the_pdf_is_positive_wherever_the_emission_is() {
+    let mesh = ceiling(5, 1.0);
+    let texture = lit_square();
+    let emission = Emission::Texture {
+        texture: &texture,
+        scale: 1.0,
+    };
+    let lit_but_zero = |strategy, defensive_fraction| {
+        let options = EmitterOptions {
+            strategy,
+            defensive_fraction,
+            ..Default::default()
+        };
+        let e = Emitter::new(mesh_ref(&mesh), emission, &options).unwrap();
+        let k = 40;
+        let mut count = 0;
+        for f in 0..mesh.2.len() {
+            for j in 0..k {
+                for i in 0..k - j {
+                    let (u, v) = ((i as f32 + 0.3) / k as f32, (j as f32 + 0.3) / k as f32);
+                    let b = [1.0 - u - v, u, v];
+                    if e.radiance(f, b)[0] > 0.0 && e.pdf_area(f, b) == 0.0 {
+                        count += 1;
+                    }
+                }
+            }
+        }
+        count
+    };
+    assert!(lit_but_zero(Strategy::Texture, 0.0) > 0);
+    assert_eq!(lit_but_zero(Strategy::Texture, 0.05), 0);
+    assert_eq!(lit_but_zero(Strategy::TextureExact, 0.0), 0);
+    assert_eq!(lit_but_zero(Strategy::TrianglePower, 0.0), 0);
+    assert_eq!(lit_but_zero(Strategy::Area, 0.0), 0);
+}
+
+/// The exact strategy's density is proportional to the luminance of the
+/// radiance: `Y(Le) / pdf_A` is the same for every sample, `Φ / (sides ·
+/// π)`, so the estimate of the power has no variance.
+#[test]
+fn exact_sampling_makes_luminance_over_pdf_constant() {
+    let (mesh, texture) = warped(6);
+    let emission = Emission::Texture {
+        texture: &texture,
+        scale: 0.5,
+    };
+    let options = EmitterOptions {
+        strategy: Strategy::TextureExact,
+        sides: Sides::Both,
+        ..Default::default()
+    };
+    let e = Emitter::new(mesh_ref(&mesh), emission, &options).unwrap();
+    let want = e.power() / (2.0 * std::f64::consts::PI);
+    for s in e.sample_n(1, 20_000).unwrap() {
+        let [r, g, b] = s.radiance.map(f64::from);
+        let y = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+        let ratio = y / f64::from(s.pdf_area());
+        assert!((ratio - want).abs() < 1e-5 * want, "{ratio} vs {want}");
+    }
+}
+
 /// The texture strategies draw points by the texture's mass per texel
 /// (chi-square on a flat square whose UVs map it once, nearest filtering,
 /// so a texel's mass is its value times its area); the area strategy
