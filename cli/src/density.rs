@@ -1,6 +1,7 @@
-//! trilux-io images → `mesh_sampling::DensityTexture`.
+//! trilux-io images → `mesh_sampling::DensityTexture` and
+//! `mesh_sampling::EmissionTexture`.
 
-use mesh_sampling::{Channel, DensityTexture};
+use mesh_sampling::{Channel, DensityTexture, EmissionTexture};
 use trilux_io::image::Image;
 
 use crate::Result;
@@ -30,6 +31,40 @@ pub fn density_texture(image: &Image, channel: Channel) -> Result<DensityTexture
         &flat,
         4,
         channel,
+    )?)
+}
+
+/// An emission texture for a `mesh_sampling::Emitter` from an image: its
+/// linear RGB as radiance (alpha ignored), row 0 at `v = 0` as for
+/// `TriMesh` UVs. HDR and EXR values are used as they are; a PNG or JPEG
+/// is decoded from sRGB to linear by default (read it with
+/// `ReadOptions { raw: true, .. }` to keep the stored values). Mesh
+/// colours emit through their atlas: [`crate::atlas_mesh`] gives the mesh
+/// and the image to pass here. Set the material's wrap with
+/// `.with_wrap(sampling_wrap(..))`.
+///
+/// # Errors
+/// mesh-sampling's: a negative, NaN or infinite channel (naming the
+/// texel).
+///
+/// # Example
+/// ```
+/// use mesh_sampling::{Emission, Emitter, EmitterOptions};
+///
+/// let sky = trilux::shapes::sky(64, 32);
+/// let texture = trilux::emission_texture(&sky)?;
+/// let torus = trilux::shapes::torus(48, 24);
+/// let emission = Emission::Texture { texture: &texture, scale: 1.0 };
+/// let emitter = Emitter::new(trilux::mesh_ref(&torus), emission, &EmitterOptions::default())?;
+/// assert!(emitter.power() > 0.0);
+/// # Ok::<(), trilux::Error>(())
+/// ```
+pub fn emission_texture(image: &Image) -> Result<EmissionTexture> {
+    let rgb = image.pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    Ok(EmissionTexture::new(
+        image.width as usize,
+        image.height as usize,
+        rgb,
     )?)
 }
 

@@ -9,6 +9,7 @@
 //! |---|---|---|
 //! | `TriMesh` | `mesh_sampling::MeshRef` (normals, UVs) | [`mesh_ref`] |
 //! | `Image` | `mesh_sampling::DensityTexture` (a channel or luminance) | [`density_texture`] |
+//! | `Image` | `mesh_sampling::EmissionTexture` (linear RGB radiance, for an `Emitter`) | [`emission_texture`] |
 //! | `Image` | `mesh_colors::Texture` (linear RGB) | [`colors::texture`] |
 //! | `TriMesh` (+ its materials' textures) | mesh colours, welded, seams averaged | [`to_mesh_colors`], [`ColorMesh`] |
 //! | `mesh_colors::atlas::Atlas` | `TriMesh` + `Image` to write | [`atlas_mesh`] |
@@ -17,8 +18,9 @@
 //!
 //! **UVs.** A `TriMesh`'s UVs are glTF's: `v = 0` is the first row of the
 //! image, as stored in PNG/EXR/HDR. trilux-io's readers and writers convert
-//! OBJ and PLY files (v up) to and from it; `DensityTexture` and
-//! mesh-colors' `Texture` use the same convention, so nothing here flips.
+//! OBJ and PLY files (v up) to and from it; `DensityTexture`,
+//! `EmissionTexture` and mesh-colors' `Texture` use the same convention, so
+//! nothing here flips.
 //!
 //! Use it without the command-line dependencies (clap, indicatif, plotters)
 //! as `trilux = { version = "0.1", default-features = false }`.
@@ -60,7 +62,7 @@ pub mod tet;
 pub mod view;
 
 pub use colors::{ColorMesh, ConvertOptions, SurfaceTexture, atlas_mesh, to_mesh_colors};
-pub use density::{density_texture, sampling_wrap};
+pub use density::{density_texture, emission_texture, sampling_wrap};
 pub use error::{Error, Result};
 pub use mesh::mesh_ref;
 pub use points::point_cloud;
