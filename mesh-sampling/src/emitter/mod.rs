@@ -401,7 +401,11 @@ impl<'a> Emitter<'a> {
                     ..options.subdivision
                 };
                 let density = Density::Texture(texture.luminance());
-                let sampler = DensitySampler::with_options(mesh, density, &subdivision)?;
+                let mut sampler = DensitySampler::with_options(mesh, density, &subdivision)?;
+                // A sample's pdf is the one pdf_area gives at its stored
+                // barycentrics, also where rounding them crossed a
+                // sub-triangle's edge.
+                sampler.settle_pdfs();
                 let mix = if !exact && texture.has_black_texel() && alpha > 0.0 {
                     Some((FaceTable::new(&mesh, &masses, total_mass)?, alpha))
                 } else {

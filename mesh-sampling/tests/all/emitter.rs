@@ -561,6 +561,45 @@ fn exact_sampling_makes_luminance_over_pdf_constant() {
     }
 }
 
+/// Many samples of the subdivision strategy on two large triangles with a
+/// fine texture, where some points' `f32` barycentrics round across a
+/// sub-triangle's edge: the pdf they carry is still the pdf at their
+/// stored barycentrics, for every one of them.
+#[test]
+fn pdfs_agree_also_where_barycentrics_round_across_sub_triangles() {
+    let positions = [
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(0.0, 1.0, 1.0),
+        Vec3::new(1.0, 0.0, 1.0),
+        Vec3::new(1.0, 1.0, 1.0),
+    ];
+    let uvs = [Vec2::ZERO, Vec2::Y, Vec2::X, Vec2::ONE];
+    let indices = [[0, 1, 2], [2, 1, 3]];
+    let mesh = MeshRef {
+        uvs: Some(&uvs),
+        ..MeshRef::new(&positions, &indices)
+    };
+    let (w, h) = (256, 128);
+    let rgb = (0..w * h)
+        .map(|k| {
+            let v = 0.5 + ((k * 7919) % 97) as f32;
+            [v, v, v]
+        })
+        .collect();
+    let texture = EmissionTexture::new(w, h, rgb).unwrap();
+    let emission = Emission::Texture {
+        texture: &texture,
+        scale: 1.0,
+    };
+    let e = Emitter::new(mesh, emission, &EmitterOptions::default()).unwrap();
+    let x = Vec3::new(0.5, 0.5, 0.0);
+    for s in e.sample_n(6, 400_000).unwrap() {
+        let (f, b) = (s.point.face as usize, s.point.barycentric);
+        assert_eq!(e.pdf_area(f, b), s.point.pdf, "at {f} {b:?}");
+        assert_eq!(e.pdf_solid_angle(f, b, x), e.toward(&s, x).pdf_solid_angle);
+    }
+}
+
 /// The texture strategies draw points by the texture's mass per texel
 /// (chi-square on a flat square whose UVs map it once, nearest filtering,
 /// so a texel's mass is its value times its area); the area strategy
