@@ -121,6 +121,27 @@ pub enum Error {
         /// The tolerance asked for.
         tolerance: f64,
     },
+    /// A [`crate::Block3`]'s matrices must share one sparsity pattern.
+    #[error(
+        "matrix {channel} of the block differs from matrix 0 in size or stored entries at row {row}"
+    )]
+    PatternMismatch {
+        /// Which matrix (0-based) differs from the first.
+        channel: usize,
+        /// The first row that differs (the smaller size when the sizes do).
+        row: usize,
+    },
+    /// A channel of a block solve stopped before reaching its tolerance
+    /// while [`crate::SolveOptions::require_convergence`] was on.
+    #[error("channel {channel} did not converge to the tolerance {tolerance:e}: it {}", reports[*channel])]
+    ChannelNotConverged {
+        /// The first channel that stopped short.
+        channel: usize,
+        /// Every channel's report (the true residual of its `x`).
+        reports: [crate::Report; 3],
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
     /// A Matrix Market file could not be read.
     #[error("{}:{line}: {message}", path.display())]
     MatrixMarket {

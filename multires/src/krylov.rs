@@ -66,7 +66,7 @@ impl SolveOptions {
         }
     }
 
-    fn check(&self) -> Result<(), Error> {
+    pub(crate) fn check(&self) -> Result<(), Error> {
         if !(self.tolerance >= 0.0 && self.tolerance.is_finite()) {
             return Err(Error::InvalidOption("tolerance must be finite and ≥ 0"));
         }
@@ -376,7 +376,7 @@ pub(crate) fn pcg_checked(
 /// Copies are rare: `x` is copied only when a step makes it worse than
 /// the best so far right after the best (the best is then the previous
 /// iterate, `x − α p`), so a monotone run copies nothing but its start.
-struct Best {
+pub(crate) struct Best {
     /// The start vector, the fallback of last resort.
     start: Vec<f64>,
     start_residual: f64,
@@ -389,7 +389,7 @@ struct Best {
 }
 
 impl Best {
-    fn new(x: &[f64], residual: f64) -> Self {
+    pub(crate) fn new(x: &[f64], residual: f64) -> Self {
         Self {
             start: x.to_vec(),
             start_residual: residual,
@@ -400,7 +400,18 @@ impl Best {
     }
 
     /// After `x += α p` gave the recurrence residual `residual`.
-    fn step(&mut self, x: &[f64], residual: f64, alpha: f64, p: &[f64]) {
+    pub(crate) fn step(&mut self, x: &[f64], residual: f64, alpha: f64, p: &[f64]) {
+        self.step_by(x, residual, |i, x| x - alpha * p[i]);
+    }
+
+    /// [`step`](Self::step) with the previous iterate's entry `i` given by
+    /// `previous(i, x[i])` (a block solver's `p` is interleaved).
+    pub(crate) fn step_by(
+        &mut self,
+        x: &[f64],
+        residual: f64,
+        previous: impl Fn(usize, f64) -> f64,
+    ) {
         if residual < self.residual {
             self.residual = residual;
             self.current_is_best = true;
@@ -409,11 +420,12 @@ impl Best {
             let previous = match self.saved.take() {
                 Some((mut v, _)) => {
                     v.iter_mut()
-                        .zip(x.iter().zip(p))
-                        .for_each(|(v, (x, p))| *v = x - alpha * p);
+                        .zip(x)
+                        .enumerate()
+                        .for_each(|(i, (v, &x))| *v = previous(i, x));
                     v
                 }
-                None => x.iter().zip(p).map(|(x, p)| x - alpha * p).collect(),
+                None => x.iter().enumerate().map(|(i, &x)| previous(i, x)).collect(),
             };
             self.saved = Some((previous, self.residual));
             self.current_is_best = false;
@@ -422,7 +434,7 @@ impl Best {
 
     /// After a restart recomputed the true residual of `x` (which
     /// replaces the recurrence's when `x` was the best).
-    fn restarted(&mut self, residual: f64) {
+    pub(crate) fn restarted(&mut self, residual: f64) {
         if self.current_is_best || residual < self.residual {
             self.residual = residual;
             self.current_is_best = true;
@@ -441,13 +453,24 @@ impl Best {
         residual: f64,
         scale: f64,
     ) -> f64 {
+        self.restore_with(x, residual, |saved| residual_into(a, b, saved, r) / scale)
+    }
+
+    /// [`restore`](Self::restore) with the relative residual of an
+    /// iterate given by `residual_of`.
+    pub(crate) fn restore_with(
+        self,
+        x: &mut [f64],
+        residual: f64,
+        mut residual_of: impl FnMut(&[f64]) -> f64,
+    ) -> f64 {
         let mut chosen = if residual.is_finite() {
             residual
         } else {
             f64::INFINITY
         };
         if let Some((saved, _)) = self.saved {
-            let saved_residual = residual_into(a, b, &saved, r) / scale;
+            let saved_residual = residual_of(&saved);
             if saved_residual < chosen {
                 x.copy_from_slice(&saved);
                 chosen = saved_residual;

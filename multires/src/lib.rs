@@ -57,6 +57,7 @@
 // Each public item has one path: the solvers and their types from the
 // root, the function families (`coarse`, `grid`, `matrix`, `mtx`) from
 // their modules, the traits also from `prelude`.
+mod block;
 mod cascade;
 pub mod coarse;
 mod dense;
@@ -75,6 +76,7 @@ mod vector;
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
 
+pub use block::{Block3, BlockMonitor, CHANNELS, Progress};
 pub use cascade::{Cascade, CascadeOptions, CascadeReport, CoarseSystem};
 pub use error::Error;
 pub use graph::Graph;
