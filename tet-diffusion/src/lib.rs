@@ -94,7 +94,10 @@ pub use lattice::{kuhn_ball, kuhn_lattice};
 pub use light::{Environment, Light};
 pub use medium::{MEASURED, Medium, Noise, ResolutionWarning};
 pub use mesh::{NONE, TetMesh};
-pub use object::{Budget, Method, Object, REFRESH_DRIFT, SolveReport, SolverSettings};
+pub use object::{
+    AUTO_PROBE, Budget, Choice, HIERARCHY_COST, Method, Object, Prediction, REFRESH_DRIFT,
+    SolveReport, Solver, SolverSettings, V_CYCLE_ITERATION_COST, V_CYCLE_RATE,
+};
 pub use paint::{PaintReport, Stroke};
 pub use quality::{POOR_DIHEDRAL_DEGREES, Quality};
 pub use session::{Applied, Edit, Log, Logged, Session, SessionOptions, UndoMemory};

@@ -8,8 +8,8 @@ use std::time::Instant;
 
 use glam::{DAffine3, DVec3};
 use multires::{
-    Cascade, CascadeOptions, Report, SolveOptions, Stop, VCycle, VCycleOptions, Weights,
-    pcg_monitored,
+    Block3, Cascade, CascadeOptions, Preconditioner, Progress, Report, SolveOptions, Stop, VCycle,
+    VCycleOptions, Weights,
 };
 use rayon::prelude::*;
 use sprs::CsMat;
@@ -23,19 +23,177 @@ use crate::{Error, Light, Medium, TetMesh, fresnel};
 /// Which solver [`Object::solve`] uses (all from `multires`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Method {
-    /// CG preconditioned by an algebraic V-cycle on TransCut's hierarchy:
-    /// 3 iterations to 1% error where Jacobi-PCG needs 12–40; its build
-    /// pays off on large systems and across solves (see the crate's
-    /// benchmark). After an edit, a warm-started [`JacobiPcg`](Self::JacobiPcg),
-    /// which needs no build, is often faster.
+    /// Chosen per solve, by the system: Jacobi-PCG runs first (the three
+    /// channels as one block, [`multires::Block3`]); after
+    /// [`AUTO_PROBE`] iterations its convergence rate predicts the
+    /// iterations it still needs, and the V-cycle's hierarchy is built
+    /// only when V-cycle-PCG (its build included, unless one is kept) is
+    /// predicted to cost less ([`Prediction`]). The probe's iterations are
+    /// not lost: the V-cycle continues from them. What ran and why is in
+    /// [`SolveReport::choice`].
     #[default]
+    Auto,
+    /// CG preconditioned by an algebraic V-cycle on TransCut's hierarchy:
+    /// 3–6 iterations where Jacobi-PCG needs 20–80, each costing about
+    /// nine of Jacobi-PCG's, after a build of about 150 (bunny_500k); it
+    /// pays on ill-conditioned systems (a long diffusion length against
+    /// the mesh's size: a small object, skim milk, a fine mesh).
     VCyclePcg,
     /// The paper's multi-resolution cascade (Sec. 4.2, Eq. 17).
     Cascade,
     /// The cascade with Galerkin coarse systems.
     CascadeGalerkin,
-    /// Jacobi-preconditioned CG (the baseline).
+    /// Jacobi-preconditioned CG, the three channels as one block.
     JacobiPcg,
+}
+
+/// Jacobi-PCG iterations [`Method::Auto`] runs before it predicts
+/// (fewer when the tolerance comes first: then nothing else runs).
+pub const AUTO_PROBE: usize = 10;
+
+/// [`Method::Auto`]'s cost model, in units of one block Jacobi-PCG
+/// iteration (three channels, one pass over the matrix): measured on
+/// bunny_500k and sphere_200k (2 cores), where the hierarchy of the three
+/// channels (one built, two refreshed) costs 100–150 iterations and a
+/// V-cycle-PCG iteration 8–9. Counts, not clocks, decide, so the choice
+/// is the same on every run and machine.
+pub const HIERARCHY_COST: f64 = 150.0;
+/// One block V-cycle-PCG iteration, in block Jacobi-PCG iterations (see
+/// [`HIERARCHY_COST`]).
+pub const V_CYCLE_ITERATION_COST: f64 = 9.0;
+/// The residual reduction per V-cycle-PCG iteration the prediction
+/// assumes (0.25–0.35 measured on the data meshes).
+pub const V_CYCLE_RATE: f64 = 0.3;
+
+/// A solver that ran.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Solver {
+    /// Jacobi-preconditioned CG.
+    JacobiPcg,
+    /// CG preconditioned by the V-cycle (after Jacobi-PCG's probe when
+    /// [`Method::Auto`] switched).
+    VCyclePcg,
+    /// The cascade (Eq. 17).
+    Cascade,
+    /// The cascade with Galerkin coarse systems.
+    CascadeGalerkin,
+}
+
+impl std::fmt::Display for Solver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::JacobiPcg => "Jacobi-PCG",
+            Self::VCyclePcg => "V-cycle-PCG",
+            Self::Cascade => "cascade",
+            Self::CascadeGalerkin => "cascade (Galerkin)",
+        })
+    }
+}
+
+/// [`Method::Auto`]'s estimate after its probe, in block Jacobi-PCG
+/// iterations (see [`HIERARCHY_COST`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prediction {
+    /// Jacobi-PCG iterations the probe ran.
+    pub probe_iterations: usize,
+    /// The slowest channel's residual reduction per iteration over the
+    /// probe's second half.
+    pub jacobi_rate: f64,
+    /// Jacobi-PCG iterations still needed (the slowest channel), also its
+    /// cost.
+    pub jacobi_cost: f64,
+    /// V-cycle-PCG iterations needed (at [`V_CYCLE_RATE`]).
+    pub v_cycle_iterations: f64,
+    /// Their cost plus the hierarchy's when none is kept.
+    pub v_cycle_cost: f64,
+    /// Whether a hierarchy was kept from an earlier solve.
+    pub hierarchy_kept: bool,
+}
+
+impl Prediction {
+    /// From the probe's relative residuals (one row per iteration, one
+    /// column per channel) and which channels still run.
+    fn new(
+        history: &[[f64; 3]],
+        running: [bool; 3],
+        tolerance: f64,
+        hierarchy_kept: bool,
+    ) -> Self {
+        let k = history.len();
+        let half = k / 2;
+        let (mut jacobi, mut v_cycle, mut slowest) = (0.0f64, 0.0f64, 0.0f64);
+        for c in (0..3).filter(|&c| running[c] && k >= 2) {
+            let now = history[k - 1][c];
+            let rate = (now / history[half - 1][c]).powf(1.0 / (k - half) as f64);
+            slowest = slowest.max(rate);
+            let left = (tolerance / now).ln();
+            if left >= 0.0 {
+                continue;
+            }
+            let j = if rate > 0.0 && rate < 1.0 {
+                left / rate.ln()
+            } else {
+                f64::INFINITY
+            };
+            jacobi = jacobi.max(j);
+            v_cycle = v_cycle.max((left / V_CYCLE_RATE.ln()).ceil().max(1.0));
+        }
+        let build = if hierarchy_kept { 0.0 } else { HIERARCHY_COST };
+        Self {
+            probe_iterations: k,
+            jacobi_rate: slowest,
+            jacobi_cost: jacobi,
+            v_cycle_iterations: v_cycle,
+            v_cycle_cost: build + v_cycle * V_CYCLE_ITERATION_COST,
+            hierarchy_kept,
+        }
+    }
+
+    /// Whether the V-cycle is predicted to cost less.
+    pub fn prefers_v_cycle(&self) -> bool {
+        self.v_cycle_cost < self.jacobi_cost
+    }
+}
+
+/// Which solver a solve ran, and why.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Choice {
+    /// What ran last (V-cycle-PCG when [`Method::Auto`] switched after its
+    /// Jacobi-PCG probe).
+    pub solver: Solver,
+    /// The settings asked for it ([`SolverSettings::method`] not
+    /// [`Method::Auto`]).
+    pub forced: bool,
+    /// [`Method::Auto`]'s estimate; `None` when the tolerance came within
+    /// the probe (or the solve was forced).
+    pub prediction: Option<Prediction>,
+}
+
+impl std::fmt::Display for Choice {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.forced {
+            return write!(f, "{} (as set)", self.solver);
+        }
+        match &self.prediction {
+            None => write!(f, "{} (auto: converged within the probe)", self.solver),
+            Some(p) => write!(
+                f,
+                "{} (auto: after {} Jacobi-PCG iterations at rate {:.3}, Jacobi-PCG predicted {:.0} more, V-cycle-PCG {:.0} iterations{}: cost {:.0} vs {:.0})",
+                self.solver,
+                p.probe_iterations,
+                p.jacobi_rate,
+                p.jacobi_cost,
+                p.v_cycle_iterations,
+                if p.hierarchy_kept {
+                    " on the kept hierarchy"
+                } else {
+                    " and its hierarchy"
+                },
+                p.jacobi_cost,
+                p.v_cycle_cost
+            ),
+        }
+    }
 }
 
 /// How [`Object::solve`] solves.
@@ -54,10 +212,11 @@ pub struct SolverSettings {
 }
 
 impl Default for SolverSettings {
-    /// V-cycle-PCG to a relative residual of 10⁻⁶, one shared hierarchy.
+    /// The solver chosen per solve ([`Method::Auto`]) to a relative
+    /// residual of 10⁻⁶, one shared hierarchy when one is built.
     fn default() -> Self {
         Self {
-            method: Method::VCyclePcg,
+            method: Method::Auto,
             tolerance: 1e-6,
             max_iterations: 5_000,
             share_hierarchy: true,
@@ -89,6 +248,8 @@ pub struct SolveReport {
     /// that level of the hierarchy (the channels' reports are then of its
     /// systems); `None` for iterations on the original system.
     pub coarse_level: Option<usize>,
+    /// Which solver ran and why.
+    pub choice: Choice,
 }
 
 impl Budget<'_> {
@@ -212,6 +373,11 @@ pub struct Object {
     /// Whether the matrices' values changed since the kept hierarchy's
     /// drift was last checked.
     pub(crate) values_changed: bool,
+    /// The matrices as one block for the block solvers, and whether it
+    /// holds their current values (a paint stroke or a material change
+    /// refreshes its values; a new mesh drops it).
+    pub(crate) block: Option<Arc<Block3>>,
+    pub(crate) block_current: bool,
 }
 
 impl Object {
@@ -315,6 +481,8 @@ impl Object {
             hierarchy_refreshes: 0,
             centres: std::sync::OnceLock::new(),
             values_changed: false,
+            block: None,
+            block_current: false,
         };
         object.rebuild();
         Ok(object)
@@ -326,6 +494,7 @@ impl Object {
     /// re-tracing with the right-hand sides, for the cut's report.
     pub(crate) fn rebuild(&mut self) -> [f64; 2] {
         self.kept = None;
+        self.block = None;
         self.centres = std::sync::OnceLock::new();
         let assembly_ms = self.reassemble();
         let start = Instant::now();
@@ -567,6 +736,7 @@ impl Object {
     pub fn reassemble(&mut self) -> f64 {
         let start = Instant::now();
         self.values_changed = true;
+        self.block_current = false;
         // Free the old arrays first: they are not read, and keeping them
         // while the new ones are built would double the peak memory.
         self.matrices = std::array::from_fn(|_| CsMat::zero((0, 0)));
@@ -637,6 +807,7 @@ impl Object {
     fn reassemble_values(&mut self) {
         let start = Instant::now();
         self.values_changed = true;
+        self.block_current = false;
         self.coefficients = self.coefficients_of_media();
         self.matrices = assembly::assemble(
             &self.mesh,
@@ -822,6 +993,11 @@ impl Object {
             hierarchy_refreshed: refreshed.is_some(),
             interrupted: false,
             coarse_level: Some(level),
+            choice: Choice {
+                solver: Solver::VCyclePcg,
+                forced: self.settings.method != Method::Auto,
+                prediction: None,
+            },
         })
     }
 
@@ -837,53 +1013,86 @@ impl Object {
         // Convergence is checked below, per channel, so that the error can
         // name the channel.
         let options = SolveOptions::new(tolerance, s.max_iterations).allow_unconverged();
-        let hierarchy_ms = built.or(refreshed).unwrap_or(0.0);
+        let mut hierarchy_ms = built.or(refreshed).unwrap_or(0.0);
+        let mut built_here = false;
         let kept = self.kept_now()?;
-        let levels = kept.solver.levels();
         let stop_now = || {
             budget.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
                 || budget.deadline.is_some_and(|d| Instant::now() >= d)
         };
-        let mut monitor = |_: usize, _: &[f64]| {
-            if stop_now() {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        };
         let t = Instant::now();
-        let mut reports: Vec<Report> = Vec::with_capacity(3);
-        let mut interrupted = false;
-        for c in 0..3 {
-            let (m, b, x) = (&self.matrices[c], &self.rhs[c], &mut self.phi[c]);
-            let r = match &kept.solver {
-                KeptSolver::Jacobi => multires::cg_monitored(m, b, x, &options, &mut monitor)?,
-                KeptSolver::VCycles(v) => {
-                    let v = &v[if v.len() == 3 { c } else { 0 }];
-                    pcg_monitored(m, b, x, v, &options, &mut monitor)?
-                }
-                KeptSolver::Cascade(cascade) => {
-                    cascade
-                        .solve_monitored(m, b, x, &options, &mut monitor)?
-                        .finest
-                }
-            };
-            reports.push(r);
-            if r.stop == Stop::Interrupted {
-                interrupted = true;
-                break;
-            }
-        }
-        let solve_ms = ms(t);
-        let skipped = Report {
-            stop: Stop::Interrupted,
-            iterations: 0,
-            residual: f64::NAN,
+        let forced = |solver| Choice {
+            solver,
+            forced: true,
+            prediction: None,
         };
-        while reports.len() < 3 {
-            reports.push(skipped);
-        }
-        let channels: [Report; 3] = [reports[0], reports[1], reports[2]];
+        let (channels, choice) = match (&kept.solver, s.method) {
+            (KeptSolver::Cascade(cascade), method) => {
+                let mut reports = Vec::with_capacity(3);
+                for c in 0..3 {
+                    let (m, b, x) = (&self.matrices[c], &self.rhs[c], &mut self.phi[c]);
+                    let mut monitor = |_: usize, _: &[f64]| {
+                        if stop_now() {
+                            ControlFlow::Break(())
+                        } else {
+                            ControlFlow::Continue(())
+                        }
+                    };
+                    let r = cascade
+                        .solve_monitored(m, b, x, &options, &mut monitor)?
+                        .finest;
+                    reports.push(r);
+                    if r.stop == Stop::Interrupted {
+                        break;
+                    }
+                }
+                let skipped = Report {
+                    stop: Stop::Interrupted,
+                    iterations: 0,
+                    residual: f64::NAN,
+                };
+                reports.resize(3, skipped);
+                let solver = if method == Method::CascadeGalerkin {
+                    Solver::CascadeGalerkin
+                } else {
+                    Solver::Cascade
+                };
+                ([reports[0], reports[1], reports[2]], forced(solver))
+            }
+            (KeptSolver::VCycles(v), Method::VCyclePcg) => {
+                let v = [0, 1, 2].map(|c| &v[if v.len() == 3 { c } else { 0 }]);
+                let reports = self.block_pcg(Some(v), &options, &mut |_| {
+                    if stop_now() {
+                        ControlFlow::Break(())
+                    } else {
+                        ControlFlow::Continue(())
+                    }
+                })?;
+                (reports, forced(Solver::VCyclePcg))
+            }
+            (_, Method::Auto) => {
+                let (reports, choice, built_ms) =
+                    self.solve_auto(&kept, &options, tolerance, &stop_now)?;
+                if let Some(built_ms) = built_ms {
+                    hierarchy_ms += built_ms;
+                    built_here = true;
+                }
+                (reports, choice)
+            }
+            _ => {
+                let reports = self.block_pcg(None, &options, &mut |_| {
+                    if stop_now() {
+                        ControlFlow::Break(())
+                    } else {
+                        ControlFlow::Continue(())
+                    }
+                })?;
+                (reports, forced(Solver::JacobiPcg))
+            }
+        };
+        let solve_ms = ms(t) - (hierarchy_ms - built.or(refreshed).unwrap_or(0.0));
+        let hierarchy_built = built.is_some() || built_here;
+        let interrupted = channels.iter().any(|r| r.stop == Stop::Interrupted);
         if !interrupted {
             for (c, r) in channels.iter().enumerate() {
                 if !r.converged() {
@@ -897,16 +1106,141 @@ impl Object {
                 }
             }
         }
+        let kept = self.kept_now()?;
         Ok(SolveReport {
             channels,
-            levels,
+            levels: kept.solver.levels(),
             hierarchy_ms,
             solve_ms,
-            hierarchy_built: built.is_some(),
+            hierarchy_built,
             hierarchy_refreshed: refreshed.is_some(),
             interrupted,
             coarse_level: None,
+            choice,
         })
+    }
+
+    /// [`Method::Auto`]: Jacobi-PCG's probe, the prediction, and V-cycle-PCG
+    /// from the probe's iterate when it is predicted to cost less. Returns
+    /// the reports (iterations of both), the choice and the time of a
+    /// hierarchy built here (ms; `None` when none was).
+    fn solve_auto(
+        &mut self,
+        kept: &Kept,
+        options: &SolveOptions,
+        tolerance: f64,
+        stop_now: &dyn Fn() -> bool,
+    ) -> Result<([Report; 3], Choice, Option<f64>), Error> {
+        let hierarchy_kept = matches!(kept.solver, KeptSolver::VCycles(_));
+        let mut history: Vec<[f64; 3]> = Vec::with_capacity(AUTO_PROBE);
+        let mut prediction = None;
+        let mut switching = false;
+        let probe = self.block_pcg(None, options, &mut |p: &Progress<'_>| {
+            if stop_now() {
+                return ControlFlow::Break(());
+            }
+            if p.iteration() <= AUTO_PROBE {
+                history.push(p.residual());
+            }
+            if p.iteration() == AUTO_PROBE {
+                let guess = Prediction::new(&history, p.running(), tolerance, hierarchy_kept);
+                prediction = Some(guess);
+                if guess.prefers_v_cycle() {
+                    switching = true;
+                    return ControlFlow::Break(());
+                }
+            }
+            ControlFlow::Continue(())
+        })?;
+        let jacobi = Choice {
+            solver: Solver::JacobiPcg,
+            forced: false,
+            prediction,
+        };
+        if !switching {
+            return Ok((probe, jacobi, None));
+        }
+        let t = Instant::now();
+        let built = !hierarchy_kept;
+        if built {
+            self.kept = Some(Arc::new(Kept {
+                method: Method::Auto,
+                share_hierarchy: self.settings.share_hierarchy,
+                solver: self.build_v_cycles()?,
+            }));
+            self.hierarchy_builds += 1;
+            self.values_changed = false;
+        }
+        let built_ms = built.then(|| ms(t));
+        let kept = self.kept_now()?;
+        let KeptSolver::VCycles(v) = &kept.solver else {
+            return Ok((probe, jacobi, built_ms));
+        };
+        let v = [0, 1, 2].map(|c| &v[if v.len() == 3 { c } else { 0 }]);
+        let done = probe.iter().map(|r| r.iterations).max().unwrap_or(0);
+        let rest = SolveOptions::new(
+            tolerance,
+            self.settings.max_iterations.saturating_sub(done),
+        )
+        .allow_unconverged();
+        let reports = self.block_pcg(Some(v), &rest, &mut |_| {
+            if stop_now() {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        })?;
+        let reports = std::array::from_fn(|c| Report {
+            iterations: probe[c].iterations + reports[c].iterations,
+            ..reports[c]
+        });
+        let choice = Choice {
+            solver: Solver::VCyclePcg,
+            ..jacobi
+        };
+        Ok((reports, choice, built_ms))
+    }
+
+    /// The three channels solved as one block from the current `φ`:
+    /// preconditioned by `v` (a V-cycle per channel) or by Jacobi.
+    fn block_pcg(
+        &mut self,
+        v: Option<[&VCycle<'static>; 3]>,
+        options: &SolveOptions,
+        monitor: &mut dyn FnMut(&Progress<'_>) -> ControlFlow<()>,
+    ) -> Result<[Report; 3], Error> {
+        let block = self.block()?;
+        let b = [&self.rhs[0][..], &self.rhs[1][..], &self.rhs[2][..]];
+        let [x0, x1, x2] = &mut self.phi;
+        let x = [&mut x0[..], &mut x1[..], &mut x2[..]];
+        let reports = match v {
+            Some(v) => {
+                let m: [&dyn Preconditioner; 3] = [v[0], v[1], v[2]];
+                block.pcg(b, x, m, options, Some(monitor))?
+            }
+            None => block.cg(b, x, options, Some(monitor))?,
+        };
+        Ok(reports)
+    }
+
+    /// The matrices as one block, made or refreshed as they changed.
+    fn block(&mut self) -> Result<Arc<Block3>, Error> {
+        if let (Some(block), true) = (&self.block, self.block_current) {
+            return Ok(block.clone());
+        }
+        let m = [&self.matrices[0], &self.matrices[1], &self.matrices[2]];
+        let block = match &self.block {
+            Some(old) => match old.refreshed(m) {
+                Ok(b) => b,
+                Err(multires::Error::PatternMismatch { .. }) => Block3::new(m)?,
+                Err(e) => return Err(e.into()),
+            },
+            None => Block3::new(m)?,
+        };
+        let block = Arc::new(block);
+        self.block = Some(block.clone());
+        self.block_current = true;
+        Ok(block)
     }
 
     /// Builds the solver's hierarchy unless one of the current method is
@@ -927,26 +1261,9 @@ impl Object {
         let weights = Weights::Points(&positions);
         let matrices = &self.matrices;
         let solver = match s.method {
-            Method::JacobiPcg => KeptSolver::Jacobi,
-            Method::VCyclePcg => {
-                let vopts = VCycleOptions::default();
-                let v = if s.share_hierarchy {
-                    // One hierarchy (the green channel's), each channel's
-                    // operators on it: a preview's coarse solve needs the
-                    // channel's own coarse system.
-                    let green = VCycle::new(&matrices[1], weights, &vopts)?.into_owned();
-                    let red = green.refreshed(&matrices[0])?;
-                    let blue = green.refreshed(&matrices[2])?;
-                    vec![red, green, blue]
-                } else {
-                    let mut v = Vec::with_capacity(3);
-                    for m in matrices {
-                        v.push(VCycle::new(m, weights, &vopts)?.into_owned());
-                    }
-                    v
-                };
-                KeptSolver::VCycles(v)
-            }
+            // Auto builds a hierarchy only when its probe says so.
+            Method::JacobiPcg | Method::Auto => KeptSolver::Jacobi,
+            Method::VCyclePcg => self.build_v_cycles()?,
             Method::Cascade | Method::CascadeGalerkin => {
                 let copts = if s.method == Method::Cascade {
                     CascadeOptions::default()
@@ -964,6 +1281,31 @@ impl Object {
         self.hierarchy_builds += 1;
         self.values_changed = false;
         Ok(Some(ms(t)))
+    }
+
+    /// The V-cycles of the three channels: one hierarchy (the green
+    /// channel's) with each channel's operators on it, or one each
+    /// (see [`SolverSettings::share_hierarchy`]).
+    fn build_v_cycles(&self) -> Result<KeptSolver, Error> {
+        let positions = self.mesh.positions();
+        let weights = Weights::Points(&positions);
+        let matrices = &self.matrices;
+        let vopts = VCycleOptions::default();
+        let v = if self.settings.share_hierarchy {
+            // A preview's coarse solve needs the channel's own coarse
+            // system.
+            let green = VCycle::new(&matrices[1], weights, &vopts)?.into_owned();
+            let red = green.refreshed(&matrices[0])?;
+            let blue = green.refreshed(&matrices[2])?;
+            vec![red, green, blue]
+        } else {
+            let mut v = Vec::with_capacity(3);
+            for m in matrices {
+                v.push(VCycle::new(m, weights, &vopts)?.into_owned());
+            }
+            v
+        };
+        Ok(KeptSolver::VCycles(v))
     }
 
     /// Recomputes the kept V-cycles' operators for the current matrices

@@ -186,6 +186,7 @@ impl Object {
         rows.sort_unstable();
         rows.dedup();
         self.values_changed |= !rows.is_empty();
+        self.block_current &= rows.is_empty();
         let a = self.boundary_factor();
         reassemble_rows(
             &self.mesh,

@@ -8,11 +8,17 @@ use std::sync::atomic::AtomicBool;
 
 use common::*;
 use tet_diffusion::glam::DVec3;
-use tet_diffusion::{Cut, Edit, Error, Light, Medium, Object, Session, SessionOptions, Stroke};
+use tet_diffusion::{
+    Cut, Edit, Error, Light, Medium, Method, Object, Session, SessionOptions, Stroke,
+};
 
+/// A lit marble ball solved with the V-cycle: these tests are about the
+/// kept hierarchy (its refresh, undo, coarse previews), which the
+/// automatic choice would not build for so small a system.
 fn lit_ball(n: usize) -> Object {
     let mut o =
         Object::homogeneous(ball(n, 5.0), 1.0, Medium::measured("marble").unwrap(), 1.3).unwrap();
+    o.settings.method = Method::VCyclePcg;
     o.add_light(Light::Directional {
         to_light: DVec3::new(0.3, 1.0, 0.2),
         irradiance: [1.0; 3],
