@@ -7,6 +7,7 @@
 //! | `load`, `save`, `Mesh` | trilux-io meshes ([`mesh`]); glTF colours and attributes, in and out ([`gltf`]) |
 //! | `sample_surface`, `blue_noise`, `sample_surface_even` | mesh-sampling ([`sampling`]) |
 //! | `Distribution1D`, `Distribution2D` | discrete-sampling ([`discrete`]) |
+//! | `Emitter` | mesh-sampling's light sampling ([`emitter`]) |
 //! | `MeshColors` | mesh-colors via `trilux::to_mesh_colors` ([`colors`]) |
 //! | `tetrahedralize`, `load_tets`, `save_tets`, `save_points` | stuffing, trilux-io ([`tets`]), PLY or glTF points |
 //! | `load_points`, `Points` | PLY or glTF points back in ([`points`]) |
@@ -26,6 +27,7 @@
 pub mod arrays;
 pub mod colors;
 pub mod discrete;
+pub mod emitter;
 pub mod error;
 pub mod gltf;
 pub mod mesh;
@@ -48,6 +50,7 @@ fn _trilux(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sampling::sample_surface_even, m)?)?;
     m.add_class::<discrete::Distribution1D>()?;
     m.add_class::<discrete::Distribution2D>()?;
+    m.add_class::<emitter::Emitter>()?;
     m.add_class::<colors::MeshColors>()?;
     m.add_function(wrap_pyfunction!(tets::tetrahedralize, m)?)?;
     m.add_function(wrap_pyfunction!(tets::load_tets, m)?)?;

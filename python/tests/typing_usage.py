@@ -82,3 +82,17 @@ def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     del skipped, tet_nodes, tet_ids, first_warning
     del idx, dirs, pdf, nodes2, tets2, tmin, light, image, whole, rgb, baked, atlas, blue, even, message
     return points, faces
+
+
+def next_event(mesh: trilux.Mesh, image: F64, shading_points: F64) -> F64:
+    emitter = trilux.Emitter(mesh, image, strategy="texture-exact", two_sided=True, wrap="clamp")
+    s = emitter.sample(len(shading_points), shading_points, seed=1)
+    face: npt.NDArray[np.int64] = s["face_index"]
+    pdf: F64 = emitter.pdf(face, s["barycentric"], shading_points)
+    le: F64 = emitter.radiance(face, s["barycentric"])
+    weights: F64 = emitter.triangle_power()
+    total: float = emitter.power
+    name: str = emitter.strategy
+    per_face = trilux.Emitter(mesh, face_radiance=np.ones((3, 3)), strategy="triangle-power")
+    del le, weights, total, name, per_face
+    return pdf

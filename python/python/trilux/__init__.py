@@ -1,4 +1,5 @@
-"""trilux: fast random points on meshes (Šik & Křivánek 2013), blue noise
+"""trilux: fast random points on meshes (Šik & Křivánek 2013), light sampling
+of emissive meshes for renderers, blue noise
 (Yuksel 2015), mesh colours (Yuksel, Keyser & House 2010), isosurface
 stuffing (Labelle & Shewchuk 2007) and TransCut diffusion (Li et al.), over
 numpy arrays.
@@ -13,6 +14,7 @@ subclasses (``InputError`` is a ``ValueError``, ``FileError`` an
 from ._trilux import (
     Distribution1D,
     Distribution2D,
+    Emitter,
     Error,
     FileError,
     InputError,
@@ -39,6 +41,7 @@ from ._trilux import (
 __all__ = [
     "Distribution1D",
     "Distribution2D",
+    "Emitter",
     "Error",
     "FileError",
     "InputError",

@@ -19,6 +19,9 @@ MeshLike = Any
 Channel = Union[Literal["r", "g", "b", "a", "luminance"], int]
 Method = Literal["uniform", "subdivision", "exact", "rejection"]
 Packing = Literal["dense", "elimination"]
+Strategy = Literal["area", "triangle-power", "texture", "texture-exact"]
+Wrap = Literal["repeat", "mirror", "clamp"]
+Filter = Literal["bilinear", "nearest"]
 MediumLike = Union[str, Tuple[Sequence[float], Sequence[float]]]
 # What sample_surface / blue_noise return when the flags are plain bools.
 PointArrays = Union[
@@ -419,6 +422,39 @@ class Distribution2D:
     def pdf(self, points: ArrayLike) -> F64: ...
     def sample_direction(self, n: int, seed: Optional[int] = None) -> Tuple[F64, F64]: ...
     def pdf_direction(self, directions: ArrayLike) -> F64: ...
+
+class Emitter:
+    def __init__(
+        self,
+        mesh: MeshLike,
+        emission: Optional[Union[ArrayLike, PathLike]] = None,
+        *,
+        face_radiance: Optional[ArrayLike] = None,
+        uv: Optional[ArrayLike] = None,
+        scale: float = 1.0,
+        strategy: Optional[Strategy] = None,
+        two_sided: bool = False,
+        wrap: Optional[Wrap] = None,
+        filter: Optional[Filter] = None,
+    ) -> None: ...
+    @property
+    def power(self) -> float: ...
+    @property
+    def strategy(self) -> Strategy: ...
+    @property
+    def two_sided(self) -> bool: ...
+    @property
+    def defensive_fraction(self) -> float: ...
+    def triangle_power(self) -> F64: ...
+    def sample(
+        self, n: int, reference_points: Optional[ArrayLike] = None, *, seed: Optional[int] = None
+    ) -> dict[str, npt.NDArray[Any]]: ...
+    def pdf(
+        self, face_index: ArrayLike, barycentric: ArrayLike, reference_points: Optional[ArrayLike] = None
+    ) -> F64: ...
+    def radiance(
+        self, face_index: ArrayLike, barycentric: ArrayLike, reference_points: Optional[ArrayLike] = None
+    ) -> F64: ...
 
 class MeshColors:
     @staticmethod
