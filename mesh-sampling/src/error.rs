@@ -217,6 +217,21 @@ pub enum Error {
         /// Faces of the mesh.
         expected: usize,
     },
+    /// An emission texel with a channel that is negative, NaN or infinite.
+    #[error(
+        "emission texel ({x}, {y}) has {} = {value}: radiance must be finite and >= 0",
+        ["R", "G", "B"][*.channel]
+    )]
+    InvalidRadianceTexel {
+        /// Column.
+        x: usize,
+        /// Row.
+        y: usize,
+        /// The channel: 0, 1 or 2 for R, G, B.
+        channel: usize,
+        /// The value.
+        value: f32,
+    },
     /// A per-face radiance channel that is negative, NaN or infinite.
     #[error("face {face} has a radiance channel of {value}: radiance must be finite and >= 0")]
     InvalidRadiance {

@@ -54,8 +54,8 @@ impl EmissionTexture {
     /// A texture of `width × height` RGB texels, row by row.
     ///
     /// # Errors
-    /// [`Error::InvalidTexel`] naming the first texel with a negative,
-    /// NaN or infinite channel; [`Error::EmptyTexture`],
+    /// [`Error::InvalidRadianceTexel`] naming the first texel with a
+    /// negative, NaN or infinite channel; [`Error::EmptyTexture`],
     /// [`Error::TextureTooLarge`], [`Error::TextureSize`] as for
     /// [`DensityTexture::new`].
     pub fn new(width: usize, height: usize, rgb: Vec<[f32; 3]>) -> Result<Self, Error> {
@@ -67,9 +67,10 @@ impl EmissionTexture {
         {
             let texel = i / 3;
             let w = width.max(1);
-            return Err(Error::InvalidTexel {
+            return Err(Error::InvalidRadianceTexel {
                 x: texel % w,
                 y: texel / w,
+                channel: i % 3,
                 value,
             });
         }
@@ -213,16 +214,22 @@ mod tests {
     #[test]
     fn bad_texels_and_sizes_are_errors() {
         let e = EmissionTexture::new(2, 2, vec![[1.0; 3], [1.0; 3], [1.0, -1.0, 0.0], [0.0; 3]]);
+        let e = e.unwrap_err();
         assert_eq!(
-            e.unwrap_err(),
-            Error::InvalidTexel {
+            e,
+            Error::InvalidRadianceTexel {
                 x: 0,
                 y: 1,
+                channel: 1,
                 value: -1.0
             }
         );
+        assert_eq!(
+            e.to_string(),
+            "emission texel (0, 1) has G = -1: radiance must be finite and >= 0"
+        );
         let e = EmissionTexture::new(2, 2, vec![[f32::NAN, 0.0, 0.0]; 4]).unwrap_err();
-        assert!(e.to_string().contains("(0, 0)"), "{e}");
+        assert!(e.to_string().contains("(0, 0) has R = NaN"), "{e}");
         assert!(matches!(
             EmissionTexture::new(2, 2, vec![[1.0; 3]; 3]),
             Err(Error::TextureSize {
