@@ -156,6 +156,10 @@ def test_bad_input_raises_input_errors_naming_the_argument():
         trilux.Emitter((v, f), image, uv=uv, scale=-1.0)
     with pytest.raises(trilux.InputError, match="texture coordinates"):
         trilux.Emitter((v, f), image)
+    with pytest.raises(trilux.InputError, match=r"emission texel \(1, 0\) has B = -1"):
+        negative = np.ones((2, 2, 3))
+        negative[0, 1, 2] = -1
+        trilux.Emitter((v, f), negative, uv=uv)
     with pytest.raises(trilux.InputError, match="zero everywhere"):
         trilux.Emitter((v, f), np.zeros((4, 4, 3)), uv=uv)
     with pytest.raises(trilux.InputError, match="face 2"):
