@@ -42,3 +42,13 @@ def test_a_second_thread_progresses_during_blue_noise():
     v, f, _ = grid(32)
     during, elapsed = progress_during(lambda: trilux.blue_noise((v, f), 100_000, seed=1))
     assert during > 20_000, (during, elapsed)
+
+
+def test_a_second_thread_progresses_during_light_sampling():
+    import numpy as np
+
+    v, f, uv = grid(32)
+    image = np.random.default_rng(0).uniform(0, 1, (256, 256, 3))
+    emitter = trilux.Emitter((v, f), image, uv=uv, strategy="texture-exact")
+    during, elapsed = progress_during(lambda: emitter.sample(1_000_000, [0.5, 0.5, 1.0], seed=1))
+    assert during > 20_000, (during, elapsed)
