@@ -18,11 +18,11 @@ use mesh_sampling::{
     Strategy, Wrap,
 };
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 use trilux_io::mesh::TriMesh;
 
 use crate::arrays::{self, Int};
-use crate::error::{Failure, Kind, Result, guarded};
+use crate::error::{Failure, Kind, Result, chain, guarded};
 use crate::mesh::{image_from, mesh_arg, path_arg};
 
 /// A call's work, run on the emitter's thread.
@@ -192,8 +192,22 @@ impl Emitter {
         face_index: &Bound<'_, PyAny>,
         barycentric: &Bound<'_, PyAny>,
     ) -> PyResult<(Vec<usize>, Vec<[f32; 3]>)> {
-        let faces = arrays::values_i64(face_index, "face_index")?;
-        let faces = faces
+        let faces = self.faces_arg(face_index)?;
+        let bary = arrays::rows_f64::<3>(barycentric, "barycentric")?;
+        if bary.len() != faces.len() {
+            return Err(Failure::input(format!(
+                "barycentric: {} rows for {} entries of face_index",
+                bary.len(),
+                faces.len()
+            ))
+            .into());
+        }
+        Ok((faces, bary.iter().map(|b| b.map(|x| x as f32)).collect()))
+    }
+
+    /// `face_index` `(n,)`, each checked to be a face of the mesh.
+    fn faces_arg(&self, face_index: &Bound<'_, PyAny>) -> PyResult<Vec<usize>> {
+        arrays::values_i64(face_index, "face_index")?
             .iter()
             .enumerate()
             .map(|(k, &f)| {
@@ -207,17 +221,7 @@ impl Emitter {
                         )))
                     })
             })
-            .collect::<PyResult<Vec<usize>>>()?;
-        let bary = arrays::rows_f64::<3>(barycentric, "barycentric")?;
-        if bary.len() != faces.len() {
-            return Err(Failure::input(format!(
-                "barycentric: {} rows for {} entries of face_index",
-                bary.len(),
-                faces.len()
-            ))
-            .into());
-        }
-        Ok((faces, bary.iter().map(|b| b.map(|x| x as f32)).collect()))
+            .collect()
     }
 }
 
@@ -228,6 +232,48 @@ fn rows_out<'py, const K: usize>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let data: Vec<f64> = rows.flat_map(|r| r.map(f64::from)).collect();
     arrays::matrix(py, data, K)
+}
+
+/// The arrays of samples every sampling call returns: `positions`,
+/// `normals`, `shading_normals`, `face_index`, `barycentric`, `radiance`
+/// (of the emitting side) and `pdf_area`.
+fn samples_dict<'py>(
+    py: Python<'py>,
+    samples: &[LightSample],
+    origin: DVec3,
+) -> PyResult<Bound<'py, PyDict>> {
+    let out = PyDict::new(py);
+    let data: Vec<f64> = samples
+        .iter()
+        .flat_map(|s| (origin + s.point.position.as_dvec3()).to_array())
+        .collect();
+    out.set_item("positions", arrays::matrix(py, data, 3)?)?;
+    out.set_item(
+        "normals",
+        rows_out(py, samples.iter().map(|s| s.point.normal.to_array()))?,
+    )?;
+    out.set_item(
+        "shading_normals",
+        rows_out(
+            py,
+            samples
+                .iter()
+                .map(|s| s.point.shading_normal.unwrap_or(s.point.normal).to_array()),
+        )?,
+    )?;
+    let faces: Vec<i64> = samples.iter().map(|s| i64::from(s.point.face)).collect();
+    out.set_item("face_index", arrays::vector(py, faces))?;
+    out.set_item(
+        "barycentric",
+        rows_out(py, samples.iter().map(|s| s.point.barycentric))?,
+    )?;
+    out.set_item(
+        "radiance",
+        rows_out(py, samples.iter().map(|s| s.radiance))?,
+    )?;
+    let pdf: Vec<f64> = samples.iter().map(|s| f64::from(s.pdf_area())).collect();
+    out.set_item("pdf_area", arrays::vector(py, pdf))?;
+    Ok(out)
 }
 
 #[pymethods]
@@ -413,35 +459,9 @@ impl Emitter {
             };
             Ok((samples, toward))
         })?;
-        let origin = self.origin;
-        let out = PyDict::new(py);
-        let data: Vec<f64> = samples
-            .iter()
-            .flat_map(|s| (origin + s.point.position.as_dvec3()).to_array())
-            .collect();
-        out.set_item("positions", arrays::matrix(py, data, 3)?)?;
-        out.set_item(
-            "normals",
-            rows_out(py, samples.iter().map(|s| s.point.normal.to_array()))?,
-        )?;
-        out.set_item(
-            "shading_normals",
-            rows_out(
-                py,
-                samples
-                    .iter()
-                    .map(|s| s.point.shading_normal.unwrap_or(s.point.normal).to_array()),
-            )?,
-        )?;
-        let faces: Vec<i64> = samples.iter().map(|s| i64::from(s.point.face)).collect();
-        out.set_item("face_index", arrays::vector(py, faces))?;
-        out.set_item(
-            "barycentric",
-            rows_out(py, samples.iter().map(|s| s.point.barycentric))?,
-        )?;
-        let pdf: Vec<f64> = samples.iter().map(|s| f64::from(s.pdf_area())).collect();
-        out.set_item("pdf_area", arrays::vector(py, pdf))?;
+        let out = samples_dict(py, &samples, self.origin)?;
         if with_references {
+            // What arrives at the reference points: 0 from the back.
             out.set_item("radiance", rows_out(py, toward.iter().map(|t| t.radiance))?)?;
             out.set_item(
                 "direction",
@@ -454,11 +474,6 @@ impl Emitter {
                 .map(|t| f64::from(t.pdf_solid_angle))
                 .collect();
             out.set_item("pdf_solid_angle", arrays::vector(py, p))?;
-        } else {
-            out.set_item(
-                "radiance",
-                rows_out(py, samples.iter().map(|s: &LightSample| s.radiance))?,
-            )?;
         }
         Ok(out)
     }
@@ -531,6 +546,100 @@ impl Emitter {
             })
         })?;
         rows_out(py, le.into_iter())
+    }
+
+    /// Points inside given triangles, for a renderer that picks the
+    /// triangle itself (a light BVH or light tree weighted by
+    /// `triangle_power()`): one point of face `face_index[k]` for the
+    /// variates `u[k]` (`(n, 2)` in `[0, 1)`, stratified or
+    /// low-discrepancy welcome), distributed inside the triangle as the
+    /// strategy does (uniformly for `'area'` and `'triangle-power'`, by the
+    /// emission for the texture strategies). The dict of `sample` without
+    /// a reference point; its `pdf_area` is the density **given the
+    /// triangle**: multiply by your probability of choosing it.
+    fn sample_in_triangle<'py>(
+        &self,
+        py: Python<'py>,
+        face_index: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let faces = self.faces_arg(face_index)?;
+        let u = arrays::rows_f64::<2>(u, "u")?;
+        if u.len() != faces.len() {
+            return Err(Failure::input(format!(
+                "u: {} rows for {} entries of face_index",
+                u.len(),
+                faces.len()
+            ))
+            .into());
+        }
+        if let Some(k) = u
+            .iter()
+            .position(|r| !r.iter().all(|x| (0.0..1.0).contains(x)))
+        {
+            return Err(Failure::input(format!(
+                "u: row {k} is [{}, {}], not in [0, 1)²",
+                u[k][0], u[k][1]
+            ))
+            .into());
+        }
+        let samples = self.run(py, move |e| {
+            faces
+                .iter()
+                .zip(&u)
+                .enumerate()
+                .map(|(k, (&f, &u))| {
+                    e.sample_in_triangle(f, u).map_err(|err| {
+                        Failure::input(format!("face_index: entry {k}: {}", chain(&err)))
+                    })
+                })
+                .collect::<Result<Vec<LightSample>>>()
+        })?;
+        samples_dict(py, &samples, self.origin)
+    }
+
+    /// The density `(n,)` (per mesh unit², given the triangle) with which
+    /// `sample_in_triangle` draws the points at `barycentric` `(n, 3)` of
+    /// faces `face_index` `(n,)`: exactly the `pdf_area` its samples carry.
+    fn pdf_in_triangle<'py>(
+        &self,
+        py: Python<'py>,
+        face_index: &Bound<'py, PyAny>,
+        barycentric: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (faces, bary) = self.hits_arg(face_index, barycentric)?;
+        let pdf = self.run(py, move |e| {
+            Ok(faces
+                .iter()
+                .zip(&bary)
+                .map(|(&f, &b)| f64::from(e.pdf_in_triangle(f, b)))
+                .collect::<Vec<f64>>())
+        })?;
+        Ok(arrays::vector(py, pdf))
+    }
+
+    /// Every triangle's bounding box and geometric normal, for a light
+    /// BVH: `(lower, upper, normal)`, three `(m, 3)` float64 arrays (the
+    /// normal is the emitting side's of a one-sided emitter; zero for a
+    /// degenerate triangle).
+    fn triangle_bounds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        let bounds = self.run(py, |e| {
+            (0..e.mesh().indices.len())
+                .map(|f| e.triangle_bounds(f).map_err(Failure::from))
+                .collect::<Result<Vec<_>>>()
+        })?;
+        let origin = self.origin;
+        let corner = |p: Vec3| (origin + p.as_dvec3()).to_array();
+        let lower: Vec<f64> = bounds.iter().flat_map(|b| corner(b.min)).collect();
+        let upper: Vec<f64> = bounds.iter().flat_map(|b| corner(b.max)).collect();
+        PyTuple::new(
+            py,
+            [
+                arrays::matrix(py, lower, 3)?,
+                arrays::matrix(py, upper, 3)?,
+                rows_out(py, bounds.iter().map(|b| b.normal.to_array()))?,
+            ],
+        )
     }
 
     fn __repr__(&self) -> String {

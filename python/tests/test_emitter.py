@@ -114,6 +114,43 @@ def test_pdf_and_radiance_from_face_and_barycentric_equal_the_samples(strategy):
     assert (s["pdf_area"] > 0).all()
 
 
+@pytest.mark.parametrize("strategy", STRATEGIES)
+def test_a_light_tree_through_sample_in_triangle_matches_the_closed_form(strategy):
+    v, f, uv = ceiling()
+    e = trilux.Emitter((v, f), lit_square(), uv=uv, filter="nearest", strategy=strategy)
+    power = e.triangle_power()
+    assert np.isclose(power.sum(), e.power)
+    rng = np.random.default_rng(7)
+    n = 100_000
+    chosen = rng.choice(len(f), size=n, p=power / power.sum())
+    s = e.sample_in_triangle(chosen, rng.uniform(0, 1, (n, 2)))
+    assert np.array_equal(s["face_index"], chosen)
+    assert np.array_equal(e.pdf_in_triangle(chosen, s["barycentric"]), s["pdf_area"])
+    d = s["positions"] - X
+    r2 = (d * d).sum(axis=1)
+    w = d / np.sqrt(r2)[:, None]
+    cos_light = w[:, 2]  # the normal is -z: cos at the light is w·z
+    pdf = s["pdf_area"] * power[chosen] / power.sum() * r2 / cos_light
+    values = s["radiance"][:, 0] * np.clip(w @ N, 0, None) / pdf
+    want = lambert(LIT[0], SQUARE, X, N)
+    mean, se = values.mean(), values.std(ddof=1) / np.sqrt(n)
+    assert abs(mean - want) < 4 * se and se < 0.015 * want, (mean, se, want)
+
+
+def test_triangle_bounds_hold_the_triangles():
+    v, f, uv = ceiling(3)
+    e = trilux.Emitter((v + [10, 0, 0], f), lit_square(), uv=uv)
+    lower, upper, normal = e.triangle_bounds()
+    corners = v[f] + [10, 0, 0]
+    assert np.allclose(lower, corners.min(axis=1)) and np.allclose(upper, corners.max(axis=1))
+    assert np.allclose(normal, [0, 0, -1])
+    lit = int(np.argmax(e.triangle_power()))
+    with pytest.raises(trilux.InputError, match=r"u: row 0 is \[1.5, 0\]"):
+        e.sample_in_triangle([lit], [[1.5, 0.0]])
+    with pytest.raises(trilux.InputError, match="entry 0: triangle 0 has no area or no emission"):
+        e.sample_in_triangle([0], [[0.5, 0.5]])
+
+
 def test_far_from_the_origin_the_same_estimate():
     v, f, uv = ceiling()
     shift = np.array([1e6, -2e6, 5e5])

@@ -94,5 +94,8 @@ def next_event(mesh: trilux.Mesh, image: F64, shading_points: F64) -> F64:
     total: float = emitter.power
     name: str = emitter.strategy
     per_face = trilux.Emitter(mesh, face_radiance=np.ones((3, 3)), strategy="triangle-power")
-    del le, weights, total, name, per_face
+    inside = emitter.sample_in_triangle(face, np.full((len(face), 2), 0.5))
+    inside_pdf: F64 = emitter.pdf_in_triangle(face, inside["barycentric"])
+    lower, upper, normal = emitter.triangle_bounds()
+    del le, weights, total, name, per_face, inside_pdf, lower, upper, normal
     return pdf
