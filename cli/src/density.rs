@@ -59,6 +59,30 @@ pub fn density_texture(image: &Image, channel: Channel) -> Result<DensityTexture
 /// assert!(emitter.power() > 0.0);
 /// # Ok::<(), trilux::Error>(())
 /// ```
+///
+/// Mesh colours emit through their atlas. Colours fitted to a texture
+/// with sharp edges can ring slightly below zero there (this checkerboard
+/// does), which is no radiance: this function refuses a negative value,
+/// naming the texel, so clamp first if that is what you mean:
+/// ```
+/// use mesh_sampling::{Emission, Emitter, EmitterOptions};
+///
+/// let torus = trilux::shapes::torus(48, 24);
+/// let checker = trilux::shapes::checkerboard(128, 128, 8);
+/// let (surface, colors) = trilux::to_mesh_colors(&torus, Some(&checker), &Default::default())?;
+/// let atlas = mesh_colors::atlas::bake(&colors, &Default::default())?;
+/// let (baked, mut image) = trilux::atlas_mesh(&surface, &atlas, None);
+/// for p in &mut image.pixels {
+///     p[..3].iter_mut().for_each(|c| *c = c.max(0.0));
+/// }
+/// let texture = trilux::emission_texture(&image)?;
+/// let emission = Emission::Texture { texture: &texture, scale: 10.0 };
+/// let emitter = Emitter::new(trilux::mesh_ref(&baked), emission, &EmitterOptions::default())?;
+/// for s in emitter.sample_n(1, 1000)? {
+///     assert!(s.radiance.iter().all(|&c| (0.0..=10.0 + 1e-3).contains(&c)));
+/// }
+/// # Ok::<(), trilux::Error>(())
+/// ```
 pub fn emission_texture(image: &Image) -> Result<EmissionTexture> {
     let rgb = image.pixels.iter().map(|p| [p[0], p[1], p[2]]).collect();
     Ok(EmissionTexture::new(
