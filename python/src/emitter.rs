@@ -70,6 +70,9 @@ struct Info {
 #[pyclass(module = "trilux", frozen)]
 pub(crate) struct Emitter {
     jobs: mpsc::Sender<Job>,
+    /// The process whose thread holds the emitter (a forked child has
+    /// no such thread: a call there would wait forever).
+    process: u32,
     origin: DVec3,
     faces: usize,
     strategy: Strategy,
@@ -173,6 +176,13 @@ impl Emitter {
         py: Python<'_>,
         f: impl for<'a> FnOnce(&RustEmitter<'a>) -> Result<T> + Send + 'static,
     ) -> PyResult<T> {
+        if std::process::id() != self.process {
+            return Err(Failure::input(
+                "this Emitter was made in another process (before a fork): make it in the \
+                 process that uses it",
+            )
+            .into());
+        }
         let (tx, rx) = mpsc::channel();
         let job: Job = Box::new(move |e| {
             let _ = tx.send(guarded(|| f(e)));
@@ -381,6 +391,7 @@ impl Emitter {
             .map_err(PyErr::from)?;
         Ok(Self {
             jobs,
+            process: std::process::id(),
             origin,
             faces,
             strategy,

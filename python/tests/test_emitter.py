@@ -238,3 +238,31 @@ def test_the_readme_light_sampling_example_runs_as_written():
     assert np.array_equal(ns["le"], s["radiance"])
     assert np.isclose(ns["weights"].sum(), ns["light"].power)
     assert (ns["irradiance"] > 0).all()
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "fork"), reason="needs os.fork")
+def test_a_forked_child_gets_an_error_not_a_hang():
+    import os
+    import warnings
+
+    v, f, uv = ceiling(2)
+    e = trilux.Emitter((v, f), lit_square(), uv=uv)
+    read, write = os.pipe()
+    with warnings.catch_warnings():
+        # Python 3.12+ warns that forking a threaded process may deadlock:
+        # what this test shows the emitter does not do.
+        warnings.simplefilter("ignore", DeprecationWarning)
+        pid = os.fork()
+    if pid == 0:  # the child: no thread holds the emitter here
+        try:
+            e.sample(10)
+            os.write(write, b"no error")
+        except trilux.InputError as err:
+            os.write(write, str(err).encode())
+        finally:
+            os._exit(0)
+    os.close(write)
+    message = os.read(read, 1000).decode()
+    os.waitpid(pid, 0)
+    assert "another process" in message, message
+    assert len(e.sample(10)["positions"]) == 10  # the parent's still works
