@@ -264,6 +264,21 @@ enum Inner<'a> {
 /// the geometric normal, never the shading normal; powers are Rec. 709
 /// luminance, `Φ = sides · π · ∫ Y(Le) dA`.
 ///
+/// # Performance
+/// Building integrates the texture exactly over every triangle (one
+/// clipping step per texel cell a triangle's UVs cover, O(1) where the
+/// texture is constant) and, for the texture strategies, builds the
+/// [`DensitySampler`] (memory: its pieces, about 16 bytes per texel the
+/// mesh covers). A sample costs the strategy's draw (a table lookup and
+/// two variates; the exact strategy's rejection step accepts
+/// [`DensitySampler::acceptance`] of its proposals), the radiance lookup
+/// (four texels) and, for the subdivision strategy, a check that the
+/// point's stored barycentrics lie in the sub-triangle drawn (so that its
+/// pdf is [`pdf_area`](Self::pdf_area)'s there, bit for bit); a pdf from `(face,
+/// barycentric)` costs a search of the triangle's pieces for the
+/// subdivision strategy, a texture lookup for the exact one, O(1) for the
+/// others.
+///
 /// # Example
 /// Next-event estimation of the irradiance at a point below a textured
 /// quad:

@@ -52,6 +52,11 @@ impl Emitter<'_> {
     /// through the first proposal, taken with probability
     /// [`DensitySampler::acceptance`] on average).
     ///
+    /// The texture strategies build, on the first call (or the first
+    /// [`pdf_in_triangle`](Self::pdf_in_triangle)), the cumulative masses
+    /// of each triangle's pieces (8 bytes a piece), then find a piece by
+    /// bisection among its triangle's.
+    ///
     /// # Errors
     /// [`Error::NoSuchFace`]; [`Error::DarkTriangle`] for a triangle with
     /// no area, or (texture strategies) no emission, to sample.
