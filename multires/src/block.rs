@@ -57,6 +57,8 @@ pub struct Block3 {
 pub struct Progress<'a> {
     iteration: usize,
     residual: Lanes,
+    alpha: Lanes,
+    beta: Lanes,
     running: [bool; CHANNELS],
     x: &'a [Vec<f64>; CHANNELS],
     order: &'a [u32],
@@ -78,6 +80,17 @@ impl Progress<'_> {
     /// Whether each channel is still iterating.
     pub fn running(&self) -> [bool; CHANNELS] {
         self.running
+    }
+
+    /// Each channel's CG step length `α_j = (r_j·z_j) / (p_j·A p_j)` of
+    /// this iteration `j`, and the `β_{j−1}` that made its direction
+    /// `p_j = z_j + β_{j−1} p_{j−1}` (0 on a run's first iteration). With
+    /// them a monitor builds CG's Lanczos matrix — diagonal
+    /// `1/α_j + β_{j−1}/α_{j−1}`, off-diagonal `√β_{j−1}/α_{j−1}` (Saad,
+    /// *Iterative Methods for Sparse Linear Systems*, Sec. 6.7.3) — whose
+    /// extreme eigenvalues estimate those of the preconditioned matrix.
+    pub fn coefficients(&self) -> (Lanes, Lanes) {
+        (self.alpha, self.beta)
     }
 
     /// Channel `c`'s current iterate, in the matrices' numbering (a copy:
@@ -718,6 +731,14 @@ impl<'s> Solve<'s> {
             let progress = Progress {
                 iteration,
                 residual: std::array::from_fn(|c| self.lanes[c].recurrence),
+                alpha: std::array::from_fn(|c| {
+                    if stepping[c] {
+                        self.lanes[c].alpha
+                    } else {
+                        0.0
+                    }
+                }),
+                beta: std::array::from_fn(|c| if stepping[c] { self.lanes[c].beta } else { 0.0 }),
                 running: self.running(),
                 x: &self.x,
                 order: &self.a.order,
@@ -770,6 +791,7 @@ impl<'s> Solve<'s> {
         for c in 0..CHANNELS {
             if which[c] {
                 self.lanes[c].rz = rz[c];
+                self.lanes[c].beta = 0.0;
             }
         }
         self.p
@@ -1317,7 +1339,9 @@ mod tests {
         let (a, b, _) = channels(6);
         let block = Block3::new([&a[0], &a[1], &a[2]]).unwrap();
         let scaled: Vec<CsMat<f64>> = a.iter().map(|m| m.map(|v| 2.0 * v)).collect();
-        let block = block.refreshed([&scaled[0], &scaled[1], &scaled[2]]).unwrap();
+        let block = block
+            .refreshed([&scaled[0], &scaled[1], &scaled[2]])
+            .unwrap();
         let fresh = Block3::new([&scaled[0], &scaled[1], &scaled[2]]).unwrap();
         let n = block.rows();
         let solve = |block: &Block3| {

@@ -66,6 +66,7 @@ mod graph;
 pub mod grid;
 mod hierarchy;
 mod krylov;
+mod lanczos;
 pub mod matrix;
 pub mod mtx;
 mod vcycle;
@@ -85,6 +86,7 @@ pub use krylov::{
     Jacobi, Monitor, Preconditioner, Report, SolveOptions, Stop, bicgstab, bicgstab_monitored, cg,
     cg_monitored, pcg, pcg_monitored,
 };
+pub use lanczos::Lanczos;
 /// The `sprs` whose `CsMat` this crate's API takes, re-exported so that
 /// callers build matrices with the same version.
 pub use sprs;
