@@ -95,8 +95,8 @@ pub use light::{Environment, Light};
 pub use medium::{MEASURED, Medium, Noise, ResolutionWarning};
 pub use mesh::{NONE, TetMesh};
 pub use object::{
-    AUTO_PROBE, Budget, Choice, HIERARCHY_COST, Method, Object, Prediction, REFRESH_DRIFT,
-    SolveReport, Solver, SolverSettings, V_CYCLE_ITERATION_COST, V_CYCLE_RATE,
+    AUTO_PROBE, AutoCosts, Budget, Choice, Method, Object, Prediction, REFRESH_DRIFT, SolveReport,
+    Solver, SolverSettings,
 };
 pub use paint::{PaintReport, Stroke};
 pub use quality::{POOR_DIHEDRAL_DEGREES, Quality};

@@ -24,20 +24,24 @@ use crate::{Error, Light, Medium, TetMesh, fresnel};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Method {
     /// Chosen per solve, by the system: Jacobi-PCG runs first (the three
-    /// channels as one block, [`multires::Block3`]); after
-    /// [`AUTO_PROBE`] iterations its convergence rate predicts the
-    /// iterations it still needs, and the V-cycle's hierarchy is built
-    /// only when V-cycle-PCG (its build included, unless one is kept) is
-    /// predicted to cost less ([`Prediction`]). The probe's iterations are
-    /// not lost: the V-cycle continues from them. What ran and why is in
+    /// channels as one block, [`multires::Block3`]), and every
+    /// [`AUTO_PROBE`] iterations its own coefficients and residuals
+    /// predict the iterations it still needs ([`Prediction`]). It switches
+    /// to V-cycle-PCG — from the iterate it reached, nothing is lost —
+    /// when the V-cycle is predicted to cost less (its hierarchy's build
+    /// included, unless one is kept) and Jacobi-PCG has already spent half
+    /// of what the V-cycle would cost: an early prediction is rough, and
+    /// this bounds a wrong switch's loss (the ski-rental rule). The costs
+    /// are [`SolverSettings::auto_costs`]. What ran and why is in
     /// [`SolveReport::choice`].
     #[default]
     Auto,
     /// CG preconditioned by an algebraic V-cycle on TransCut's hierarchy:
-    /// 3–6 iterations where Jacobi-PCG needs 20–80, each costing about
-    /// nine of Jacobi-PCG's, after a build of about 150 (bunny_500k); it
-    /// pays on ill-conditioned systems (a long diffusion length against
-    /// the mesh's size: a small object, skim milk, a fine mesh).
+    /// 3–6 iterations to 1% error where Jacobi-PCG needs 10–120, but each
+    /// costs about 12 of the block Jacobi-PCG's, after a build of about
+    /// 150 (bunny_500k, 2 cores): it pays only on badly conditioned
+    /// systems (a long diffusion length against a finely meshed object)
+    /// or tight tolerances.
     VCyclePcg,
     /// The paper's multi-resolution cascade (Sec. 4.2, Eq. 17).
     Cascade,
@@ -47,23 +51,36 @@ pub enum Method {
     JacobiPcg,
 }
 
-/// Jacobi-PCG iterations [`Method::Auto`] runs before it predicts
-/// (fewer when the tolerance comes first: then nothing else runs).
-pub const AUTO_PROBE: usize = 10;
+/// Jacobi-PCG iterations between [`Method::Auto`]'s predictions.
+pub const AUTO_PROBE: usize = 5;
 
 /// [`Method::Auto`]'s cost model, in units of one block Jacobi-PCG
-/// iteration (three channels, one pass over the matrix): measured on
-/// bunny_500k and sphere_200k (2 cores), where the hierarchy of the three
-/// channels (one built, two refreshed) costs 100–150 iterations and a
-/// V-cycle-PCG iteration 8–9. Counts, not clocks, decide, so the choice
-/// is the same on every run and machine.
-pub const HIERARCHY_COST: f64 = 150.0;
-/// One block V-cycle-PCG iteration, in block Jacobi-PCG iterations (see
-/// [`HIERARCHY_COST`]).
-pub const V_CYCLE_ITERATION_COST: f64 = 9.0;
-/// The residual reduction per V-cycle-PCG iteration the prediction
-/// assumes (0.25–0.35 measured on the data meshes).
-pub const V_CYCLE_RATE: f64 = 0.3;
+/// iteration (three channels, one pass over the matrix). Counts, not
+/// clocks, decide, so the choice is the same on every run and machine.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AutoCosts {
+    /// Building the V-cycle hierarchy of the three channels (one built,
+    /// two refreshed).
+    pub hierarchy: f64,
+    /// One block V-cycle-PCG iteration.
+    pub v_cycle_iteration: f64,
+    /// The residual reduction per V-cycle-PCG iteration to expect.
+    pub v_cycle_rate: f64,
+}
+
+impl Default for AutoCosts {
+    /// Measured on the data meshes (bunny_500k, sphere_200k, bunny_50k;
+    /// 2 cores): the hierarchy costs 100–150 block Jacobi-PCG iterations,
+    /// a V-cycle-PCG iteration 9–13, and V-cycle-PCG reduces the residual
+    /// 0.2–0.3× per iteration to 1% error, 0.5× towards 10⁻⁸.
+    fn default() -> Self {
+        Self {
+            hierarchy: 150.0,
+            v_cycle_iteration: 12.0,
+            v_cycle_rate: 0.5,
+        }
+    }
+}
 
 /// A solver that ran.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -90,19 +107,26 @@ impl std::fmt::Display for Solver {
     }
 }
 
-/// [`Method::Auto`]'s estimate after its probe, in block Jacobi-PCG
-/// iterations (see [`HIERARCHY_COST`]).
+/// [`Method::Auto`]'s estimate, in block Jacobi-PCG iterations (see
+/// [`AutoCosts`]). Jacobi-PCG's own coefficients give, at no extra
+/// cost, a lower estimate `κ` of the condition number of the
+/// Jacobi-preconditioned matrix ([`multires::Lanczos`]); CG then needs
+/// about `ln(r / τ) / −ln ρ` more iterations to go from the relative
+/// residual `r` to the tolerance `τ`, with `ρ = (√κ − 1)/(√κ + 1)` (the
+/// classical bound, Saad Sec. 6.11.3), and V-cycle-PCG about
+/// `ln(r / τ) / −ln` [`AutoCosts::v_cycle_rate`]. Where the residual has already
+/// fallen faster than the bound allows (CG's superlinear convergence, a
+/// few outlying eigenvalues) that observed rate is used instead.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Prediction {
-    /// Jacobi-PCG iterations the probe ran.
+    /// Jacobi-PCG iterations done when it was made.
     pub probe_iterations: usize,
-    /// The slowest channel's residual reduction per iteration over the
-    /// probe's second half.
-    pub jacobi_rate: f64,
-    /// Jacobi-PCG iterations still needed (the slowest channel), also its
-    /// cost.
+    /// The estimated condition number (the worst channel).
+    pub condition: f64,
+    /// Jacobi-PCG iterations still needed (the slowest channel), also
+    /// their cost.
     pub jacobi_cost: f64,
-    /// V-cycle-PCG iterations needed (at [`V_CYCLE_RATE`]).
+    /// V-cycle-PCG iterations needed.
     pub v_cycle_iterations: f64,
     /// Their cost plus the hierarchy's when none is kept.
     pub v_cycle_cost: f64,
@@ -111,47 +135,101 @@ pub struct Prediction {
 }
 
 impl Prediction {
-    /// From the probe's relative residuals (one row per iteration, one
-    /// column per channel) and which channels still run.
-    fn new(
-        history: &[[f64; 3]],
-        running: [bool; 3],
-        tolerance: f64,
-        hierarchy_kept: bool,
-    ) -> Self {
-        let k = history.len();
-        let half = k / 2;
-        let (mut jacobi, mut v_cycle, mut slowest) = (0.0f64, 0.0f64, 0.0f64);
-        for c in (0..3).filter(|&c| running[c] && k >= 2) {
-            let now = history[k - 1][c];
-            let rate = (now / history[half - 1][c]).powf(1.0 / (k - half) as f64);
-            slowest = slowest.max(rate);
-            let left = (tolerance / now).ln();
-            if left >= 0.0 {
-                continue;
-            }
-            let j = if rate > 0.0 && rate < 1.0 {
-                left / rate.ln()
-            } else {
-                f64::INFINITY
-            };
-            jacobi = jacobi.max(j);
-            v_cycle = v_cycle.max((left / V_CYCLE_RATE.ln()).ceil().max(1.0));
-        }
-        let build = if hierarchy_kept { 0.0 } else { HIERARCHY_COST };
-        Self {
-            probe_iterations: k,
-            jacobi_rate: slowest,
-            jacobi_cost: jacobi,
-            v_cycle_iterations: v_cycle,
-            v_cycle_cost: build + v_cycle * V_CYCLE_ITERATION_COST,
-            hierarchy_kept,
-        }
-    }
-
     /// Whether the V-cycle is predicted to cost less.
     pub fn prefers_v_cycle(&self) -> bool {
         self.v_cycle_cost < self.jacobi_cost
+    }
+
+    /// Whether [`Method::Auto`] switches on it: the V-cycle predicted
+    /// cheaper, and Jacobi-PCG's iterations so far at least half the
+    /// V-cycle's cost.
+    pub fn switches(&self) -> bool {
+        self.prefers_v_cycle() && 2.0 * self.probe_iterations as f64 >= self.v_cycle_cost
+    }
+}
+
+/// The running estimate of [`Method::Auto`]: per channel, one Lanczos
+/// matrix fed by each iteration's CG coefficients, and the residual's
+/// envelope (its smallest value so far).
+struct Estimator {
+    lanczos: [multires::Lanczos; 3],
+    envelope: [Vec<f64>; 3],
+    tolerance: f64,
+    hierarchy_kept: bool,
+    costs: AutoCosts,
+}
+
+impl Estimator {
+    fn new(tolerance: f64, hierarchy_kept: bool, costs: AutoCosts) -> Self {
+        Self {
+            lanczos: Default::default(),
+            envelope: Default::default(),
+            tolerance,
+            hierarchy_kept,
+            costs,
+        }
+    }
+
+    /// Takes in an iteration; every [`AUTO_PROBE`] iterations, the
+    /// prediction from there.
+    fn step(&mut self, p: &Progress<'_>) -> Option<Prediction> {
+        let (alpha, beta) = p.coefficients();
+        let running = p.running();
+        for c in (0..3).filter(|&c| running[c]) {
+            self.lanczos[c].push(alpha[c], beta[c]);
+            let r = p.residual()[c];
+            let least = self.envelope[c].last().map_or(r, |&e: &f64| e.min(r));
+            self.envelope[c].push(least);
+        }
+        let k = p.iteration();
+        if k == 0 || k % AUTO_PROBE != 0 {
+            return None;
+        }
+        let (mut jacobi, mut v_cycle, mut worst) = (0.0f64, 0.0f64, 1.0f64);
+        for c in (0..3).filter(|&c| running[c]) {
+            let kappa = self.lanczos[c].condition().unwrap_or(1.0).max(1.0);
+            worst = worst.max(kappa);
+            let left = (p.residual()[c] / self.tolerance).ln();
+            if left.is_nan() || left <= 0.0 {
+                continue;
+            }
+            jacobi = jacobi.max(left / self.decay(c, kappa));
+            v_cycle = v_cycle.max((left / -self.costs.v_cycle_rate.ln()).ceil().max(1.0));
+        }
+        let build = if self.hierarchy_kept {
+            0.0
+        } else {
+            self.costs.hierarchy
+        };
+        Some(Prediction {
+            probe_iterations: k,
+            condition: worst,
+            jacobi_cost: jacobi,
+            v_cycle_iterations: v_cycle,
+            v_cycle_cost: build + v_cycle * self.costs.v_cycle_iteration,
+            hierarchy_kept: self.hierarchy_kept,
+        })
+    }
+
+    /// Channel `c`'s expected `−ln` of the residual per iteration from
+    /// here: the faster of the bound for the estimated `κ` and the rate
+    /// the residual's envelope fell at over the second half of the
+    /// iterations. Each alone overstates what is left — the bound where a
+    /// few small eigenvalues (a nearly insulated object) inflate `κ` but
+    /// cost CG only an iteration each, the observed rate because CG speeds
+    /// up as it goes — so the faster is the closer.
+    fn decay(&self, c: usize, kappa: f64) -> f64 {
+        let root = kappa.sqrt();
+        let bound = -((root - 1.0) / (root + 1.0)).ln();
+        let e = &self.envelope[c];
+        let k = e.len();
+        let half = k / 2;
+        let observed = if half >= 1 && e[half - 1] > 0.0 && e[k - 1] > 0.0 {
+            (e[half - 1] / e[k - 1]).ln() / (k - half) as f64
+        } else {
+            0.0
+        };
+        bound.max(observed).max(f64::MIN_POSITIVE)
     }
 }
 
@@ -164,8 +242,9 @@ pub struct Choice {
     /// The settings asked for it ([`SolverSettings::method`] not
     /// [`Method::Auto`]).
     pub forced: bool,
-    /// [`Method::Auto`]'s estimate; `None` when the tolerance came within
-    /// the probe (or the solve was forced).
+    /// [`Method::Auto`]'s last estimate (the one that switched, if it
+    /// did); `None` when the tolerance came before the first (or the solve
+    /// was forced).
     pub prediction: Option<Prediction>,
 }
 
@@ -178,10 +257,10 @@ impl std::fmt::Display for Choice {
             None => write!(f, "{} (auto: converged within the probe)", self.solver),
             Some(p) => write!(
                 f,
-                "{} (auto: after {} Jacobi-PCG iterations at rate {:.3}, Jacobi-PCG predicted {:.0} more, V-cycle-PCG {:.0} iterations{}: cost {:.0} vs {:.0})",
+                "{} (auto: after {} Jacobi-PCG iterations, condition ≥ {:.0}: Jacobi-PCG predicted {:.0} more, V-cycle-PCG {:.0} iterations{}: cost {:.0} vs {:.0})",
                 self.solver,
                 p.probe_iterations,
-                p.jacobi_rate,
+                p.condition,
                 p.jacobi_cost,
                 p.v_cycle_iterations,
                 if p.hierarchy_kept {
@@ -209,6 +288,8 @@ pub struct SolverSettings {
     /// all three channels (each with its own Galerkin operators on it),
     /// instead of one per channel.
     pub share_hierarchy: bool,
+    /// [`Method::Auto`]'s cost model.
+    pub auto_costs: AutoCosts,
 }
 
 impl Default for SolverSettings {
@@ -220,6 +301,7 @@ impl Default for SolverSettings {
             tolerance: 1e-6,
             max_iterations: 5_000,
             share_hierarchy: true,
+            auto_costs: AutoCosts::default(),
         }
     }
 }
@@ -1132,20 +1214,16 @@ impl Object {
         stop_now: &dyn Fn() -> bool,
     ) -> Result<([Report; 3], Choice, Option<f64>), Error> {
         let hierarchy_kept = matches!(kept.solver, KeptSolver::VCycles(_));
-        let mut history: Vec<[f64; 3]> = Vec::with_capacity(AUTO_PROBE);
+        let mut estimator = Estimator::new(tolerance, hierarchy_kept, self.settings.auto_costs);
         let mut prediction = None;
         let mut switching = false;
         let probe = self.block_pcg(None, options, &mut |p: &Progress<'_>| {
             if stop_now() {
                 return ControlFlow::Break(());
             }
-            if p.iteration() <= AUTO_PROBE {
-                history.push(p.residual());
-            }
-            if p.iteration() == AUTO_PROBE {
-                let guess = Prediction::new(&history, p.running(), tolerance, hierarchy_kept);
+            if let Some(guess) = estimator.step(p) {
                 prediction = Some(guess);
-                if guess.prefers_v_cycle() {
+                if guess.switches() {
                     switching = true;
                     return ControlFlow::Break(());
                 }
@@ -1178,11 +1256,8 @@ impl Object {
         };
         let v = [0, 1, 2].map(|c| &v[if v.len() == 3 { c } else { 0 }]);
         let done = probe.iter().map(|r| r.iterations).max().unwrap_or(0);
-        let rest = SolveOptions::new(
-            tolerance,
-            self.settings.max_iterations.saturating_sub(done),
-        )
-        .allow_unconverged();
+        let rest = SolveOptions::new(tolerance, self.settings.max_iterations.saturating_sub(done))
+            .allow_unconverged();
         let reports = self.block_pcg(Some(v), &rest, &mut |_| {
             if stop_now() {
                 ControlFlow::Break(())
@@ -1273,13 +1348,18 @@ impl Object {
                 KeptSolver::Cascade(Cascade::new(&matrices[1], weights, &copts)?)
             }
         };
+        // Jacobi builds nothing: neither a build to count nor its time.
+        let hierarchy = !matches!(solver, KeptSolver::Jacobi);
         self.kept = Some(Arc::new(Kept {
             method: s.method,
             share_hierarchy: s.share_hierarchy,
             solver,
         }));
-        self.hierarchy_builds += 1;
         self.values_changed = false;
+        if !hierarchy {
+            return Ok(None);
+        }
+        self.hierarchy_builds += 1;
         Ok(Some(ms(t)))
     }
 

@@ -235,3 +235,41 @@ fn exact_plane_cuts_of_bunny_500k_lie_on_the_plane() {
         assert!(error < 1e-3, "{error}");
     }
 }
+
+#[test]
+#[cfg_attr(
+    not(trilux_data),
+    ignore = "needs TRILUX_DATA (the data folder, e.g. ../shared/data)"
+)]
+fn the_chosen_solver_is_within_one_percent_on_every_tetgen_mesh() {
+    // The default solve (Method::Auto, 10⁻⁶) against a reference by
+    // V-cycle-PCG to 10⁻¹⁰, marble and skim milk: the choice never costs
+    // accuracy.
+    for (name, scale, unit_mm) in [
+        ("sphere_20k.node", 10.0, 1.0),
+        ("sphere_200k.node", 1.0, 10.0),
+        ("bunny_50k.node", 1.0, 1000.0),
+        ("bunny_500k.node", 1.0, 1000.0),
+    ] {
+        let mesh = read(name, scale);
+        for material in ["marble", "skimmilk"] {
+            let m = Medium::measured(material).unwrap();
+            let mut o = Object::homogeneous(mesh.clone(), unit_mm, m, 1.3).unwrap();
+            o.add_light(Light::Directional {
+                to_light: DVec3::new(0.3, 1.0, 0.5),
+                irradiance: [1.0; 3],
+            })
+            .unwrap();
+            let mut reference = o.clone();
+            reference.settings.method = tet_diffusion::Method::VCyclePcg;
+            reference.settings.tolerance = 1e-10;
+            reference.solve().unwrap();
+            let report = o.solve().unwrap();
+            eprintln!("{name} {material}: {}", report.choice);
+            for c in 0..3 {
+                let e = rel_l2(o.mesh(), o.phi(c), reference.phi(c));
+                assert!(e < 0.01, "{name} {material} channel {c}: {e:e}");
+            }
+        }
+    }
+}

@@ -3,6 +3,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod choice;
 mod data;
 mod edit;
 mod lights;
