@@ -45,8 +45,10 @@ pub struct Block3 {
     cols: Vec<u32>,
     /// Entry `k` of the block is entry `source[k]` of the matrices.
     source: Vec<u32>,
-    /// The matrices' row offsets (their pattern, with `source`).
+    /// The matrices' own pattern (row offsets and columns), to check new
+    /// values against in one sequential pass.
     source_offsets: Vec<usize>,
+    source_cols: Vec<u32>,
     values: Vec<Lanes>,
     /// `1 / a_ii` per row and channel: the Jacobi preconditioner.
     inverse_diagonal: Vec<Lanes>,
@@ -145,35 +147,28 @@ impl Block3 {
         }
         let mut cols = vec![0u32; nnz];
         let mut source = vec![0u32; nnz];
-        // Each new row: the old row's entries renumbered, sorted by column
-        // (rows are short: an insertion sort, no allocation).
+        // Each new row: the old row's entries, renumbered, in their order
+        // (the mat-vec needs no sorted rows).
         row_chunks(&new_offsets, &mut cols, &mut source)
             .into_par_iter()
             .for_each(|(first, cols, source)| {
                 let mut at = 0;
                 for &i in &order[first..(first + ROWS).min(n)] {
-                    let i = i as usize;
-                    let start = at;
-                    for e in offsets[i]..offsets[i + 1] {
-                        let j = rank[cols0[e]];
-                        let mut slot = at;
-                        while slot > start && cols[slot - 1] > j {
-                            cols[slot] = cols[slot - 1];
-                            source[slot] = source[slot - 1];
-                            slot -= 1;
-                        }
-                        cols[slot] = j;
-                        source[slot] = e as u32;
+                    for e in offsets[i as usize]..offsets[i as usize + 1] {
+                        cols[at] = rank[cols0[e]];
+                        source[at] = e as u32;
                         at += 1;
                     }
                 }
             });
+        let source_cols: Vec<u32> = cols0.par_iter().map(|&j| j as u32).collect();
         let mut block = Self {
             order,
             offsets: new_offsets,
             cols,
             source,
             source_offsets: offsets,
+            source_cols,
             values: Vec::new(),
             inverse_diagonal: Vec::new(),
         };
@@ -205,6 +200,7 @@ impl Block3 {
             cols: self.cols.clone(),
             source: self.source.clone(),
             source_offsets: self.source_offsets.clone(),
+            source_cols: self.source_cols.clone(),
             values: Vec::new(),
             inverse_diagonal: Vec::new(),
         }
@@ -225,18 +221,19 @@ impl Block3 {
                 return Err(Error::PatternMismatch { channel, row });
             }
             let cols = m.indices();
-            let bad = (0..n).into_par_iter().find_first(|&k| {
-                let range = self.offsets[k]..self.offsets[k + 1];
-                self.source[range.clone()]
-                    .iter()
-                    .zip(&self.cols[range])
-                    .any(|(&e, &j)| cols[e as usize] != self.order[j as usize] as usize)
-            });
-            if let Some(k) = bad {
-                return Err(Error::PatternMismatch {
-                    channel,
-                    row: self.order[k] as usize,
+            let bad = cols
+                .par_chunks(1 << 16)
+                .zip(self.source_cols.par_chunks(1 << 16))
+                .enumerate()
+                .find_map_first(|(chunk, (a, b))| {
+                    a.iter()
+                        .zip(b)
+                        .position(|(&a, &b)| a != b as usize)
+                        .map(|k| (chunk << 16) + k)
                 });
+            if let Some(e) = bad {
+                let row = self.source_offsets.partition_point(|&o| o <= e) - 1;
+                return Err(Error::PatternMismatch { channel, row });
             }
         }
         let data = a.map(|m| m.data());
@@ -256,7 +253,8 @@ impl Block3 {
             .find_map_first(|(k, inv)| {
                 let (cols, vals) = self.row(k);
                 let d = cols
-                    .binary_search(&(k as u32))
+                    .iter()
+                    .position(|&j| j as usize == k)
                     .map_or([0.0; CHANNELS], |e| vals[e]);
                 for c in 0..CHANNELS {
                     if d[c] <= 0.0 {
@@ -285,6 +283,13 @@ impl Block3 {
     /// Stored entries of the pattern.
     pub fn nnz(&self) -> usize {
         self.cols.len()
+    }
+
+    /// Bytes of its arrays (about 40 per entry).
+    pub fn bytes(&self) -> usize {
+        let n = self.rows();
+        let nnz = self.nnz();
+        nnz * (4 + 4 + 4 + 24) + (n + 1) * 16 + n * (4 + 24)
     }
 
     fn row(&self, i: usize) -> (&[u32], &[Lanes]) {
@@ -340,14 +345,14 @@ impl Block3 {
     }
 
     /// Every stored `(i, j)` has a stored `(j, i)` with the same three
-    /// values up to rounding (the rule of [`crate::cg`]'s check). Rows are
-    /// sorted with no duplicates (`sprs` guarantees it), so the mirror is a
-    /// binary search.
+    /// values up to rounding (the rule of [`crate::cg`]'s check); rows
+    /// have no duplicates (`sprs` guarantees it), so the mirror is found
+    /// by a scan of the (short) row.
     fn check_symmetric_entries(&self) -> Result<(), Error> {
         let n = self.rows();
         let lookup = |i: usize, j: usize| -> Option<Lanes> {
             let (cols, vals) = self.row(i);
-            cols.binary_search(&(j as u32)).ok().map(|k| vals[k])
+            cols.iter().position(|&c| c as usize == j).map(|k| vals[k])
         };
         let zero = [0.0; CHANNELS];
         let bad = (0..n).into_par_iter().find_map_first(|i| {
@@ -983,19 +988,22 @@ impl<'s> Solve<'s> {
 }
 
 /// A breadth-first numbering of the graph of a symmetric pattern
-/// (`order[k]` is the `k`-th row visited), each component from a vertex
-/// found far out by a second search (George and Liu's pseudo-peripheral
-/// start, one sweep), so that every row's neighbours are numbered close
-/// to it. Serial and deterministic.
+/// (`order[k]` is the `k`-th row visited), each component from its
+/// lowest-numbered vertex, so that every row's neighbours are numbered
+/// close to it (Cuthill–McKee's locality, without its degree sort or
+/// peripheral start, which matter for fill-in, not for a mat-vec's
+/// cache). Serial and deterministic.
 fn breadth_first(offsets: &[usize], cols: &[usize]) -> Vec<u32> {
     let n = offsets.len() - 1;
     let mut order: Vec<u32> = Vec::with_capacity(n);
     let mut seen = vec![false; n];
-    let search = |from: usize, seen: &mut [bool], order: &mut Vec<u32>| {
-        let head = order.len();
-        seen[from] = true;
-        order.push(from as u32);
-        let mut k = head;
+    for start in 0..n {
+        if seen[start] {
+            continue;
+        }
+        seen[start] = true;
+        order.push(start as u32);
+        let mut k = order.len() - 1;
         while k < order.len() {
             let i = order[k] as usize;
             for &j in &cols[offsets[i]..offsets[i + 1]] {
@@ -1006,21 +1014,6 @@ fn breadth_first(offsets: &[usize], cols: &[usize]) -> Vec<u32> {
             }
             k += 1;
         }
-        head
-    };
-    for start in 0..n {
-        if seen[start] {
-            continue;
-        }
-        // The last vertex one search reaches is far from `start`; the
-        // component is numbered from there.
-        let head = search(start, &mut seen, &mut order);
-        let far = order[order.len() - 1] as usize;
-        for &v in &order[head..] {
-            seen[v as usize] = false;
-        }
-        order.truncate(head);
-        search(far, &mut seen, &mut order);
     }
     order
 }
