@@ -834,11 +834,13 @@ impl Object {
             &self.coefficients,
             self.boundary_factor(),
         );
+        self.assemble_block();
         self.assembly_ms = start.elapsed().as_secs_f64() * 1e3;
         self.assembly_ms
     }
 
-    /// Bytes of the arrays this object holds (mesh, matrices, geometry,
+    /// Bytes of the arrays this object holds (mesh, matrices and their
+    /// block form, geometry,
     /// media, lights' visibility, `φ`, `q`, `b`; not the kept hierarchy,
     /// which clones share), to budget copies of it.
     pub fn memory_bytes(&self) -> usize {
@@ -850,8 +852,10 @@ impl Object {
             .map(|m| m.nnz() * 12 + (m.rows() + 1) * 8)
             .sum();
         let lights: usize = self.lights.iter().map(LitLight::bytes).sum();
+        let block = self.block.as_deref().map_or(0, Block3::bytes);
         self.mesh.memory_bytes()
             + matrices
+            + block
             + t * (8 + 48 + 48)
             + self.media.len() * std::mem::size_of::<Medium>()
             + lights
@@ -897,6 +901,7 @@ impl Object {
             &self.coefficients,
             self.boundary_factor(),
         );
+        self.assemble_block();
         self.assembly_ms = start.elapsed().as_secs_f64() * 1e3;
     }
 
@@ -1296,6 +1301,16 @@ impl Object {
             None => block.cg(b, x, options, Some(monitor))?,
         };
         Ok(reports)
+    }
+
+    /// The block solvers' form of the matrices, made with them (part of
+    /// the assembly, as TransCut assembles into its solver's format). A
+    /// matrix the block refuses (which the assembly does not make) is
+    /// reported by the next solve.
+    fn assemble_block(&mut self) {
+        if self.block().is_err() {
+            self.block_current = false;
+        }
     }
 
     /// The matrices as one block, made or refreshed as they changed.
