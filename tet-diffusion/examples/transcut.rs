@@ -5,7 +5,20 @@
 //!
 //! ```sh
 //! cargo run --release -p tet-diffusion --example transcut -- [--json] [--export-mtx DIR] [--repeat R]
+//! cargo run --release -p tet-diffusion --example transcut -- --matrix [--mesh FILE]... [--json] [--export-mtx DIR]
 //! ```
+//!
+//! `--matrix` instead solves the matrix of systems: every mesh (and each
+//! `--mesh` file, taken in metres) × ketchup, marble and skim milk × the
+//! mesh's own size and a tenth of it. Per system: block Jacobi-PCG and
+//! block V-cycle-PCG to 1% error (iterations per channel, times with the
+//! block's and the hierarchy's builds), `Object::solve` with the default
+//! `Method::Auto` at the residual where Jacobi-PCG reaches 1% error (what
+//! it chose, its time and error) and forced to each solver; `--json` rows
+//! carry `system`, `solver`, `mesh_ms`, `hierarchy_ms` and `ts_ms` (per
+//! channel, the chosen solver's) beside today's keys, and `--export-mtx`
+//! writes each system's red channel as `SYSTEM.A.mtx`, `.b.mtx`, `.x.mtx`
+//! for `bench/peers.py` (scipy and pyamg; `bench/run.sh` runs both).
 //!
 //! The second table compares the solvers to 1% error for all three channels,
 //! hierarchy build included (built once, shared by the channels).
@@ -40,7 +53,8 @@ use std::time::Instant;
 
 use tet_diffusion::glam::DVec3;
 use tet_diffusion::multires::{
-    self, Cascade, CascadeOptions, SolveOptions, VCycle, VCycleOptions, Weights,
+    self, Block3, Cascade, CascadeOptions, Preconditioner, Progress, SolveOptions, VCycle,
+    VCycleOptions, Weights,
 };
 use tet_diffusion::sprs::CsMat;
 use tet_diffusion::{Cut, CutMethod, Integration, Light, Medium, Method, Object, Stroke, TetMesh};
@@ -54,18 +68,35 @@ struct Args {
     json: bool,
     export: Option<PathBuf>,
     repeat: usize,
+    /// The matrix of systems: every mesh × [`MEDIA`] × [`SCALES`].
+    matrix: bool,
+    /// Extra tetrahedral meshes (a stuffed one, say), in metres.
+    meshes: Vec<PathBuf>,
 }
+
+/// The matrix's media: short, medium and long diffusion lengths.
+const MEDIA: [&str; 3] = ["ketchup", "marble", "skimmilk"];
+
+/// The matrix's unit scales: the mesh's own size and a tenth of it (the
+/// same object 10× smaller: diffusion lengths 10× longer against it).
+const SCALES: [f64; 2] = [1.0, 0.1];
 
 fn parse() -> Result<Args, String> {
     let mut args = Args {
         json: false,
         export: None,
         repeat: 3,
+        matrix: false,
+        meshes: Vec::new(),
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
         match a.as_str() {
             "--json" => args.json = true,
+            "--matrix" => args.matrix = true,
+            "--mesh" => args
+                .meshes
+                .push(it.next().ok_or("--mesh needs a file")?.into()),
             "--export-mtx" => {
                 args.export = Some(it.next().ok_or("--export-mtx needs a folder")?.into())
             }
@@ -86,7 +117,9 @@ fn main() {
     let args = match parse() {
         Ok(a) => a,
         Err(e) => {
-            eprintln!("transcut: {e}\nusage: transcut [--json] [--export-mtx DIR] [--repeat R]");
+            eprintln!(
+                "transcut: {e}\nusage: transcut [--json] [--matrix] [--mesh FILE]... [--export-mtx DIR] [--repeat R]"
+            );
             std::process::exit(2);
         }
     };
@@ -95,7 +128,10 @@ fn main() {
         .unwrap_or_else(|| PathBuf::from("../shared/data"));
     let dir = data.join("tets");
     let meshes = match list(&dir) {
-        Ok(m) if !m.is_empty() => m,
+        Ok(mut m) if !m.is_empty() => {
+            m.extend(args.meshes.iter().cloned());
+            m
+        }
         _ => {
             eprintln!(
                 "transcut: no tetrahedral meshes in {} (set TRILUX_DATA to the data folder)",
@@ -116,12 +152,29 @@ fn main() {
     let mut solvers = String::from(
         "| mesh | solver | build ms | iterations to 1% (per channel) | 3-channel solve ms | build + solve ms | speed-up vs Jacobi-PCG |\n|---|---|---:|---:|---:|---:|---:|\n",
     );
+    let mut systems = String::from(SystemRow::HEADER);
     for path in meshes {
         let name = path
             .file_stem()
             .unwrap_or_default()
             .to_string_lossy()
             .to_string();
+        if args.matrix {
+            match matrix(&name, &path, &args) {
+                Ok(rows) => {
+                    for row in rows {
+                        if args.json {
+                            println!("{}", row.json());
+                        } else {
+                            systems.push_str(&row.markdown());
+                        }
+                    }
+                }
+                Err(e) => eprintln!("transcut: {name}: {e}"),
+            }
+            let _ = std::io::stdout().flush();
+            continue;
+        }
         match bench(&name, &path, &args) {
             Ok(row) => {
                 if args.json {
@@ -136,7 +189,11 @@ fn main() {
         let _ = std::io::stdout().flush();
     }
     if !args.json {
-        println!("{table}\n{solvers}");
+        if args.matrix {
+            println!("{systems}");
+        } else {
+            println!("{table}\n{solvers}");
+        }
     }
 }
 
@@ -181,6 +238,9 @@ struct Row {
     tets: usize,
     levels: usize,
     tb: f64,
+    /// T_b's two parts: the validated mesh and the hierarchy.
+    mesh_ms: f64,
+    hierarchy_ms: f64,
     tm: f64,
     ts: f64,
     tcut: [f64; 2],
@@ -217,7 +277,7 @@ impl Row {
 
     fn json(&self) -> String {
         format!(
-            "{{\"mesh\":\"{}\",\"tets\":{},\"levels\":{},\"tb_ms\":{:.3},\"tm_ms\":{:.3},\"ts_ms\":{:.3},\"tcut_ms\":{:.3},\"tpaint_ms\":{:.3},\"fem_quadrature_tm_ms\":{:.3},\"max_rel_diff_vs_fem\":{:.6},\"solver\":\"{}\",\"peak_mb\":{:.1}}}",
+            "{{\"mesh\":\"{}\",\"tets\":{},\"levels\":{},\"tb_ms\":{:.3},\"tm_ms\":{:.3},\"ts_ms\":{:.3},\"tcut_ms\":{:.3},\"tpaint_ms\":{:.3},\"fem_quadrature_tm_ms\":{:.3},\"max_rel_diff_vs_fem\":{:.6},\"solver\":\"{}\",\"mesh_ms\":{:.3},\"hierarchy_ms\":{:.3},\"peak_mb\":{:.1}}}",
             self.mesh,
             self.tets,
             self.levels,
@@ -229,6 +289,8 @@ impl Row {
             self.quad,
             self.diff,
             self.solver,
+            self.mesh_ms,
+            self.hierarchy_ms,
             self.peak_mb
         )
     }
@@ -277,11 +339,7 @@ fn relative_error(x: &[f64], reference: &[f64], norm: f64) -> f64 {
 fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
     reset_peak();
     let file = trilux_io::tet::TetMesh::read(path).map_err(|e| e.to_string())?;
-    let unit_mm = if name.starts_with("sphere") {
-        20.0
-    } else {
-        1000.0
-    };
+    let unit_mm = unit_of(name);
     let marble = Medium::measured("marble").map_err(|e| e.to_string())?;
     // T_b: neighbourhoods (validated mesh) …
     let mut mesh_ms = Vec::new();
@@ -318,7 +376,8 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
         hier_ms.push(ms(t));
     }
     let vcycle = vcycle.ok_or("no run")?;
-    let tb = median(mesh_ms) + median(hier_ms.clone());
+    let (mesh_only, hierarchy_only) = (median(mesh_ms), median(hier_ms.clone()));
+    let tb = mesh_only + hierarchy_only;
     let levels = vcycle.hierarchy().levels();
     // Tight references.
     let tight = SolveOptions::new(1e-10, 20_000);
@@ -511,6 +570,8 @@ fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
         tets,
         levels,
         tb,
+        mesh_ms: mesh_only,
+        hierarchy_ms: hierarchy_only,
         tm,
         ts,
         tcut,
@@ -546,4 +607,301 @@ fn write_vector(path: &Path, x: &[f64]) -> std::io::Result<()> {
         writeln!(out, "{v:e}")?;
     }
     out.flush()
+}
+
+/// Millimetres per mesh unit: the unit spheres are 20 mm in radius, the
+/// rest (the bunnies, a stuffed mesh from metres) in metres.
+fn unit_of(name: &str) -> f64 {
+    if name.starts_with("sphere") {
+        20.0
+    } else {
+        1000.0
+    }
+}
+
+/// One system of the matrix: a mesh, a medium and a unit scale, its
+/// solvers to 1% error from φ = 0 (all three channels).
+struct SystemRow {
+    system: String,
+    mesh: String,
+    tets: usize,
+    levels: usize,
+    n: usize,
+    nnz: usize,
+    mesh_ms: f64,
+    tm_ms: f64,
+    /// [`multires::Block3`]'s build (renumbering, checks).
+    block_ms: f64,
+    jacobi_iterations: [usize; 3],
+    /// Block Jacobi-PCG, block build included.
+    jacobi_ms: f64,
+    hierarchy_ms: f64,
+    vcycle_iterations: [usize; 3],
+    /// Block V-cycle-PCG, block build included, hierarchy not.
+    vcycle_ms: f64,
+    /// What `Method::Auto` chose at the residual Jacobi-PCG reaches 1%
+    /// error at, its time (everything: block, probe, hierarchy if built)
+    /// and its error against the reference.
+    solver: String,
+    /// Why (the choice's report).
+    choice: String,
+    auto_ms: f64,
+    auto_hierarchy_ms: f64,
+    auto_error: f64,
+    /// `Object::solve` forced to each, at the same tolerance.
+    forced_ms: [f64; 2],
+}
+
+impl SystemRow {
+    const HEADER: &str = "| system | unknowns | T_mesh ms | T_m ms | Jacobi-PCG iterations (R/G/B) | Jacobi-PCG ms | hierarchy ms | V-cycle iterations | V-cycle-PCG ms | chosen | chosen ms (error) | forced Jacobi / V-cycle ms | chosen / best forced |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|\n";
+
+    fn markdown(&self) -> String {
+        let best = self.forced_ms[0].min(self.forced_ms[1]);
+        format!(
+            "| {} | {} | {:.0} | {:.0} | {:?} | {:.1} | {:.0} | {:?} | {:.1} | {} | {:.1} ({:.2}%) | {:.1} / {:.1} | {:.2}× |\n",
+            self.system,
+            self.n,
+            self.mesh_ms,
+            self.tm_ms,
+            self.jacobi_iterations,
+            self.jacobi_ms,
+            self.hierarchy_ms,
+            self.vcycle_iterations,
+            self.vcycle_ms,
+            self.solver,
+            self.auto_ms,
+            100.0 * self.auto_error,
+            self.forced_ms[0],
+            self.forced_ms[1],
+            self.auto_ms / best
+        )
+    }
+
+    /// `ts_ms` and `hierarchy_ms` per channel for the chosen solver (what
+    /// a solve costs beyond the mesh is their sum), beside the rest.
+    fn json(&self) -> String {
+        let chosen_hierarchy = self.auto_hierarchy_ms / 3.0;
+        format!(
+            "{{\"system\":\"{}\",\"mesh\":\"{}\",\"tets\":{},\"levels\":{},\"tb_ms\":{:.3},\"n\":{},\"nnz\":{},\"mesh_ms\":{:.3},\"tm_ms\":{:.3},\"block_ms\":{:.3},\"solver\":\"{}\",\"solver_choice\":\"{}\",\"hierarchy_ms\":{:.3},\"ts_ms\":{:.3},\"auto_ms\":{:.3},\"auto_error\":{:.5},\"jacobi_iterations\":{:?},\"jacobi_ms\":{:.3},\"vcycle_hierarchy_ms\":{:.3},\"vcycle_iterations\":{:?},\"vcycle_ms\":{:.3},\"forced_jacobi_ms\":{:.3},\"forced_vcycle_ms\":{:.3}}}",
+            self.system,
+            self.mesh,
+            self.tets,
+            self.levels,
+            self.mesh_ms + self.auto_hierarchy_ms,
+            self.n,
+            self.nnz,
+            self.mesh_ms,
+            self.tm_ms,
+            self.block_ms,
+            self.solver,
+            self.choice,
+            chosen_hierarchy,
+            self.auto_ms / 3.0 - chosen_hierarchy,
+            self.auto_ms,
+            self.auto_error,
+            self.jacobi_iterations,
+            self.jacobi_ms,
+            self.hierarchy_ms,
+            self.vcycle_iterations,
+            self.vcycle_ms,
+            self.forced_ms[0],
+            self.forced_ms[1]
+        )
+    }
+}
+
+/// The matrix's rows of one mesh: every medium × scale.
+fn matrix(name: &str, path: &Path, args: &Args) -> Result<Vec<SystemRow>, String> {
+    let file = trilux_io::tet::TetMesh::read(path).map_err(|e| e.to_string())?;
+    let mut mesh_ms = Vec::new();
+    let mut mesh = None;
+    for _ in 0..args.repeat {
+        let t = Instant::now();
+        mesh = Some(TetMesh::new(&file.positions, &file.tets).map_err(|e| e.to_string())?);
+        mesh_ms.push(ms(t));
+    }
+    let mesh = mesh.ok_or("no run")?;
+    let mesh_ms = median(mesh_ms);
+    let mut rows = Vec::new();
+    for medium in MEDIA {
+        for scale in SCALES {
+            let system = format!("{name}-{medium}-{scale}x");
+            let mut row = system_row(&system, &mesh, unit_of(name) * scale, medium, mesh_ms, args)?;
+            row.mesh = name.to_owned();
+            eprintln!("transcut: {}", row.markdown().trim_end());
+            rows.push(row);
+        }
+    }
+    Ok(rows)
+}
+
+/// `‖x − x*‖ / ‖x*‖` of each channel.
+fn errors(x: &[Vec<f64>; 3], reference: &[Vec<f64>; 3]) -> [f64; 3] {
+    std::array::from_fn(|c| relative_error(&x[c], &reference[c], norm(&reference[c])))
+}
+
+fn system_row(
+    system: &str,
+    mesh: &TetMesh,
+    unit_mm: f64,
+    medium: &str,
+    mesh_ms: f64,
+    args: &Args,
+) -> Result<SystemRow, String> {
+    let medium = Medium::measured(medium).map_err(|e| e.to_string())?;
+    let mut object =
+        Object::homogeneous(mesh.clone(), unit_mm, medium, 1.3).map_err(|e| e.to_string())?;
+    object
+        .add_light(Light::Directional {
+            to_light: DVec3::new(0.1, 1.0, 0.3),
+            irradiance: [1.0; 3],
+        })
+        .map_err(|e| e.to_string())?;
+    let tm_ms = median((0..args.repeat).map(|_| object.reassemble()).collect());
+    let matrices: [CsMat<f64>; 3] = std::array::from_fn(|c| object.matrix(c).clone());
+    let m = [&matrices[0], &matrices[1], &matrices[2]];
+    let rhs: [Vec<f64>; 3] = std::array::from_fn(|c| object.rhs(c).to_vec());
+    let b = [&rhs[0][..], &rhs[1][..], &rhs[2][..]];
+    let n = rhs[0].len();
+    // The reference: V-cycle-PCG to 10⁻¹⁰.
+    let mut tight = object.clone();
+    tight.settings.method = Method::VCyclePcg;
+    tight.settings.tolerance = 1e-10;
+    tight.settings.max_iterations = 20_000;
+    tight.solve().map_err(|e| e.to_string())?;
+    let reference: [Vec<f64>; 3] = std::array::from_fn(|c| tight.phi(c).to_vec());
+    drop(tight);
+    // Block Jacobi-PCG: iterations to 1% error per channel, and the
+    // residual there.
+    let mut block_ms = Vec::new();
+    let mut block = None;
+    for _ in 0..args.repeat {
+        let t = Instant::now();
+        block = Some(Block3::new(m).map_err(|e| e.to_string())?);
+        block_ms.push(ms(t));
+    }
+    let block = block.ok_or("no run")?;
+    let block_ms = median(block_ms);
+    let count = |pre: Option<[&dyn Preconditioner; 3]>| -> Result<([usize; 3], f64), String> {
+        let mut hit = [usize::MAX; 3];
+        let mut residual_at = f64::INFINITY;
+        let mut monitor = |p: &Progress<'_>| {
+            for c in 0..3 {
+                if hit[c] == usize::MAX {
+                    let x = p.solution(c).unwrap_or_default();
+                    if relative_error(&x, &reference[c], norm(&reference[c])) <= 0.01 {
+                        hit[c] = p.iteration();
+                        residual_at = residual_at.min(p.residual()[c]);
+                    }
+                }
+            }
+            if hit.iter().all(|&h| h != usize::MAX) {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        };
+        let mut x = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        let [x0, x1, x2] = &mut x;
+        let options = SolveOptions::new(0.0, 20_000).allow_unconverged();
+        let _ = match pre {
+            Some(v) => block.pcg(b, [x0, x1, x2], v, &options, Some(&mut monitor)),
+            None => block.cg(b, [x0, x1, x2], &options, Some(&mut monitor)),
+        }
+        .map_err(|e| e.to_string())?;
+        Ok((hit, residual_at))
+    };
+    let timed = |pre: Option<[&dyn Preconditioner; 3]>, k: usize| -> f64 {
+        let runs = (0..args.repeat)
+            .map(|_| {
+                let mut x = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+                let [x0, x1, x2] = &mut x;
+                let options = SolveOptions::new(0.0, k).allow_unconverged();
+                let t = Instant::now();
+                let _ = match pre {
+                    Some(v) => block.pcg(b, [x0, x1, x2], v, &options, None),
+                    None => block.cg(b, [x0, x1, x2], &options, None),
+                };
+                ms(t)
+            })
+            .collect();
+        median(runs)
+    };
+    let (jacobi_iterations, tolerance) = count(None)?;
+    let jacobi_ms = block_ms + timed(None, jacobi_iterations.into_iter().max().unwrap_or(0));
+    // V-cycle-PCG: the hierarchy as `Object` builds it (one, each
+    // channel's operators on it).
+    let positions = object.mesh().positions().to_vec();
+    let weights = Weights::Points(&positions);
+    let mut hier_ms = Vec::new();
+    let mut vcycles = None;
+    for _ in 0..args.repeat {
+        let t = Instant::now();
+        let green = VCycle::new(&matrices[1], weights, &VCycleOptions::default())
+            .map_err(|e| e.to_string())?;
+        let red = green.refreshed(&matrices[0]).map_err(|e| e.to_string())?;
+        let blue = green.refreshed(&matrices[2]).map_err(|e| e.to_string())?;
+        hier_ms.push(ms(t));
+        vcycles = Some([red, green, blue]);
+    }
+    let hierarchy_ms = median(hier_ms);
+    let v = vcycles.ok_or("no run")?;
+    let pre: [&dyn Preconditioner; 3] = [&v[0], &v[1], &v[2]];
+    let (vcycle_iterations, _) = count(Some(pre))?;
+    let vcycle_ms = block_ms + timed(Some(pre), vcycle_iterations.into_iter().max().unwrap_or(0));
+    // `Object::solve`, auto and forced, at the residual of 1% error.
+    let mut fresh = object.clone();
+    fresh.settings.tolerance = tolerance;
+    fresh.settings.max_iterations = 20_000;
+    fresh.forget_hierarchy();
+    let solve = |method: Method| -> Result<(f64, tet_diffusion::Choice, f64, f64, usize), String> {
+        let mut times = Vec::new();
+        let mut last = None;
+        for _ in 0..args.repeat {
+            let mut o = fresh.clone();
+            o.settings.method = method;
+            let t = Instant::now();
+            let r = o.solve().map_err(|e| e.to_string())?;
+            times.push(ms(t));
+            last = Some((r, o));
+        }
+        let (r, o) = last.ok_or("no run")?;
+        let x: [Vec<f64>; 3] = std::array::from_fn(|c| o.phi(c).to_vec());
+        let e = errors(&x, &reference).into_iter().fold(0.0, f64::max);
+        Ok((median(times), r.choice, r.hierarchy_ms, e, r.levels))
+    };
+    let (auto_ms, choice, auto_hierarchy_ms, auto_error, levels) = solve(Method::Auto)?;
+    let forced_ms = [solve(Method::JacobiPcg)?.0, solve(Method::VCyclePcg)?.0];
+    if let Some(dir) = &args.export {
+        write_mtx(&dir.join(format!("{system}.A.mtx")), &matrices[0]).map_err(|e| e.to_string())?;
+        write_vector(&dir.join(format!("{system}.b.mtx")), &rhs[0]).map_err(|e| e.to_string())?;
+        write_vector(&dir.join(format!("{system}.x.mtx")), &reference[0])
+            .map_err(|e| e.to_string())?;
+    }
+    Ok(SystemRow {
+        system: system.to_owned(),
+        mesh: String::new(),
+        tets: mesh.tets().len(),
+        levels,
+        n,
+        nnz: block.nnz(),
+        mesh_ms,
+        tm_ms,
+        block_ms,
+        jacobi_iterations,
+        jacobi_ms,
+        hierarchy_ms,
+        vcycle_iterations,
+        vcycle_ms,
+        solver: choice.solver.to_string(),
+        choice: choice.to_string(),
+        auto_ms,
+        auto_hierarchy_ms: if auto_hierarchy_ms > 0.0 {
+            auto_hierarchy_ms
+        } else {
+            0.0
+        },
+        auto_error,
+        forced_ms,
+    })
 }
