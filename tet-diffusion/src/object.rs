@@ -460,6 +460,8 @@ pub struct Object {
     /// refreshes its values; a new mesh drops it).
     pub(crate) block: Option<Arc<Block3>>,
     pub(crate) block_current: bool,
+    /// Solves (fine or preview) since the mesh last changed.
+    pub(crate) solves_on_mesh: usize,
 }
 
 impl Object {
@@ -565,6 +567,7 @@ impl Object {
             values_changed: false,
             block: None,
             block_current: false,
+            solves_on_mesh: 0,
         };
         object.rebuild();
         Ok(object)
@@ -577,6 +580,7 @@ impl Object {
     pub(crate) fn rebuild(&mut self) -> [f64; 2] {
         self.kept = None;
         self.block = None;
+        self.solves_on_mesh = 0;
         self.centres = std::sync::OnceLock::new();
         let assembly_ms = self.reassemble();
         let start = Instant::now();
@@ -976,6 +980,7 @@ impl Object {
             });
         }
         let prepared = self.prepare_kept()?;
+        self.solves_on_mesh += 1;
         self.solve_prepared(budget, tolerance, prepared)
     }
 
@@ -1027,7 +1032,29 @@ impl Object {
                 need: "it must be finite and at least 0",
             });
         }
-        let prepared = self.prepare_kept()?;
+        let mut prepared = self.prepare_kept()?;
+        // The coarse-level answer needs the hierarchy. Auto builds it for a
+        // preview once this mesh has been solved before: an edit after an
+        // edit, where later edits reuse it (TransCut's interactive loop);
+        // the first solve after a cut answers from fine iterations, sooner.
+        let large = self.phi[0].len() > max_rows;
+        if self.settings.method == Method::Auto
+            && large
+            && self.solves_on_mesh > 0
+            && matches!(self.kept_now()?.solver, KeptSolver::Jacobi)
+        {
+            let t = Instant::now();
+            let solver = self.build_v_cycles()?;
+            self.kept = Some(Arc::new(Kept {
+                method: Method::Auto,
+                share_hierarchy: self.settings.share_hierarchy,
+                solver,
+            }));
+            self.hierarchy_builds += 1;
+            self.values_changed = false;
+            prepared[0] = Some(ms(t));
+        }
+        self.solves_on_mesh += 1;
         let kept = self.kept_now()?;
         let level = match &kept.solver {
             KeptSolver::VCycles(v) => {
