@@ -152,6 +152,8 @@ fn solve_report<'py>(
     )?;
     d.set_item("hierarchy_ms", r.hierarchy_ms)?;
     d.set_item("solve_ms", r.solve_ms)?;
+    d.set_item("solver", r.choice.solver.to_string())?;
+    d.set_item("solver_choice", r.choice.to_string())?;
     Ok(d)
 }
 
@@ -244,7 +246,8 @@ impl Object {
 
     /// Solves the diffusion equation for `φ` (three channels); returns a
     /// report dict: `levels`, `iterations` and `residuals` per channel,
-    /// `hierarchy_ms`, `solve_ms`. Before solving, a `UserWarning` for each
+    /// `hierarchy_ms`, `solve_ms`, `solver` (which ran: "Jacobi-PCG" or
+    /// "V-cycle-PCG", chosen by the system) and `solver_choice` (why). Before solving, a `UserWarning` for each
     /// channel in which a medium's diffusion length is below the mesh's
     /// mean edge length (too coarse a mesh to resolve it).
     fn solve<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {

@@ -391,10 +391,11 @@ fn translucent(d: &Demo<'_>, i: &Inputs) -> Pipeline {
     let r = &stuffed.report;
     Ok((
         format!(
-            "blob stuffed into {} tetrahedra (dihedral {:.1}°..{:.1}°), cut open, marble diffusion solved ({} level{})",
+            "blob stuffed into {} tetrahedra (dihedral {:.1}°..{:.1}°), cut open, marble diffusion solved by {} ({} level{})",
             r.tets,
             r.min_dihedral_deg,
             r.max_dihedral_deg,
+            report.choice.solver,
             report.levels,
             if report.levels == 1 { "" } else { "s" }
         ),

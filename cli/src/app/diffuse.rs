@@ -92,6 +92,8 @@ struct Solved {
     lights: Vec<Light>,
     unit_mm: f64,
     levels: usize,
+    /// The solver the (first) solve chose, and why.
+    choice: Option<tet_diffusion::Choice>,
     painted: Vec<usize>,
     /// The nodes dropped from the file's mesh, to write the VTU back in
     /// its numbering.
@@ -128,17 +130,20 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     cut(context, &args, &mut object)?;
     let mut objects = fracture(&args, object, diagonal)?;
     let mut levels = None;
+    let mut choice = None;
     for o in &mut objects {
         let report = context
             .step("solving", || o.solve())
             .map_err(|e| file_cause(input, super::placed("the solve failed", false, e)))?;
         levels.get_or_insert(report.levels);
+        choice.get_or_insert(report.choice);
     }
     let solved = Solved {
         objects,
         lights,
         unit_mm,
         levels: levels.unwrap_or(0),
+        choice,
         painted,
         dropped,
     };
@@ -429,7 +434,7 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: 
     let tets: usize = objects.iter().map(|o| o.mesh().tets().len()).sum();
     let painted = &solved.painted;
     let text = format!(
-        "{} tetrahedra ({} object{}), {} mm per unit{}, solved ({} level{}); written to {}\n",
+        "{} tetrahedra ({} object{}), {} mm per unit{}, solved by {} ({} level{}); written to {}\n",
         tets,
         objects.len(),
         if objects.len() > 1 { "s" } else { "" },
@@ -446,6 +451,9 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: 
                     .join(" + ")
             )
         },
+        solved
+            .choice
+            .map_or_else(|| "no solver".to_owned(), |c| c.solver.to_string()),
         solved.levels,
         if solved.levels == 1 { "" } else { "s" },
         listed(files)
@@ -465,6 +473,8 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: 
             .collect::<Vec<_>>(),
         "output": super::shown(&args.output),
         "files": shown_all(files),
+        "solver": solved.choice.map(|c| c.solver.to_string()),
+        "solver_choice": solved.choice.map(|c| c.to_string()),
         "seconds": context.timings_json(),
     });
     context.report(&text, json);

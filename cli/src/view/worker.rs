@@ -437,6 +437,7 @@ impl Worker {
                 "hierarchy_ms": r.hierarchy_ms,
                 "coarse_level": r.coarse_level,
                 "solve_ms": r.solve_ms,
+                "solver": r.choice.solver.to_string(),
             })).collect::<Vec<_>>(),
             "pieces": s.pieces().len(),
             "offsets": s.offsets().iter().map(|o| o.to_array()).collect::<Vec<_>>(),

@@ -185,6 +185,15 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
         ],
     );
     assert_eq!(report["objects"], 1);
+    // A small, well-conditioned blob: the automatic choice stays with
+    // Jacobi-PCG, and the report says so and why.
+    assert_eq!(report["solver"], "Jacobi-PCG", "{report:#}");
+    assert!(
+        report["solver_choice"]
+            .as_str()
+            .unwrap()
+            .starts_with("Jacobi-PCG (auto")
+    );
     // The cut removes the cap above z = 0.2 (splitting the tetrahedra it
     // crosses): fewer remain than were stuffed, but most of the blob.
     let cut = report["tetrahedra"].as_u64().unwrap();

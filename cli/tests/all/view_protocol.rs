@@ -384,6 +384,8 @@ async fn every_edit_through_the_protocol() {
         assert!(!solves.is_empty(), "{m}");
         for sv in solves {
             assert!(sv["levels"].as_u64().unwrap() >= 1);
+            let solver = sv["solver"].as_str().unwrap();
+            assert!(solver == "Jacobi-PCG" || solver == "V-cycle-PCG", "{m}");
             assert!(
                 sv["residual"]
                     .as_array()
