@@ -666,7 +666,12 @@ impl<'s> Solve<'s> {
             z: vec![[0.0; CHANNELS]; n],
             p: vec![[0.0; CHANNELS]; n],
             q: vec![[0.0; CHANNELS]; n],
-            scratch: [vec![0.0; n], vec![0.0; n]],
+            // Only a preconditioner of its own needs them (a short stop
+            // makes the first when it needs it).
+            scratch: match m {
+                Precondition::Jacobi => [Vec::new(), Vec::new()],
+                Precondition::Each(_) => [vec![0.0; n], vec![0.0; n]],
+            },
             lanes: std::array::from_fn(lane),
         }
     }
@@ -771,10 +776,16 @@ impl<'s> Solve<'s> {
             let continuing: [bool; CHANNELS] =
                 std::array::from_fn(|c| stepping[c] && ends[c].is_none());
             self.next_directions(continuing);
+            // The true residuals of the channels whose run ended, in one
+            // pass over the matrix.
+            let ending: [bool; CHANNELS] = std::array::from_fn(|c| ends[c].is_some());
             let mut restarting = [false; CHANNELS];
-            for c in 0..CHANNELS {
-                if let Some(end) = ends[c] {
-                    restarting[c] = self.end_run(c, end);
+            if ending.iter().any(|&e| e) {
+                let norms = self.a.residual_into(&self.b, &self.x, ending, &mut self.r);
+                for c in 0..CHANNELS {
+                    if let Some(end) = ends[c] {
+                        restarting[c] = self.end_run(c, end, norms[c]);
+                    }
                 }
             }
             self.begin_runs(restarting);
@@ -930,14 +941,12 @@ impl<'s> Solve<'s> {
     }
 
     /// The end of channel `c`'s run, as in [`crate::pcg`]: the true
-    /// residual decides between stopping and a restart. Returns whether
-    /// the channel restarts (its `r` then holds the true residual).
-    fn end_run(&mut self, c: usize, end: RunEnd) -> bool {
-        let which = std::array::from_fn(|k| k == c);
-        let norms = self.a.residual_into(&self.b, &self.x, which, &mut self.r);
+    /// residual (`norm`, with `r` holding `b − A x`) decides between
+    /// stopping and a restart. Returns whether the channel restarts.
+    fn end_run(&mut self, c: usize, end: RunEnd, norm: f64) -> bool {
         let lane = &mut self.lanes[c];
         let before = lane.residual;
-        lane.residual = norms[c] / lane.scale;
+        lane.residual = norm / lane.scale;
         lane.recurrence = lane.residual;
         let (residual, done) = (lane.residual, lane.done);
         let tolerance = self.options.tolerance;
@@ -976,6 +985,7 @@ impl<'s> Solve<'s> {
         let lane = &mut self.lanes[c];
         let scale = lane.scale;
         let scratch = &mut self.scratch[0];
+        scratch.resize(a.rows(), 0.0);
         let residual = match lane.best.take() {
             Some(best) => best.restore_with(&mut self.x[c], lane.residual, |v| {
                 a.channel_residual(c, b, v, scratch) / scale
