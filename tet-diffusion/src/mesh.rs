@@ -684,54 +684,72 @@ fn neighbors(vertex_tets: &Csr, tets: &[[u32; 4]]) -> (Csr, Vec<[u32; 4]>) {
     (Csr { offsets, items }, slots)
 }
 
-/// Face adjacency and the outward boundary triangles, by sorting the
-/// faces' sorted vertex triples.
 /// Face adjacency per tet and the outward boundary triangles.
 type Faces = (Vec<[u32; 4]>, Vec<[u32; 3]>);
 
+/// A face's sorted vertex triple and its `4 t + k` (tet `t`, face `k`)
+/// packed into one integer, triple first: sorting the integers sorts the
+/// faces by triple, and compares two words instead of four fields.
+fn face_key(triple: [u32; 3], face: u32) -> u128 {
+    (u128::from(triple[0]) << 96)
+        | (u128::from(triple[1]) << 64)
+        | (u128::from(triple[2]) << 32)
+        | u128::from(face)
+}
+
+/// Face adjacency and the outward boundary triangles, by sorting the
+/// faces' sorted vertex triples.
 fn faces(tets: &[[u32; 4]]) -> Result<Faces, Error> {
-    let mut keys: Vec<([u32; 3], u32)> = tets
+    let mut keys: Vec<u128> = tets
         .par_iter()
         .enumerate()
         .flat_map_iter(|(t, tet)| {
             (0..4).map(move |k| {
-                let f = OUTWARD_FACES[k].map(|l| tet[l]);
-                let mut s = f;
+                let mut s = OUTWARD_FACES[k].map(|l| tet[l]);
                 s.sort_unstable();
-                (s, (t * 4 + k) as u32)
+                face_key(s, (t * 4 + k) as u32)
             })
         })
         .collect();
     keys.par_sort_unstable();
+    let triple = |key: u128| key >> 32;
+    let face = |key: u128| key as u32;
     let mut adjacency = vec![[NONE; 4]; tets.len()];
     let mut boundary = Vec::new();
     let mut i = 0;
     while i < keys.len() {
         let mut j = i + 1;
-        while j < keys.len() && keys[j].0 == keys[i].0 {
+        while j < keys.len() && triple(keys[j]) == triple(keys[i]) {
             j += 1;
         }
         match j - i {
-            1 => {
-                let (t, k) = ((keys[i].1 / 4) as usize, (keys[i].1 % 4) as usize);
-                boundary.push((keys[i].1, OUTWARD_FACES[k].map(|l| tets[t][l])));
-            }
+            1 => boundary.push(face(keys[i])),
             2 => {
-                let (a, b) = (keys[i].1, keys[i + 1].1);
+                let (a, b) = (face(keys[i]), face(keys[i + 1]));
                 adjacency[(a / 4) as usize][(a % 4) as usize] = b / 4;
                 adjacency[(b / 4) as usize][(b % 4) as usize] = a / 4;
             }
             _ => {
+                let t = triple(keys[i]);
                 return Err(Error::NonManifoldFace {
-                    face: keys[i].0,
-                    tet: (keys[i + 2].1 / 4) as usize,
+                    face: [(t >> 64) as u32, (t >> 32) as u32, t as u32],
+                    tet: (face(keys[i + 2]) / 4) as usize,
                 });
             }
         }
         i = j;
     }
-    boundary.sort_unstable_by_key(|b| b.0);
-    Ok((adjacency, boundary.into_iter().map(|b| b.1).collect()))
+    boundary.sort_unstable();
+    Ok((
+        adjacency,
+        boundary
+            .into_iter()
+            .map(|f| {
+                let (t, k) = ((f / 4) as usize, (f % 4) as usize);
+                OUTWARD_FACES[k].map(|l| tets[t][l])
+            })
+            .collect(),
+    ))
 }
 
 #[cfg(test)]
@@ -741,6 +759,38 @@ pub(crate) mod tests {
     /// The Kuhn lattice of `[0, size]³` the unit tests share.
     pub(crate) fn cube(n: usize, size: f64) -> (Vec<DVec3>, Vec<[u32; 4]>) {
         crate::kuhn_lattice(n, DVec3::ZERO, DVec3::splat(size))
+    }
+
+    #[test]
+    fn a_face_of_three_tets_is_named() {
+        // Three tets on the triangle (0, 1, 2), apexes above and below.
+        let p = [
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::Y,
+            DVec3::new(0.2, 0.2, 1.0),
+            DVec3::new(0.2, 0.2, -1.0),
+            DVec3::new(0.3, 0.3, 2.0),
+        ];
+        let tets = [[0, 1, 2, 3], [0, 1, 2, 4], [0, 1, 2, 5]];
+        match TetMesh::new(&p, &tets) {
+            Err(Error::NonManifoldFace { face, tet }) => {
+                assert_eq!(face, [0, 1, 2]);
+                assert!(tet < 3);
+            }
+            other => panic!("{other:?}"),
+        }
+        // Two of them are a mesh: one shared face, six on the boundary.
+        let two = TetMesh::new(&p[..5], &tets[..2]).unwrap();
+        assert_eq!(two.boundary.len(), 6);
+        assert_eq!(
+            two.tet_neighbors
+                .iter()
+                .flatten()
+                .filter(|&&t| t != NONE)
+                .count(),
+            2
+        );
     }
 
     #[test]
