@@ -412,6 +412,21 @@ impl Block3 {
         Ok(())
     }
 
+    /// Row `i` of the three matrices times the vectors whose entries
+    /// `x(j)` gives (the three channels' at column `j`).
+    #[inline]
+    fn row_times(&self, i: usize, x: impl Fn(usize) -> Lanes) -> Lanes {
+        let (cols, vals) = self.row(i);
+        let mut s = [0.0; CHANNELS];
+        for (&j, v) in cols.iter().zip(vals) {
+            let xj = x(j as usize);
+            s[0] += v[0] * xj[0];
+            s[1] += v[1] * xj[1];
+            s[2] += v[2] * xj[2];
+        }
+        s
+    }
+
     /// `q ← A p` (interleaved), returning `p_c · q_c` per channel, the
     /// partial sums added in chunk order (the same on any number of
     /// threads).
@@ -424,17 +439,9 @@ impl Block3 {
                 let mut dot = [0.0; CHANNELS];
                 for (k, q) in q.iter_mut().enumerate() {
                     let i = first + k;
-                    let (cols, vals) = self.row(i);
-                    let mut s = [0.0; CHANNELS];
-                    for (&j, v) in cols.iter().zip(vals) {
-                        let pj = p[j as usize];
-                        s[0] += v[0] * pj[0];
-                        s[1] += v[1] * pj[1];
-                        s[2] += v[2] * pj[2];
-                    }
-                    *q = s;
+                    *q = self.row_times(i, |j| p[j]);
                     for c in 0..CHANNELS {
-                        dot[c] += p[i][c] * s[c];
+                        dot[c] += p[i][c] * q[c];
                     }
                 }
                 dot
@@ -460,19 +467,10 @@ impl Block3 {
                 let mut sq = [0.0; CHANNELS];
                 for (k, r) in r.iter_mut().enumerate() {
                     let i = first + k;
-                    let (cols, vals) = self.row(i);
-                    let mut s = [0.0; CHANNELS];
-                    for (&j, v) in cols.iter().zip(vals) {
-                        let j = j as usize;
-                        for c in 0..CHANNELS {
-                            s[c] += v[c] * x[c][j];
-                        }
-                    }
-                    for c in 0..CHANNELS {
-                        if which[c] {
-                            r[c] = b[c][i] - s[c];
-                            sq[c] += r[c] * r[c];
-                        }
+                    let s = self.row_times(i, |j| [x[0][j], x[1][j], x[2][j]]);
+                    for c in (0..CHANNELS).filter(|&c| which[c]) {
+                        r[c] = b[c][i] - s[c];
+                        sq[c] += r[c] * r[c];
                     }
                 }
                 sq
@@ -481,7 +479,9 @@ impl Block3 {
         sum_lanes(&partial).map(f64::sqrt)
     }
 
-    /// `‖b_c − A_c x‖` for one channel's vector `x` (`r` is scratch).
+    /// `‖b_c − A_c x‖` for one channel's vector `x` (`r` is scratch; a
+    /// short stop's rare path, so the other two lanes' products are
+    /// simply wasted).
     fn channel_residual(&self, c: usize, b: &[f64], x: &[f64], r: &mut [f64]) -> f64 {
         let partial: Vec<f64> = r
             .par_chunks_mut(ROWS)
@@ -491,13 +491,7 @@ impl Block3 {
                 let mut sq = 0.0;
                 for (k, r) in r.iter_mut().enumerate() {
                     let i = first + k;
-                    let (cols, vals) = self.row(i);
-                    let s: f64 = cols
-                        .iter()
-                        .zip(vals)
-                        .map(|(&j, v)| v[c] * x[j as usize])
-                        .sum();
-                    *r = b[i] - s;
+                    *r = b[i] - self.row_times(i, |j| [x[j]; CHANNELS])[c];
                     sq += *r * *r;
                 }
                 sq

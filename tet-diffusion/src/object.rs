@@ -399,6 +399,20 @@ impl KeptSolver {
     }
 }
 
+/// A solve's monitor's answer to a budget: stop when it is spent.
+fn budget_flow(spent: bool) -> ControlFlow<()> {
+    if spent {
+        ControlFlow::Break(())
+    } else {
+        ControlFlow::Continue(())
+    }
+}
+
+/// Each channel's V-cycle: its own, or the one shared by all.
+fn per_channel<'v>(v: &'v [VCycle<'static>]) -> [&'v VCycle<'static>; 3] {
+    [0, 1, 2].map(|c| &v[if v.len() == 3 { c } else { 0 }])
+}
+
 /// Where a fractured piece came from, to recombine it exactly.
 #[derive(Debug, Clone)]
 pub(crate) struct Lineage {
@@ -1043,16 +1057,7 @@ impl Object {
             && self.solves_on_mesh > 0
             && matches!(self.kept_now()?.solver, KeptSolver::Jacobi)
         {
-            let t = Instant::now();
-            let solver = self.build_v_cycles()?;
-            self.kept = Some(Arc::new(Kept {
-                method: Method::Auto,
-                share_hierarchy: self.settings.share_hierarchy,
-                solver,
-            }));
-            self.hierarchy_builds += 1;
-            self.values_changed = false;
-            prepared[0] = Some(ms(t));
+            prepared[0] = Some(self.keep_auto_v_cycles()?);
         }
         self.solves_on_mesh += 1;
         let kept = self.kept_now()?;
@@ -1145,13 +1150,7 @@ impl Object {
                 let mut reports = Vec::with_capacity(3);
                 for c in 0..3 {
                     let (m, b, x) = (&self.matrices[c], &self.rhs[c], &mut self.phi[c]);
-                    let mut monitor = |_: usize, _: &[f64]| {
-                        if stop_now() {
-                            ControlFlow::Break(())
-                        } else {
-                            ControlFlow::Continue(())
-                        }
-                    };
+                    let mut monitor = |_: usize, _: &[f64]| budget_flow(stop_now());
                     let r = cascade
                         .solve_monitored(m, b, x, &options, &mut monitor)?
                         .finest;
@@ -1174,14 +1173,9 @@ impl Object {
                 ([reports[0], reports[1], reports[2]], forced(solver))
             }
             (KeptSolver::VCycles(v), Method::VCyclePcg) => {
-                let v = [0, 1, 2].map(|c| &v[if v.len() == 3 { c } else { 0 }]);
-                let reports = self.block_pcg(Some(v), &options, &mut |_| {
-                    if stop_now() {
-                        ControlFlow::Break(())
-                    } else {
-                        ControlFlow::Continue(())
-                    }
-                })?;
+                let v = per_channel(v);
+                let reports =
+                    self.block_pcg(Some(v), &options, &mut |_| budget_flow(stop_now()))?;
                 (reports, forced(Solver::VCyclePcg))
             }
             (_, Method::Auto) => {
@@ -1194,13 +1188,7 @@ impl Object {
                 (reports, choice)
             }
             _ => {
-                let reports = self.block_pcg(None, &options, &mut |_| {
-                    if stop_now() {
-                        ControlFlow::Break(())
-                    } else {
-                        ControlFlow::Continue(())
-                    }
-                })?;
+                let reports = self.block_pcg(None, &options, &mut |_| budget_flow(stop_now()))?;
                 (reports, forced(Solver::JacobiPcg))
             }
         };
@@ -1270,33 +1258,20 @@ impl Object {
         if !switching {
             return Ok((probe, jacobi, None));
         }
-        let t = Instant::now();
-        let built = !hierarchy_kept;
-        if built {
-            self.kept = Some(Arc::new(Kept {
-                method: Method::Auto,
-                share_hierarchy: self.settings.share_hierarchy,
-                solver: self.build_v_cycles()?,
-            }));
-            self.hierarchy_builds += 1;
-            self.values_changed = false;
-        }
-        let built_ms = built.then(|| ms(t));
+        let built_ms = if hierarchy_kept {
+            None
+        } else {
+            Some(self.keep_auto_v_cycles()?)
+        };
         let kept = self.kept_now()?;
         let KeptSolver::VCycles(v) = &kept.solver else {
             return Ok((probe, jacobi, built_ms));
         };
-        let v = [0, 1, 2].map(|c| &v[if v.len() == 3 { c } else { 0 }]);
+        let v = per_channel(v);
         let done = probe.iter().map(|r| r.iterations).max().unwrap_or(0);
         let rest = SolveOptions::new(tolerance, self.settings.max_iterations.saturating_sub(done))
             .allow_unconverged();
-        let reports = self.block_pcg(Some(v), &rest, &mut |_| {
-            if stop_now() {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            }
-        })?;
+        let reports = self.block_pcg(Some(v), &rest, &mut |_| budget_flow(stop_now()))?;
         let reports = std::array::from_fn(|c| Report {
             iterations: probe[c].iterations + reports[c].iterations,
             ..reports[c]
@@ -1403,6 +1378,21 @@ impl Object {
         }
         self.hierarchy_builds += 1;
         Ok(Some(ms(t)))
+    }
+
+    /// Builds the V-cycles for [`Method::Auto`] and keeps them; returns
+    /// the build's time, ms.
+    fn keep_auto_v_cycles(&mut self) -> Result<f64, Error> {
+        let t = Instant::now();
+        let solver = self.build_v_cycles()?;
+        self.kept = Some(Arc::new(Kept {
+            method: Method::Auto,
+            share_hierarchy: self.settings.share_hierarchy,
+            solver,
+        }));
+        self.hierarchy_builds += 1;
+        self.values_changed = false;
+        Ok(ms(t))
     }
 
     /// The V-cycles of the three channels: one hierarchy (the green
