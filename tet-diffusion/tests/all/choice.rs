@@ -1,6 +1,7 @@
-//! `Method::Auto`: the solver chosen by the system, from Jacobi-PCG's
-//! probe, before any hierarchy is built.
+//! `Method::Auto`: the solver chosen by the system while Jacobi-PCG runs,
+//! before any hierarchy is built.
 
+use crate::common::on_threads;
 use tet_diffusion::glam::DVec3;
 use tet_diffusion::{AutoCosts, Light, Medium, Method, Object, Solver, TetMesh, kuhn_lattice};
 
@@ -154,16 +155,12 @@ fn forcing_either_solver_gives_the_same_phi() {
 #[test]
 fn the_choice_is_the_same_on_every_run_and_thread_count() {
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| {
-                let mut o = long_diffusion();
-                o.settings.auto_costs = cheap_v_cycle();
-                let r = o.solve().unwrap();
-                (r.choice, r.channels, o.phi(0).to_vec())
-            })
+        on_threads(threads, || {
+            let mut o = long_diffusion();
+            o.settings.auto_costs = cheap_v_cycle();
+            let r = o.solve().unwrap();
+            (r.choice, r.channels, o.phi(0).to_vec())
+        })
     };
     let one = run(1);
     assert_eq!(one, run(2));

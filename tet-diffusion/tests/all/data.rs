@@ -142,6 +142,18 @@ fn manufactured(mesh: TetMesh, mu_a: f64, sigma_s: f64) -> f64 {
     rel_l2(o.mesh(), o.phi(0), &exact)
 }
 
+/// `mesh` of one measured material, lit by one directional light.
+fn lit(mesh: &TetMesh, material: &str, unit_mm: f64, eta: f64) -> Object {
+    let m = Medium::measured(material).unwrap();
+    let mut o = Object::homogeneous(mesh.clone(), unit_mm, m, eta).unwrap();
+    o.add_light(Light::Directional {
+        to_light: DVec3::new(0.3, 1.0, 0.5),
+        irradiance: [1.0; 3],
+    })
+    .unwrap();
+    o
+}
+
 #[test]
 #[cfg_attr(
     not(trilux_data),
@@ -170,13 +182,7 @@ fn radiance_balances_the_power_on_every_tetgen_mesh() {
                 if big && eta != if material == "marble" { 1.3 } else { 1.5 } {
                     continue;
                 }
-                let m = Medium::measured(material).unwrap();
-                let mut o = Object::homogeneous(mesh.clone(), unit_mm, m, eta).unwrap();
-                o.add_light(Light::Directional {
-                    to_light: DVec3::new(0.3, 1.0, 0.5),
-                    irradiance: [1.0; 3],
-                })
-                .unwrap();
+                let mut o = lit(&mesh, material, unit_mm, eta);
                 o.settings.tolerance = 1e-9;
                 o.solve().unwrap();
                 let outside = radiance_balance(&o, |o, d| o.radiance(Some(d)), 1024);
@@ -253,13 +259,7 @@ fn the_chosen_solver_is_within_one_percent_on_every_tetgen_mesh() {
     ] {
         let mesh = read(name, scale);
         for material in ["marble", "skimmilk"] {
-            let m = Medium::measured(material).unwrap();
-            let mut o = Object::homogeneous(mesh.clone(), unit_mm, m, 1.3).unwrap();
-            o.add_light(Light::Directional {
-                to_light: DVec3::new(0.3, 1.0, 0.5),
-                irradiance: [1.0; 3],
-            })
-            .unwrap();
+            let mut o = lit(&mesh, material, unit_mm, 1.3);
             let mut reference = o.clone();
             reference.settings.method = tet_diffusion::Method::VCyclePcg;
             reference.settings.tolerance = 1e-10;

@@ -749,11 +749,9 @@ fn the_log_replays_bit_identically_on_one_and_two_threads() {
         [false, true, true]
     );
     let replay = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| Session::replay(lit_ball(7), SessionOptions::default(), &log).unwrap())
+        on_threads(threads, || {
+            Session::replay(lit_ball(7), SessionOptions::default(), &log).unwrap()
+        })
     };
     let one = replay(1);
     let two = replay(2);
@@ -799,11 +797,9 @@ fn a_coarse_level_first_result_refines_to_the_plain_solve_and_replays_exactly() 
     );
     let log = live.log();
     let replay = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| Session::replay(lit_ball(8), coarse_first(), &log).unwrap())
+        on_threads(threads, || {
+            Session::replay(lit_ball(8), coarse_first(), &log).unwrap()
+        })
     };
     assert!(snapshot(&replay(1)) == snapshot(&live));
     assert!(snapshot(&replay(2)) == snapshot(&live));

@@ -233,17 +233,13 @@ fn units_do_not_change_phi() {
 #[test]
 fn one_and_two_threads_agree_bit_for_bit() {
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| {
-                let mut o = noisy(6);
-                o.solve().unwrap();
-                let m: Vec<Vec<f64>> = (0..3).map(|c| o.matrix(c).data().to_vec()).collect();
-                let phi: Vec<Vec<f64>> = (0..3).map(|c| o.phi(c).to_vec()).collect();
-                (m, phi, o.incident().to_vec())
-            })
+        on_threads(threads, || {
+            let mut o = noisy(6);
+            o.solve().unwrap();
+            let m: Vec<Vec<f64>> = (0..3).map(|c| o.matrix(c).data().to_vec()).collect();
+            let phi: Vec<Vec<f64>> = (0..3).map(|c| o.phi(c).to_vec()).collect();
+            (m, phi, o.incident().to_vec())
+        })
     };
     assert_eq!(run(1), run(2));
 }

@@ -296,3 +296,12 @@ pub(crate) fn check_exact_plane_cut(
     assert!(worst < 1.0, "the cut face's normal deviates by {worst}°");
     (farthest, worst, count)
 }
+
+/// `f` run on a pool of `threads` threads (the determinism tests).
+pub(crate) fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
