@@ -338,18 +338,10 @@ fn relative_error(x: &[f64], reference: &[f64], norm: f64) -> f64 {
 
 fn bench(name: &str, path: &Path, args: &Args) -> Result<Row, String> {
     reset_peak();
-    let file = trilux_io::tet::TetMesh::read(path).map_err(|e| e.to_string())?;
     let unit_mm = unit_of(name);
     let marble = Medium::measured("marble").map_err(|e| e.to_string())?;
     // T_b: neighbourhoods (validated mesh) …
-    let mut mesh_ms = Vec::new();
-    let mut mesh = None;
-    for _ in 0..args.repeat {
-        let t = Instant::now();
-        mesh = Some(TetMesh::new(&file.positions, &file.tets).map_err(|e| e.to_string())?);
-        mesh_ms.push(ms(t));
-    }
-    let mesh = mesh.ok_or("no run")?;
+    let (mesh, mesh_ms) = read_mesh(path, args)?;
     let tets = mesh.tets().len();
     let mut object = Object::homogeneous(mesh, unit_mm, marble, 1.3).map_err(|e| e.to_string())?;
     for w in object.warnings() {
@@ -710,17 +702,23 @@ impl SystemRow {
     }
 }
 
-/// The matrix's rows of one mesh: every medium × scale.
-fn matrix(name: &str, path: &Path, args: &Args) -> Result<Vec<SystemRow>, String> {
+/// The file's tetrahedra as a validated mesh, built `repeat` times: the
+/// mesh and each build's time (T_b's neighbourhoods), ms.
+fn read_mesh(path: &Path, args: &Args) -> Result<(TetMesh, Vec<f64>), String> {
     let file = trilux_io::tet::TetMesh::read(path).map_err(|e| e.to_string())?;
-    let mut mesh_ms = Vec::new();
+    let mut times = Vec::new();
     let mut mesh = None;
     for _ in 0..args.repeat {
         let t = Instant::now();
         mesh = Some(TetMesh::new(&file.positions, &file.tets).map_err(|e| e.to_string())?);
-        mesh_ms.push(ms(t));
+        times.push(ms(t));
     }
-    let mesh = mesh.ok_or("no run")?;
+    Ok((mesh.ok_or("no run")?, times))
+}
+
+/// The matrix's rows of one mesh: every medium × scale.
+fn matrix(name: &str, path: &Path, args: &Args) -> Result<Vec<SystemRow>, String> {
+    let (mesh, mesh_ms) = read_mesh(path, args)?;
     let mesh_ms = median(mesh_ms);
     let mut rows = Vec::new();
     for medium in MEDIA {
@@ -854,28 +852,32 @@ fn system_row(
     fresh.settings.tolerance = tolerance;
     fresh.settings.max_iterations = 20_000;
     fresh.forget_hierarchy();
-    let solve = |method: Method| -> Result<(f64, tet_diffusion::Choice, f64, f64, usize), String> {
-        let mut times = Vec::new();
-        let mut last = None;
-        // One untimed run first: the first solve of the three pays the
-        // allocator's first touch of its vectors.
-        for run in 0..=args.repeat {
+    // The three round-robin (auto, Jacobi, V-cycle, auto, ...), so that a
+    // drift of the machine's speed falls on all alike, after one untimed
+    // round (the allocator's first touch of the vectors).
+    let methods = [Method::Auto, Method::JacobiPcg, Method::VCyclePcg];
+    let mut times: [Vec<f64>; 3] = Default::default();
+    let mut last = None;
+    for round in 0..=args.repeat {
+        for (k, &method) in methods.iter().enumerate() {
             let mut o = fresh.clone();
             o.settings.method = method;
             let t = Instant::now();
             let r = o.solve().map_err(|e| e.to_string())?;
-            if run > 0 {
-                times.push(ms(t));
+            if round > 0 {
+                times[k].push(ms(t));
             }
-            last = Some((r, o));
+            if k == 0 {
+                last = Some((r, o));
+            }
         }
-        let (r, o) = last.ok_or("no run")?;
-        let x: [Vec<f64>; 3] = std::array::from_fn(|c| o.phi(c).to_vec());
-        let e = errors(&x, &reference).into_iter().fold(0.0, f64::max);
-        Ok((median(times), r.choice, r.hierarchy_ms, e, r.levels))
-    };
-    let (auto_ms, choice, auto_hierarchy_ms, auto_error, levels) = solve(Method::Auto)?;
-    let forced_ms = [solve(Method::JacobiPcg)?.0, solve(Method::VCyclePcg)?.0];
+    }
+    let (r, o) = last.ok_or("no run")?;
+    let x: [Vec<f64>; 3] = std::array::from_fn(|c| o.phi(c).to_vec());
+    let auto_error = errors(&x, &reference).into_iter().fold(0.0, f64::max);
+    let (choice, auto_hierarchy_ms, levels) = (r.choice, r.hierarchy_ms, r.levels);
+    let [auto_ms, jacobi_forced, vcycle_forced] = times.map(median);
+    let forced_ms = [jacobi_forced, vcycle_forced];
     if let Some(dir) = &args.export {
         write_mtx(&dir.join(format!("{system}.A.mtx")), &matrices[0]).map_err(|e| e.to_string())?;
         write_vector(&dir.join(format!("{system}.b.mtx")), &rhs[0]).map_err(|e| e.to_string())?;
