@@ -123,9 +123,7 @@ impl Block3 {
     /// (a diagonal entry ≤ 0 or not stored), [`Error::TooLarge`] for more
     /// than 2³² − 1 rows.
     pub fn new(a: [&CsMat<f64>; CHANNELS]) -> Result<Self, Error> {
-        for m in a {
-            check_square(m)?;
-        }
+        check_matrices(a)?;
         let n = a[0].rows();
         let nnz = a[0].nnz();
         if u32::try_from(n.max(nnz)).is_err() {
@@ -185,9 +183,7 @@ impl Block3 {
     /// As [`new`](Self::new); [`Error::PatternMismatch`] when a matrix's
     /// pattern is not the block's.
     pub fn refreshed(&self, a: [&CsMat<f64>; CHANNELS]) -> Result<Self, Error> {
-        for m in a {
-            check_square(m)?;
-        }
+        check_matrices(a)?;
         let mut next = self.clone_structure();
         next.set_values(a)?;
         Ok(next)
@@ -212,27 +208,33 @@ impl Block3 {
     fn set_values(&mut self, a: [&CsMat<f64>; CHANNELS]) -> Result<(), Error> {
         let n = self.rows();
         for (channel, m) in a.iter().enumerate() {
+            if m.rows() != n {
+                return Err(Error::BlockSize {
+                    channel,
+                    rows: m.rows(),
+                    expected: n,
+                });
+            }
             let indptr = m.indptr();
             let indptr = indptr.to_proper();
-            if m.rows() != n || *indptr != self.source_offsets[..] {
-                let row = (0..n.min(m.rows()))
-                    .find(|&i| indptr.get(i + 1) != self.source_offsets.get(i + 1))
-                    .unwrap_or(n.min(m.rows()));
-                return Err(Error::PatternMismatch { channel, row });
-            }
             let cols = m.indices();
-            let bad = cols
-                .par_chunks(1 << 16)
-                .zip(self.source_cols.par_chunks(1 << 16))
-                .enumerate()
-                .find_map_first(|(chunk, (a, b))| {
-                    a.iter()
-                        .zip(b)
-                        .position(|(&a, &b)| a != b as usize)
-                        .map(|k| (chunk << 16) + k)
-                });
-            if let Some(e) = bad {
-                let row = self.source_offsets.partition_point(|&o| o <= e) - 1;
+            let same = *indptr == self.source_offsets[..]
+                && cols
+                    .par_chunks(1 << 16)
+                    .zip(self.source_cols.par_chunks(1 << 16))
+                    .all(|(a, b)| a.iter().zip(b).all(|(&a, &b)| a == b as usize));
+            if !same {
+                let so = &self.source_offsets;
+                let row = (0..n)
+                    .find(|&i| {
+                        let (ours, theirs) = (so[i]..so[i + 1], indptr[i]..indptr[i + 1]);
+                        ours.len() != theirs.len()
+                            || self.source_cols[ours]
+                                .iter()
+                                .zip(&cols[theirs])
+                                .any(|(&a, &b)| a as usize != b)
+                    })
+                    .unwrap_or(n);
                 return Err(Error::PatternMismatch { channel, row });
             }
         }
@@ -258,17 +260,20 @@ impl Block3 {
                     .map_or([0.0; CHANNELS], |e| vals[e]);
                 for c in 0..CHANNELS {
                     if d[c] <= 0.0 {
-                        return Some((self.order[k] as usize, d[c]));
+                        return Some((c, self.order[k] as usize, d[c]));
                     }
                     inv[c] = 1.0 / d[c];
                 }
                 None
             });
-        if let Some((row, value)) = bad {
-            return Err(Error::BadDiagonal {
-                row,
-                value,
-                need: "Jacobi-preconditioned CG needs a positive diagonal",
+        if let Some((channel, row, value)) = bad {
+            return Err(Error::InMatrix {
+                channel,
+                error: Box::new(Error::BadDiagonal {
+                    row,
+                    value,
+                    need: "Jacobi-preconditioned CG needs a positive diagonal",
+                }),
             });
         }
         self.inverse_diagonal = inverse_diagonal;
@@ -370,16 +375,19 @@ impl Block3 {
                         .abs()
                         .max(w[c].abs())
                         .max((d_i[c] * d_j[c]).abs().sqrt());
-                    ((v[c] - w[c]).abs() > 1e-10 * scale).then_some((i, j, v[c], w[c]))
+                    ((v[c] - w[c]).abs() > 1e-10 * scale).then_some((c, i, j, v[c], w[c]))
                 })
             })
         });
         match bad {
-            Some((row, col, value, transposed)) => Err(Error::NotSymmetric {
-                row: self.order[row] as usize,
-                col: self.order[col] as usize,
-                value,
-                transposed,
+            Some((channel, row, col, value, transposed)) => Err(Error::InMatrix {
+                channel,
+                error: Box::new(Error::NotSymmetric {
+                    row: self.order[row] as usize,
+                    col: self.order[col] as usize,
+                    value,
+                    transposed,
+                }),
             }),
             None => Ok(()),
         }
@@ -549,9 +557,19 @@ impl Block3 {
         monitor: Option<BlockMonitor<'_>>,
     ) -> Result<[Report; CHANNELS], Error> {
         let n = self.rows();
+        const RHS: [&str; CHANNELS] = [
+            "right-hand side of channel 0",
+            "right-hand side of channel 1",
+            "right-hand side of channel 2",
+        ];
+        const START: [&str; CHANNELS] = [
+            "start vector of channel 0",
+            "start vector of channel 1",
+            "start vector of channel 2",
+        ];
         for c in 0..CHANNELS {
-            check_vector("right-hand side", b[c], n)?;
-            check_vector("start vector", x[c], n)?;
+            check_vector(RHS[c], b[c], n)?;
+            check_vector(START[c], x[c], n)?;
         }
         options.check()?;
         let mut no_monitor = |_: &Progress<'_>| ControlFlow::Continue(());
@@ -1042,6 +1060,17 @@ fn row_chunks<'a>(
     out
 }
 
+/// Each matrix on its own (CSR, square, finite), its errors naming it.
+fn check_matrices(a: [&CsMat<f64>; CHANNELS]) -> Result<(), Error> {
+    for (channel, m) in a.into_iter().enumerate() {
+        check_square(m).map_err(|error| Error::InMatrix {
+            channel,
+            error: Box::new(error),
+        })?;
+    }
+    Ok(())
+}
+
 /// Two pseudo-random values in `[−1, 1)` for index `i` (SplitMix64).
 fn probe(i: usize) -> (f64, f64) {
     let mut z = (i as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
@@ -1277,23 +1306,56 @@ mod tests {
     fn bad_blocks_and_vectors_are_named() {
         let (a, b, _) = channels(5);
         let other = grid::diffusion([5, 5, 6], 4.0).unwrap().matrix;
+        let err = Block3::new([&a[0], &other, &a[2]]).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "matrix 1 of the block has 150 rows, matrix 0 has 125"
+        );
+        // Same size, another pattern from row 0 on: (i, i ± 1) against
+        // (i, i ± 2).
+        let band = |k: usize| {
+            let mut t = sprs::TriMat::new((6, 6));
+            for i in 0..6 {
+                t.add_triplet(i, i, 4.0);
+                if i + k < 6 {
+                    t.add_triplet(i, i + k, -1.0);
+                    t.add_triplet(i + k, i, -1.0);
+                }
+            }
+            t.to_csr::<usize>()
+        };
+        let (one, two) = (band(1), band(2));
         assert!(matches!(
-            Block3::new([&a[0], &other, &a[2]]),
-            Err(Error::PatternMismatch { channel: 1, .. })
+            Block3::new([&one, &one, &two]),
+            Err(Error::PatternMismatch { channel: 2, row: 0 })
         ));
         let mut skew = a[2].clone();
         *skew.get_mut(0, 1).unwrap() += 0.5;
-        assert!(matches!(
-            Block3::new([&a[0], &a[1], &skew]),
-            Err(Error::NotSymmetric { row: 0, col: 1, .. }
-                | Error::NotSymmetric { row: 1, col: 0, .. })
-        ));
+        let err = Block3::new([&a[0], &a[1], &skew]).unwrap_err();
+        assert!(
+            matches!(&err, Error::InMatrix { channel: 2, error }
+                if matches!(**error, Error::NotSymmetric { row: 0, col: 1, .. }
+                    | Error::NotSymmetric { row: 1, col: 0, .. })),
+            "{err}"
+        );
+        assert!(
+            err.to_string()
+                .starts_with("matrix 2 of the block: CG needs a symmetric")
+        );
         let mut negative = a[1].clone();
         *negative.get_mut(4, 4).unwrap() = -1.0;
         assert!(matches!(
             Block3::new([&a[0], &negative, &a[2]]),
-            Err(Error::NotSymmetric { .. } | Error::BadDiagonal { .. })
+            Err(Error::InMatrix { channel: 1, .. })
         ));
+        let mut nan = a[0].clone();
+        *nan.get_mut(3, 3).unwrap() = f64::NAN;
+        let err = Block3::new([&a[0], &a[1], &nan]).unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("matrix 2 of the block: matrix entry (3, 3) is NaN"),
+            "{err}"
+        );
         let block = Block3::new([&a[0], &a[1], &a[2]]).unwrap();
         let n = block.rows();
         let mut x = [vec![0.0; n], vec![f64::NAN; n], vec![0.0; n]];
@@ -1310,7 +1372,7 @@ mod tests {
             matches!(
                 err,
                 Error::NotFiniteVector {
-                    what: "start vector",
+                    what: "start vector of channel 1",
                     index: 0,
                     ..
                 }
@@ -1368,7 +1430,7 @@ mod tests {
         let other = grid::diffusion([6, 6, 7], 4.0).unwrap().matrix;
         assert!(matches!(
             block.refreshed([&scaled[0], &other, &scaled[2]]),
-            Err(Error::PatternMismatch { channel: 1, .. })
+            Err(Error::BlockSize { channel: 1, .. })
         ));
         assert_eq!(solve(&block), solve(&fresh));
     }

@@ -122,14 +122,30 @@ pub enum Error {
         tolerance: f64,
     },
     /// A [`crate::Block3`]'s matrices must share one sparsity pattern.
-    #[error(
-        "matrix {channel} of the block differs from matrix 0 in size or stored entries at row {row}"
-    )]
+    #[error("matrix {channel} of the block stores other entries than matrix 0 in row {row}")]
     PatternMismatch {
         /// Which matrix (0-based) differs from the first.
         channel: usize,
         /// The first row that differs (the smaller size when the sizes do).
         row: usize,
+    },
+    /// A matrix of a [`crate::Block3`] has another size than the first.
+    #[error("matrix {channel} of the block has {rows} rows, matrix 0 has {expected}")]
+    BlockSize {
+        /// Which matrix (0-based).
+        channel: usize,
+        /// Its rows.
+        rows: usize,
+        /// Matrix 0's rows.
+        expected: usize,
+    },
+    /// What is wrong with one matrix of a [`crate::Block3`].
+    #[error("matrix {channel} of the block: {error}")]
+    InMatrix {
+        /// Which matrix (0-based).
+        channel: usize,
+        /// The error of that matrix alone.
+        error: Box<Error>,
     },
     /// A channel of a block solve stopped before reaching its tolerance
     /// while [`crate::SolveOptions::require_convergence`] was on.
