@@ -137,7 +137,8 @@ pub enum Error {
     NotMatchingPieces,
     /// The solver stopped before reaching the tolerance.
     #[error(
-        "the {channel} channel did not converge: relative residual {residual:e} after {iterations} iterations ({stop:?}), tolerance {tolerance:e}"
+        "the {channel} channel did not converge to the tolerance {tolerance:e}: it {stop} after {iterations} iteration{} at relative residual {residual:.3e}",
+        if *iterations == 1 { "" } else { "s" }
     )]
     NotConverged {
         /// "red", "green" or "blue".

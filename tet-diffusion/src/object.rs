@@ -68,6 +68,44 @@ pub struct AutoCosts {
     pub v_cycle_rate: f64,
 }
 
+impl AutoCosts {
+    /// # Errors
+    /// [`Error::BadArgument`] naming the cost that is out of its range:
+    /// `hierarchy` finite and ≥ 0, `v_cycle_iteration` finite and > 0,
+    /// `v_cycle_rate` in (0, 1) (a reduction per iteration).
+    pub fn check(&self) -> Result<(), Error> {
+        let bad = |what: &str, value: f64, need: &'static str| {
+            Err(Error::BadArgument {
+                what: format!("AutoCosts::{what}"),
+                value,
+                need,
+            })
+        };
+        if !(self.hierarchy.is_finite() && self.hierarchy >= 0.0) {
+            return bad(
+                "hierarchy",
+                self.hierarchy,
+                "it must be finite and at least 0",
+            );
+        }
+        if !(self.v_cycle_iteration.is_finite() && self.v_cycle_iteration > 0.0) {
+            return bad(
+                "v_cycle_iteration",
+                self.v_cycle_iteration,
+                "it must be finite and positive",
+            );
+        }
+        if !(self.v_cycle_rate > 0.0 && self.v_cycle_rate < 1.0) {
+            return bad(
+                "v_cycle_rate",
+                self.v_cycle_rate,
+                "it is a residual reduction per iteration: above 0 and below 1",
+            );
+        }
+        Ok(())
+    }
+}
+
 impl Default for AutoCosts {
     /// Measured on the data meshes (bunny_500k, sphere_200k, bunny_50k;
     /// 2 cores): the hierarchy costs 100–150 block Jacobi-PCG iterations,
@@ -242,9 +280,9 @@ pub struct Choice {
     /// The settings asked for it ([`SolverSettings::method`] not
     /// [`Method::Auto`]).
     pub forced: bool,
-    /// [`Method::Auto`]'s last estimate (the one that switched, if it
-    /// did); `None` when the tolerance came before the first (or the solve
-    /// was forced).
+    /// [`Method::Auto`]'s estimate that came closest to a switch (the one
+    /// that switched, if it did); `None` when the tolerance came before the
+    /// first (or the solve was forced).
     pub prediction: Option<Prediction>,
 }
 
@@ -257,12 +295,14 @@ impl std::fmt::Display for Choice {
             None => write!(f, "{} (auto: converged within the probe)", self.solver),
             Some(p) => write!(
                 f,
-                "{} (auto: after {} Jacobi-PCG iterations, condition ≥ {:.0}: Jacobi-PCG predicted {:.0} more, V-cycle-PCG {:.0} iterations{}: cost {:.0} vs {:.0})",
+                "{} (auto: after {} Jacobi-PCG iteration{}, condition ≥ {:.0}: Jacobi-PCG predicted {:.0} more, V-cycle-PCG {:.0} iteration{}{}: cost {:.0} vs {:.0})",
                 self.solver,
                 p.probe_iterations,
+                plural(p.probe_iterations as f64),
                 p.condition,
                 p.jacobi_cost,
                 p.v_cycle_iterations,
+                plural(p.v_cycle_iterations),
                 if p.hierarchy_kept {
                     " on the kept hierarchy"
                 } else {
@@ -310,6 +350,8 @@ impl Default for SolverSettings {
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolveReport {
     /// Per channel: the solver's report (iterations, true final residual).
+    /// After [`Method::Auto`] switched, the iterations are Jacobi-PCG's
+    /// and then V-cycle-PCG's, added.
     pub channels: [Report; 3],
     /// Levels of the hierarchy (1 for Jacobi-PCG).
     pub levels: usize,
@@ -397,6 +439,11 @@ impl KeptSolver {
             Self::Cascade(c) => c.hierarchy().levels(),
         }
     }
+}
+
+/// "s" unless `n` is 1.
+fn plural(n: f64) -> &'static str {
+    if n == 1.0 { "" } else { "s" }
 }
 
 /// A solve's monitor's answer to a budget: stop when it is spent.
@@ -993,6 +1040,7 @@ impl Object {
                 need: "it must be finite and at least 0",
             });
         }
+        s.auto_costs.check()?;
         let prepared = self.prepare_kept()?;
         self.solves_on_mesh += 1;
         self.solve_prepared(budget, tolerance, prepared)
@@ -1046,6 +1094,7 @@ impl Object {
                 need: "it must be finite and at least 0",
             });
         }
+        self.settings.auto_costs.check()?;
         let mut prepared = self.prepare_kept()?;
         // The coarse-level answer needs the hierarchy. Auto builds it for a
         // preview once this mesh has been solved before: an edit after an
@@ -1242,8 +1291,14 @@ impl Object {
                 return ControlFlow::Break(());
             }
             if let Some(guess) = estimator.step(p) {
-                prediction = Some(guess);
+                // Keep the estimate that came closest to a switch: the
+                // report's reason for staying (or for switching).
+                let margin = |p: &Prediction| p.v_cycle_cost - p.jacobi_cost;
+                if prediction.is_none_or(|best: Prediction| margin(&guess) < margin(&best)) {
+                    prediction = Some(guess);
+                }
                 if guess.switches() {
+                    prediction = Some(guess);
                     switching = true;
                     return ControlFlow::Break(());
                 }
@@ -1324,7 +1379,9 @@ impl Object {
         let block = match &self.block {
             Some(old) => match old.refreshed(m) {
                 Ok(b) => b,
-                Err(multires::Error::PatternMismatch { .. }) => Block3::new(m)?,
+                Err(
+                    multires::Error::PatternMismatch { .. } | multires::Error::BlockSize { .. },
+                ) => Block3::new(m)?,
                 Err(e) => return Err(e.into()),
             },
             None => Block3::new(m)?,

@@ -166,3 +166,45 @@ fn the_choice_is_the_same_on_every_run_and_thread_count() {
     assert_eq!(one, run(2));
     assert_eq!(one, run(2));
 }
+
+#[test]
+fn costs_out_of_range_are_named() {
+    let cases = [
+        (
+            AutoCosts {
+                hierarchy: -100.0,
+                ..AutoCosts::default()
+            },
+            "AutoCosts::hierarchy",
+        ),
+        (
+            AutoCosts {
+                v_cycle_iteration: f64::INFINITY,
+                ..AutoCosts::default()
+            },
+            "AutoCosts::v_cycle_iteration",
+        ),
+        (
+            AutoCosts {
+                v_cycle_rate: 1.0,
+                ..AutoCosts::default()
+            },
+            "AutoCosts::v_cycle_rate",
+        ),
+        (
+            AutoCosts {
+                v_cycle_rate: f64::NAN,
+                ..AutoCosts::default()
+            },
+            "AutoCosts::v_cycle_rate",
+        ),
+    ];
+    for (costs, name) in cases {
+        let mut o = short_diffusion();
+        o.settings.auto_costs = costs;
+        let e = o.solve().unwrap_err().to_string();
+        assert!(e.contains(name), "{e}");
+        let e = o.solve_preview(10, 1e-2).unwrap_err().to_string();
+        assert!(e.contains(name), "{e}");
+    }
+}
