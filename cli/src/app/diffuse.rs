@@ -92,8 +92,8 @@ struct Solved {
     lights: Vec<Light>,
     unit_mm: f64,
     levels: usize,
-    /// The solver the (first) solve chose, and why.
-    choice: Option<tet_diffusion::Choice>,
+    /// The solver each object's solve chose, and why.
+    choices: Vec<tet_diffusion::Choice>,
     painted: Vec<usize>,
     /// The nodes dropped from the file's mesh, to write the VTU back in
     /// its numbering.
@@ -128,22 +128,22 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let lights = light(context, &args, input, &mut object)?;
     let painted = paint(&args, &mut object)?;
     cut(context, &args, &mut object)?;
-    let mut objects = fracture(&args, object, diagonal)?;
+    let mut objects = context.step("fracturing", || fracture(&args, object, diagonal))?;
     let mut levels = None;
-    let mut choice = None;
+    let mut choices = Vec::with_capacity(objects.len());
     for o in &mut objects {
         let report = context
             .step("solving", || o.solve())
             .map_err(|e| file_cause(input, super::placed("the solve failed", false, e)))?;
         levels.get_or_insert(report.levels);
-        choice.get_or_insert(report.choice);
+        choices.push(report.choice);
     }
     let solved = Solved {
         objects,
         lights,
         unit_mm,
         levels: levels.unwrap_or(0),
-        choice,
+        choices,
         painted,
         dropped,
     };
@@ -428,6 +428,19 @@ fn write_vtu(
     })
 }
 
+/// The solvers that ran, once each in order ("Jacobi-PCG", or
+/// "Jacobi-PCG, V-cycle-PCG" when the pieces of a fracture differ).
+fn solvers(choices: &[tet_diffusion::Choice]) -> String {
+    let mut names: Vec<String> = Vec::new();
+    for c in choices {
+        let name = c.solver.to_string();
+        if !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    names.join(", ")
+}
+
 /// The summary line, or the JSON object; `files` are every file written.
 fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: &[PathBuf]) {
     let objects = &solved.objects;
@@ -451,9 +464,7 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: 
                     .join(" + ")
             )
         },
-        solved
-            .choice
-            .map_or_else(|| "no solver".to_owned(), |c| c.solver.to_string()),
+        solvers(&solved.choices),
         solved.levels,
         if solved.levels == 1 { "" } else { "s" },
         listed(files)
@@ -473,8 +484,8 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: 
             .collect::<Vec<_>>(),
         "output": super::shown(&args.output),
         "files": shown_all(files),
-        "solver": solved.choice.map(|c| c.solver.to_string()),
-        "solver_choice": solved.choice.map(|c| c.to_string()),
+        "solver": solvers(&solved.choices),
+        "solver_choice": solved.choices.iter().map(ToString::to_string).collect::<Vec<_>>(),
         "seconds": context.timings_json(),
     });
     context.report(&text, json);

@@ -189,13 +189,22 @@ impl Context {
     }
 
     /// The recorded step times as a JSON object.
+    /// The steps' times by name, seconds; a step run more than once (one
+    /// solve per fractured piece) is the sum of its runs.
     pub(crate) fn timings_json(&self) -> serde_json::Value {
-        serde_json::Value::Object(
-            self.timings
-                .iter()
-                .map(|(k, v)| (k.clone(), serde_json::json!(round(*v, 4))))
-                .collect(),
-        )
+        let mut map = serde_json::Map::new();
+        for (name, seconds) in &self.timings {
+            let total = map
+                .get(name)
+                .and_then(serde_json::Value::as_f64)
+                .unwrap_or(0.0)
+                + seconds;
+            map.insert(name.clone(), serde_json::json!(total));
+        }
+        for value in map.values_mut() {
+            *value = serde_json::json!(round(value.as_f64().unwrap_or(0.0), 4));
+        }
+        serde_json::Value::Object(map)
     }
 
     /// Prints `text` (human) or `json` (with `--json`) on stdout.

@@ -188,12 +188,10 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
     // A small, well-conditioned blob: the automatic choice stays with
     // Jacobi-PCG, and the report says so and why.
     assert_eq!(report["solver"], "Jacobi-PCG", "{report:#}");
-    assert!(
-        report["solver_choice"]
-            .as_str()
-            .unwrap()
-            .starts_with("Jacobi-PCG (auto")
-    );
+    // One reason per object.
+    let why = report["solver_choice"].as_array().unwrap();
+    assert_eq!(why.len(), 1);
+    assert!(why[0].as_str().unwrap().starts_with("Jacobi-PCG (auto"));
     // The cut removes the cap above z = 0.2 (splitting the tetrahedra it
     // crosses): fewer remain than were stuffed, but most of the blob.
     let cut = report["tetrahedra"].as_u64().unwrap();
@@ -231,6 +229,12 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
         ],
     );
     assert_eq!(report["objects"], 2);
+    // Each piece's solve says what ran and why; the timings add both
+    // solves (a repeated step is summed, not overwritten) and the fracture.
+    assert_eq!(report["solver_choice"].as_array().unwrap().len(), 2);
+    let seconds = &report["seconds"];
+    assert!(seconds["solving"].as_f64().unwrap() > 0.0, "{seconds}");
+    assert!(seconds["fracturing"].as_f64().unwrap() > 0.0, "{seconds}");
     // The fracture splits the tetrahedra the plane crosses (both crack
     // faces flat), so the pieces hold more than were stuffed.
     let pieces = report["tetrahedra"].as_u64().unwrap();
