@@ -20,8 +20,11 @@
 //!   term `2 S_i / 3A`, `A = (1 + F_dr)/(1 − F_dr)` ([`fresnel`]), `b` of
 //!   Eq. 12 — sharing one sparsity pattern, assembled in parallel with
 //!   results independent of the number of threads. [`Object::solve`] uses
-//!   `multires` (V-cycle-PCG by default; the paper's cascade and
-//!   Jacobi-PCG selectable), warm-started from the last `φ`;
+//!   `multires`: by default ([`Method::Auto`]) the three channels as one
+//!   block of Jacobi-PCG, switching to V-cycle-PCG when its estimate of
+//!   the system says the hierarchy pays ([`SolveReport::choice`] says what
+//!   ran and why); V-cycle-PCG, the paper's cascade and Jacobi-PCG can be
+//!   forced. Warm-started from the last `φ`;
 //!   [`Object::radiance`] is Eq. 3 divided by `η²`, the radiance in air
 //!   (Eq. 3 as printed, the radiance just inside, is
 //!   [`Object::radiance_inside`]).
