@@ -28,6 +28,7 @@ pub(crate) struct Args {
     #[cfg(feature = "view")]
     #[arg(long, value_name = "SESSION.json", conflicts_with_all = [
         "input", "material", "unit_mm", "light", "envmap", "cut", "relax_cut", "paint", "fracture",
+        "solver",
     ])]
     pub(crate) session: Option<PathBuf>,
     /// A measured material (Jensen et al. 2001) or noise:A,B.
@@ -62,6 +63,11 @@ pub(crate) struct Args {
     /// plane:nx,ny,nz,d breaks the object in two along the plane.
     #[arg(long, value_name = "SPEC", value_parser = Plane::parse)]
     pub(crate) fracture: Option<Plane>,
+    /// The linear solver: auto chooses by the system (Jacobi-PCG, or the
+    /// V-cycle where its hierarchy pays; the summary says which ran and
+    /// --json why); jacobi or vcycle force one.
+    #[arg(long, value_enum, default_value_t = SolverArg::Auto)]
+    pub(crate) solver: SolverArg,
     #[command(flatten)]
     pub(crate) picture: PictureArgs,
     /// The picture (tone-mapped, 8-bit sRGB PNG).
@@ -79,6 +85,27 @@ pub(crate) struct Args {
     /// object per piece.
     #[arg(long, value_name = "OUT.glb")]
     pub(crate) glb: Option<PathBuf>,
+}
+
+/// `--solver`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum SolverArg {
+    /// Chosen by the system (tet-diffusion's `Method::Auto`).
+    Auto,
+    /// Jacobi-preconditioned CG.
+    Jacobi,
+    /// CG preconditioned by TransCut's multigrid V-cycle.
+    Vcycle,
+}
+
+impl SolverArg {
+    fn method(self) -> tet_diffusion::Method {
+        match self {
+            Self::Auto => tet_diffusion::Method::Auto,
+            Self::Jacobi => tet_diffusion::Method::JacobiPcg,
+            Self::Vcycle => tet_diffusion::Method::VCyclePcg,
+        }
+    }
 }
 
 /// Sweeps of TransCut's relaxation of the cross-section after a
@@ -132,6 +159,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let mut levels = None;
     let mut choices = Vec::with_capacity(objects.len());
     for o in &mut objects {
+        o.settings.method = args.solver.method();
         let report = context
             .step("solving", || o.solve())
             .map_err(|e| file_cause(input, super::placed("the solve failed", false, e)))?;
@@ -447,7 +475,7 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: 
     let tets: usize = objects.iter().map(|o| o.mesh().tets().len()).sum();
     let painted = &solved.painted;
     let text = format!(
-        "{} tetrahedra ({} object{}), {} mm per unit{}, solved by {} ({} level{}); written to {}\n",
+        "{} tetrahedra ({} object{}), {} mm per unit{}, solved by {}{}; written to {}\n",
         tets,
         objects.len(),
         if objects.len() > 1 { "s" } else { "" },
@@ -465,8 +493,11 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: 
             )
         },
         solvers(&solved.choices),
-        solved.levels,
-        if solved.levels == 1 { "" } else { "s" },
+        if solved.levels > 1 {
+            format!(" ({} levels)", solved.levels)
+        } else {
+            String::new()
+        },
         listed(files)
     );
     let json = serde_json::json!({

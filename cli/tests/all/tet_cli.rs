@@ -192,6 +192,42 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
     let why = report["solver_choice"].as_array().unwrap();
     assert_eq!(why.len(), 1);
     assert!(why[0].as_str().unwrap().starts_with("Jacobi-PCG (auto"));
+    // --solver forces one; the picture is the same to 8 bits but for
+    // rounding at the solver's tolerance.
+    let forced = json(
+        d,
+        &[
+            "diffuse",
+            "blob.node",
+            "--material",
+            "marble",
+            "--unit-mm",
+            "20",
+            "--light",
+            "dir:0.3,1,0.6",
+            "--light",
+            "point:2,2,2:0.5,0.5,1",
+            "--cut",
+            "plane:0,0,1,0.2",
+            "--size",
+            "96",
+            "--solver",
+            "vcycle",
+            "-o",
+            "vcycle.png",
+        ],
+    );
+    assert_eq!(forced["solver"], "V-cycle-PCG", "{forced:#}");
+    assert_eq!(forced["solver_choice"][0], "V-cycle-PCG (as set)");
+    let vcycle = trilux_io::image::read(d.join("vcycle.png")).unwrap();
+    let auto = trilux_io::image::read(d.join("marble.png")).unwrap();
+    let worst = auto
+        .pixels
+        .iter()
+        .zip(&vcycle.pixels)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(worst <= 2.0 / 255.0, "{worst}");
     // The cut removes the cap above z = 0.2 (splitting the tetrahedra it
     // crosses): fewer remain than were stuffed, but most of the blob.
     let cut = report["tetrahedra"].as_u64().unwrap();
