@@ -133,7 +133,9 @@ impl std::fmt::Display for Stop {
         f.write_str(match self {
             Stop::Converged => "converged",
             Stop::MaxIterations => "reached the iteration cap",
-            Stop::Breakdown => "broke down (a recurrence scalar vanished or overflowed)",
+            Stop::Breakdown => {
+                "broke down (a recurrence scalar vanished or overflowed: for CG, the matrix or preconditioner is likely not positive definite)"
+            }
             Stop::Interrupted => "was stopped by its monitor",
             Stop::Stagnated => "stagnated (restarts no longer lowered the residual)",
         })
