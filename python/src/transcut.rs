@@ -249,8 +249,21 @@ impl Object {
     /// `hierarchy_ms`, `solve_ms`, `solver` (which ran: "Jacobi-PCG" or
     /// "V-cycle-PCG", chosen by the system) and `solver_choice` (why). Before solving, a `UserWarning` for each
     /// channel in which a medium's diffusion length is below the mesh's
-    /// mean edge length (too coarse a mesh to resolve it).
-    fn solve<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    /// mean edge length (too coarse a mesh to resolve it). `solver`:
+    /// "auto" (chosen by the system), "jacobi" or "vcycle" (forced).
+    #[pyo3(signature = (solver = "auto"))]
+    fn solve<'py>(&mut self, py: Python<'py>, solver: &str) -> PyResult<Bound<'py, PyDict>> {
+        self.inner.settings.method = match solver {
+            "auto" => tet_diffusion::Method::Auto,
+            "jacobi" => tet_diffusion::Method::JacobiPcg,
+            "vcycle" => tet_diffusion::Method::VCyclePcg,
+            other => {
+                return Err(Failure::input(format!(
+                    "solver: {other:?} is not 'auto', 'jacobi' or 'vcycle'"
+                ))
+                .into());
+            }
+        };
         for w in resolution_warnings(&self.inner.warnings()) {
             warn_user(py, &w)?;
         }

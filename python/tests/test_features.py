@@ -80,6 +80,11 @@ def test_transcut_object_solve_cut_paint_fracture_render():
     report = obj.solve()
     assert report["levels"] >= 1 and len(report["iterations"]) == 3
     assert report["solver"] in ("Jacobi-PCG", "V-cycle-PCG"), report["solver_choice"]
+    forced = obj.solve(solver="vcycle")
+    assert forced["solver"] == "V-cycle-PCG" and forced["solver_choice"] == "V-cycle-PCG (as set)"
+    with pytest.raises(ValueError, match="solver"):
+        obj.solve(solver="multigrid")
+    obj.solve()
     radiance = obj.radiance()
     assert radiance.shape == (len(obj.boundary_vertices), 3) and (radiance >= 0).all()
     lit = radiance[np.asarray(nodes)[obj.boundary_vertices] @ np.array([0.3, 1, 0.6]) > 0].mean()
