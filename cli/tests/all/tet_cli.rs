@@ -159,30 +159,37 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
     let d = dir.path();
     stuffed_blob(d, "0.12");
     let tets = trilux_io::tet::read(d.join("blob.node")).unwrap();
+    // The scene, rendered below with the chosen and a forced solver.
+    let scene = [
+        "diffuse",
+        "blob.node",
+        "--material",
+        "marble",
+        "--unit-mm",
+        "20",
+        "--light",
+        "dir:0.3,1,0.6",
+        "--light",
+        "point:2,2,2:0.5,0.5,1",
+        "--cut",
+        "plane:0,0,1,0.2",
+        "--size",
+        "96",
+    ];
     let report = json(
         d,
         &[
-            "diffuse",
-            "blob.node",
-            "--material",
-            "marble",
-            "--unit-mm",
-            "20",
-            "--light",
-            "dir:0.3,1,0.6",
-            "--light",
-            "point:2,2,2:0.5,0.5,1",
-            "--cut",
-            "plane:0,0,1,0.2",
-            "--size",
-            "96",
-            "-o",
-            "marble.png",
-            "--exr",
-            "marble.exr",
-            "--vtu",
-            "marble.vtu",
-        ],
+            &scene[..],
+            &[
+                "-o",
+                "marble.png",
+                "--exr",
+                "marble.exr",
+                "--vtu",
+                "marble.vtu",
+            ],
+        ]
+        .concat(),
     );
     assert_eq!(report["objects"], 1);
     // A small, well-conditioned blob: the automatic choice stays with
@@ -196,26 +203,7 @@ fn diffuse_renders_a_cut_translucent_blob_to_png_exr_and_vtu() {
     // rounding at the solver's tolerance.
     let forced = json(
         d,
-        &[
-            "diffuse",
-            "blob.node",
-            "--material",
-            "marble",
-            "--unit-mm",
-            "20",
-            "--light",
-            "dir:0.3,1,0.6",
-            "--light",
-            "point:2,2,2:0.5,0.5,1",
-            "--cut",
-            "plane:0,0,1,0.2",
-            "--size",
-            "96",
-            "--solver",
-            "vcycle",
-            "-o",
-            "vcycle.png",
-        ],
+        &[&scene[..], &["--solver", "vcycle", "-o", "vcycle.png"]].concat(),
     );
     assert_eq!(forced["solver"], "V-cycle-PCG", "{forced:#}");
     assert_eq!(forced["solver_choice"][0], "V-cycle-PCG (as set)");
