@@ -135,6 +135,26 @@ fn texture_arg(emission: &Bound<'_, PyAny>) -> PyResult<EmissionTexture> {
 
 /// `(n, 3)` points (one per row) or one `(3,)` point for all `n`, made
 /// relative to `origin` (the mesh's shift) in `f64`, then `f32`.
+/// `toward(face, barycentric, reference)` for each hit when reference
+/// points are given, else `alone(face, barycentric)`.
+fn per_hit<T>(
+    faces: &[usize],
+    bary: &[[f32; 3]],
+    references: Option<&[Vec3]>,
+    toward: impl Fn(usize, [f32; 3], Vec3) -> T,
+    alone: impl Fn(usize, [f32; 3]) -> T,
+) -> Vec<T> {
+    match references {
+        Some(r) => faces
+            .iter()
+            .zip(bary)
+            .zip(r)
+            .map(|((&f, &b), &x)| toward(f, b, x))
+            .collect(),
+        None => faces.iter().zip(bary).map(|(&f, &b)| alone(f, b)).collect(),
+    }
+}
+
 fn points_arg(obj: &Bound<'_, PyAny>, what: &str, n: usize, origin: DVec3) -> PyResult<Vec<Vec3>> {
     let np = obj.py().import("numpy")?;
     let ndim: usize = np
@@ -509,19 +529,13 @@ impl Emitter {
             .map(|r| points_arg(r, "reference_points", faces.len(), self.origin))
             .transpose()?;
         let pdf = self.run(py, move |e| {
-            Ok(match &references {
-                Some(r) => faces
-                    .iter()
-                    .zip(&bary)
-                    .zip(r)
-                    .map(|((&f, &b), &x)| f64::from(e.pdf_solid_angle(f, b, x)))
-                    .collect::<Vec<f64>>(),
-                None => faces
-                    .iter()
-                    .zip(&bary)
-                    .map(|(&f, &b)| f64::from(e.pdf_area(f, b)))
-                    .collect(),
-            })
+            Ok(per_hit(
+                &faces,
+                &bary,
+                references.as_deref(),
+                |f, b, x| f64::from(e.pdf_solid_angle(f, b, x)),
+                |f, b| f64::from(e.pdf_area(f, b)),
+            ))
         })?;
         Ok(arrays::vector(py, pdf))
     }
@@ -542,19 +556,13 @@ impl Emitter {
             .map(|r| points_arg(r, "reference_points", faces.len(), self.origin))
             .transpose()?;
         let le = self.run(py, move |e| {
-            Ok(match &references {
-                Some(r) => faces
-                    .iter()
-                    .zip(&bary)
-                    .zip(r)
-                    .map(|((&f, &b), &x)| e.radiance_toward(f, b, x))
-                    .collect::<Vec<[f32; 3]>>(),
-                None => faces
-                    .iter()
-                    .zip(&bary)
-                    .map(|(&f, &b)| e.radiance(f, b))
-                    .collect(),
-            })
+            Ok(per_hit(
+                &faces,
+                &bary,
+                references.as_deref(),
+                |f, b, x| e.radiance_toward(f, b, x),
+                |f, b| e.radiance(f, b),
+            ))
         })?;
         rows_out(py, le.into_iter())
     }
