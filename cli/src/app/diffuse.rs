@@ -87,14 +87,13 @@ pub(crate) struct Args {
     pub(crate) glb: Option<PathBuf>,
 }
 
-/// `--solver`.
+/// The values of `--solver` (no doc comments on them: clap would switch
+/// the whole help to its long layout): tet-diffusion's `Method::Auto`,
+/// `JacobiPcg` and `VCyclePcg`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum SolverArg {
-    /// Chosen by the system (tet-diffusion's `Method::Auto`).
     Auto,
-    /// Jacobi-preconditioned CG.
     Jacobi,
-    /// CG preconditioned by TransCut's multigrid V-cycle.
     Vcycle,
 }
 
