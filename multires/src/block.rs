@@ -1153,6 +1153,19 @@ mod tests {
         (a, b, p.positions)
     }
 
+    /// `block.cg` from `x = 0`: its result and the iterates.
+    fn cg_from_zero(
+        block: &Block3,
+        b: [&[f64]; 3],
+        options: &SolveOptions,
+        monitor: Option<BlockMonitor<'_>>,
+    ) -> (Result<[Report; 3], Error>, [Vec<f64>; 3]) {
+        let n = block.rows();
+        let mut x = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        let [x0, x1, x2] = &mut x;
+        (block.cg(b, [x0, x1, x2], options, monitor), x)
+    }
+
     #[test]
     fn a_block_solve_is_three_separate_solves() {
         let (a, b, _) = channels(12);
@@ -1272,32 +1285,28 @@ mod tests {
         let (a, b, _) = channels(8);
         let block = Block3::new([&a[0], &a[1], &a[2]]).unwrap();
         let n = block.rows();
-        let mut x = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-        let [x0, x1, x2] = &mut x;
-        let err = block
-            .cg(
-                [&b[0], &b[1], &b[2]],
-                [x0, x1, x2],
-                &SolveOptions::new(1e-12, 2),
-                None,
-            )
-            .unwrap_err();
+        let err = cg_from_zero(
+            &block,
+            [&b[0], &b[1], &b[2]],
+            &SolveOptions::new(1e-12, 2),
+            None,
+        )
+        .0
+        .unwrap_err();
         assert!(
             matches!(err, Error::ChannelNotConverged { channel: 0, reports, .. } if reports.iter().all(|r| r.stop == Stop::MaxIterations && r.iterations == 2)),
             "{err}"
         );
         // A zero right-hand side is solved at once (x = 0).
         let zero = vec![0.0; n];
-        let mut y = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-        let [y0, y1, y2] = &mut y;
-        let reports = block
-            .cg(
-                [&zero, &b[1], &zero],
-                [y0, y1, y2],
-                &SolveOptions::new(1e-8, 500),
-                None,
-            )
-            .unwrap();
+        let reports = cg_from_zero(
+            &block,
+            [&zero, &b[1], &zero],
+            &SolveOptions::new(1e-8, 500),
+            None,
+        )
+        .0
+        .unwrap();
         assert_eq!(reports[0].iterations, 0);
         assert!(reports[1].iterations > 0);
     }
@@ -1404,17 +1413,13 @@ mod tests {
         let fresh = Block3::new([&scaled[0], &scaled[1], &scaled[2]]).unwrap();
         let n = block.rows();
         let solve = |block: &Block3| {
-            let mut x = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
-            let [x0, x1, x2] = &mut x;
-            let r = block
-                .cg(
-                    [&b[0], &b[1], &b[2]],
-                    [x0, x1, x2],
-                    &SolveOptions::new(1e-10, 500),
-                    None,
-                )
-                .unwrap();
-            (x, r)
+            let (r, x) = cg_from_zero(
+                block,
+                [&b[0], &b[1], &b[2]],
+                &SolveOptions::new(1e-10, 500),
+                None,
+            );
+            (x, r.unwrap())
         };
         assert_eq!(solve(&block), solve(&fresh));
         // Half the solution of the unscaled system.

@@ -217,6 +217,25 @@ impl Emitter {
 
     /// `face_index` `(n,)` and `barycentric` `(n, 3)` of the same length,
     /// faces checked in range.
+    /// [`hits_arg`](Self::hits_arg) and, when given, one reference
+    /// point per hit (`reference_points`: one `(3,)` or `(n, 3)`).
+    #[allow(
+        clippy::type_complexity,
+        reason = "three parallel arrays, named at the call"
+    )]
+    fn hits_toward(
+        &self,
+        face_index: &Bound<'_, PyAny>,
+        barycentric: &Bound<'_, PyAny>,
+        reference_points: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<(Vec<usize>, Vec<[f32; 3]>, Option<Vec<Vec3>>)> {
+        let (faces, bary) = self.hits_arg(face_index, barycentric)?;
+        let references = reference_points
+            .map(|r| points_arg(r, "reference_points", faces.len(), self.origin))
+            .transpose()?;
+        Ok((faces, bary, references))
+    }
+
     fn hits_arg(
         &self,
         face_index: &Bound<'_, PyAny>,
@@ -524,10 +543,8 @@ impl Emitter {
         barycentric: &Bound<'py, PyAny>,
         reference_points: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (faces, bary) = self.hits_arg(face_index, barycentric)?;
-        let references = reference_points
-            .map(|r| points_arg(r, "reference_points", faces.len(), self.origin))
-            .transpose()?;
+        let (faces, bary, references) =
+            self.hits_toward(face_index, barycentric, reference_points)?;
         let pdf = self.run(py, move |e| {
             Ok(per_hit(
                 &faces,
@@ -551,10 +568,8 @@ impl Emitter {
         barycentric: &Bound<'py, PyAny>,
         reference_points: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let (faces, bary) = self.hits_arg(face_index, barycentric)?;
-        let references = reference_points
-            .map(|r| points_arg(r, "reference_points", faces.len(), self.origin))
-            .transpose()?;
+        let (faces, bary, references) =
+            self.hits_toward(face_index, barycentric, reference_points)?;
         let le = self.run(py, move |e| {
             Ok(per_hit(
                 &faces,

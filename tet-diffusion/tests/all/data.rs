@@ -142,6 +142,15 @@ fn manufactured(mesh: TetMesh, mu_a: f64, sigma_s: f64) -> f64 {
     rel_l2(o.mesh(), o.phi(0), &exact)
 }
 
+/// Every TetGen mesh of the data with its scale and millimetres per unit:
+/// the 10 mm spheres in mm, the bunnies in metres.
+const TETGEN_MESHES: [(&str, f64, f64); 4] = [
+    ("sphere_20k.node", 10.0, 1.0),
+    ("sphere_200k.node", 1.0, 10.0),
+    ("bunny_50k.node", 1.0, 1000.0),
+    ("bunny_500k.node", 1.0, 1000.0),
+];
+
 /// `mesh` of one measured material, lit by one directional light.
 fn lit(mesh: &TetMesh, material: &str, unit_mm: f64, eta: f64) -> Object {
     let m = Medium::measured(material).unwrap();
@@ -168,12 +177,7 @@ fn radiance_balances_the_power_on_every_tetgen_mesh() {
     // power in − ∫ μa φ dV, to 1 %, for two materials and three indices
     // (the 10 mm spheres in mm, the bunnies in metres); Eq. 3 as printed
     // is η² off.
-    for (name, scale, unit_mm) in [
-        ("sphere_20k.node", 10.0, 1.0),
-        ("sphere_200k.node", 1.0, 10.0),
-        ("bunny_50k.node", 1.0, 1000.0),
-        ("bunny_500k.node", 1.0, 1000.0),
-    ] {
+    for (name, scale, unit_mm) in TETGEN_MESHES {
         let mesh = read(name, scale);
         let big = mesh.tets().len() > 300_000;
         for material in ["marble", "skimmilk"] {
@@ -251,12 +255,7 @@ fn the_chosen_solver_is_within_one_percent_on_every_tetgen_mesh() {
     // The default solve (Method::Auto, 10⁻⁶) against a reference by
     // V-cycle-PCG to 10⁻¹⁰, marble and skim milk: the choice never costs
     // accuracy.
-    for (name, scale, unit_mm) in [
-        ("sphere_20k.node", 10.0, 1.0),
-        ("sphere_200k.node", 1.0, 10.0),
-        ("bunny_50k.node", 1.0, 1000.0),
-        ("bunny_500k.node", 1.0, 1000.0),
-    ] {
+    for (name, scale, unit_mm) in TETGEN_MESHES {
         let mesh = read(name, scale);
         for material in ["marble", "skimmilk"] {
             let mut o = lit(&mesh, material, unit_mm, 1.3);
