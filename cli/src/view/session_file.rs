@@ -386,7 +386,10 @@ pub fn from_json_in(text: &str, dir: Option<&Path>) -> Result<(Value, Log, EnvFi
 }
 
 /// The camera direction a session file's `source` keeps (`"view"`, from
-/// the object toward the camera), if any.
+/// the object toward the camera), if any: exactly as saved, not
+/// normalized, so that a replay frames the picture with the very vector
+/// the page's export used (normalizing twice moves the eye by an ulp,
+/// enough to change a pixel of the PNG).
 ///
 /// # Errors
 /// A message naming `source.view` when it is not three finite numbers
@@ -395,17 +398,21 @@ pub fn saved_view(source: &Value) -> Result<Option<DVec3>, String> {
     let Some(v) = source.get("view").filter(|v| !v.is_null()) else {
         return Ok(None);
     };
-    let bad = || "source.view: expected three finite numbers, not all zero".to_string();
+    let bad = || {
+        "source.view: expected three finite numbers, not all zero, within f32's range".to_string()
+    };
     let a = v.as_array().filter(|a| a.len() == 3).ok_or_else(bad)?;
     let x: Vec<f64> = a
         .iter()
         .map(|x| x.as_f64().ok_or_else(bad))
         .collect::<Result<_, _>>()?;
     let d = DVec3::new(x[0], x[1], x[2]);
-    if !d.is_finite() || d.length() == 0.0 {
+    // The camera works in f32: the direction must keep a length there.
+    let f = d.as_vec3();
+    if !d.is_finite() || !f.length_recip().is_finite() || f.length_recip() == 0.0 {
         return Err(bad());
     }
-    Ok(Some(d.normalize()))
+    Ok(Some(d))
 }
 
 /// Writes the file atomically; an existing file only with `overwrite`.

@@ -283,6 +283,12 @@ fn a_bad_session_file_is_an_error_naming_the_file_and_the_entry() {
             .to_string(),
             "source.view: expected three finite numbers",
         ),
+        (
+            json!({"format": "trilux-session", "version": 1, "refined_initially": true,
+                   "source": {"mesh": null, "view": [1e300, 0, 0]}, "edits": []})
+            .to_string(),
+            "within f32's range",
+        ),
     ];
     for (k, (text, needle)) in cases.iter().enumerate() {
         let name = format!("bad{k}.json");
