@@ -1,19 +1,26 @@
 //! Editing coloured meshes without resampling (Sec. 3.3): exact 1-to-4
-//! subdivision, deleting and adding faces, and changing one face's
-//! resolution. Vertex moves need nothing: samples live on primitives, not
-//! at positions.
+//! subdivision, deleting and adding faces, and changing face resolutions
+//! (Sec. 3.2, the painting system's "on-the-fly adjustment of local
+//! resolution", Sec. 5.1). Vertex moves need nothing: samples live on
+//! primitives, not at positions.
 //!
-//! Edits build a new sample array and copy every sample they keep (the
-//! indices of Fig. 10 change, the values do not): the cost is a copy of
-//! the array, and only the primitives an edit touches get new values.
+//! Topology edits build a new sample array and copy every sample they keep
+//! (the indices of Fig. 10 change, the values do not): the cost is a copy
+//! of the array, and only the primitives an edit touches get new values.
+//! [`MeshColors::set_face_resolutions`] works in place: it resamples only
+//! the faces it is given and the edges whose resolution follows them, and
+//! returns a [`ResolutionChange`] that undoes it exactly.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use glam::Vec3;
 
 use crate::Error;
 use crate::filter::{FINEST, Store, edge_point, eval, lattice};
-use crate::structure::{MeshColors, lattice_points, level_of, sample_position};
+use crate::structure::{
+    MeshColors, lattice_points, level_of, sample_position, samples_per_edge, samples_per_face,
+};
+use crate::topology::NO_FACE;
 use crate::topology::Topology;
 
 /// Corners of the four children of a face, as lattice points of the
@@ -324,5 +331,457 @@ impl MeshColors {
             }
         }
         Ok(out)
+    }
+}
+
+/// What one [`MeshColors::set_face_resolutions`] did, and all an undo
+/// needs: the resolution and the samples, before the change, of every face
+/// and edge it resampled — nothing else (Sec. 5.1's undo: deltas, never
+/// whole copies).
+///
+/// Undo is [`MeshColors::revert_resolutions`], which restores those
+/// samples bit for bit; redo is `set_face_resolutions(&change.requests())`
+/// on the reverted colours, which is deterministic and so gives the same
+/// samples (and an equal record) again.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResolutionChange {
+    channels: usize,
+    /// The validated requests, in order: face and level.
+    requests: Vec<(u32, u8)>,
+    /// Resampled faces in the order first touched: face, level before,
+    /// level after.
+    faces: Vec<(u32, u8, u8)>,
+    /// Their interior samples before, concatenated in `faces` order.
+    face_values: Vec<f32>,
+    /// Resampled edges (their resolution changed): edge, level before,
+    /// level after.
+    edges: Vec<(u32, u8, u8)>,
+    /// Their samples before, concatenated in `edges` order.
+    edge_values: Vec<f32>,
+}
+
+impl ResolutionChange {
+    /// The requests as given (face, resolution), for redo.
+    pub fn requests(&self) -> Vec<(usize, u32)> {
+        self.requests
+            .iter()
+            .map(|&(f, n)| (f as usize, 1u32 << n))
+            .collect()
+    }
+
+    /// The faces that were resampled, each once: `(face, resolution
+    /// before, resolution after)`. A face asked for at its own resolution
+    /// is not resampled and not listed.
+    pub fn faces(&self) -> impl ExactSizeIterator<Item = (usize, u32, u32)> + '_ {
+        self.faces
+            .iter()
+            .map(|&(f, a, b)| (f as usize, 1u32 << a, 1u32 << b))
+    }
+
+    /// The edges whose resolution changed (the lowest of their faces,
+    /// Sec. 3.2), each once: `(edge, resolution before, resolution after)`.
+    pub fn edges(&self) -> impl ExactSizeIterator<Item = (usize, u32, u32)> + '_ {
+        self.edges
+            .iter()
+            .map(|&(e, a, b)| (e as usize, 1u32 << a, 1u32 << b))
+    }
+
+    /// Whether nothing changed (every request was a face's own resolution).
+    pub fn is_empty(&self) -> bool {
+        self.faces.is_empty()
+    }
+
+    /// Heap bytes this record holds (its capacity, not just its length).
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.requests.capacity() * std::mem::size_of::<(u32, u8)>()
+            + (self.faces.capacity() + self.edges.capacity()) * std::mem::size_of::<(u32, u8, u8)>()
+            + (self.face_values.capacity() + self.edge_values.capacity()) * 4
+    }
+}
+
+/// The mesh colours as a batch sees them between two of its steps: levels
+/// already updated in `mc`, the new samples of resampled faces and edges
+/// in the overlays, every other sample where it was.
+struct Staged<'a> {
+    mc: &'a MeshColors,
+    faces: &'a HashMap<usize, Vec<f32>>,
+    edges: &'a HashMap<usize, Vec<f32>>,
+}
+
+impl Store for Staged<'_> {
+    #[inline]
+    fn colors(&self) -> &MeshColors {
+        self.mc
+    }
+    #[inline]
+    fn vertex_at(&self, v: usize, level: u8) -> &[f32] {
+        self.mc.vertex_at(v, level)
+    }
+    #[inline]
+    fn edge_at(&self, e: usize, level: u8, s: u32) -> &[f32] {
+        let c = self.mc.channels;
+        match self.edges.get(&e) {
+            Some(values) => &values[(s as usize - 1) * c..s as usize * c],
+            None => self.mc.edge_at(e, level, s),
+        }
+    }
+    #[inline]
+    fn face_at(&self, f: usize, level: u8, idx: usize) -> &[f32] {
+        let c = self.mc.channels;
+        match self.faces.get(&f) {
+            Some(values) => &values[idx * c..(idx + 1) * c],
+            None => self.mc.face_at(f, level, idx),
+        }
+    }
+}
+
+impl MeshColors {
+    /// Changes the resolution of many faces in place (Sec. 3.2 mixed
+    /// resolutions; the "on-the-fly adjustment of local resolution" of the
+    /// painting system, Sec. 5.1): `changes` is a list of `(face,
+    /// resolution)`, each resolution a power of two up to
+    /// `2^`[`crate::MAX_LEVEL`].
+    ///
+    /// The result is exactly (bit for bit, samples and layout) that of
+    /// calling [`MeshColors::set_face_resolution`] for each pair in order:
+    /// a face is resampled by linear filtering of its current colours, and
+    /// an edge whose resolution (the lowest of its faces) changes is
+    /// resampled from its current samples (copies when coarser, linear
+    /// interpolation when finer), which keeps shared edges continuous. A
+    /// face listed twice is resampled twice. Every other sample keeps its
+    /// value.
+    ///
+    /// **Cost**: the resampling is proportional to the samples of the
+    /// faces and edges touched; the layout of Fig. 10 stays contiguous, so
+    /// the samples after the first touched primitive move once (one
+    /// `memcpy`-speed pass, not one per face), and the per-edge and
+    /// per-face indices after it are renumbered.
+    ///
+    /// Returns what undoes it ([`MeshColors::revert_resolutions`]).
+    ///
+    /// # Errors
+    /// Checked before anything changes (an error leaves the colours as
+    /// they were): [`Error::MissingFace`] naming the first face out of
+    /// range, [`Error::BadResolution`] naming the face whose resolution is
+    /// not a power of two in `1..=2^MAX_LEVEL`, [`Error::TooLarge`] when
+    /// the resulting layout would exceed [`crate::MAX_SAMPLE_VALUES`].
+    ///
+    /// # Example
+    /// ```
+    /// use mesh_colors::{MeshColors, Topology};
+    /// let topology = Topology::new(4, &[[0, 1, 2], [2, 1, 3]])?;
+    /// let mut colors = MeshColors::uniform(topology, 2, 3)?;
+    /// colors.samples_mut().iter_mut().enumerate().for_each(|(i, x)| *x = i as f32);
+    /// let before = colors.clone();
+    /// let change = colors.set_face_resolutions(&[(0, 8), (1, 4)])?;
+    /// assert_eq!(colors.face_resolution(0), Some(8));
+    /// assert_eq!(colors.edge_resolution(1), Some(4)); // the shared edge
+    /// colors.revert_resolutions(&change)?;
+    /// assert_eq!(colors, before);
+    /// assert!(colors.set_face_resolutions(&[(0, 4), (7, 2)]).is_err());
+    /// assert_eq!(colors, before); // nothing changed
+    /// # Ok::<(), mesh_colors::Error>(())
+    /// ```
+    pub fn set_face_resolutions(
+        &mut self,
+        changes: &[(usize, u32)],
+    ) -> Result<ResolutionChange, Error> {
+        let face_count = self.face_count();
+        let mut requests = Vec::with_capacity(changes.len());
+        for &(f, r) in changes {
+            if f >= face_count {
+                return Err(Error::MissingFace {
+                    face: f,
+                    count: face_count,
+                });
+            }
+            requests.push((f as u32, level_of(f, r)?));
+        }
+        self.check_budget(&requests)?;
+        let c = self.channels;
+        let mut record = ResolutionChange {
+            channels: c,
+            requests,
+            faces: Vec::new(),
+            face_values: Vec::new(),
+            edges: Vec::new(),
+            edge_values: Vec::new(),
+        };
+        let mut face_new: HashMap<usize, Vec<f32>> = HashMap::new();
+        let mut edge_new: HashMap<usize, Vec<f32>> = HashMap::new();
+        let mut value = vec![0.0f32; c];
+        let mut lowered = false;
+        for &(f, n1) in &record.requests {
+            let f = f as usize;
+            let n0 = self.face_level[f];
+            if n0 == n1 {
+                continue;
+            }
+            lowered |= n1 < n0;
+            // Each local edge: its level now and after this step.
+            let plan = self.topology.face_edges[f].map(|e| {
+                let e = e as usize;
+                let after = self.topology.edge_faces[e]
+                    .iter()
+                    .filter(|&&g| g != NO_FACE)
+                    .map(|&g| {
+                        if g as usize == f {
+                            n1
+                        } else {
+                            self.face_level[g as usize]
+                        }
+                    })
+                    .min()
+                    .unwrap_or(n1);
+                (e, self.edge_level[e], after)
+            });
+            // New values, all computed from the state before this step
+            // (as `rebuild` computes them from the old colours).
+            let (face_values, edge_values) = {
+                let staged = Staged {
+                    mc: self,
+                    faces: &face_new,
+                    edges: &edge_new,
+                };
+                let r = 1u32 << n1;
+                let mut fv = Vec::with_capacity(samples_per_face(r) as usize * c);
+                for i in 1..r {
+                    for j in 1..r - i {
+                        let b = sample_position(r, i, j).map(|x| x as f32);
+                        eval(&staged, f, b, FINEST, false, &mut value);
+                        fv.extend_from_slice(&value);
+                    }
+                }
+                let mut ev: [Option<Vec<f32>>; 3] = [None, None, None];
+                for (slot, &(e, le0, le1)) in ev.iter_mut().zip(&plan) {
+                    if le0 == le1 {
+                        continue;
+                    }
+                    let lp = le0.max(le1);
+                    let mut v = Vec::with_capacity(samples_per_edge(1 << le1) as usize * c);
+                    for s in 1..1u32 << le1 {
+                        value.fill(0.0);
+                        edge_point(
+                            &staged,
+                            e,
+                            FINEST,
+                            lp,
+                            s << (lp - le1),
+                            1.0,
+                            false,
+                            &mut value,
+                        );
+                        v.extend_from_slice(&value);
+                    }
+                    *slot = Some(v);
+                }
+                (fv, ev)
+            };
+            // The record keeps each primitive's state before the batch,
+            // taken when the batch first touches it.
+            if !face_new.contains_key(&f) {
+                record.faces.push((f as u32, n0, n1));
+                let at = self.face_offset[f] * c;
+                let len = samples_per_face(1 << n0) as usize * c;
+                record
+                    .face_values
+                    .extend_from_slice(&self.samples[at..at + len]);
+            }
+            face_new.insert(f, face_values);
+            self.face_level[f] = n1;
+            for ((e, le0, le1), v) in plan.into_iter().zip(edge_values) {
+                let Some(v) = v else { continue };
+                if !edge_new.contains_key(&e) {
+                    record.edges.push((e as u32, le0, le1));
+                    let at = self.edge_offset[e] * c;
+                    let len = samples_per_edge(1 << le0) as usize * c;
+                    record
+                        .edge_values
+                        .extend_from_slice(&self.samples[at..at + len]);
+                }
+                edge_new.insert(e, v);
+                self.edge_level[e] = le1;
+            }
+        }
+        for x in &mut record.faces {
+            x.2 = self.face_level[x.0 as usize];
+        }
+        for x in &mut record.edges {
+            x.2 = self.edge_level[x.0 as usize];
+        }
+        self.relayout(&face_new, &edge_new);
+        let touched: Vec<usize> = record.faces.iter().map(|x| x.0 as usize).collect();
+        self.update_vertex_levels(&touched, lowered);
+        record.requests.shrink_to_fit();
+        record.faces.shrink_to_fit();
+        record.face_values.shrink_to_fit();
+        record.edges.shrink_to_fit();
+        record.edge_values.shrink_to_fit();
+        Ok(record)
+    }
+
+    /// Undoes a [`MeshColors::set_face_resolutions`]: the faces and edges it
+    /// resampled get their resolutions and samples back, bit for bit.
+    /// Changes made after it must be undone first (undo is last in, first
+    /// out); samples painted since on *other* primitives are kept.
+    ///
+    /// # Errors
+    /// [`Error::StaleUndo`] naming the face or edge that is not at the
+    /// resolution the change left it at, or the channel count that
+    /// differs (the record belongs to another state); nothing changes then.
+    pub fn revert_resolutions(&mut self, change: &ResolutionChange) -> Result<(), Error> {
+        if change.channels != self.channels {
+            return Err(Error::StaleUndo {
+                what: "channels",
+                index: change.channels,
+                reason: "differ from these colours' channel count",
+            });
+        }
+        for &(f, _, after) in &change.faces {
+            if self.face_level.get(f as usize) != Some(&after) {
+                return Err(Error::StaleUndo {
+                    what: "face",
+                    index: f as usize,
+                    reason: "is not at the resolution the change left it at",
+                });
+            }
+        }
+        for &(e, _, after) in &change.edges {
+            if self.edge_level.get(e as usize) != Some(&after) {
+                return Err(Error::StaleUndo {
+                    what: "edge",
+                    index: e as usize,
+                    reason: "is not at the resolution the change left it at",
+                });
+            }
+        }
+        let c = self.channels;
+        let mut face_old = HashMap::with_capacity(change.faces.len());
+        let mut at = 0;
+        let mut lowered = false;
+        for &(f, before, after) in &change.faces {
+            let len = samples_per_face(1 << before) as usize * c;
+            face_old.insert(f as usize, change.face_values[at..at + len].to_vec());
+            at += len;
+            self.face_level[f as usize] = before;
+            lowered |= before < after;
+        }
+        let mut edge_old = HashMap::with_capacity(change.edges.len());
+        let mut at = 0;
+        for &(e, before, _) in &change.edges {
+            let len = samples_per_edge(1 << before) as usize * c;
+            edge_old.insert(e as usize, change.edge_values[at..at + len].to_vec());
+            at += len;
+            self.edge_level[e as usize] = before;
+        }
+        self.relayout(&face_old, &edge_old);
+        let touched: Vec<usize> = change.faces.iter().map(|x| x.0 as usize).collect();
+        self.update_vertex_levels(&touched, lowered);
+        Ok(())
+    }
+
+    /// Checks that applying `requests` (validated face, level) keeps the
+    /// layout within [`crate::MAX_SAMPLE_VALUES`].
+    fn check_budget(&self, requests: &[(u32, u8)]) -> Result<(), Error> {
+        let mut last: HashMap<usize, u8> = HashMap::new();
+        for &(f, n) in requests {
+            last.insert(f as usize, n);
+        }
+        let level = |f: usize| last.get(&f).copied().unwrap_or(self.face_level[f]);
+        let mut total = self.sample_count() as i128;
+        let mut edges = HashSet::new();
+        for (&f, &n) in &last {
+            total += i128::from(samples_per_face(1 << n))
+                - i128::from(samples_per_face(1 << self.face_level[f]));
+            for e in self.topology.face_edges[f] {
+                if !edges.insert(e) {
+                    continue;
+                }
+                let e = e as usize;
+                let le = self.topology.edge_faces[e]
+                    .iter()
+                    .filter(|&&g| g != NO_FACE)
+                    .map(|&g| level(g as usize))
+                    .min()
+                    .unwrap_or(0);
+                total += i128::from(samples_per_edge(1 << le))
+                    - i128::from(samples_per_edge(1 << self.edge_level[e]));
+            }
+        }
+        let values = total.max(0) as u128 * self.channels as u128;
+        if values > u128::from(crate::MAX_SAMPLE_VALUES) {
+            return Err(Error::TooLarge {
+                what: "the mesh colours after the resolution change",
+                requested: u64::try_from(values).unwrap_or(u64::MAX),
+                budget: crate::MAX_SAMPLE_VALUES,
+                unit: "f32 values",
+            });
+        }
+        Ok(())
+    }
+
+    /// Rewrites the sample array after the levels of the primitives in
+    /// `faces` and `edges` changed: those get the given values (at their
+    /// new level), the others keep theirs. The samples before the first
+    /// such primitive stay in place; the rest move once.
+    fn relayout(&mut self, faces: &HashMap<usize, Vec<f32>>, edges: &HashMap<usize, Vec<f32>>) {
+        let c = self.channels;
+        let first_edge = edges.keys().copied().min();
+        let first_face = faces.keys().copied().min();
+        let (e0, f0, start) = match (first_edge, first_face) {
+            (Some(e), _) => (e, 0, self.edge_offset[e]),
+            (None, Some(f)) => (self.edge_offset.len(), f, self.face_offset[f]),
+            (None, None) => return,
+        };
+        let tail = self.samples.split_off(start * c);
+        let mut next = start;
+        for e in e0..self.edge_offset.len() {
+            let n = samples_per_edge(1 << self.edge_level[e]) as usize;
+            match edges.get(&e) {
+                Some(v) => self.samples.extend_from_slice(v),
+                None => {
+                    let from = (self.edge_offset[e] - start) * c;
+                    self.samples.extend_from_slice(&tail[from..from + n * c]);
+                }
+            }
+            self.edge_offset[e] = next;
+            next += n;
+        }
+        for f in f0..self.face_offset.len() {
+            let n = samples_per_face(1 << self.face_level[f]) as usize;
+            match faces.get(&f) {
+                Some(v) => self.samples.extend_from_slice(v),
+                None => {
+                    let from = (self.face_offset[f] - start) * c;
+                    self.samples.extend_from_slice(&tail[from..from + n * c]);
+                }
+            }
+            self.face_offset[f] = next;
+            next += n;
+        }
+    }
+
+    /// Brings the vertex levels (the finest of each vertex's faces) up to
+    /// date after the faces `touched` changed level: raised in place, or
+    /// recomputed over all faces when one was lowered.
+    fn update_vertex_levels(&mut self, touched: &[usize], lowered: bool) {
+        if lowered {
+            self.vertex_level.fill(0);
+            for (face, &n) in self.topology.faces.iter().zip(&self.face_level) {
+                for &v in face {
+                    let l = &mut self.vertex_level[v as usize];
+                    *l = (*l).max(n);
+                }
+            }
+        } else {
+            for &f in touched {
+                let n = self.face_level[f];
+                for v in self.topology.faces[f] {
+                    let l = &mut self.vertex_level[v as usize];
+                    *l = (*l).max(n);
+                }
+            }
+        }
     }
 }

@@ -148,6 +148,20 @@ pub enum Error {
         /// The unit of both numbers.
         unit: &'static str,
     },
+    /// An undo record (a [`crate::undo::Delta`] or an
+    /// [`crate::edit::ResolutionChange`]) applied to mesh colours it does not
+    /// describe: another mesh, or a state it was not taken from (an undo
+    /// applied twice, or out of order).
+    #[error("the undo record does not fit these mesh colours: {what} {index} {reason}")]
+    StaleUndo {
+        /// The element that does not fit ("face", "edge", "sample",
+        /// "channels").
+        what: &'static str,
+        /// Its index (or the count, for "channels").
+        index: usize,
+        /// How it differs from the record.
+        reason: &'static str,
+    },
     /// Mesh colours loaded for a mesh they do not belong to.
     #[error("the mesh colours belong to a mesh with {stored}, but this mesh has {expected}")]
     WrongMesh {

@@ -22,7 +22,10 @@ fn mixed(seed: u64) -> (Vec<Vec3>, Vec<[u32; 3]>, MeshColors) {
 
 /// For every interior edge and many parameters `t`, the barycentrics of
 /// the point from each of its two faces.
-fn edge_points(mc: &MeshColors, rng: &mut Rng) -> Vec<(usize, [f32; 3], usize, [f32; 3])> {
+pub(crate) fn edge_points(
+    mc: &MeshColors,
+    rng: &mut Rng,
+) -> Vec<(usize, [f32; 3], usize, [f32; 3])> {
     let t = mc.topology();
     let mut out = Vec::new();
     for (e, fs) in t.edge_faces().iter().enumerate() {

@@ -14,5 +14,6 @@ mod file;
 mod filtering;
 mod limits;
 mod paint;
+mod resolution;
 mod structure;
 mod texture;
