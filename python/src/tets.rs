@@ -47,7 +47,13 @@ pub(crate) fn tets_in(
 /// int64 node indices (positive volume), plus a report dict when
 /// `return_report=True`: `tets`, `vertices`, `boundary_triangles`,
 /// `spacing`, `min_dihedral_deg`, `max_dihedral_deg` (the dihedral-angle
-/// range, the stuffing's quality bound), `seconds`.
+/// range, the stuffing's quality bound), how far the tets' boundary lies
+/// from the surface — `hausdorff` (symmetric), `input_to_tets`,
+/// `tets_to_input`, `mean_distance` in mesh units, `hausdorff_fraction` and
+/// `mean_distance_fraction` of the bounding box's `diagonal`, measured at
+/// `distance_points` (input, boundary) points — `left_out_triangles` and
+/// `left_out_area_fraction` (input triangles that enclose no volume, also
+/// a `UserWarning`), and `seconds`.
 ///
 /// `spacing`: the lattice spacing in mesh units (default: 1/40 of the
 /// bounding box's diagonal, as `trilux tetra`); `graded=True` makes the
@@ -85,8 +91,36 @@ pub(crate) fn tetrahedralize<'py>(
         d.set_item("spacing", h)?;
         d.set_item("min_dihedral_deg", r.min_dihedral_deg)?;
         d.set_item("max_dihedral_deg", r.max_dihedral_deg)?;
+        if let Some(m) = &r.distance {
+            d.set_item("hausdorff", m.hausdorff)?;
+            d.set_item("hausdorff_fraction", m.hausdorff_fraction())?;
+            d.set_item("mean_distance", m.mean)?;
+            d.set_item("mean_distance_fraction", m.mean_fraction())?;
+            d.set_item("input_to_tets", m.input_to_tets)?;
+            d.set_item("tets_to_input", m.tets_to_input)?;
+            d.set_item("diagonal", m.diagonal)?;
+            d.set_item("distance_points", (m.input_samples, m.boundary_samples))?;
+            d.set_item("left_out_triangles", m.left_out_triangles)?;
+            d.set_item("left_out_area_fraction", m.left_out_area)?;
+        }
         d.set_item("seconds", r.elapsed.as_secs_f64())?;
         items.push(d.into_any());
+    }
+    if let Some(m) = stuffed
+        .report
+        .distance
+        .as_ref()
+        .filter(|m| m.left_out_triangles > 0)
+    {
+        crate::mesh::warn_user(
+            py,
+            &format!(
+                "trilux.tetrahedralize: {} triangles ({:.2}% of the area) enclose no volume \
+                 (open sheets or fins by the winding number) and are left out of the tetrahedra",
+                m.left_out_triangles,
+                100.0 * m.left_out_area
+            ),
+        )?;
     }
     PyTuple::new(py, items)
 }

@@ -60,6 +60,11 @@ def test_tetrahedralize_and_tet_files(tmp_path):
     nodes, tets, report = trilux.tetrahedralize(sphere, spacing=0.15, return_report=True)
     assert nodes.dtype == np.float64 and tets.dtype == np.int64
     assert report["tets"] == len(tets) and report["min_dihedral_deg"] > 5
+    # The boundary within the spacing of the sphere, both ways.
+    assert 0 < report["mean_distance"] < report["hausdorff"] < 0.15
+    assert report["hausdorff"] == max(report["input_to_tets"], report["tets_to_input"])
+    assert report["hausdorff_fraction"] == pytest.approx(report["hausdorff"] / report["diagonal"])
+    assert report["left_out_triangles"] == 0 and min(report["distance_points"]) >= 65536
     t = nodes[tets]
     volume = np.einsum("ij,ij->i", np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), t[:, 3] - t[:, 0]) / 6
     assert (volume > 0).all() and abs(volume.sum() - 4 / 3 * np.pi) < 0.15
@@ -68,6 +73,19 @@ def test_tetrahedralize_and_tet_files(tmp_path):
     trilux.save_tets(tmp_path / "s.node", nodes, tets)
     n2, t2 = trilux.load_tets(tmp_path / "s.node")
     assert np.array_equal(t2, tets) and np.abs(n2 - nodes).max() < 1e-9
+
+
+def test_tetrahedralize_warns_of_a_sheet_it_leaves_out():
+    import trimesh
+
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    sheet_v = np.array([[3, -0.5, -0.5], [3, 0.5, -0.5], [3, 0.5, 0.5], [3, -0.5, 0.5]], dtype=float)
+    v = np.vstack([sphere.vertices, sheet_v])
+    n = len(sphere.vertices)
+    f = np.vstack([sphere.faces, [[n, n + 1, n + 2], [n, n + 2, n + 3]]])
+    with pytest.warns(UserWarning, match="2 triangles .* left out"):
+        _, _, report = trilux.tetrahedralize((v, f), spacing=0.15, return_report=True)
+    assert report["left_out_triangles"] == 2 and report["hausdorff"] < 0.15
 
 
 def test_transcut_object_solve_cut_paint_fracture_render():

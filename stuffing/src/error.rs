@@ -82,6 +82,10 @@ pub enum Error {
         /// Its value.
         value: f64,
     },
+    /// The second surface of [`crate::surface_distance`] (the boundary
+    /// measured against the input) is not a valid triangle soup.
+    #[error("the boundary surface: {0}")]
+    InBoundary(Box<Error>),
 }
 
 /// A vertex count for a message: "more than 10^36" for the saturated one.

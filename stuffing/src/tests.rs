@@ -411,6 +411,7 @@ fn the_same_input_gives_the_same_mesh_on_one_and_two_threads() {
         let b = run_on(2, &options);
         assert_eq!(a.tets, b.tets);
         assert_eq!(a.boundary, b.boundary);
+        assert_eq!(a.report.distance, b.report.distance);
         assert!(
             a.positions
                 .iter()
@@ -522,4 +523,93 @@ fn bad_input_is_refused_with_the_reason() {
     }
     .to_string();
     assert!(msg.contains("triangle 5") && msg.contains("vertex 9"));
+}
+
+#[test]
+fn the_distance_between_concentric_spheres_is_the_difference_of_their_radii() {
+    let (p, t) = sphere(48, 1.0, DVec3::ZERO);
+    let (q, u) = sphere(48, 1.1, DVec3::ZERO);
+    let wn = winding::WindingNumber::new(&p, &t, winding::DEFAULT_BETA).unwrap();
+    let d = distance::measure(&wn, &q, &u, 20_000);
+    // Each facet of the 48-ring spheres sags at most r (1 - cos(pi/48))
+    // (0.0024 at r = 1.1) below the round sphere.
+    for x in [d.hausdorff, d.input_to_tets, d.tets_to_input, d.mean] {
+        assert!((x - 0.1).abs() < 0.005, "{d:?}");
+    }
+    assert!((d.diagonal - 2.0 * 3f64.sqrt()).abs() < 1e-9, "{d:?}");
+    assert_eq!(d.left_out_triangles, 0);
+    // Samples plus every vertex (fewer than the samples).
+    assert_eq!(d.input_samples, 20_000 + p.len());
+    assert_eq!(d.boundary_samples, 20_000 + q.len());
+}
+
+#[test]
+fn an_open_sheet_is_left_out_and_counted_not_measured() {
+    // A unit sphere and, far from it, a square sheet of side 2: it
+    // encloses no volume, so its distance to the boundary (about 5) must
+    // not count, and its area share is reported.
+    let sheet: Soup = (
+        vec![
+            DVec3::new(5.0, -1.0, -1.0),
+            DVec3::new(5.0, 1.0, -1.0),
+            DVec3::new(5.0, 1.0, 1.0),
+            DVec3::new(5.0, -1.0, 1.0),
+        ],
+        vec![[0, 1, 2], [0, 2, 3]],
+    );
+    let (p, t) = join(sphere(32, 1.0, DVec3::ZERO), sheet);
+    let m = tetrahedralize(&p, &t, &Options::new(0.15)).unwrap();
+    let d = m.report.distance.unwrap();
+    assert_eq!(d.left_out_triangles, 2, "{d:?}");
+    let sphere_area: f64 = t[..t.len() - 2]
+        .iter()
+        .map(|f| {
+            0.5 * (p[f[1] as usize] - p[f[0] as usize])
+                .cross(p[f[2] as usize] - p[f[0] as usize])
+                .length()
+        })
+        .sum();
+    assert!(
+        (d.left_out_area - 4.0 / (4.0 + sphere_area)).abs() < 1e-9,
+        "{d:?}"
+    );
+    assert!(d.input_to_tets < 0.15, "{d:?}");
+    // The boundary is measured against every input triangle.
+    assert!(d.tets_to_input < 0.15, "{d:?}");
+}
+
+#[test]
+fn a_stuffed_sphere_reports_its_distance_within_the_lattice_spacing() {
+    let (p, t) = sphere(48, 1.0, DVec3::ZERO);
+    let h = 0.15;
+    let m = tetrahedralize(&p, &t, &Options::new(h)).unwrap();
+    let d = m.report.distance.clone().unwrap();
+    assert!(
+        d.hausdorff < h && d.mean < d.hausdorff && d.mean > 0.0,
+        "{d:?}"
+    );
+    assert!((d.hausdorff_fraction() - d.hausdorff / d.diagonal).abs() < 1e-15);
+    // Measured again, the same figures to the bit.
+    let again = surface_distance(&p, &t, &m.positions, &m.boundary, 1 << 16).unwrap();
+    assert_eq!(&again, &d);
+    // A bad second surface is named as such.
+    let e = surface_distance(&p, &t, &m.positions, &[[0, 1, u32::MAX]], 10).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("the boundary surface: triangle 0"),
+        "{e}"
+    );
+    let e = surface_distance(&p, &t, &[DVec3::NAN; 3], &[[0, 1, 2]], 10).unwrap_err();
+    assert!(e.to_string().contains("vertex 0 has a NaN"), "{e}");
+    let e = surface_distance(&p, &[], &m.positions, &m.boundary, 10).unwrap_err();
+    assert_eq!(e, Error::NoTriangles);
+    let mut options = Options::new(h);
+    options.distance_samples = 0;
+    assert!(
+        tetrahedralize(&p, &t, &options)
+            .unwrap()
+            .report
+            .distance
+            .is_none()
+    );
 }

@@ -181,6 +181,21 @@ impl WindingNumber {
         solid_angle(a, b, c)
     }
 
+    /// The positions the tree was built on.
+    pub(crate) fn positions(&self) -> &[DVec3] {
+        &self.positions
+    }
+
+    /// The triangles the tree was built on.
+    pub(crate) fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// The tree over [`Self::triangles`].
+    pub(crate) fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+
     /// Crossings of the segment `a -> b` with the triangles, sorted by the
     /// segment parameter (used to place cut points exactly on the surface).
     pub(crate) fn segment_hits(&self, a: DVec3, b: DVec3, out: &mut Vec<(f64, i8)>) {

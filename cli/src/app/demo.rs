@@ -358,6 +358,7 @@ fn translucent(d: &Demo<'_>, i: &Inputs) -> Pipeline {
             option: "--spacing",
         },
         true,
+        false,
     )?;
     let tets = trilux::tet::from_stuffing(&stuffed, i.blob.origin);
     let files = trilux::output::write_atomic_files(&d.path("blob.node"), d.context.force, |tmp| {

@@ -64,7 +64,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     };
     let mesh = super::read_mesh(context, &args.surface)?;
     let (tets, h) = context.step("stuffing", || {
-        stuff(&mesh, &args.surface, spacing, args.graded)
+        stuff(&mesh, &args.surface, spacing, args.graded, true)
     })?;
     let out = trilux::tet::from_stuffing(&tets, mesh.origin);
     let force = context.force;
@@ -90,8 +90,16 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     // The writer's list follows the folder's order; show a stable one.
     files.sort();
     let r = &tets.report;
+    if let Some(d) = r.distance.as_ref().filter(|d| d.left_out_triangles > 0) {
+        eprintln!(
+            "warning: {}: {} triangles ({:.2}% of the area) enclose no volume (open sheets or fins by the winding number) and are left out of the tetrahedra",
+            args.surface.display(),
+            d.left_out_triangles,
+            100.0 * d.left_out_area
+        );
+    }
     let text = format!(
-        "{} tetrahedra, {} vertices, {} boundary triangles at spacing {}{} in {:.2} s; dihedral angles {:.2}° .. {:.2}°; written to {}\n",
+        "{} tetrahedra, {} vertices, {} boundary triangles at spacing {}{} in {:.2} s; dihedral angles {:.2}° .. {:.2}°{}; written to {}\n",
         r.tets,
         r.vertices,
         r.boundary_triangles,
@@ -100,6 +108,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         r.elapsed.as_secs_f64(),
         r.min_dihedral_deg,
         r.max_dihedral_deg,
+        r.distance.as_ref().map(distance_text).unwrap_or_default(),
         files
             .iter()
             .map(|f| f.display().to_string())
@@ -115,10 +124,40 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "spacing": h,
         "graded": args.graded,
         "dihedral_degrees": [r.min_dihedral_deg, r.max_dihedral_deg],
+        "distance": r.distance.as_ref().map(distance_json),
         "stuffing_seconds": r.elapsed.as_secs_f64(),
         "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
         "seconds": context.timings_json(),
     });
     context.report(&text, json);
     Ok(())
+}
+
+/// The summary's clause on how far the boundary lies from the surface.
+fn distance_text(d: &tet_stuffing::SurfaceDistance) -> String {
+    format!(
+        "; boundary within {:.3}% of the diagonal of the surface (Hausdorff; mean {:.3}%; {} + {} points measured)",
+        100.0 * d.hausdorff_fraction(),
+        100.0 * d.mean_fraction(),
+        d.input_samples,
+        d.boundary_samples
+    )
+}
+
+/// `--json`'s `distance`: lengths in the surface's unit, fractions of its
+/// bounding box's diagonal.
+fn distance_json(d: &tet_stuffing::SurfaceDistance) -> serde_json::Value {
+    serde_json::json!({
+        "hausdorff": d.hausdorff,
+        "hausdorff_fraction": d.hausdorff_fraction(),
+        "mean": d.mean,
+        "mean_fraction": d.mean_fraction(),
+        "input_to_tets": d.input_to_tets,
+        "tets_to_input": d.tets_to_input,
+        "diagonal": d.diagonal,
+        "input_points": d.input_samples,
+        "boundary_points": d.boundary_samples,
+        "left_out_triangles": d.left_out_triangles,
+        "left_out_area_fraction": d.left_out_area,
+    })
 }

@@ -73,6 +73,65 @@ fn tetra_writes_tetgen_medit_and_vtu_with_the_reported_counts() {
 }
 
 #[test]
+fn tetra_reports_how_far_the_boundary_lies_from_the_surface_and_what_it_left_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // The blob (about unit size) and, beside it, a square sheet of two
+    // triangles that encloses nothing.
+    let mut surface = trilux::shapes::blob(2);
+    let base = surface.positions.len() as u32;
+    surface.positions.extend(
+        [
+            [3.0, -0.5, -0.5],
+            [3.0, 0.5, -0.5],
+            [3.0, 0.5, 0.5],
+            [3.0, -0.5, 0.5],
+        ]
+        .map(Vec3::from),
+    );
+    surface
+        .indices
+        .extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+    surface.normals = None;
+    surface.uvs = None;
+    surface.objects.clear();
+    surface.write(d.join("blob_sheet.obj")).unwrap();
+    let args = [
+        "tetra",
+        "blob_sheet.obj",
+        "--spacing",
+        "0.1",
+        "-o",
+        "b.node",
+        "--force",
+    ];
+    let report = json(d, &args);
+    let distance = &report["distance"];
+    let get = |key: &str| {
+        distance[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key} in {report}"))
+    };
+    assert_eq!(distance["left_out_triangles"], 2, "{report}");
+    // Within the lattice spacing, and the sheet (2 units away) not counted.
+    assert!(
+        get("hausdorff") < 0.1 && get("mean") < get("hausdorff"),
+        "{report}"
+    );
+    assert!((get("hausdorff_fraction") - get("hausdorff") / get("diagonal")).abs() < 1e-12);
+    assert!(get("input_points") >= 65536.0 && get("boundary_points") >= 65536.0);
+    let out = run(d, &args);
+    assert!(out.status.success());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("; boundary within "), "{stdout}");
+    let stderr = common::stderr(&out);
+    assert!(
+        stderr.contains("blob_sheet.obj: 2 triangles") && stderr.contains("left out"),
+        "{stderr}"
+    );
+}
+
+#[test]
 fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();

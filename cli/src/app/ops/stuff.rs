@@ -51,12 +51,15 @@ impl Spacing {
 
 /// Stuffs `mesh` (read from `path`) at the spacing `spacing` says, by
 /// default 1/40 of the bounding box's diagonal; returns the mesh and the
-/// spacing used.
+/// spacing used. With `distance`, the report says how far the boundary
+/// lies from the surface (`tetra` prints it; a command that goes on to
+/// solve skips the cost).
 pub(crate) fn stuff(
     mesh: &TriMesh,
     path: &Path,
     spacing: Spacing,
     graded: bool,
+    distance: bool,
 ) -> Result<(stuffing::TetMesh, f64)> {
     let (h, given) = match spacing {
         Spacing::Given { h: Some(h), .. } => (h, true),
@@ -83,9 +86,15 @@ pub(crate) fn stuff(
             )
         });
     }
+    let defaults = stuffing::Options::new(h);
     let options = stuffing::Options {
         graded,
-        ..stuffing::Options::new(h)
+        distance_samples: if distance {
+            defaults.distance_samples
+        } else {
+            0
+        },
+        ..defaults
     };
     let stuffed = stuffing::tetrahedralize(&mesh.positions, &mesh.indices, &options)
         .map_err(|e| failure(e, path, spacing, h, given))?;

@@ -1,0 +1,404 @@
+//! How far the stuffed boundary lies from the input surface: the
+//! symmetric Hausdorff distance and the mean distance, sampled on both
+//! surfaces, as meshing papers and tools (Metro, fTetWild's envelope)
+//! report it.
+//!
+//! Only the part of the input that encloses volume is held to the
+//! boundary: a triangle whose two sides have the same inside/outside
+//! status by the winding number (an open sheet, a fin, a doubled wall)
+//! bounds nothing, so the stuffing leaves it out and
+//! [`SurfaceDistance::left_out_triangles`] counts it instead. The other
+//! direction measures the boundary against every input triangle, so a
+//! boundary that spans a hole counts as far from the input by the hole's
+//! size.
+//!
+//! Sampling is deterministic: point `i` of `n` falls in the triangle where
+//! the area's cumulative sum passes `(i + ½) / n` (stratified by area) at
+//! the barycentrics of the `i`-th point of the R₂ sequence (Roberts 2018),
+//! so the same surfaces give the same figures on any number of threads.
+//! The vertices are added when there are no more of them than samples, so
+//! tips and corners, where the largest distances hide, are measured.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::bvh::{Aabb, Bvh};
+use crate::winding::WindingNumber;
+
+/// Distances between the stuffed boundary and the input surface, in the
+/// surface's length unit (see the [module docs](self)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SurfaceDistance {
+    /// The symmetric Hausdorff distance: the larger of
+    /// [`input_to_tets`](Self::input_to_tets) and
+    /// [`tets_to_input`](Self::tets_to_input).
+    pub hausdorff: f64,
+    /// The largest distance from a sampled point of the input (where it
+    /// encloses volume) to the boundary: the parts of the input the
+    /// tetrahedra miss, such as thin parts.
+    pub input_to_tets: f64,
+    /// The largest distance from a sampled point of the boundary to the
+    /// input.
+    pub tets_to_input: f64,
+    /// The mean over both directions' samples of the distance to the other
+    /// surface.
+    pub mean: f64,
+    /// The length of the diagonal of the input's bounding box (of the
+    /// vertices triangles use), the scale the figures are usually quoted
+    /// against.
+    pub diagonal: f64,
+    /// Points measured on the input (samples plus vertices).
+    pub input_samples: usize,
+    /// Points measured on the boundary (samples plus vertices).
+    pub boundary_samples: usize,
+    /// Input triangles of positive area that enclose no volume (the
+    /// winding number is on the same side of ½ in front and behind): left
+    /// out of the tetrahedra and of `input_to_tets`.
+    pub left_out_triangles: usize,
+    /// Their share of the input's area, 0 to 1.
+    pub left_out_area: f64,
+}
+
+impl SurfaceDistance {
+    /// [`hausdorff`](Self::hausdorff) as a fraction of the
+    /// [`diagonal`](Self::diagonal) (0 for a degenerate diagonal).
+    pub fn hausdorff_fraction(&self) -> f64 {
+        fraction(self.hausdorff, self.diagonal)
+    }
+
+    /// [`mean`](Self::mean) as a fraction of the [`diagonal`](Self::diagonal).
+    pub fn mean_fraction(&self) -> f64 {
+        fraction(self.mean, self.diagonal)
+    }
+}
+
+fn fraction(x: f64, diagonal: f64) -> f64 {
+    if diagonal > 0.0 { x / diagonal } else { 0.0 }
+}
+
+/// A triangle surface with the tree its nearest-point queries walk.
+struct Surface<'a> {
+    positions: &'a [DVec3],
+    triangles: &'a [[u32; 3]],
+    bvh: &'a Bvh,
+}
+
+impl Surface<'_> {
+    fn corners(&self, t: usize) -> [DVec3; 3] {
+        self.triangles[t].map(|v| self.positions[v as usize])
+    }
+
+    /// The distance from `q` to the nearest point of the surface.
+    fn distance(&self, q: DVec3) -> f64 {
+        let mut best = f64::INFINITY;
+        // Depth-first, nearer child first; the tree's depth is below 40.
+        let mut stack = [(0u32, 0.0f64); 64];
+        let mut len = 1;
+        while len > 0 {
+            len -= 1;
+            let (n, d2) = stack[len];
+            if d2 >= best {
+                continue;
+            }
+            let node = &self.bvh.nodes[n as usize];
+            if node.is_leaf() {
+                let s = node.start as usize;
+                for &t in &self.bvh.order[s..s + node.count as usize] {
+                    let [a, b, c] = self.corners(t as usize);
+                    best = best.min(closest_point_on_triangle(q, a, b, c).distance_squared(q));
+                }
+                continue;
+            }
+            let [l, r] = node.children;
+            let dl = box_distance2(&self.bvh.nodes[l as usize].bounds, q);
+            let dr = box_distance2(&self.bvh.nodes[r as usize].bounds, q);
+            let (near, far) = if dl <= dr {
+                ((l, dl), (r, dr))
+            } else {
+                ((r, dr), (l, dl))
+            };
+            stack[len] = far;
+            stack[len + 1] = near;
+            len += 2;
+        }
+        best.sqrt()
+    }
+
+    /// `n` points spread over the triangles `chosen` by area (see the
+    /// module docs), plus the vertices those triangles use when there are
+    /// at most `n` of them.
+    fn sample(&self, chosen: &[u32], n: usize) -> Vec<DVec3> {
+        let mut cumulative = Vec::with_capacity(chosen.len());
+        let mut total = 0.0;
+        for &t in chosen {
+            total += area(self.corners(t as usize));
+            cumulative.push(total);
+        }
+        let mut points = Vec::new();
+        if total > 0.0 {
+            points.extend((0..n).map(|i| {
+                let target = (i as f64 + 0.5) / n as f64 * total;
+                let k = cumulative
+                    .partition_point(|&c| c <= target)
+                    .min(chosen.len() - 1);
+                let [a, b, c] = self.corners(chosen[k] as usize);
+                let (u, v) = r2(i);
+                // Uniform on the triangle (Turk 1990's square-root map).
+                let s = u.sqrt();
+                a * (1.0 - s) + b * (s * (1.0 - v)) + c * (s * v)
+            }));
+        }
+        let mut used: Vec<u32> = chosen
+            .iter()
+            .flat_map(|&t| self.triangles[t as usize])
+            .collect();
+        used.sort_unstable();
+        used.dedup();
+        if used.len() <= n {
+            points.extend(used.iter().map(|&v| self.positions[v as usize]));
+        }
+        points
+    }
+}
+
+/// The `i`-th point of the R₂ sequence in the unit square (Roberts 2018:
+/// additive recurrence on the inverse powers of the plastic number).
+fn r2(i: usize) -> (f64, f64) {
+    const G: f64 = 1.324_717_957_244_746;
+    let x = 0.5 + i as f64 / G;
+    let y = 0.5 + i as f64 / (G * G);
+    (x.fract(), y.fract())
+}
+
+fn area([a, b, c]: [DVec3; 3]) -> f64 {
+    0.5 * (b - a).cross(c - a).length()
+}
+
+/// Squared distance from `q` to the box (0 inside).
+fn box_distance2(b: &Aabb, q: DVec3) -> f64 {
+    let d = (b.min - q).max(q - b.max).max(DVec3::ZERO);
+    d.length_squared()
+}
+
+/// The point of the triangle `abc` nearest to `q`, by the Voronoi regions
+/// of its vertices, edges and face (Ericson, Real-Time Collision Detection,
+/// Sec. 5.1.5). Degenerate triangles fall into an edge or vertex region.
+pub(crate) fn closest_point_on_triangle(q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = q - a;
+    let d1 = ab.dot(ap);
+    let d2 = ac.dot(ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = q - b;
+    let d3 = ab.dot(bp);
+    let d4 = ac.dot(bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = q - c;
+    let d5 = ab.dot(cp);
+    let d6 = ac.dot(cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = va + vb + vc;
+    if denom.is_nan() || denom <= 0.0 {
+        // Collinear corners that no region above took: the nearest of
+        // the three edges' points.
+        return [
+            closest_on_segment(q, a, b),
+            closest_on_segment(q, b, c),
+            closest_on_segment(q, c, a),
+        ]
+        .into_iter()
+        .min_by(|x, y| x.distance_squared(q).total_cmp(&y.distance_squared(q)))
+        .unwrap_or(a);
+    }
+    a + ab * (vb / denom) + ac * (vc / denom)
+}
+
+fn closest_on_segment(q: DVec3, a: DVec3, b: DVec3) -> DVec3 {
+    let d = b - a;
+    let len2 = d.length_squared();
+    if len2 == 0.0 {
+        return a;
+    }
+    a + d * ((q - a).dot(d) / len2).clamp(0.0, 1.0)
+}
+
+/// Whether triangle `t` bounds the region `w > ½`: the winding number just
+/// in front of its centroid and just behind are on different sides of ½.
+fn encloses_volume(wn: &WindingNumber, [a, b, c]: [DVec3; 3]) -> bool {
+    let n = (b - a).cross(c - a);
+    let len = n.length();
+    let longest = (b - a).length().max((c - b).length()).max((a - c).length());
+    // Zero, or NaN from overflow: no side to tell apart.
+    if !(len.is_finite() && len > 0.0 && longest.is_finite() && longest > 0.0) {
+        return false;
+    }
+    // Far closer than any other triangle is likely to be, far from the
+    // rounding of the centroid: the triangle's own solid angle, ±2π,
+    // dominates the jump.
+    let step = n / len * (longest * 1e-4);
+    let centroid = (a + b + c) / 3.0;
+    (wn.fast(centroid + step) > 0.5) != (wn.fast(centroid - step) > 0.5)
+}
+
+/// Samples per parallel chunk: fixed, so the sum's order (and the mean's
+/// last bits) does not depend on the number of threads.
+const CHUNK: usize = 4096;
+
+/// The largest and the summed distance from `points` to `surface`.
+fn one_way(points: &[DVec3], surface: &Surface<'_>) -> (f64, f64) {
+    let partial: Vec<(f64, f64)> = points
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            chunk.iter().fold((0.0f64, 0.0f64), |(max, sum), &p| {
+                let d = surface.distance(p);
+                (max.max(d), sum + d)
+            })
+        })
+        .collect();
+    partial
+        .iter()
+        .fold((0.0, 0.0), |(max, sum), &(m, s)| (max.max(m), sum + s))
+}
+
+/// Measures the boundary `(positions, boundary)` against the input
+/// surface `wn` was built on, with `samples` points on each surface (plus
+/// their vertices when there are no more of them).
+pub(crate) fn measure(
+    wn: &WindingNumber,
+    positions: &[DVec3],
+    boundary: &[[u32; 3]],
+    samples: usize,
+) -> SurfaceDistance {
+    let input = Surface {
+        positions: wn.positions(),
+        triangles: wn.triangles(),
+        bvh: wn.bvh(),
+    };
+    let output_bvh = Bvh::build(positions, boundary);
+    let output = Surface {
+        positions,
+        triangles: boundary,
+        bvh: &output_bvh,
+    };
+    let all_area: Vec<f64> = (0..input.triangles.len())
+        .into_par_iter()
+        .map(|t| area(input.corners(t)))
+        .collect();
+    let bounding: Vec<bool> = (0..input.triangles.len())
+        .into_par_iter()
+        .map(|t| encloses_volume(wn, input.corners(t)))
+        .collect();
+    let kept: Vec<u32> = (0..input.triangles.len() as u32)
+        .filter(|&t| bounding[t as usize])
+        .collect();
+    let total_area: f64 = all_area.iter().sum();
+    let (mut left_out, mut left_out_area) = (0, 0.0);
+    for (t, &a) in all_area.iter().enumerate() {
+        if !bounding[t] && a > 0.0 {
+            left_out += 1;
+            left_out_area += a;
+        }
+    }
+    let on_input = input.sample(&kept, samples);
+    let all: Vec<u32> = (0..output.triangles.len() as u32).collect();
+    let on_boundary = output.sample(&all, samples);
+    let (input_to_tets, sum_in) = one_way(&on_input, &output);
+    let (tets_to_input, sum_out) = one_way(&on_boundary, &input);
+    let count = on_input.len() + on_boundary.len();
+    let mut bounds = Aabb::EMPTY;
+    for t in input.triangles {
+        for &v in t {
+            bounds.grow(input.positions[v as usize]);
+        }
+    }
+    SurfaceDistance {
+        hausdorff: input_to_tets.max(tets_to_input),
+        input_to_tets,
+        tets_to_input,
+        mean: if count > 0 {
+            (sum_in + sum_out) / count as f64
+        } else {
+            0.0
+        },
+        diagonal: (bounds.max - bounds.min).length(),
+        input_samples: on_input.len(),
+        boundary_samples: on_boundary.len(),
+        left_out_triangles: left_out,
+        left_out_area: fraction(left_out_area, total_area),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The nearest point by brute force over a fine grid of barycentrics.
+    fn brute(q: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
+        let n = 400;
+        let mut best = f64::INFINITY;
+        for i in 0..=n {
+            for j in 0..=(n - i) {
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                let p = a + (b - a) * u + (c - a) * v;
+                best = best.min(p.distance(q));
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn the_nearest_point_of_a_triangle_matches_a_brute_force_search() {
+        let (a, b, c) = (
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.2, 0.1),
+            DVec3::new(0.3, 1.5, -0.2),
+        );
+        for k in 0..200 {
+            let (x, y) = r2(k);
+            let q = DVec3::new(4.0 * x - 1.0, 3.0 * y - 1.0, (k as f64 * 0.37).sin());
+            let exact = closest_point_on_triangle(q, a, b, c).distance(q);
+            // The grid's spacing bounds how far above the truth it can be.
+            assert!(exact <= brute(q, a, b, c) + 1e-12, "{q}");
+            assert!(brute(q, a, b, c) - exact < 0.01, "{q}");
+        }
+    }
+
+    #[test]
+    fn a_wrong_region_test_is_caught_by_the_same_check() {
+        // The face projection for every point (no edge or vertex regions)
+        // lands outside the triangle: the brute force rejects it.
+        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
+        let q = DVec3::new(2.0, 2.0, 1.0);
+        let wrong = DVec3::new(q.x, q.y, 0.0).distance(q);
+        assert!(wrong + 1e-12 < brute(q, a, b, c));
+        assert!(closest_point_on_triangle(q, a, b, c).distance(q) <= brute(q, a, b, c) + 1e-12);
+    }
+
+    #[test]
+    fn degenerate_triangles_give_the_nearest_point_of_their_segment() {
+        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::X * 2.0);
+        let q = DVec3::new(1.5, 1.0, 0.0);
+        assert!((closest_point_on_triangle(q, a, b, c).distance(q) - 1.0).abs() < 1e-12);
+        let p = DVec3::splat(3.0);
+        assert_eq!(closest_point_on_triangle(DVec3::ZERO, p, p, p), p);
+    }
+}
