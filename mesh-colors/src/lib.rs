@@ -22,7 +22,9 @@
 //! - **Editing** (Sec. 3.3, [`edit`]): exact 1-to-4 subdivision, adding
 //!   and deleting faces, changing one face's resolution.
 //! - **Painting** ([`Painter`], Sec. 5.1): brush strokes whose cost is the
-//!   samples they touch.
+//!   samples they touch, undone and redone from the deltas of the samples
+//!   a stroke touched ([`undo`]); many faces' resolutions changed in place
+//!   ([`MeshColors::set_face_resolutions`]).
 //! - **UV textures** ([`convert`], [`atlas`]): from a textured mesh (seams
 //!   averaged away) and back to an atlas with per-corner UVs.
 //! - **Files** ([`mod@file`]): the versioned little-endian `.meshcolors` format.
@@ -67,6 +69,7 @@ mod paint;
 mod structure;
 mod texture;
 mod topology;
+pub mod undo;
 
 pub use error::{Error, IoError};
 pub use luminance::luminance;

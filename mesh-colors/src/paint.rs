@@ -8,8 +8,9 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
-use crate::Error;
 use crate::structure::MeshColors;
+use crate::undo::Recorder;
+use crate::{Error, MAX_CHANNELS};
 
 /// How a brush combines its colour with a sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -176,6 +177,33 @@ impl Painter {
     /// [`Error::ChannelMismatch`] if the brush colour or `colors` do not
     /// match this painter; [`Error::NonFinite`] for a bad radius.
     pub fn paint(&self, colors: &mut MeshColors, brush: &Brush<'_>) -> Result<Stroke, Error> {
+        self.dab(colors, brush, None)
+    }
+
+    /// As [`Painter::paint`], recording into `recorder` the old value of
+    /// every sample the dab changes (once per stroke: a sample already
+    /// recorded by an earlier dab keeps its first value), for undo
+    /// (Sec. 5.1; see [`crate::undo`]).
+    ///
+    /// # Errors
+    /// As for [`Painter::paint`], and [`Error::StaleUndo`] if `recorder`
+    /// was made for other colours; nothing changes then.
+    pub fn paint_recorded(
+        &self,
+        colors: &mut MeshColors,
+        brush: &Brush<'_>,
+        recorder: &mut Recorder,
+    ) -> Result<Stroke, Error> {
+        recorder.fits(colors)?;
+        self.dab(colors, brush, Some(recorder))
+    }
+
+    fn dab(
+        &self,
+        colors: &mut MeshColors,
+        brush: &Brush<'_>,
+        mut recorder: Option<&mut Recorder>,
+    ) -> Result<Stroke, Error> {
         if brush.color.len() != self.channels || colors.channels() != self.channels {
             return Err(Error::ChannelMismatch {
                 what: "brush colour",
@@ -201,13 +229,26 @@ impl Painter {
             touched += 1;
             let w = brush.weight(d);
             let s = colors.sample_at_mut(i);
-            for (x, &c) in s.iter_mut().zip(brush.color) {
-                *x = match brush.blend {
+            let mut new = [0.0f32; MAX_CHANNELS];
+            let new = &mut new[..s.len()];
+            for ((n, &x), &c) in new.iter_mut().zip(s.iter()).zip(brush.color) {
+                *n = match brush.blend {
                     Blend::Set => c,
-                    Blend::Mix => *x + w * (c - *x),
-                    Blend::Add => *x + w * c,
+                    Blend::Mix => x + w * (c - x),
+                    Blend::Add => x + w * c,
                 };
             }
+            // Only samples whose bits change are recorded (the rim of a
+            // dab, weight 0, changes nothing).
+            if let Some(r) = recorder.as_deref_mut()
+                && new
+                    .iter()
+                    .zip(s.iter())
+                    .any(|(a, b)| a.to_bits() != b.to_bits())
+            {
+                r.note(i, s);
+            }
+            s.copy_from_slice(new);
         });
         Ok(Stroke { touched, examined })
     }

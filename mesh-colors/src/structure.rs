@@ -231,6 +231,19 @@ impl MeshColors {
         &self.samples
     }
 
+    /// Heap bytes of these colours: the samples (`4 · channels` bytes
+    /// each) and the per-primitive levels and indices, not counting the
+    /// [`Topology`] (which the mesh has anyway).
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.samples.capacity() * std::mem::size_of::<f32>()
+            + (self.face_level.capacity()
+                + self.edge_level.capacity()
+                + self.vertex_level.capacity())
+            + (self.edge_offset.capacity() + self.face_offset.capacity())
+                * std::mem::size_of::<usize>()
+    }
+
     /// All samples, mutable.
     pub fn samples_mut(&mut self) -> &mut [f32] {
         &mut self.samples

@@ -17,3 +17,4 @@ mod paint;
 mod resolution;
 mod structure;
 mod texture;
+mod undo;

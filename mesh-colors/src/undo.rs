@@ -1,0 +1,341 @@
+//! Undo and redo for the painting system (Sec. 5.1): a stroke is kept as
+//! the delta of the samples it touched — each sample's value before the
+//! stroke, stored once however many dabs reached it — and a detail change
+//! as the [`ResolutionChange`] of the faces it resampled; never a copy of
+//! the whole colours.
+//!
+//! A [`Recorder`] collects a stroke's old values as [`Painter::paint_recorded`]
+//! (or the caller, through [`Recorder::record`]) changes samples;
+//! [`Recorder::finish`] turns it into a [`Delta`]: sorted runs of sample
+//! indices and their values, `4 · channels` bytes per touched sample plus
+//! 8 bytes per run. [`Delta::undo`] and [`Delta::redo`] *swap* the stored
+//! values with the colours' ones, so one copy serves both directions and
+//! both are exact. [`History`] keeps a bounded list of steps of either kind.
+//!
+//! Deltas hold sample indices, which a resolution change renumbers: undo
+//! and redo must run in history order (last in, first out), which
+//! [`History`] does.
+//!
+//! [`Painter::paint_recorded`]: crate::Painter::paint_recorded
+
+use std::collections::VecDeque;
+
+use crate::Error;
+use crate::edit::ResolutionChange;
+use crate::structure::MeshColors;
+
+/// Collects the old values of the samples one stroke changes, each sample
+/// once (the first time it is recorded). Its scratch memory is one bit per
+/// sample of the colours, freed by [`Recorder::finish`].
+#[derive(Debug, Clone)]
+pub struct Recorder {
+    channels: usize,
+    sample_count: usize,
+    seen: Vec<u64>,
+    indices: Vec<u32>,
+    values: Vec<f32>,
+}
+
+impl Recorder {
+    /// A recorder for a stroke on `colors`.
+    pub fn new(colors: &MeshColors) -> Self {
+        Self {
+            channels: colors.channels(),
+            sample_count: colors.sample_count(),
+            seen: vec![0; colors.sample_count().div_ceil(64)],
+            indices: Vec::new(),
+            values: Vec::new(),
+        }
+    }
+
+    /// Checks that `colors` have the channel and sample counts this
+    /// recorder (or delta) was made for.
+    pub(crate) fn fits(&self, colors: &MeshColors) -> Result<(), Error> {
+        fits(self.channels, self.sample_count, colors)
+    }
+
+    /// Records sample `sample`'s current value in `colors`, to be called
+    /// *before* the caller changes it; returns whether this was the first
+    /// time (later calls for the same sample keep the first value).
+    ///
+    /// # Errors
+    /// [`Error::StaleUndo`] if `colors` have other channel or sample counts
+    /// than the colours this recorder was made for, or `sample` is out of
+    /// range.
+    pub fn record(&mut self, colors: &MeshColors, sample: usize) -> Result<bool, Error> {
+        self.fits(colors)?;
+        match colors.sample(sample) {
+            Some(value) => Ok(self.note(sample, value)),
+            None => Err(Error::StaleUndo {
+                what: "sample",
+                index: sample,
+                reason: "is out of range",
+            }),
+        }
+    }
+
+    /// As [`Recorder::record`] for an index and value already checked.
+    #[inline]
+    pub(crate) fn note(&mut self, sample: usize, value: &[f32]) -> bool {
+        let (word, bit) = (sample / 64, 1u64 << (sample % 64));
+        if self.seen[word] & bit != 0 {
+            return false;
+        }
+        self.seen[word] |= bit;
+        self.indices.push(sample as u32);
+        self.values.extend_from_slice(value);
+        true
+    }
+
+    /// The number of samples recorded so far.
+    pub fn len(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// Whether no sample was recorded.
+    pub fn is_empty(&self) -> bool {
+        self.indices.is_empty()
+    }
+
+    /// The stroke's delta: the recorded samples sorted into runs of
+    /// consecutive indices, with their old values.
+    pub fn finish(self) -> Delta {
+        let c = self.channels;
+        let mut order: Vec<u32> = (0..self.indices.len() as u32).collect();
+        order.sort_unstable_by_key(|&k| self.indices[k as usize]);
+        let mut runs: Vec<(u32, u32)> = Vec::new();
+        let mut values = Vec::with_capacity(self.values.len());
+        for &k in &order {
+            let i = self.indices[k as usize];
+            match runs.last_mut() {
+                Some((start, len)) if *start + *len == i => *len += 1,
+                _ => runs.push((i, 1)),
+            }
+            let k = k as usize;
+            values.extend_from_slice(&self.values[k * c..(k + 1) * c]);
+        }
+        runs.shrink_to_fit();
+        Delta {
+            channels: c,
+            sample_count: self.sample_count,
+            runs,
+            values,
+            undone: false,
+        }
+    }
+}
+
+fn fits(channels: usize, sample_count: usize, colors: &MeshColors) -> Result<(), Error> {
+    if colors.channels() != channels {
+        return Err(Error::StaleUndo {
+            what: "channels",
+            index: colors.channels(),
+            reason: "differ from the colours the record was made for",
+        });
+    }
+    if colors.sample_count() != sample_count {
+        return Err(Error::StaleUndo {
+            what: "sample count",
+            index: colors.sample_count(),
+            reason: "differs from the colours the record was made for",
+        });
+    }
+    Ok(())
+}
+
+/// The samples one stroke changed and their values on the other side of
+/// the stroke: before it while it is applied, after it once undone.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Delta {
+    channels: usize,
+    sample_count: usize,
+    /// Sorted, disjoint, non-adjacent runs `(first sample, length)`.
+    runs: Vec<(u32, u32)>,
+    /// `channels` values per sample, in run order.
+    values: Vec<f32>,
+    undone: bool,
+}
+
+impl Delta {
+    /// Puts the samples back to their values before the stroke (and keeps
+    /// the stroke's values for [`Delta::redo`]), exactly.
+    ///
+    /// # Errors
+    /// [`Error::StaleUndo`] if it is undone already or `colors` are not
+    /// the colours it was recorded on (other channel or sample counts);
+    /// nothing changes then.
+    pub fn undo(&mut self, colors: &mut MeshColors) -> Result<(), Error> {
+        self.toggle(colors, false)
+    }
+
+    /// Applies the stroke again after [`Delta::undo`], exactly.
+    ///
+    /// # Errors
+    /// [`Error::StaleUndo`] if it is not undone, or as for [`Delta::undo`].
+    pub fn redo(&mut self, colors: &mut MeshColors) -> Result<(), Error> {
+        self.toggle(colors, true)
+    }
+
+    fn toggle(&mut self, colors: &mut MeshColors, undone: bool) -> Result<(), Error> {
+        if self.undone != undone {
+            return Err(Error::StaleUndo {
+                what: "stroke of samples",
+                index: self.samples(),
+                reason: if undone {
+                    "is not undone, so it cannot be redone"
+                } else {
+                    "is undone already"
+                },
+            });
+        }
+        fits(self.channels, self.sample_count, colors)?;
+        let c = self.channels;
+        let mut at = 0;
+        let samples = colors.samples_mut();
+        for &(start, len) in &self.runs {
+            let (start, len) = (start as usize * c, len as usize * c);
+            samples[start..start + len].swap_with_slice(&mut self.values[at..at + len]);
+            at += len;
+        }
+        self.undone = !undone;
+        Ok(())
+    }
+
+    /// Whether the stroke is undone (the colours hold the old values).
+    pub fn is_undone(&self) -> bool {
+        self.undone
+    }
+
+    /// The changed samples as sorted runs `(first sample index, count)`:
+    /// what a renderer must upload again after undo or redo.
+    pub fn runs(&self) -> &[(u32, u32)] {
+        &self.runs
+    }
+
+    /// The number of samples the stroke changed.
+    pub fn samples(&self) -> usize {
+        self.values.len() / self.channels.max(1)
+    }
+
+    /// Whether the stroke changed nothing.
+    pub fn is_empty(&self) -> bool {
+        self.runs.is_empty()
+    }
+
+    /// Heap bytes this delta holds: `4 · channels` per sample, 8 per run,
+    /// and the struct.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.runs.capacity() * std::mem::size_of::<(u32, u32)>()
+            + self.values.capacity() * std::mem::size_of::<f32>()
+    }
+}
+
+/// One undoable gesture.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Step {
+    /// A paint stroke (any number of dabs).
+    Paint(Delta),
+    /// A detail (resolution) change.
+    Resolution(ResolutionChange),
+}
+
+impl Step {
+    /// Heap bytes the step holds.
+    pub fn memory_bytes(&self) -> usize {
+        match self {
+            Step::Paint(d) => d.memory_bytes(),
+            Step::Resolution(r) => r.memory_bytes(),
+        }
+    }
+}
+
+/// A linear undo history of at most `limit` steps: pushing a step drops
+/// the steps undone before it (no branches) and, beyond the limit, the
+/// oldest one.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct History {
+    steps: VecDeque<Step>,
+    /// Steps `0..done` are applied, `done..` undone.
+    done: usize,
+    limit: usize,
+}
+
+impl History {
+    /// An empty history keeping up to `limit` steps (0: none).
+    pub fn new(limit: usize) -> Self {
+        Self {
+            steps: VecDeque::new(),
+            done: 0,
+            limit,
+        }
+    }
+
+    /// Records a step just applied to the colours.
+    pub fn push(&mut self, step: Step) {
+        self.steps.truncate(self.done);
+        self.steps.push_back(step);
+        while self.steps.len() > self.limit {
+            self.steps.pop_front();
+        }
+        self.done = self.steps.len();
+    }
+
+    /// Undoes the last applied step; returns it (`None` when there is
+    /// nothing to undo) so the caller knows what changed.
+    ///
+    /// # Errors
+    /// As [`Delta::undo`] or [`MeshColors::revert_resolutions`] when the
+    /// colours are not in the state the history left them in; the history
+    /// and the colours are unchanged then.
+    pub fn undo(&mut self, colors: &mut MeshColors) -> Result<Option<&Step>, Error> {
+        if self.done == 0 {
+            return Ok(None);
+        }
+        let k = self.done - 1;
+        match &mut self.steps[k] {
+            Step::Paint(d) => d.undo(colors)?,
+            Step::Resolution(r) => colors.revert_resolutions(r)?,
+        }
+        self.done = k;
+        Ok(Some(&self.steps[k]))
+    }
+
+    /// Redoes the first undone step; returns it (`None` when there is
+    /// nothing to redo).
+    ///
+    /// # Errors
+    /// As [`History::undo`].
+    pub fn redo(&mut self, colors: &mut MeshColors) -> Result<Option<&Step>, Error> {
+        let k = self.done;
+        let Some(step) = self.steps.get_mut(k) else {
+            return Ok(None);
+        };
+        match step {
+            Step::Paint(d) => d.redo(colors)?,
+            Step::Resolution(r) => *r = colors.set_face_resolutions(&r.requests())?,
+        }
+        self.done = k + 1;
+        Ok(Some(&self.steps[k]))
+    }
+
+    /// Steps that can be undone.
+    pub fn undo_len(&self) -> usize {
+        self.done
+    }
+
+    /// Steps that can be redone.
+    pub fn redo_len(&self) -> usize {
+        self.steps.len() - self.done
+    }
+
+    /// All steps kept, oldest first.
+    pub fn steps(&self) -> impl ExactSizeIterator<Item = &Step> {
+        self.steps.iter()
+    }
+
+    /// Heap bytes of every step kept.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>() + self.steps.iter().map(Step::memory_bytes).sum::<usize>()
+    }
+}
