@@ -53,7 +53,8 @@ pub(crate) fn tets_in(
 /// `mean_distance_fraction` of the bounding box's `diagonal`, measured at
 /// `distance_points` (input, boundary) points — `left_out_triangles` and
 /// `left_out_area_fraction` (input triangles that enclose no volume, also
-/// a `UserWarning`), and `seconds`.
+/// a `UserWarning`), and `seconds`. The distances are measured only for
+/// the report: they can cost as much as the stuffing.
 ///
 /// `spacing`: the lattice spacing in mesh units (default: 1/40 of the
 /// bounding box's diagonal, as `trilux tetra`); `graded=True` makes the
@@ -69,9 +70,16 @@ pub(crate) fn tetrahedralize<'py>(
 ) -> PyResult<Bound<'py, PyTuple>> {
     let mesh = mesh_arg(mesh, None)?;
     let h = spacing.unwrap_or_else(|| trilux::tet::default_spacing(&mesh));
+    let defaults = stuffing::Options::new(h);
     let options = stuffing::Options {
         graded,
-        ..stuffing::Options::new(h)
+        // Measured only when asked for: it can cost as much as the stuffing.
+        distance_samples: if return_report {
+            defaults.distance_samples
+        } else {
+            0
+        },
+        ..defaults
     };
     let stuffed = detached(py, || {
         Ok(stuffing::tetrahedralize(

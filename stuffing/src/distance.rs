@@ -23,7 +23,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::bvh::{Aabb, Bvh};
-use crate::winding::WindingNumber;
+use crate::winding::{WindingNumber, solid_angle};
 
 /// Distances between the stuffed boundary and the input surface, in the
 /// surface's length unit (see the [module docs](self)).
@@ -241,22 +241,27 @@ fn closest_on_segment(q: DVec3, a: DVec3, b: DVec3) -> DVec3 {
     a + d * ((q - a).dot(d) / len2).clamp(0.0, 1.0)
 }
 
-/// Whether triangle `t` bounds the region `w > ½`: the winding number just
-/// in front of its centroid and just behind are on different sides of ½.
+/// Whether a triangle bounds the region `w > ½`: the winding number just
+/// in front of it and just behind are on different sides of ½. Across the
+/// triangle the winding number jumps by exactly 1 (its own solid angle
+/// goes from −2π in front to 2π behind), so with `w₀`, the other
+/// triangles' winding number at its centroid, the two sides are `w₀ ∓ ½`
+/// and the test is `0 < w₀ ≤ 1`: one evaluation. (The triangle's own
+/// term at its centroid is ±2π by the sign of a rounded zero; it is taken
+/// out exactly as the sum computed it: a point on the triangle is never in
+/// a far-field cluster of it.) The test's margin, ½ on a closed surface,
+/// allows the coarsest series (β = 1), which keeps the exact near field,
+/// the costly part of a query on the surface, small.
 fn encloses_volume(wn: &WindingNumber, [a, b, c]: [DVec3; 3]) -> bool {
-    let n = (b - a).cross(c - a);
-    let len = n.length();
-    let longest = (b - a).length().max((c - b).length()).max((a - c).length());
-    // Zero, or NaN from overflow: no side to tell apart.
-    if !(len.is_finite() && len > 0.0 && longest.is_finite() && longest > 0.0) {
+    let doubled_area = (b - a).cross(c - a).length();
+    // Zero, or NaN from overflow: no sides to tell apart.
+    if !(doubled_area.is_finite() && doubled_area > 0.0) {
         return false;
     }
-    // Far closer than any other triangle is likely to be, far from the
-    // rounding of the centroid: the triangle's own solid angle, ±2π,
-    // dominates the jump.
-    let step = n / len * (longest * 1e-4);
-    let centroid = (a + b + c) / 3.0;
-    (wn.fast(centroid + step) > 0.5) != (wn.fast(centroid - step) > 0.5)
+    let q = (a + b + c) / 3.0;
+    let own = solid_angle(a - q, b - q, c - q) / (4.0 * std::f64::consts::PI);
+    let w = wn.fast_with(q, 1.0) - own;
+    w > 0.0 && w <= 1.0
 }
 
 /// Samples per parallel chunk: fixed, so the sum's order (and the mean's
@@ -391,6 +396,36 @@ mod tests {
         let wrong = DVec3::new(q.x, q.y, 0.0).distance(q);
         assert!(wrong + 1e-12 < brute(q, a, b, c));
         assert!(closest_point_on_triangle(q, a, b, c).distance(q) <= brute(q, a, b, c) + 1e-12);
+    }
+
+    #[test]
+    fn every_triangle_of_a_closed_sphere_encloses_volume_and_no_triangle_of_a_sheet() {
+        let (p, t) = crate::tests::sphere(24, 1.0, DVec3::ZERO);
+        let sheet = [
+            DVec3::new(3.0, 0.0, 0.0),
+            DVec3::new(3.0, 1.0, 0.0),
+            DVec3::new(3.0, 0.0, 1.0),
+        ];
+        let mut positions = p.clone();
+        positions.extend(sheet);
+        let n = p.len() as u32;
+        let mut triangles = t.clone();
+        triangles.push([n, n + 1, n + 2]);
+        let wn = WindingNumber::new(&positions, &triangles, 2.0).unwrap();
+        let corners = |f: &[u32; 3]| f.map(|v| positions[v as usize]);
+        let kept = triangles
+            .iter()
+            .filter(|f| encloses_volume(&wn, corners(f)))
+            .count();
+        assert_eq!(kept, t.len());
+        // The wrong twin: the sum at the centroid with the triangle's own
+        // term left in, whose sign is a rounded zero's.
+        let naive = |[a, b, c]: [DVec3; 3]| {
+            let w = wn.fast_with((a + b + c) / 3.0, 1.0);
+            w > 0.0 && w <= 1.0
+        };
+        let wrong = t.iter().filter(|f| naive(corners(f))).count();
+        assert!(wrong < t.len(), "{wrong} of {}", t.len());
     }
 
     #[test]

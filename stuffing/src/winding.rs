@@ -140,7 +140,12 @@ impl WindingNumber {
     /// farther than `β` times their radius. O(log n) per query for points
     /// away from the surface.
     pub fn fast(&self, q: DVec3) -> f64 {
-        let beta2 = self.beta * self.beta;
+        self.fast_with(q, self.beta)
+    }
+
+    /// [`Self::fast`] with another accuracy `beta` (at least 1).
+    pub(crate) fn fast_with(&self, q: DVec3, beta: f64) -> f64 {
+        let beta2 = beta * beta;
         let mut sum = 0.0;
         // The tree is a median split of at most 2^32 triangles: its depth is
         // below 40, and depth-first traversal keeps at most depth + 1 nodes.
