@@ -162,6 +162,14 @@ pub enum Error {
         /// How it differs from the record.
         reason: &'static str,
     },
+    /// An argument outside the values it can take.
+    #[error("argument `{argument}` {reason}")]
+    InvalidArgument {
+        /// The argument's name.
+        argument: &'static str,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
     /// Mesh colours loaded for a mesh they do not belong to.
     #[error("the mesh colours belong to a mesh with {stored}, but this mesh has {expected}")]
     WrongMesh {

@@ -25,6 +25,10 @@
 //!   samples they touch, undone and redone from the deltas of the samples
 //!   a stroke touched ([`undo`]); many faces' resolutions changed in place
 //!   ([`MeshColors::set_face_resolutions`]).
+//! - **Real-time rendering** ([`gpu`], Sec. 5.3): every sample and MIP
+//!   level packed in 2D textures with a per-face table, the formulas a
+//!   fragment shader implements, and a CPU reference that reads the
+//!   packed layout.
 //! - **UV textures** ([`convert`], [`atlas`]): from a textured mesh (seams
 //!   averaged away) and back to an atlas with per-corner UVs.
 //! - **Files** ([`mod@file`]): the versioned little-endian `.meshcolors` format.
@@ -63,6 +67,7 @@ pub mod edit;
 mod error;
 pub mod file;
 mod filter;
+pub mod gpu;
 mod luminance;
 mod mip;
 mod paint;

@@ -17,11 +17,11 @@ const fn face_level_offsets() -> [usize; MAX_LEVEL as usize + 2] {
     }
     out
 }
-const FACE_LEVEL_OFFSET: [usize; MAX_LEVEL as usize + 2] = face_level_offsets();
+pub(crate) const FACE_LEVEL_OFFSET: [usize; MAX_LEVEL as usize + 2] = face_level_offsets();
 
 /// Offset of level `l` within an edge's levels: `Σ_{m<l} (2^m − 1)`.
 #[inline]
-fn edge_level_offset(l: u8) -> usize {
+pub(crate) fn edge_level_offset(l: u8) -> usize {
     (1usize << l) - 1 - l as usize
 }
 
@@ -582,7 +582,7 @@ pub const MAX_PROBES: u32 = 64;
 
 /// `λ = −log2(footprint)`, clamped to the levels that exist.
 #[inline]
-fn level_of_footprint(footprint: f32) -> f32 {
+pub(crate) fn level_of_footprint(footprint: f32) -> f32 {
     if footprint.is_nan() || footprint <= 0.0 {
         return f32::from(MAX_LEVEL);
     }

@@ -12,6 +12,7 @@ mod convert;
 mod edit;
 mod file;
 mod filtering;
+mod gpu;
 mod limits;
 mod paint;
 mod resolution;

@@ -1,0 +1,309 @@
+//! The packed GPU layout (Sec. 5.3): its CPU reference lookup equals every
+//! CPU filter bit for bit, a wrong twin of the layout fails the same
+//! check, and updates name exactly the texels that changed.
+
+use crate::filtering::edge_points;
+use crate::support;
+
+use mesh_colors::gpu::{FACE_WORDS, Filter, GpuLayout, GpuParts};
+use mesh_colors::{Error, MeshColors, MipMap, Topology};
+use support::Rng;
+
+/// A bumpy grid with levels 0..=5 and random values in `channels`.
+fn mixed(seed: u64, channels: usize) -> MeshColors {
+    let (positions, faces) = support::grid(6, 0.4);
+    let mut rng = Rng(seed);
+    let levels: Vec<u32> = (0..faces.len()).map(|_| 1 << rng.below(6)).collect();
+    let topology = Topology::new(positions.len(), &faces).unwrap();
+    let mut mc = MeshColors::new(topology, &levels, channels).unwrap();
+    for x in mc.samples_mut() {
+        *x = rng.f32();
+    }
+    mc
+}
+
+/// Lookup points: random interiors, dyadic lattice-like points, points on
+/// every interior edge from both faces, and the corners.
+fn points(mc: &MeshColors, rng: &mut Rng) -> Vec<(usize, [f32; 3])> {
+    let mut out = Vec::new();
+    for f in 0..mc.face_count() {
+        for _ in 0..40 {
+            out.push((f, rng.barycentric()));
+        }
+        for _ in 0..20 {
+            let (i, j) = (rng.below(65) as u32, rng.below(65) as u32);
+            let (i, j) = if i + j > 64 { (64 - i, 64 - j) } else { (i, j) };
+            out.push((
+                f,
+                [i as f32 / 64.0, j as f32 / 64.0, (64 - i - j) as f32 / 64.0],
+            ));
+        }
+        for k in 0..3 {
+            let mut b = [0.0; 3];
+            b[k] = 1.0;
+            out.push((f, b));
+        }
+    }
+    for (f0, b0, f1, b1) in edge_points(mc, rng).into_iter().step_by(3) {
+        out.push((f0, b0));
+        out.push((f1, b1));
+    }
+    out
+}
+
+/// Every filter, with the parameters the tests use.
+fn filters(rng: &mut Rng) -> Vec<Filter> {
+    let mut out = vec![Filter::Nearest, Filter::Linear];
+    out.extend((0..=6).map(Filter::Level));
+    out.push(Filter::Level(255));
+    for footprint in [1.0, 0.7, 0.3, 0.2, 0.09, 0.04, 0.011, 0.0] {
+        out.push(Filter::Trilinear { footprint });
+    }
+    for _ in 0..6 {
+        let scale = 0.3 * rng.f32();
+        let d = |rng: &mut Rng| {
+            let (x, y) = (rng.f32() - 0.5, rng.f32() - 0.5);
+            [scale * x, scale * y, -scale * (x + y)]
+        };
+        out.push(Filter::Anisotropic {
+            db_dx: d(rng),
+            db_dy: d(rng),
+            max_samples: 1 + rng.below(16) as u32,
+        });
+    }
+    out
+}
+
+/// The CPU filter a [`Filter`] names.
+fn cpu(mc: &MeshColors, mip: &MipMap, f: usize, b: [f32; 3], filter: Filter, out: &mut [f32]) {
+    match filter {
+        Filter::Nearest => mc.nearest(f, b, out),
+        Filter::Linear => mc.linear(f, b, out),
+        Filter::Level(l) => mip.at_level(f, b, l, out),
+        Filter::Trilinear { footprint } => mip.trilinear(f, b, footprint, out),
+        Filter::Anisotropic {
+            db_dx,
+            db_dy,
+            max_samples,
+        } => mip.anisotropic(f, b, db_dx, db_dy, max_samples, out),
+    }
+    .unwrap();
+}
+
+/// Lookups whose bits differ from the CPU filter's, out of all made.
+fn mismatches(layout: &GpuLayout, mc: &MeshColors, seed: u64) -> (usize, usize) {
+    let mip = mc.mip_map();
+    let mut rng = Rng(seed);
+    let c = mc.channels();
+    let (mut want, mut got) = (vec![0.0f32; c], vec![0.0f32; c]);
+    let (mut bad, mut all) = (0, 0);
+    let pts = points(mc, &mut rng);
+    for filter in filters(&mut rng) {
+        for &(f, b) in &pts {
+            cpu(mc, &mip, f, b, filter, &mut want);
+            layout.lookup(f, b, filter, &mut got).unwrap();
+            all += 1;
+            let same = want
+                .iter()
+                .zip(&got)
+                .all(|(x, y)| x.to_bits() == y.to_bits());
+            if !same {
+                bad += 1;
+            }
+        }
+    }
+    (bad, all)
+}
+
+#[test]
+fn the_packed_lookup_equals_every_cpu_filter_bit_for_bit() {
+    for (seed, channels, width) in [
+        (1, 3, 4096),
+        (2, 3, 131),
+        (3, 1, 250),
+        (4, 6, 1000),
+        (5, 4, 200),
+    ] {
+        let mc = mixed(seed, channels);
+        let layout = GpuLayout::new(&mc.mip_map(), width).unwrap();
+        assert!(layout.width() <= width && layout.sample_height() <= width);
+        let (bad, all) = mismatches(&layout, &mc, seed + 10);
+        assert!(all > 50_000, "{all} lookups");
+        assert_eq!(
+            bad, 0,
+            "{bad} of {all} lookups differ ({channels} channels, width {width})"
+        );
+    }
+}
+
+#[test]
+fn a_wrong_twin_of_the_layout_fails_the_same_check() {
+    let mc = mixed(6, 3);
+    let layout = GpuLayout::new(&mc.mip_map(), 150).unwrap();
+    let parts = layout.clone().into_parts();
+    // The same image with rows one texel wider than the width the
+    // indices were packed for (a page that allocates the texture at
+    // W + 1): texel t is then read from (t % (W+1), t / (W+1)), which
+    // holds packed texel y·W + x.
+    let restride = |flat: &[f32], w: usize| -> Vec<f32> {
+        flat.chunks(4 * w)
+            .flat_map(|row| row.iter().copied().chain([0.0; 4]))
+            .collect()
+    };
+    let restride_u32 = |flat: &[u32], w: usize| -> Vec<u32> {
+        flat.chunks(4 * w)
+            .flat_map(|row| row.iter().copied().chain([0; 4]))
+            .collect()
+    };
+    let mut wide = parts.clone();
+    let w = parts.width as usize;
+    wide.width += 1;
+    wide.samples = restride(&parts.samples, w);
+    wide.faces = restride_u32(&parts.faces, w);
+    let (bad, all) = mismatches(&GpuLayout::from_parts(wide).unwrap(), &mc, 1);
+    assert!(
+        bad > all / 2,
+        "off-by-one row width: only {bad} of {all} differ"
+    );
+    // Edge samples read from the wrong end: the direction bits flipped.
+    let mut flipped = parts.clone();
+    for f in 0..flipped.face_count {
+        flipped.faces[f * FACE_WORDS + 7] ^= 0b111 << 28;
+    }
+    let (bad, all) = mismatches(&GpuLayout::from_parts(flipped).unwrap(), &mc, 2);
+    assert!(bad > all / 10, "edges reversed: only {bad} of {all} differ");
+    // One vertex level off (a vertex read one MIP level too coarse).
+    let mut coarse = parts;
+    for f in 0..coarse.face_count {
+        let w = &mut coarse.faces[f * FACE_WORDS + 7];
+        let vl = (*w >> 4) & 0xF;
+        if vl > 0 {
+            *w = (*w & !(0xF << 4)) | ((vl - 1) << 4);
+        }
+    }
+    let (bad, _) = mismatches(&GpuLayout::from_parts(coarse).unwrap(), &mc, 3);
+    assert!(bad > 100, "vertex levels off by one: only {bad} differ");
+}
+
+/// Applies `changes` of `new` onto `old` the way `texSubImage2D` does.
+fn upload(old: &mut [f32], new: &[f32], w: usize, rects: &[mesh_colors::gpu::TexelRect]) {
+    for r in rects {
+        for y in r.y as usize..(r.y + r.height) as usize {
+            let from = (y * w + r.x as usize) * 4;
+            let to = from + r.width as usize * 4;
+            old[from..to].copy_from_slice(&new[from..to]);
+        }
+    }
+}
+
+#[test]
+fn updates_name_exactly_the_texels_that_changed() {
+    let mut mc = mixed(8, 3);
+    let mut layout = GpuLayout::new(&mc.mip_map(), 128).unwrap();
+    assert!(layout.update(&mc.mip_map()).unwrap().is_empty());
+    let mut rng = Rng(9);
+    for round in 0..6 {
+        let before = layout.clone();
+        // A few changed samples (a small stroke) …
+        for _ in 0..1 + rng.below(20) {
+            let i = rng.below(mc.sample_count() as u64) as usize;
+            mc.sample_mut(i).unwrap()[rng.below(3) as usize] = rng.f32();
+        }
+        let changes = layout.update(&mc.mip_map()).unwrap();
+        assert!(!changes.resized);
+        let w = layout.width() as usize;
+        let mut texels = before.sample_texels().to_vec();
+        upload(&mut texels, layout.sample_texels(), w, &changes.samples);
+        assert_eq!(texels, layout.sample_texels(), "round {round}");
+        let uploaded: u32 = changes.samples.iter().map(|r| r.width * r.height).sum();
+        assert!(
+            (uploaded as usize) < layout.sample_texels().len() / 8,
+            "round {round}: {uploaded} texels uploaded for a small stroke"
+        );
+        assert!(changes.faces.is_empty());
+        for r in &changes.samples {
+            assert!(r.x + r.width <= layout.width() && r.y + r.height <= layout.sample_height());
+            assert!(r.height == 1 || (r.x == 0 && r.width == layout.width()));
+        }
+        let lookups_agree = mismatches(&layout, &mc, round);
+        assert_eq!(lookups_agree.0, 0);
+    }
+    // A resolution change moves the layout: everything is new.
+    mc.set_face_resolutions(&[(0, 32), (5, 1)]).unwrap();
+    let changes = layout.update(&mc.mip_map()).unwrap();
+    assert!(changes.resized);
+    let covered: u32 = changes.samples.iter().map(|r| r.width * r.height).sum();
+    assert_eq!(covered as usize * 4, layout.sample_texels().len());
+    assert_eq!(mismatches(&layout, &mc, 99).0, 0);
+}
+
+#[test]
+fn bad_arguments_name_what_is_wrong() {
+    let mc = mixed(10, 3);
+    let mip = mc.mip_map();
+    assert_eq!(
+        GpuLayout::new(&mip, 0),
+        Err(Error::InvalidArgument {
+            argument: "max_width",
+            reason: "must be at least 1 texel"
+        })
+    );
+    assert!(matches!(
+        GpuLayout::new(&mip, 8),
+        Err(Error::TooLarge { unit: "rows", .. })
+    ));
+    let layout = GpuLayout::new(&mip, 256).unwrap();
+    let mut out = [0.0f32; 3];
+    assert!(matches!(
+        layout.lookup(mc.face_count(), [0.3; 3], Filter::Linear, &mut out),
+        Err(Error::MissingFace { .. })
+    ));
+    assert!(matches!(
+        layout.lookup(0, [0.3; 3], Filter::Linear, &mut [0.0; 2]),
+        Err(Error::ChannelMismatch { .. })
+    ));
+    // NaN and huge inputs give a value, not a panic.
+    for b in [
+        [f32::NAN; 3],
+        [f32::INFINITY, 0.0, 1.0],
+        [-1.0, -2.0, -3.0],
+        [1e30, 1.0, 0.0],
+    ] {
+        for filter in [
+            Filter::Nearest,
+            Filter::Linear,
+            Filter::Trilinear {
+                footprint: f32::NAN,
+            },
+            Filter::Anisotropic {
+                db_dx: [f32::NAN; 3],
+                db_dy: [1e30, 0.0, 0.0],
+                max_samples: u32::MAX,
+            },
+        ] {
+            layout.lookup(0, b, filter, &mut out).unwrap();
+        }
+    }
+    let parts = GpuParts {
+        width: 4,
+        channels: 3,
+        face_count: 2,
+        samples: vec![0.0; 15],
+        faces: vec![0; 16],
+    };
+    let e = GpuLayout::from_parts(parts).unwrap_err();
+    assert!(e.to_string().contains("`samples`"), "{e}");
+    // Garbage parts read as zeros, never panic.
+    let garbage = GpuParts {
+        width: 3,
+        channels: 3,
+        face_count: 2,
+        samples: vec![1.0; 12],
+        faces: vec![u32::MAX; 24],
+    };
+    let g = GpuLayout::from_parts(garbage).unwrap();
+    for filter in filters(&mut Rng(1)) {
+        g.lookup(1, [0.2, 0.3, 0.5], filter, &mut out).unwrap();
+        g.lookup(0, [0.0, 0.3, 0.7], filter, &mut out).unwrap();
+    }
+}
