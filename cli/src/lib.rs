@@ -60,6 +60,8 @@ pub mod shapes;
 pub mod tet;
 #[cfg(feature = "view")]
 pub mod view;
+#[cfg(feature = "web")]
+pub mod web;
 
 pub use colors::{ColorMesh, ConvertOptions, SurfaceTexture, atlas_mesh, to_mesh_colors};
 pub use density::{density_texture, emission_texture, sampling_wrap};

@@ -37,12 +37,15 @@ use serde_json::{Map, Value};
 use tet_diffusion::glam::DVec3;
 use tet_diffusion::{Cut, Edit, Light, Medium, Stroke};
 
+use crate::web::frame::Header;
+pub use crate::web::frame::{HEADER, put_f32, put_u32};
+pub use crate::web::json::{BadField, seq_of};
+use crate::web::json::{Incoming, Parsed, get, nonzero, number, vec3};
+
 /// Magic of binary frames.
 pub const MAGIC: &[u8; 4] = b"TLXF";
 /// Version of the binary frames.
 pub const VERSION: u8 = 1;
-/// Header size.
-pub const HEADER: usize = 16;
 /// Kind of a surface frame.
 pub const SURFACE: u8 = 1;
 /// Kind of a radiance frame.
@@ -142,48 +145,6 @@ impl ExportKind {
     }
 }
 
-/// A bad message: the field (JSON path) and what is wrong.
-#[derive(Debug, Clone, PartialEq)]
-pub struct BadField {
-    /// The field, as a JSON path (`dabs[3].radius`).
-    pub field: String,
-    /// What is wrong with it.
-    pub problem: String,
-}
-
-impl BadField {
-    fn new(field: impl Into<String>, problem: impl Into<String>) -> Self {
-        Self {
-            field: field.into(),
-            problem: problem.into(),
-        }
-    }
-}
-
-type Parsed<T> = Result<T, BadField>;
-
-fn get<'a>(o: &'a Map<String, Value>, key: &str) -> Parsed<&'a Value> {
-    o.get(key).ok_or_else(|| BadField::new(key, "missing"))
-}
-
-fn number(v: &Value, field: &str) -> Parsed<f64> {
-    v.as_f64()
-        .filter(|x| x.is_finite())
-        .ok_or_else(|| BadField::new(field, "expected a finite number"))
-}
-
-fn vec3(v: &Value, field: &str) -> Parsed<DVec3> {
-    let a = v
-        .as_array()
-        .filter(|a| a.len() == 3)
-        .ok_or_else(|| BadField::new(field, "expected [x, y, z]"))?;
-    Ok(DVec3::new(
-        number(&a[0], &format!("{field}[0]"))?,
-        number(&a[1], &format!("{field}[1]"))?,
-        number(&a[2], &format!("{field}[2]"))?,
-    ))
-}
-
 fn rgb(v: Option<&Value>, field: &str) -> Parsed<[f64; 3]> {
     match v {
         None => Ok([1.0; 3]),
@@ -202,13 +163,6 @@ fn index(v: &Value, field: &str) -> Parsed<usize> {
         .filter(|&i| i < 256)
         .map(|i| i as usize)
         .ok_or_else(|| BadField::new(field, "expected a piece index 0..255"))
-}
-
-fn nonzero(v: DVec3, field: &str) -> Parsed<DVec3> {
-    if v.length_squared() == 0.0 {
-        return Err(BadField::new(field, "must not be zero"));
-    }
-    Ok(v)
 }
 
 fn points(v: &Value, field: &str, least: usize) -> Parsed<Vec<DVec3>> {
@@ -239,11 +193,6 @@ pub fn medium(v: &Value, field: &str) -> Parsed<Medium> {
             format!("unknown material {name:?} (one of {})", names.join(", ")),
         )
     })
-}
-
-/// The `seq` of a message, if it has a usable one (echoed in errors).
-pub fn seq_of(v: &Value) -> Option<u64> {
-    v.get("seq").and_then(Value::as_u64)
 }
 
 /// Parses one binary message (an upload, see the [module docs](self)).
@@ -300,18 +249,16 @@ pub fn upload_header(seq: u64) -> [u8; HEADER] {
 /// # Errors
 /// A [`BadField`] naming the first bad field.
 pub fn parse(text: &str) -> Result<(u64, Request), BadField> {
-    let v: Value = serde_json::from_str(text)
-        .map_err(|e| BadField::new("(message)", format!("not JSON: {e}")))?;
-    let o = v
-        .as_object()
-        .ok_or_else(|| BadField::new("(message)", "expected a JSON object"))?;
-    let seq = get(o, "seq")?
-        .as_u64()
-        .ok_or_else(|| BadField::new("seq", "expected a non-negative integer"))?;
-    let op = get(o, "op")?
-        .as_str()
-        .ok_or_else(|| BadField::new("op", "expected a string"))?;
-    let request = match op {
+    crate::web::json::parse(text, parse_incoming)
+}
+
+/// Parses one message's op and fields (its envelope read by the core).
+///
+/// # Errors
+/// A [`BadField`] naming the first bad field.
+pub fn parse_incoming(m: &Incoming<'_>) -> Result<Request, BadField> {
+    let o = m.fields;
+    let request = match m.op {
         "hello" => Request::Hello,
         "undo" => Request::Undo,
         "redo" => Request::Redo,
@@ -354,11 +301,10 @@ pub fn parse(text: &str) -> Result<(u64, Request), BadField> {
             return Err(BadField::new("op", format!("unknown op {other:?}")));
         }
     };
-    let request = match request {
+    Ok(match request {
         Request::Edit(edit, _) => Request::Edit(edit, gesture(o)?),
         other => other,
-    };
-    Ok((seq, request))
+    })
 }
 
 /// The optional `gesture` of an edit message: an id the page gives all
@@ -573,27 +519,16 @@ fn check_name(name: &str, kind: ExportKind) -> Parsed<()> {
 
 /// A binary frame: the header, then `payload`.
 pub fn frame(kind: u8, flags: u8, piece: u8, a: u32, b: u32, payload: &[u8]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(HEADER + payload.len());
-    out.extend_from_slice(MAGIC);
-    out.extend_from_slice(&[VERSION, kind, flags, piece]);
-    out.extend_from_slice(&a.to_le_bytes());
-    out.extend_from_slice(&b.to_le_bytes());
-    out.extend_from_slice(payload);
-    out
-}
-
-/// Appends `values` as little-endian f32.
-pub fn put_f32(out: &mut Vec<u8>, values: impl IntoIterator<Item = f32>) {
-    for v in values {
-        out.extend_from_slice(&v.to_le_bytes());
+    Header {
+        magic: *MAGIC,
+        version: VERSION,
+        kind,
+        flags,
+        tag: piece,
+        a,
+        b,
     }
-}
-
-/// Appends `values` as little-endian u32.
-pub fn put_u32(out: &mut Vec<u8>, values: impl IntoIterator<Item = u32>) {
-    for v in values {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
+    .frame(payload)
 }
 
 #[cfg(test)]

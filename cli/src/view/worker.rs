@@ -1,38 +1,32 @@
-//! The thread that owns the [`Session`]: it takes requests in order,
-//! coalesces the edits waiting, solves coarse first, refines when idle
-//! (cancelled by the next request), and sends frames and status to every
-//! connected page. A dropped connection does not touch it: a reload
-//! continues the same session.
+//! The app that owns the [`Session`] on the web core's thread
+//! ([`App`]): it takes requests in order, coalesces the edits waiting,
+//! solves coarse first, refines when idle (cancelled by the next
+//! request), and sends frames and status to every connected page. A
+//! dropped connection does not touch it: a reload continues the same
+//! session.
 
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{Receiver, TryRecvError};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use axum::body::Bytes;
 use serde_json::{Value, json};
 use tet_diffusion::glam::DVec3;
 use tet_diffusion::{Applied, Edit, Light, Session, SolveReport};
-use tokio::sync::broadcast;
 
 use super::protocol::{self, ExportKind, FINAL, LAST, RADIANCE, Request, SURFACE};
-use super::{Exporter, Out, session_file};
+use super::{Exporter, session_file};
+use crate::web::{App, Asset, BadField, Idle, Inbox, Incoming, Limits, Out, Outbox, ReplyTo};
 
-/// What a page needs on (re)connection: the last frames sent.
-#[derive(Debug, Default)]
-pub(crate) struct Latest {
-    pub(crate) hello: Option<String>,
-    pub(crate) surfaces: Vec<Arc<Vec<u8>>>,
-    pub(crate) radiance: Vec<Arc<Vec<u8>>>,
-    pub(crate) status: Option<String>,
-}
+/// The snapshot slots a page that connects is sent, in this order.
+const HELLO: usize = 0;
+const SURFACES: usize = 1;
+const RADIANCES: usize = 2;
+const STATUS: usize = 3;
 
 pub(crate) struct Worker {
     pub(crate) session: Session,
-    pub(crate) requests: Receiver<(u64, Request)>,
-    pub(crate) cancel: Arc<AtomicBool>,
-    pub(crate) out: broadcast::Sender<Out>,
-    pub(crate) latest: Arc<Mutex<Latest>>,
     pub(crate) exporter: Box<dyn Exporter>,
     pub(crate) export_dir: PathBuf,
     pub(crate) source: Value,
@@ -58,53 +52,55 @@ fn cpu_ms() -> f64 {
     (ticks(11) + ticks(12)) * 10.0
 }
 
-impl Worker {
-    pub(crate) fn run(mut self) {
-        self.send_all(&[]);
-        loop {
-            let next = if self.session.needs_refinement() {
-                self.cancel.store(false, Ordering::SeqCst);
-                match self.requests.try_recv() {
-                    Ok(r) => Some(r),
-                    Err(TryRecvError::Empty) => None,
-                    Err(TryRecvError::Disconnected) => return,
-                }
-            } else {
-                match self.requests.recv() {
-                    Ok(r) => Some(r),
-                    Err(_) => return,
-                }
-            };
-            match next {
-                None => self.refine(),
-                Some(first) => self.handle(first),
-            }
+impl App for Worker {
+    const NAME: &'static str = "view";
+    const PAGE: &'static [Asset] = super::PAGE;
+    const LIMITS: Limits = super::LIMITS;
+    type Request = Request;
+
+    fn parse(m: &Incoming<'_>) -> Result<Request, BadField> {
+        protocol::parse_incoming(m)
+    }
+
+    fn parse_binary(bytes: &[u8]) -> Result<(u64, Request), BadField> {
+        protocol::parse_upload(bytes)
+    }
+
+    fn begin(&mut self, out: &Outbox) {
+        self.send_all(out, &[]);
+    }
+
+    fn handle(&mut self, first: (ReplyTo, Request), inbox: &mut Inbox<Request>, out: &Outbox) {
+        self.gather(out, first, inbox);
+    }
+
+    fn idle(&mut self, cancel: &AtomicBool, out: &Outbox) -> Idle {
+        if !self.session.needs_refinement() {
+            return Idle::Wait;
         }
+        self.refine(out, cancel);
+        Idle::Busy
     }
+}
 
-    fn send(&self, out: Out) {
-        // No page connected is not an error: the state is kept in
-        // `latest` for the next one.
-        let _ = self.out.send(out);
-    }
-
-    fn error(&self, seq: u64, field: &str, message: &str) {
-        self.send(Out::Text(
+impl Worker {
+    fn error(&self, out: &Outbox, seq: u64, field: &str, message: &str) {
+        out.broadcast(Out::Text(
             json!({"type": "error", "seq": seq, "field": field, "message": message}).to_string(),
         ));
     }
 
-    fn refine(&mut self) {
+    fn refine(&mut self, out: &Outbox, cancel: &AtomicBool) {
         let t = Instant::now();
         let c = cpu_ms();
-        match self.session.refine(&self.cancel) {
+        match self.session.refine(cancel) {
             Ok((reports, true)) => {
-                self.send_radiance(true, 0);
-                self.send_status(&[], "refine", &reports, t, c, false);
+                self.send_radiance(out, true, 0);
+                self.send_status(out, &[], "refine", &reports, t, c, false);
             }
             Ok((_, false)) => {}
             Err(e) => {
-                self.error(0, "(solve)", &e.to_string());
+                self.error(out, 0, "(solve)", &e.to_string());
                 // Keep the coarse result; nothing more to refine until the
                 // next edit.
                 self.session.skip_refinement();
@@ -115,11 +111,12 @@ impl Worker {
     /// Handles `first` and, if it is an edit, every edit already waiting
     /// behind it (coalesced by the session); a non-edit request stops
     /// the gathering and is handled after them.
-    fn handle(&mut self, first: (u64, Request)) {
+    fn gather(&mut self, out: &Outbox, first: (ReplyTo, Request), inbox: &mut Inbox<Request>) {
         let mut seqs = Vec::new();
         let mut after = None;
         let mut request = Some(first);
-        while let Some((seq, r)) = request.take() {
+        while let Some((to, r)) = request.take() {
+            let seq = to.seq.unwrap_or(0);
             match r {
                 Request::Edit(mut edit, gesture) => {
                     // The page's lights are the directional and point ones:
@@ -132,35 +129,34 @@ impl Worker {
                     }
                     match self.session.push_in(edit, gesture) {
                         Ok(()) => seqs.push(seq),
-                        Err(e) => self.error(seq, &field_of(&e), &e.to_string()),
+                        Err(e) => self.error(out, seq, &field_of(&e), &e.to_string()),
                     }
-                    request = self.requests.try_recv().ok();
+                    request = inbox.try_next();
                 }
                 other => after = Some((seq, other)),
             }
         }
         if !seqs.is_empty() || self.session.pending() > 0 {
-            self.apply(&seqs);
+            self.apply(out, &seqs);
         }
         if let Some((seq, r)) = after {
-            self.other(seq, r);
+            self.other(out, seq, r);
         }
     }
 
-    fn apply(&mut self, seqs: &[u64]) {
+    fn apply(&mut self, out: &Outbox, seqs: &[u64]) {
         let t = Instant::now();
         let c = cpu_ms();
         let mut reports: Vec<SolveReport> = Vec::new();
         let mut name = "edit";
         let last = seqs.last().copied().unwrap_or(0);
-        let (out, latest) = (&self.out, &self.latest);
         // A cut's new surface goes out before its solve (a new hierarchy
         // and the coarse solve take longer than the cut), coloured by the
         // φ carried over until the solved radiance follows.
         let show_new_surface = |s: &Session, edit: &Edit| {
             if edit.changes_topology() {
-                publish_surfaces(out, latest, s);
-                publish_radiance(out, latest, s, false, last);
+                publish_surfaces(out, s);
+                publish_radiance(out, s, false, last);
             }
         };
         while let Some(result) = self.session.apply_pending_with(show_new_surface) {
@@ -170,20 +166,21 @@ impl Worker {
                     reports.extend(solves);
                 }
                 Err(e) => {
-                    self.error(last, &field_of(&e), &e.to_string());
+                    self.error(out, last, &field_of(&e), &e.to_string());
                 }
             }
         }
-        self.send_radiance(!self.session.needs_refinement(), last);
-        self.send_status(seqs, name, &reports, t, c, self.session.needs_refinement());
+        self.send_radiance(out, !self.session.needs_refinement(), last);
+        let coarse = self.session.needs_refinement();
+        self.send_status(out, seqs, name, &reports, t, c, coarse);
     }
 
-    fn other(&mut self, seq: u64, r: Request) {
+    fn other(&mut self, out: &Outbox, seq: u64, r: Request) {
         let t = Instant::now();
         let c = cpu_ms();
         match r {
             Request::Edit(..) => {}
-            Request::Hello => self.send_all(&[seq]),
+            Request::Hello => self.send_all(out, &[seq]),
             Request::Undo | Request::Redo => {
                 let undo = matches!(r, Request::Undo);
                 let result = if undo {
@@ -194,13 +191,14 @@ impl Worker {
                 match result {
                     Ok(Some(edit)) => {
                         if edit.changes_topology() {
-                            self.send_surfaces();
+                            publish_surfaces(out, &self.session);
                         }
-                        self.send_radiance(true, seq);
+                        self.send_radiance(out, true, seq);
                         let name = if undo { "undo" } else { "redo" };
-                        self.send_status(&[seq], name, &[], t, c, false);
+                        self.send_status(out, &[seq], name, &[], t, c, false);
                     }
                     Ok(None) => self.error(
+                        out,
                         seq,
                         "op",
                         if undo {
@@ -209,11 +207,11 @@ impl Worker {
                             "nothing to redo"
                         },
                     ),
-                    Err(e) => self.error(seq, "op", &e.to_string()),
+                    Err(e) => self.error(out, seq, "op", &e.to_string()),
                 }
             }
-            Request::Probe { piece, point } => self.probe(seq, piece, point),
-            Request::Environment { hdr } => self.environment(seq, &hdr),
+            Request::Probe { piece, point } => self.probe(out, seq, piece, point),
+            Request::Environment { hdr } => self.environment(out, seq, &hdr),
             Request::Export {
                 kind,
                 name,
@@ -233,7 +231,7 @@ impl Worker {
                         .export(&self.session, kind, &path, size, view, overwrite),
                 };
                 match result {
-                    Ok(()) => self.send(Out::Text(
+                    Ok(()) => out.broadcast(Out::Text(
                         json!({"type": "export", "seq": seq, "path": path.display().to_string()})
                             .to_string(),
                     )),
@@ -246,7 +244,7 @@ impl Worker {
                         } else {
                             e.to_string()
                         };
-                        self.send(Out::Text(
+                        out.broadcast(Out::Text(
                             json!({"type": "error", "seq": seq, "field": "name",
                                    "message": message, "exists": exists})
                             .to_string(),
@@ -271,7 +269,7 @@ impl Worker {
     /// Lights the object by the uploaded `.hdr` (kept beside the exports
     /// under a name from its content, for session files), or without an
     /// environment map when `hdr` is empty; the other lights stay.
-    fn environment(&mut self, seq: u64, hdr: &[u8]) {
+    fn environment(&mut self, out: &Outbox, seq: u64, hdr: &[u8]) {
         let off = self.session.offsets()[0];
         let mut lights: Vec<Light> = self.session.pieces()[0]
             .lights()
@@ -291,12 +289,12 @@ impl Worker {
         if !hdr.is_empty() {
             match self.load_environment(hdr) {
                 Ok(env) => lights.push(Light::Environment(env)),
-                Err(e) => return self.error(seq, "(upload)", &e),
+                Err(e) => return self.error(out, seq, "(upload)", &e),
             }
         }
         match self.session.push(Edit::Lights(lights)) {
-            Ok(()) => self.apply(&[seq]),
-            Err(e) => self.error(seq, "(upload)", &e.to_string()),
+            Ok(()) => self.apply(out, &[seq]),
+            Err(e) => self.error(out, seq, "(upload)", &e.to_string()),
         }
     }
 
@@ -324,9 +322,9 @@ impl Worker {
         Ok(env)
     }
 
-    fn probe(&self, seq: u64, piece: usize, point: DVec3) {
+    fn probe(&self, out: &Outbox, seq: u64, piece: usize, point: DVec3) {
         let Some(o) = self.session.pieces().get(piece) else {
-            return self.error(seq, "piece", "no such piece");
+            return self.error(out, seq, "piece", "no such piece");
         };
         let local = point - self.session.offsets()[piece];
         let m = o.mesh();
@@ -335,7 +333,7 @@ impl Worker {
             let db = m.positions()[*b.1 as usize].distance_squared(local);
             da.total_cmp(&db)
         }) else {
-            return self.error(seq, "piece", "the piece has no surface");
+            return self.error(out, seq, "piece", "the piece has no surface");
         };
         let radiance = o.radiance(None)[k];
         // The medium of a tet around the vertex, by name when measured.
@@ -347,7 +345,7 @@ impl Worker {
                 .find(|(n, _, _)| tet_diffusion::Medium::measured(n).ok() == Some(md))
                 .map(|(n, _, _)| n.to_string())
         });
-        self.send(Out::Text(
+        out.broadcast(Out::Text(
             json!({
                 "type": "probe", "seq": seq, "piece": piece, "vertex": v,
                 "material": name.unwrap_or_else(|| "mixed".into()),
@@ -389,29 +387,24 @@ impl Worker {
     }
 
     /// Everything a page needs; the status answers `seqs` (a hello's).
-    fn send_all(&mut self, seqs: &[u64]) {
-        let hello = self.hello();
-        self.latest_mut().hello = Some(hello.clone());
-        self.send(Out::Text(hello));
-        self.send_surfaces();
-        self.send_radiance(!self.session.needs_refinement(), 0);
-        self.send_status(seqs, "hello", &[], Instant::now(), cpu_ms(), false);
+    fn send_all(&mut self, out: &Outbox, seqs: &[u64]) {
+        out.publish(HELLO, vec![Out::Text(self.hello())]);
+        publish_surfaces(out, &self.session);
+        self.send_radiance(out, !self.session.needs_refinement(), 0);
+        self.send_status(out, seqs, "hello", &[], Instant::now(), cpu_ms(), false);
     }
 
-    fn latest_mut(&self) -> std::sync::MutexGuard<'_, Latest> {
-        lock(&self.latest)
+    fn send_radiance(&mut self, out: &Outbox, refined: bool, seq: u64) {
+        publish_radiance(out, &self.session, refined, seq);
     }
 
-    fn send_surfaces(&mut self) {
-        publish_surfaces(&self.out, &self.latest, &self.session);
-    }
-
-    fn send_radiance(&mut self, refined: bool, seq: u64) {
-        publish_radiance(&self.out, &self.latest, &self.session, refined, seq);
-    }
-
+    #[expect(
+        clippy::too_many_arguments,
+        reason = "the status's parts, each from its caller"
+    )]
     fn send_status(
         &mut self,
+        out: &Outbox,
         seqs: &[u64],
         edit: &str,
         reports: &[SolveReport],
@@ -452,8 +445,7 @@ impl Worker {
             "lights": lights_json(s, &self.envs),
         })
         .to_string();
-        self.latest_mut().status = Some(status.clone());
-        self.send(Out::Text(status));
+        out.publish(STATUS, vec![Out::Text(status)]);
     }
 }
 
@@ -479,7 +471,7 @@ fn write_glb(
 
 /// Sends each piece's boundary surface (positions, normals, triangles)
 /// and keeps the frames for pages that connect later.
-fn publish_surfaces(out: &broadcast::Sender<Out>, latest: &Mutex<Latest>, session: &Session) {
+fn publish_surfaces(out: &Outbox, session: &Session) {
     let frames = piece_frames(session, |p, o, last| {
         let m = o.mesh();
         let bv = m.boundary_vertices();
@@ -507,19 +499,12 @@ fn publish_surfaces(out: &broadcast::Sender<Out>, latest: &Mutex<Latest>, sessio
             &payload,
         )
     });
-    broadcast_frames(out, &frames);
-    lock(latest).surfaces = frames;
+    out.publish(SURFACES, frames);
 }
 
 /// Sends each piece's radiance per boundary vertex, tagged with the edit
 /// `seq` and whether it is refined, and keeps the frames.
-fn publish_radiance(
-    out: &broadcast::Sender<Out>,
-    latest: &Mutex<Latest>,
-    session: &Session,
-    refined: bool,
-    seq: u64,
-) {
+fn publish_radiance(out: &Outbox, session: &Session, refined: bool, seq: u64) {
     let frames = piece_frames(session, |p, o, last| {
         let l = o.radiance(None);
         let mut payload = Vec::with_capacity(l.len() * 12);
@@ -534,8 +519,7 @@ fn publish_radiance(
             &payload,
         )
     });
-    broadcast_frames(out, &frames);
-    lock(latest).radiance = frames;
+    out.publish(RADIANCES, frames);
 }
 
 /// One frame per piece, made by `frame(piece index, piece, flag)`, where
@@ -543,28 +527,17 @@ fn publish_radiance(
 fn piece_frames(
     session: &Session,
     frame: impl Fn(usize, &tet_diffusion::Object, u8) -> Vec<u8>,
-) -> Vec<Arc<Vec<u8>>> {
+) -> Vec<Out> {
     let n = session.pieces().len();
     session
         .pieces()
         .iter()
         .enumerate()
-        .map(|(p, o)| Arc::new(frame(p, o, if p + 1 == n { LAST } else { 0 })))
+        .map(|(p, o)| {
+            let flag = if p + 1 == n { LAST } else { 0 };
+            Out::Binary(Bytes::from(frame(p, o, flag)))
+        })
         .collect()
-}
-
-fn broadcast_frames(out: &broadcast::Sender<Out>, frames: &[Arc<Vec<u8>>]) {
-    for f in frames {
-        // No page connected is not an error: the state is kept in
-        // `latest` for the next one.
-        let _ = out.send(Out::Binary(f.clone()));
-    }
-}
-
-fn lock(latest: &Mutex<Latest>) -> std::sync::MutexGuard<'_, Latest> {
-    latest
-        .lock()
-        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// The field an edit's error names: the argument for a bad one, else the

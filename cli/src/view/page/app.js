@@ -1,8 +1,10 @@
 // trilux view: the page. Modes, pointer handling, the HUD; drawing is in
-// gl.js, the camera in camera.js, the socket in net.js.
+// gl.js, the camera in camera.js, the socket in net.js, the frames in
+// protocol.js.
 import { Renderer } from './gl.js';
 import { Camera, normalize, cross, dot } from './camera.js';
-import { Connection, SURFACE, FINAL } from './net.js';
+import { Connection } from './net.js';
+import { parseFrame, SURFACE, FINAL, ENVIRONMENT_UPLOAD } from './protocol.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('view'), overlay = $('overlay'), brush = $('brush');
@@ -26,7 +28,7 @@ state.renderer = renderer;
 
 // On a new connection, edits sent on the old one get no answer: the
 // hello's status shows what the server has.
-const conn = new Connection(onText, onFrame, (s) => {
+const conn = new Connection('view', parseFrame, onText, onFrame, (s) => {
   $('status').textContent = s;
   if (s === 'connected') { state.pending.clear(); conn.send('hello'); }
 });
@@ -395,7 +397,7 @@ async function loadEnvironment(file) {
   if (file && file.size + 16 > limit) { $('status').textContent = `${file.name}: ${file.size} bytes; at most ${limit - 16} may be uploaded`; return; }
   const bytes = file ? new Uint8Array(await file.arrayBuffer()) : new Uint8Array(0);
   state.uploadName = file ? file.name : null;
-  const seq = conn.upload(bytes);
+  const seq = conn.upload(ENVIRONMENT_UPLOAD, bytes);
   if (seq === null) { $('status').textContent = 'not connected to trilux view: the environment map was not sent'; return; }
   state.pending.set(seq, performance.now());
 }

@@ -7,6 +7,9 @@
 // 99th percentile of the luminance of the pixels the object covers (a
 // small offscreen pass writes each covered pixel's log-luminance).
 
+import { program, fitCanvas, offscreen } from './glutil.js';
+import { pick } from './pick.js';
+
 const VS = `#version 300 es
 in vec3 position; in vec3 normal; in vec3 radiance;
 uniform mat4 viewProj; uniform vec3 offset;
@@ -68,24 +71,12 @@ void main() {
   color = vec4(srgb(clamp(c.r, 0.0, 1.0)), srgb(clamp(c.g, 0.0, 1.0)), srgb(clamp(c.b, 0.0, 1.0)), 1.0);
 }`;
 
-function shader(gl, type, text) {
-  const s = gl.createShader(type);
-  gl.shaderSource(s, text);
-  gl.compileShader(s);
-  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
-  return s;
-}
-
 export class Renderer {
   constructor(canvas) {
     const gl = canvas.getContext('webgl2', { antialias: true, preserveDrawingBuffer: true });
     if (!gl) throw new Error('WebGL2 is not available in this browser');
     this.gl = gl;
-    const p = gl.createProgram();
-    gl.attachShader(p, shader(gl, gl.VERTEX_SHADER, VS));
-    gl.attachShader(p, shader(gl, gl.FRAGMENT_SHADER, FS));
-    gl.linkProgram(p);
-    if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p));
+    const p = program(gl, VS, FS);
     this.program = p;
     this.loc = {};
     for (const u of ['viewProj', 'offset', 'eye', 'eta', 'exposure', 'lightDir', 'lightRgb', 'specular', 'unitScale', 'measure'])
@@ -139,8 +130,7 @@ export class Renderer {
   draw(camera, opts) {
     const gl = this.gl;
     const c = gl.canvas;
-    const w = Math.floor(c.clientWidth * devicePixelRatio), h = Math.floor(c.clientHeight * devicePixelRatio);
-    if (c.width !== w || c.height !== h) { c.width = w; c.height = h; }
+    fitCanvas(c);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     gl.viewport(0, 0, c.width, c.height);
     gl.clearColor(0.106, 0.11, 0.122, 1);
@@ -182,20 +172,7 @@ export class Renderer {
     const c = gl.canvas;
     const aspect = c.width / Math.max(c.height, 1);
     const w = Math.max(16, Math.min(256, c.width)), h = Math.max(16, Math.round(w / aspect));
-    if (!this.fbo || this.fbo.w !== w || this.fbo.h !== h) {
-      if (this.fbo) { gl.deleteFramebuffer(this.fbo.fb); gl.deleteTexture(this.fbo.tex); gl.deleteRenderbuffer(this.fbo.depth); }
-      const tex = gl.createTexture();
-      gl.bindTexture(gl.TEXTURE_2D, tex);
-      gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, w, h);
-      const depth = gl.createRenderbuffer();
-      gl.bindRenderbuffer(gl.RENDERBUFFER, depth);
-      gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, w, h);
-      const fb = gl.createFramebuffer();
-      gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
-      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
-      gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, depth);
-      this.fbo = { fb, tex, depth, w, h, pixels: new Uint8Array(w * h * 4) };
-    }
+    this.fbo = offscreen(gl, this.fbo, w, h);
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.fbo.fb);
     gl.viewport(0, 0, w, h);
     gl.clearColor(0, 0, 0, 0);
@@ -216,31 +193,9 @@ export class Renderer {
     return { white: lum.length ? Math.max(lum[Math.floor(lum.length * 0.99)], 1e-12) : 1, covered };
   }
 
-  // The nearest surface hit of a ray (origin o, direction d): {piece, point, t}.
+  // The nearest surface hit of a ray (origin o, direction d): {piece,
+  // point, t} (and the triangle and its barycentrics), or null.
   pick(o, d) {
-    let best = null;
-    this.pieces.forEach((p, k) => {
-      if (!p) return;
-      const P = p.positions, I = p.indices, off = p.offset;
-      for (let i = 0; i < I.length; i += 3) {
-        const a = I[i] * 3, b = I[i + 1] * 3, c = I[i + 2] * 3;
-        const ax = P[a] + off[0], ay = P[a + 1] + off[1], az = P[a + 2] + off[2];
-        const e1x = P[b] + off[0] - ax, e1y = P[b + 1] + off[1] - ay, e1z = P[b + 2] + off[2] - az;
-        const e2x = P[c] + off[0] - ax, e2y = P[c + 1] + off[1] - ay, e2z = P[c + 2] + off[2] - az;
-        const px = d[1] * e2z - d[2] * e2y, py = d[2] * e2x - d[0] * e2z, pz = d[0] * e2y - d[1] * e2x;
-        const det = e1x * px + e1y * py + e1z * pz;
-        if (Math.abs(det) < 1e-20) continue;
-        const inv = 1 / det;
-        const tx = o[0] - ax, ty = o[1] - ay, tz = o[2] - az;
-        const u = (tx * px + ty * py + tz * pz) * inv;
-        if (u < 0 || u > 1) continue;
-        const qx = ty * e1z - tz * e1y, qy = tz * e1x - tx * e1z, qz = tx * e1y - ty * e1x;
-        const v = (d[0] * qx + d[1] * qy + d[2] * qz) * inv;
-        if (v < 0 || u + v > 1) continue;
-        const t = (e2x * qx + e2y * qy + e2z * qz) * inv;
-        if (t > 0 && (!best || t < best.t)) best = { piece: k, t, point: [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]] };
-      }
-    });
-    return best;
+    return pick(this.pieces, o, d);
   }
 }

@@ -1,0 +1,112 @@
+//! Binary frames: a fixed 16-byte header, then raw little-endian arrays.
+//! Each app owns its magic and version (bump the version when a payload
+//! changes); the page's `frame.js` reads the same header.
+//!
+//! | bytes | field |
+//! |---|---|
+//! | 0..4 | magic |
+//! | 4 | version |
+//! | 5 | kind |
+//! | 6 | flags |
+//! | 7 | tag (view: the piece index) |
+//! | 8..12 | `a`, u32 |
+//! | 12..16 | `b`, u32 |
+
+/// Header size.
+pub const HEADER: usize = 16;
+
+/// A frame's header.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Header {
+    /// The app's magic.
+    pub magic: [u8; 4],
+    /// The app's frame version.
+    pub version: u8,
+    /// What the payload holds.
+    pub kind: u8,
+    /// Flags of the kind.
+    pub flags: u8,
+    /// A small tag of the kind.
+    pub tag: u8,
+    /// A count of the kind.
+    pub a: u32,
+    /// Another count or id of the kind.
+    pub b: u32,
+}
+
+impl Header {
+    /// The 16 header bytes.
+    pub fn bytes(&self) -> [u8; HEADER] {
+        let mut h = [0u8; HEADER];
+        h[..4].copy_from_slice(&self.magic);
+        h[4..8].copy_from_slice(&[self.version, self.kind, self.flags, self.tag]);
+        h[8..12].copy_from_slice(&self.a.to_le_bytes());
+        h[12..16].copy_from_slice(&self.b.to_le_bytes());
+        h
+    }
+
+    /// The header, then `payload`.
+    pub fn frame(&self, payload: &[u8]) -> Vec<u8> {
+        let mut out = Vec::with_capacity(HEADER + payload.len());
+        out.extend_from_slice(&self.bytes());
+        out.extend_from_slice(payload);
+        out
+    }
+
+    /// The header at the start of `bytes`; `None` when shorter.
+    pub fn read(bytes: &[u8]) -> Option<Self> {
+        let h: &[u8; HEADER] = bytes.get(..HEADER)?.try_into().ok()?;
+        let word = |i: usize| u32::from_le_bytes([h[i], h[i + 1], h[i + 2], h[i + 3]]);
+        Some(Self {
+            magic: [h[0], h[1], h[2], h[3]],
+            version: h[4],
+            kind: h[5],
+            flags: h[6],
+            tag: h[7],
+            a: word(8),
+            b: word(12),
+        })
+    }
+}
+
+/// Appends `values` as little-endian f32.
+pub fn put_f32(out: &mut Vec<u8>, values: impl IntoIterator<Item = f32>) {
+    for v in values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+/// Appends `values` as little-endian u32.
+pub fn put_u32(out: &mut Vec<u8>, values: impl IntoIterator<Item = u32>) {
+    for v in values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_header_reads_back_and_short_input_is_none() {
+        let h = Header {
+            magic: *b"TEST",
+            version: 3,
+            kind: 2,
+            flags: 1,
+            tag: 9,
+            a: 0x0102_0304,
+            b: u32::MAX,
+        };
+        let f = h.frame(&[7, 8]);
+        assert_eq!(&f[..4], b"TEST");
+        assert_eq!(&f[8..12], &[4, 3, 2, 1]);
+        assert_eq!(&f[HEADER..], &[7, 8]);
+        assert_eq!(Header::read(&f), Some(h));
+        assert_eq!(Header::read(&f[..HEADER - 1]), None);
+        let mut v = Vec::new();
+        put_f32(&mut v, [1.0]);
+        put_u32(&mut v, [2]);
+        assert_eq!(v, [0, 0, 128, 63, 2, 0, 0, 0]);
+    }
+}

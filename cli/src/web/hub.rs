@@ -1,0 +1,181 @@
+//! The app's thread and what joins it to the connections: the [`Inbox`]
+//! of parsed requests, and the [`Outbox`] of snapshot slots, broadcasts
+//! and replies.
+
+use std::collections::{BTreeMap, HashMap};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{self, RecvTimeoutError, TryRecvError};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
+
+use tokio::sync::{broadcast, mpsc as async_mpsc};
+
+use super::{App, ConnId, Idle, Out, ReplyTo};
+
+/// How many broadcast messages a slow page may fall behind before it is
+/// sent the snapshot instead.
+const BACKLOG: usize = 256;
+
+/// What the connections share with the app's thread.
+#[derive(Debug)]
+pub(crate) struct Hub {
+    state: Mutex<State>,
+    all: broadcast::Sender<Out>,
+}
+
+#[derive(Debug, Default)]
+struct State {
+    /// The snapshot a page that connects is sent first, in slot order.
+    slots: BTreeMap<usize, Vec<Out>>,
+    /// Each open connection's queue of replies.
+    conns: HashMap<ConnId, async_mpsc::UnboundedSender<Out>>,
+}
+
+/// A connection's view of the hub: everything broadcast, the replies to
+/// it, and the snapshot it starts from.
+pub(crate) struct Joined {
+    pub(crate) all: broadcast::Receiver<Out>,
+    pub(crate) replies: async_mpsc::UnboundedReceiver<Out>,
+    pub(crate) snapshot: Vec<Out>,
+}
+
+impl Hub {
+    pub(crate) fn new() -> Arc<Self> {
+        Arc::new(Self {
+            state: Mutex::new(State::default()),
+            all: broadcast::channel(BACKLOG).0,
+        })
+    }
+
+    fn lock(&self) -> MutexGuard<'_, State> {
+        // A panic while publishing leaves whole slots: keep serving them.
+        self.state.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Registers connection `conn`. Under one lock with [`Outbox::publish`],
+    /// so that the snapshot and the broadcasts after it neither miss nor
+    /// repeat a publication.
+    pub(crate) fn join(&self, conn: ConnId) -> Joined {
+        let mut state = self.lock();
+        let (tx, replies) = async_mpsc::unbounded_channel();
+        state.conns.insert(conn, tx);
+        Joined {
+            all: self.all.subscribe(),
+            replies,
+            snapshot: state.slots.values().flatten().cloned().collect(),
+        }
+    }
+
+    /// The snapshot alone (a page that fell behind catches up with it).
+    pub(crate) fn snapshot(&self) -> Vec<Out> {
+        self.lock().slots.values().flatten().cloned().collect()
+    }
+
+    /// Forgets connection `conn`.
+    pub(crate) fn leave(&self, conn: ConnId) {
+        self.lock().conns.remove(&conn);
+    }
+}
+
+/// What the app sends to the pages.
+#[derive(Debug, Clone)]
+pub struct Outbox {
+    hub: Arc<Hub>,
+}
+
+impl Outbox {
+    /// Replaces snapshot slot `slot` with `messages` and broadcasts them.
+    /// A page that connects later is sent every slot, in slot order.
+    pub fn publish(&self, slot: usize, messages: Vec<Out>) {
+        let mut state = self.hub.lock();
+        for m in &messages {
+            // No page connected is not an error: the slot keeps it.
+            let _ = self.hub.all.send(m.clone());
+        }
+        state.slots.insert(slot, messages);
+    }
+
+    /// Sends `message` to every connected page (not kept for later ones).
+    pub fn broadcast(&self, message: Out) {
+        let _ = self.hub.all.send(message);
+    }
+
+    /// Sends `message` to the connection `to` names, if it is still open.
+    pub fn reply(&self, to: ReplyTo, message: Out) {
+        if let Some(conn) = self.hub.lock().conns.get(&to.conn) {
+            let _ = conn.send(message);
+        }
+    }
+
+    /// Answers `to` with an error naming `field`.
+    pub fn error(&self, to: ReplyTo, field: &str, message: &str) {
+        self.reply(to, Out::Text(super::json::error(to.seq, field, message)));
+    }
+}
+
+/// The requests waiting for the app.
+#[derive(Debug)]
+pub struct Inbox<R> {
+    rx: mpsc::Receiver<(ReplyTo, R)>,
+}
+
+impl<R> Inbox<R> {
+    /// The next request if one is already waiting.
+    pub fn try_next(&mut self) -> Option<(ReplyTo, R)> {
+        self.rx.try_recv().ok()
+    }
+}
+
+/// The queue the connections put requests in.
+pub(crate) type Requests<R> = mpsc::Sender<(ReplyTo, R)>;
+
+/// Moves `app` onto its own thread (named after the app) and returns the
+/// queue of its requests. The thread ends when every sender is gone.
+pub(crate) fn spawn<A: App>(
+    app: A,
+    hub: Arc<Hub>,
+    cancel: Arc<AtomicBool>,
+) -> Result<Requests<A::Request>, String> {
+    let (requests, rx) = mpsc::channel();
+    let out = Outbox { hub };
+    std::thread::Builder::new()
+        .name(format!("trilux-{}-session", A::NAME))
+        .spawn(move || run(app, Inbox { rx }, &out, &cancel))
+        .map_err(|e| format!("trilux {}: could not start its thread: {e}", A::NAME))?;
+    Ok(requests)
+}
+
+/// The app's loop: requests in order, background work in between (see
+/// [`Idle`]).
+fn run<A: App>(mut app: A, mut inbox: Inbox<A::Request>, out: &Outbox, cancel: &AtomicBool) {
+    app.begin(out);
+    let mut next = Idle::Busy;
+    loop {
+        let request = match next {
+            Idle::Busy => {
+                cancel.store(false, Ordering::SeqCst);
+                match inbox.rx.try_recv() {
+                    Ok(r) => Some(r),
+                    Err(TryRecvError::Empty) => None,
+                    Err(TryRecvError::Disconnected) => break,
+                }
+            }
+            Idle::Wait => match inbox.rx.recv() {
+                Ok(r) => Some(r),
+                Err(_) => break,
+            },
+            Idle::WaitAtMost(d) => match inbox.rx.recv_timeout(d) {
+                Ok(r) => Some(r),
+                Err(RecvTimeoutError::Timeout) => None,
+                Err(RecvTimeoutError::Disconnected) => break,
+            },
+        };
+        next = match request {
+            Some(first) => {
+                app.handle(first, &mut inbox, out);
+                Idle::Busy
+            }
+            None => app.idle(cancel, out),
+        };
+    }
+    app.stop(out);
+}
