@@ -4,9 +4,11 @@
 //! WebGL2 has no texture buffers: a linear index `i` is the texel
 //! `(i % W, i / W)` of a texture `W` texels wide, read with `texelFetch`.
 //!
-//! [`GpuLayout::new`] packs a [`MipMap`]; [`GpuLayout::update`] repacks it
-//! after a stroke or a resolution change and says which texel rectangles
-//! changed (for `texSubImage2D`); [`GpuLayout::lookup`] is the CPU
+//! [`GpuLayout::new`] packs a [`MipMap`]; after a stroke,
+//! [`MipMap::refresh`] and [`GpuLayout::refresh`] rewrite only the values
+//! near the stroke and say which texel rectangles changed (for
+//! `texSubImage2D`); after a resolution change [`GpuLayout::update`]
+//! repacks a new pyramid and says the same; [`GpuLayout::lookup`] is the CPU
 //! reference of the shader: it reads *only* the packed arrays, with the
 //! formulas below, and equals [`MeshColors::nearest`],
 //! [`MeshColors::linear`], [`MipMap::at_level`], [`MipMap::trilinear`] and
@@ -352,6 +354,69 @@ impl GpuLayout {
         };
         self.parts = new;
         Ok(changes)
+    }
+
+    /// Rewrites only the values of `spans` (value indices `[start, end)`,
+    /// as [`MipMap::refresh`] returns them after a stroke) from `mip`, and
+    /// returns the rectangles whose texels changed. The cost follows the
+    /// spans, not the mesh. `mip` must have the layout this was packed
+    /// from (same resolutions); after a resolution change use
+    /// [`GpuLayout::update`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] naming `mip` when its channel, face or
+    /// value counts differ from this layout's, or `spans` when a span
+    /// leaves the values; nothing changes then.
+    pub fn refresh(&mut self, mip: &MipMap, spans: &[(usize, usize)]) -> Result<Changes, Error> {
+        let c = mip.colors.channels;
+        let p = c.div_ceil(4);
+        let values = mip.data.len() / c;
+        let w = self.parts.width as usize;
+        if c != self.parts.channels
+            || mip.colors.face_level.len() != self.parts.face_count
+            || (values * p).div_ceil(w).max(1) != self.sample_height() as usize
+        {
+            return Err(Error::InvalidArgument {
+                argument: "mip",
+                reason: "does not have this layout's channels, faces or values \
+                         (after a resolution change, use update)",
+            });
+        }
+        if spans.iter().any(|&(a, b)| a > b || b > values) {
+            return Err(Error::InvalidArgument {
+                argument: "spans",
+                reason: "has a span beyond the pyramid's values",
+            });
+        }
+        let mut changed: Vec<(usize, usize)> = Vec::new();
+        for &(a, b) in spans {
+            for i in a..b {
+                let value = &mip.data[i * c..(i + 1) * c];
+                for (g, chunk) in value.chunks(4).enumerate() {
+                    let t = i * p + g;
+                    let texel = &mut self.parts.samples[t * 4..t * 4 + 4];
+                    let mut new = [0.0f32; 4];
+                    new[..chunk.len()].copy_from_slice(chunk);
+                    if texel
+                        .iter()
+                        .zip(&new)
+                        .all(|(x, y)| x.to_bits() == y.to_bits())
+                    {
+                        continue;
+                    }
+                    texel.copy_from_slice(&new);
+                    match changed.last_mut() {
+                        Some((_, end)) if t >= *end && t - *end < MERGE_GAP => *end = t + 1,
+                        _ => changed.push((t, t + 1)),
+                    }
+                }
+            }
+        }
+        Ok(Changes {
+            resized: false,
+            samples: rects(w, changed),
+            faces: Vec::new(),
+        })
     }
 
     /// The filtered value at barycentrics `b` of face `face` into `out`

@@ -25,6 +25,54 @@ pub(crate) fn edge_level_offset(l: u8) -> usize {
     (1usize << l) - 1 - l as usize
 }
 
+/// The primitives one level of [`MipMap::refresh`] recomputes.
+struct Subset {
+    faces: Vec<usize>,
+    edges: Vec<usize>,
+    vertices: Vec<usize>,
+}
+
+impl Subset {
+    /// The faces `faces` finer than `l`, and their edges and vertices
+    /// finer than `l`, each once, in increasing order.
+    fn of(mc: &MeshColors, faces: &[usize], l: u8) -> Self {
+        let mut fs: Vec<usize> = faces
+            .iter()
+            .copied()
+            .filter(|&f| mc.face_level[f] > l)
+            .collect();
+        let mut es: Vec<usize> = Vec::new();
+        let mut vs: Vec<usize> = Vec::new();
+        for &f in faces {
+            for k in 0..3 {
+                let e = mc.topology.face_edges[f][k] as usize;
+                if mc.edge_level[e] > l {
+                    es.push(e);
+                }
+                let v = mc.topology.faces[f][k] as usize;
+                if mc.vertex_level[v] > l {
+                    vs.push(v);
+                }
+            }
+        }
+        for list in [&mut fs, &mut es, &mut vs] {
+            list.sort_unstable();
+            list.dedup();
+        }
+        Self {
+            faces: fs,
+            edges: es,
+            vertices: vs,
+        }
+    }
+}
+
+/// The indices of `list`, or `0..n` when there is no list.
+fn ids(list: Option<&[usize]>, n: usize) -> impl Iterator<Item = usize> + '_ {
+    let all = if list.is_none() { 0..n } else { 0..0 };
+    list.into_iter().flatten().copied().chain(all)
+}
+
 /// The hexagonal neighbours of a lattice point (Eq. 5's six colours).
 const HEX: [[i32; 3]; 6] = [
     [1, -1, 0],
@@ -137,7 +185,7 @@ impl MipMap {
         }
         let top = mip.colors.vertex_level.iter().copied().max().unwrap_or(0);
         for l in (0..top).rev() {
-            mip.build_level(l, &vertex_edges);
+            mip.build_level(l, &vertex_edges, None);
         }
         mip.build_cache();
         mip
@@ -258,31 +306,211 @@ impl MipMap {
             })
             .collect();
         let mut flat = vec![0.0f32; next * c];
-        for (f, (&n, &first)) in mc.face_level.iter().zip(&offsets).enumerate() {
-            for slot in 0..=n + 1 {
-                let (q, lf) = if slot <= n { (slot, slot) } else { (FINEST, n) };
-                let r = 1u32 << lf;
-                let base = first + FLAT_SLOT_OFFSET[slot as usize];
-                for i in 0..=r {
-                    for j in 0..=r - i {
-                        let at = (base + lattice_row_index(r, i, j)) * c;
-                        lattice(
-                            self,
-                            f,
-                            q,
-                            lf,
-                            [i, j, r - i - j],
-                            1.0,
-                            false,
-                            &mut flat[at..at + c],
-                        );
-                    }
-                }
-            }
+        for (f, &first) in offsets.iter().enumerate() {
+            self.fill_face_cache(f, first, &mut flat);
         }
         self.flat_offset = offsets;
         self.flat = flat;
         self.corner_level = corner_level;
+    }
+
+    /// Writes face `f`'s cache, from `first` (in values), into `flat`.
+    fn fill_face_cache(&self, f: usize, first: usize, flat: &mut [f32]) {
+        let c = self.colors.channels;
+        let n = self.colors.face_level[f];
+        let len = FLAT_SLOT_OFFSET[n as usize + 2] * c;
+        flat[first * c..first * c + len].fill(0.0);
+        for slot in 0..=n + 1 {
+            let (q, lf) = if slot <= n { (slot, slot) } else { (FINEST, n) };
+            let r = 1u32 << lf;
+            let base = first + FLAT_SLOT_OFFSET[slot as usize];
+            for i in 0..=r {
+                for j in 0..=r - i {
+                    let at = (base + lattice_row_index(r, i, j)) * c;
+                    lattice(
+                        self,
+                        f,
+                        q,
+                        lf,
+                        [i, j, r - i - j],
+                        1.0,
+                        false,
+                        &mut flat[at..at + c],
+                    );
+                }
+            }
+        }
+    }
+
+    /// Brings the pyramid up to date after finest samples of `colors`
+    /// changed — a stroke, or its undo — at a cost that follows the
+    /// faces near the change, not the mesh: `changed` lists the changed
+    /// samples as runs `(first sample index, count)` (what
+    /// [`crate::undo::Delta::runs`] gives). A level `l` value reads level
+    /// `l + 1` of its own and its neighbours' primitives, so the faces
+    /// recomputed grow by one ring of faces (sharing a vertex) per level
+    /// below the finest. The result equals [`MipMap::new`] of `colors`
+    /// bit for bit.
+    ///
+    /// Returns the spans `[start, end)` of values (indices into
+    /// [`MipMap::data`] divided by the channel count) that were rewritten,
+    /// sorted and disjoint, for [`crate::gpu::GpuLayout::refresh`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] naming `colors` when they do not have
+    /// this pyramid's layout (channels, connectivity and face resolutions:
+    /// after a resolution change, build a new pyramid) or `changed` when
+    /// a run leaves the samples; nothing changes then.
+    pub fn refresh(
+        &mut self,
+        colors: &MeshColors,
+        changed: &[(u32, u32)],
+    ) -> Result<Vec<(usize, usize)>, Error> {
+        let mine = &self.colors;
+        if colors.channels != mine.channels
+            || colors.face_level != mine.face_level
+            || colors.topology != mine.topology
+        {
+            return Err(Error::InvalidArgument {
+                argument: "colors",
+                reason: "do not have this pyramid's layout (after a resolution change, \
+                         build a new MipMap)",
+            });
+        }
+        let count = colors.sample_count();
+        if changed
+            .iter()
+            .any(|&(start, len)| u64::from(start) + u64::from(len) > count as u64)
+        {
+            return Err(Error::InvalidArgument {
+                argument: "changed",
+                reason: "names a sample beyond the colours' samples",
+            });
+        }
+        // `colors` has this pyramid's layout: read it from there.
+        let c = colors.channels;
+        let t = &colors.topology;
+        let (nv, nf) = (t.vertex_count, t.faces.len());
+        // Vertex → faces (CSR) and vertex → edges (in MipMap::new's order,
+        // so that Eq. 6 sums in the same order).
+        let mut vf_start = vec![0u32; nv + 1];
+        for face in &t.faces {
+            for &v in face {
+                vf_start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..nv {
+            vf_start[v + 1] += vf_start[v];
+        }
+        let mut vf = vec![0u32; vf_start[nv] as usize];
+        let mut fill = vf_start.clone();
+        for (f, face) in t.faces.iter().enumerate() {
+            for &v in face {
+                vf[fill[v as usize] as usize] = f as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        let faces_of = |v: usize| &vf[vf_start[v] as usize..vf_start[v + 1] as usize];
+        let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); nv];
+        for (e, &[a, b]) in t.edges.iter().enumerate() {
+            vertex_edges[a as usize].push(e as u32);
+            vertex_edges[b as usize].push(e as u32);
+        }
+        // Copy the new finest values, and mark their faces.
+        let mut dirty = vec![false; nf];
+        let mut list: Vec<usize> = Vec::new();
+        let mark = |f: usize, dirty: &mut Vec<bool>, list: &mut Vec<usize>| {
+            if !dirty[f] {
+                dirty[f] = true;
+                list.push(f);
+            }
+        };
+        let faces_start = colors.face_offset.first().copied().unwrap_or(count);
+        for &(start, len) in changed {
+            for i in start as usize..start as usize + len as usize {
+                let value = &colors.samples[i * c..(i + 1) * c];
+                self.colors.samples[i * c..(i + 1) * c].copy_from_slice(value);
+                let mc = colors;
+                let at = if i < nv {
+                    for &f in faces_of(i) {
+                        mark(f as usize, &mut dirty, &mut list);
+                    }
+                    self.vertex_offset[i] + mc.vertex_level[i] as usize
+                } else if i < faces_start {
+                    let e = mc.edge_offset.partition_point(|&o| o <= i) - 1;
+                    for &f in &t.edge_faces[e] {
+                        if f != NO_FACE {
+                            mark(f as usize, &mut dirty, &mut list);
+                        }
+                    }
+                    self.edge_offset[e]
+                        + edge_level_offset(mc.edge_level[e])
+                        + (i - mc.edge_offset[e])
+                } else {
+                    let f = mc.face_offset.partition_point(|&o| o <= i) - 1;
+                    mark(f, &mut dirty, &mut list);
+                    self.face_offset[f]
+                        + FACE_LEVEL_OFFSET[mc.face_level[f] as usize]
+                        + (i - mc.face_offset[f])
+                };
+                self.data[at * c..(at + 1) * c].copy_from_slice(value);
+            }
+        }
+        // One ring more per level, then that level of the ring's
+        // primitives.
+        let grow = |dirty: &mut Vec<bool>, list: &mut Vec<usize>| {
+            let before = list.len();
+            for k in 0..before {
+                for v in t.faces[list[k]] {
+                    for &g in faces_of(v as usize) {
+                        if !dirty[g as usize] {
+                            dirty[g as usize] = true;
+                            list.push(g as usize);
+                        }
+                    }
+                }
+            }
+        };
+        let top = colors.vertex_level.iter().copied().max().unwrap_or(0);
+        for l in (0..top).rev() {
+            grow(&mut dirty, &mut list);
+            let subset = Subset::of(colors, &list, l);
+            self.build_level(l, &vertex_edges, Some(&subset));
+        }
+        // The spans rewritten: every primitive of the faces reached.
+        let mut spans: Vec<(usize, usize)> = Vec::new();
+        let mc = colors;
+        for &f in &list {
+            spans.push((
+                self.face_offset[f],
+                self.face_offset[f] + FACE_LEVEL_OFFSET[mc.face_level[f] as usize + 1],
+            ));
+            for k in 0..3 {
+                let v = t.faces[f][k] as usize;
+                let e = t.face_edges[f][k] as usize;
+                let o = self.vertex_offset[v];
+                spans.push((o, o + mc.vertex_level[v] as usize + 1));
+                let o = self.edge_offset[e];
+                spans.push((o, o + edge_level_offset(mc.edge_level[e] + 1)));
+            }
+        }
+        spans.sort_unstable();
+        let mut merged: Vec<(usize, usize)> = Vec::with_capacity(spans.len());
+        for (a, b) in spans {
+            match merged.last_mut() {
+                Some((_, end)) if a <= *end => *end = (*end).max(b),
+                _ if a < b => merged.push((a, b)),
+                _ => {}
+            }
+        }
+        // Caches of every face touching a rewritten primitive.
+        grow(&mut dirty, &mut list);
+        let mut flat = std::mem::take(&mut self.flat);
+        for &f in &list {
+            self.fill_face_cache(f, self.flat_offset[f], &mut flat);
+        }
+        self.flat = flat;
+        Ok(merged)
     }
 
     /// A lookup at query level `q` of a point inside face `f`, from the
@@ -340,7 +568,8 @@ impl MipMap {
 
     /// Computes level `l` of every primitive finer than `l` from level
     /// `l + 1` (all of which exists already).
-    fn build_level(&mut self, l: u8, vertex_edges: &[Vec<u32>]) {
+    /// (Only the faces, edges and vertices of `subset` when given.)
+    fn build_level(&mut self, l: u8, vertex_edges: &[Vec<u32>], subset: Option<&Subset>) {
         let c = self.colors.channels;
         let q = l + 1;
         let mut writes: Vec<(usize, Vec<f32>)> = Vec::new();
@@ -355,7 +584,7 @@ impl MipMap {
         };
         // Faces, Eq. 5.
         let r = 1u32 << l;
-        for f in 0..mc.face_level.len() {
+        for f in ids(subset.map(|s| &s.faces[..]), mc.face_level.len()) {
             if mc.face_level[f] <= l || r < 3 {
                 continue;
             }
@@ -380,7 +609,7 @@ impl MipMap {
             }
         }
         // Edges: the six-neighbour rule.
-        for e in 0..mc.edge_level.len() {
+        for e in ids(subset.map(|s| &s.edges[..]), mc.edge_level.len()) {
             if mc.edge_level[e] <= l || r < 2 {
                 continue;
             }
@@ -428,7 +657,8 @@ impl MipMap {
             }
         }
         // Vertices, Eq. 6.
-        for (v, edges) in vertex_edges.iter().enumerate() {
+        for v in ids(subset.map(|s| &s.vertices[..]), vertex_edges.len()) {
+            let edges = &vertex_edges[v];
             if mc.vertex_level[v] <= l {
                 continue;
             }

@@ -307,3 +307,72 @@ fn bad_arguments_name_what_is_wrong() {
         g.lookup(0, [0.0, 0.3, 0.7], filter, &mut out).unwrap();
     }
 }
+
+#[test]
+fn a_stroke_refreshes_the_pyramid_and_texels_near_it_as_a_rebuild_would() {
+    use glam::Vec3;
+    use mesh_colors::undo::Recorder;
+    use mesh_colors::{Blend, Brush, Painter};
+    let (positions, faces) = support::grid(30, 0.1);
+    let mut rng = Rng(21);
+    let levels: Vec<u32> = (0..faces.len()).map(|_| 1 << rng.below(5)).collect();
+    let mut mc =
+        MeshColors::new(Topology::new(positions.len(), &faces).unwrap(), &levels, 3).unwrap();
+    for x in mc.samples_mut() {
+        *x = rng.f32();
+    }
+    let painter = Painter::new(&mc, &positions, 0.03).unwrap();
+    let mut mip = mc.mip_map();
+    let mut layout = GpuLayout::new(&mip, 512).unwrap();
+    let values = mip.data().len() / 3;
+    for round in 0..8 {
+        let mut recorder = Recorder::new(&mc);
+        let start = Vec3::new(rng.f32(), rng.f32(), 0.0);
+        for k in 0..5 {
+            let brush = Brush {
+                center: start + Vec3::new(0.01 * k as f32, 0.005 * k as f32, 0.05),
+                radius: 0.03 + 0.05 * rng.f32(),
+                color: &[rng.f32(), rng.f32(), rng.f32()],
+                strength: 0.8,
+                blend: Blend::Mix,
+            };
+            painter
+                .paint_recorded(&mut mc, &brush, &mut recorder)
+                .unwrap();
+        }
+        let mut delta = recorder.finish();
+        for undo in [false, true] {
+            if undo {
+                delta.undo(&mut mc).unwrap();
+            }
+            let spans = mip.refresh(&mc, delta.runs()).unwrap();
+            assert_eq!(mip, mc.mip_map(), "round {round} (undo: {undo})");
+            let rewritten: usize = spans.iter().map(|s| s.1 - s.0).sum();
+            assert!(
+                rewritten < values / 3,
+                "round {round}: {rewritten} of {values} values rewritten"
+            );
+            let before = layout.clone();
+            let changes = layout.refresh(&mip, &spans).unwrap();
+            assert_eq!(layout, GpuLayout::new(&mip, 512).unwrap(), "round {round}");
+            let mut texels = before.sample_texels().to_vec();
+            upload(
+                &mut texels,
+                layout.sample_texels(),
+                layout.width() as usize,
+                &changes.samples,
+            );
+            assert_eq!(texels, layout.sample_texels());
+        }
+    }
+    // Another layout is refused, naming the argument.
+    let other = mc.set_face_resolution(0, 32).unwrap();
+    let e = mip.refresh(&other, &[(0, 1)]).unwrap_err();
+    assert!(e.to_string().contains("`colors`"), "{e}");
+    let e = mip.refresh(&mc, &[(u32::MAX, 2)]).unwrap_err();
+    assert!(e.to_string().contains("`changed`"), "{e}");
+    let e = layout.refresh(&other.mip_map(), &[]).unwrap_err();
+    assert!(e.to_string().contains("`mip`"), "{e}");
+    let e = layout.refresh(&mip, &[(0, values + 1)]).unwrap_err();
+    assert!(e.to_string().contains("`spans`"), "{e}");
+}
