@@ -17,7 +17,7 @@ use tet_diffusion::{Applied, Edit, Light, Session, SolveReport};
 
 use super::protocol::{self, ExportKind, FINAL, LAST, RADIANCE, Request, SURFACE};
 use super::{Exporter, session_file};
-use crate::web::{App, Asset, BadField, Idle, Inbox, Incoming, Limits, Out, Outbox, ReplyTo};
+use crate::web::{App, Asset, BadField, Idle, Inbox, Incoming, Limits, Out, Outbox, ReplyTo, json};
 
 /// The snapshot slots a page that connects is sent, in this order.
 const HELLO: usize = 0;
@@ -84,10 +84,9 @@ impl App for Worker {
 }
 
 impl Worker {
+    /// An error answering `seq` (0: none, as a failed refinement's).
     fn error(&self, out: &Outbox, seq: u64, field: &str, message: &str) {
-        out.broadcast(Out::Text(
-            json!({"type": "error", "seq": seq, "field": field, "message": message}).to_string(),
-        ));
+        out.broadcast(Out::Text(json::error(Some(seq), field, message)));
     }
 
     fn refine(&mut self, out: &Outbox, cancel: &AtomicBool) {
@@ -244,11 +243,9 @@ impl Worker {
                         } else {
                             e.to_string()
                         };
-                        out.broadcast(Out::Text(
-                            json!({"type": "error", "seq": seq, "field": "name",
-                                   "message": message, "exists": exists})
-                            .to_string(),
-                        ));
+                        let extra = [("exists", json!(exists))];
+                        let e = json::error_with(Some(seq), "name", &message, &extra);
+                        out.broadcast(Out::Text(e));
                     }
                 }
             }

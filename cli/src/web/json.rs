@@ -83,9 +83,24 @@ pub fn seq_of(v: &Value) -> Option<u64> {
 }
 
 /// The error message answering `seq` (`null` when the message had none):
-/// `{"type": "error", "seq", "field", "message"}`.
+/// `{"type": "error", "seq", "field", "message"}`. Every error a page
+/// gets is made here or by [`error_with`].
 pub fn error(seq: Option<u64>, field: &str, message: &str) -> String {
-    json!({"type": "error", "seq": seq, "field": field, "message": message}).to_string()
+    error_with(seq, field, message, &[])
+}
+
+/// [`error`] with more fields (view's `exists`); they cannot replace the
+/// four every error has.
+pub fn error_with(seq: Option<u64>, field: &str, message: &str, extra: &[(&str, Value)]) -> String {
+    let mut e = Map::new();
+    for (k, v) in extra {
+        e.insert((*k).to_string(), v.clone());
+    }
+    e.insert("type".into(), json!("error"));
+    e.insert("seq".into(), json!(seq));
+    e.insert("field".into(), json!(field));
+    e.insert("message".into(), json!(message));
+    Value::Object(e).to_string()
 }
 
 /// The field `key` of `o`.
@@ -165,5 +180,22 @@ mod tests {
         let e: Value = serde_json::from_str(&error(None, "(rate)", "slow down")).unwrap();
         assert_eq!(e["seq"], Value::Null);
         assert_eq!(e["field"], "(rate)");
+    }
+
+    #[test]
+    fn one_error_shape_with_or_without_extra_fields() {
+        let plain: Value = serde_json::from_str(&error(Some(0), "op", "no")).unwrap();
+        assert_eq!(
+            plain,
+            json!({"type": "error", "seq": 0, "field": "op", "message": "no"})
+        );
+        let extra = [("exists", json!(true)), ("type", json!("export"))];
+        let e: Value =
+            serde_json::from_str(&error_with(Some(3), "name", "x: the file exists", &extra))
+                .unwrap();
+        assert_eq!(
+            e,
+            json!({"type": "error", "seq": 3, "field": "name", "message": "x: the file exists", "exists": true})
+        );
     }
 }
