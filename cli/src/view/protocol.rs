@@ -15,7 +15,9 @@
 //!
 //! **Down**: JSON text messages (`status`, `error`, `probe`, `export`,
 //! `hello`) and binary frames: a fixed 16-byte header, then raw
-//! little-endian arrays.
+//! little-endian arrays. The answers to one message (`error`, `probe`,
+//! `export`) go to the page that sent it; `hello`, `status` and the
+//! frames (the shared state) go to every page.
 //!
 //! | bytes | field |
 //! |---|---|

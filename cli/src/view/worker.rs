@@ -83,12 +83,16 @@ impl App for Worker {
     }
 }
 
-impl Worker {
-    /// An error answering `seq` (0: none, as a failed refinement's).
-    fn error(&self, out: &Outbox, seq: u64, field: &str, message: &str) {
-        out.broadcast(Out::Text(json::error(Some(seq), field, message)));
+/// An error for the page that asked `to`; with no asker (a failed
+/// refinement) for every page, with seq 0.
+fn error(out: &Outbox, to: Option<ReplyTo>, field: &str, message: &str) {
+    match to {
+        Some(to) => out.error(to, field, message),
+        None => out.broadcast(Out::Text(json::error(Some(0), field, message))),
     }
+}
 
+impl Worker {
     fn refine(&mut self, out: &Outbox, cancel: &AtomicBool) {
         let t = Instant::now();
         let c = cpu_ms();
@@ -99,7 +103,7 @@ impl Worker {
             }
             Ok((_, false)) => {}
             Err(e) => {
-                self.error(out, 0, "(solve)", &e.to_string());
+                error(out, None, "(solve)", &e.to_string());
                 // Keep the coarse result; nothing more to refine until the
                 // next edit.
                 self.session.skip_refinement();
@@ -111,11 +115,10 @@ impl Worker {
     /// behind it (coalesced by the session); a non-edit request stops
     /// the gathering and is handled after them.
     fn gather(&mut self, out: &Outbox, first: (ReplyTo, Request), inbox: &mut Inbox<Request>) {
-        let mut seqs = Vec::new();
+        let mut askers = Vec::new();
         let mut after = None;
         let mut request = Some(first);
         while let Some((to, r)) = request.take() {
-            let seq = to.seq.unwrap_or(0);
             match r {
                 Request::Edit(mut edit, gesture) => {
                     // The page's lights are the directional and point ones:
@@ -127,27 +130,30 @@ impl Worker {
                         l.push(Light::Environment(env));
                     }
                     match self.session.push_in(edit, gesture) {
-                        Ok(()) => seqs.push(seq),
-                        Err(e) => self.error(out, seq, &field_of(&e), &e.to_string()),
+                        Ok(()) => askers.push(to),
+                        Err(e) => error(out, Some(to), &field_of(&e), &e.to_string()),
                     }
                     request = inbox.try_next();
                 }
-                other => after = Some((seq, other)),
+                other => after = Some((to, other)),
             }
         }
-        if !seqs.is_empty() || self.session.pending() > 0 {
-            self.apply(out, &seqs);
+        if !askers.is_empty() || self.session.pending() > 0 {
+            self.apply(out, &askers);
         }
-        if let Some((seq, r)) = after {
-            self.other(out, seq, r);
+        if let Some((to, r)) = after {
+            self.other(out, to, r);
         }
     }
 
-    fn apply(&mut self, out: &Outbox, seqs: &[u64]) {
+    /// Applies the edits waiting, which `askers` sent (an error goes to
+    /// the last of them).
+    fn apply(&mut self, out: &Outbox, askers: &[ReplyTo]) {
         let t = Instant::now();
         let c = cpu_ms();
         let mut reports: Vec<SolveReport> = Vec::new();
         let mut name = "edit";
+        let seqs: Vec<u64> = askers.iter().map(|a| a.seq.unwrap_or(0)).collect();
         let last = seqs.last().copied().unwrap_or(0);
         // A cut's new surface goes out before its solve (a new hierarchy
         // and the coarse solve take longer than the cut), coloured by the
@@ -165,16 +171,17 @@ impl Worker {
                     reports.extend(solves);
                 }
                 Err(e) => {
-                    self.error(out, last, &field_of(&e), &e.to_string());
+                    error(out, askers.last().copied(), &field_of(&e), &e.to_string());
                 }
             }
         }
         self.send_radiance(out, !self.session.needs_refinement(), last);
         let coarse = self.session.needs_refinement();
-        self.send_status(out, seqs, name, &reports, t, c, coarse);
+        self.send_status(out, &seqs, name, &reports, t, c, coarse);
     }
 
-    fn other(&mut self, out: &Outbox, seq: u64, r: Request) {
+    fn other(&mut self, out: &Outbox, to: ReplyTo, r: Request) {
+        let seq = to.seq.unwrap_or(0);
         let t = Instant::now();
         let c = cpu_ms();
         match r {
@@ -196,9 +203,9 @@ impl Worker {
                         let name = if undo { "undo" } else { "redo" };
                         self.send_status(out, &[seq], name, &[], t, c, false);
                     }
-                    Ok(None) => self.error(
+                    Ok(None) => error(
                         out,
-                        seq,
+                        Some(to),
                         "op",
                         if undo {
                             "nothing to undo"
@@ -206,11 +213,11 @@ impl Worker {
                             "nothing to redo"
                         },
                     ),
-                    Err(e) => self.error(out, seq, "op", &e.to_string()),
+                    Err(e) => error(out, Some(to), "op", &e.to_string()),
                 }
             }
-            Request::Probe { piece, point } => self.probe(out, seq, piece, point),
-            Request::Environment { hdr } => self.environment(out, seq, &hdr),
+            Request::Probe { piece, point } => self.probe(out, to, piece, point),
+            Request::Environment { hdr } => self.environment(out, to, &hdr),
             Request::Export {
                 kind,
                 name,
@@ -230,7 +237,7 @@ impl Worker {
                         .export(&self.session, kind, &path, size, view, overwrite),
                 };
                 match result {
-                    Ok(()) => out.broadcast(Out::Text(
+                    Ok(()) => out.reply(to, Out::Text(
                         json!({"type": "export", "seq": seq, "path": path.display().to_string()})
                             .to_string(),
                     )),
@@ -244,8 +251,8 @@ impl Worker {
                             e.to_string()
                         };
                         let extra = [("exists", json!(exists))];
-                        let e = json::error_with(Some(seq), "name", &message, &extra);
-                        out.broadcast(Out::Text(e));
+                        let e = json::error_with(to.seq, "name", &message, &extra);
+                        out.reply(to, Out::Text(e));
                     }
                 }
             }
@@ -266,7 +273,7 @@ impl Worker {
     /// Lights the object by the uploaded `.hdr` (kept beside the exports
     /// under a name from its content, for session files), or without an
     /// environment map when `hdr` is empty; the other lights stay.
-    fn environment(&mut self, out: &Outbox, seq: u64, hdr: &[u8]) {
+    fn environment(&mut self, out: &Outbox, to: ReplyTo, hdr: &[u8]) {
         let off = self.session.offsets()[0];
         let mut lights: Vec<Light> = self.session.pieces()[0]
             .lights()
@@ -286,12 +293,12 @@ impl Worker {
         if !hdr.is_empty() {
             match self.load_environment(hdr) {
                 Ok(env) => lights.push(Light::Environment(env)),
-                Err(e) => return self.error(out, seq, "(upload)", &e),
+                Err(e) => return error(out, Some(to), "(upload)", &e),
             }
         }
         match self.session.push(Edit::Lights(lights)) {
-            Ok(()) => self.apply(out, &[seq]),
-            Err(e) => self.error(out, seq, "(upload)", &e.to_string()),
+            Ok(()) => self.apply(out, &[to]),
+            Err(e) => error(out, Some(to), "(upload)", &e.to_string()),
         }
     }
 
@@ -319,9 +326,9 @@ impl Worker {
         Ok(env)
     }
 
-    fn probe(&self, out: &Outbox, seq: u64, piece: usize, point: DVec3) {
+    fn probe(&self, out: &Outbox, to: ReplyTo, piece: usize, point: DVec3) {
         let Some(o) = self.session.pieces().get(piece) else {
-            return self.error(out, seq, "piece", "no such piece");
+            return error(out, Some(to), "piece", "no such piece");
         };
         let local = point - self.session.offsets()[piece];
         let m = o.mesh();
@@ -330,7 +337,7 @@ impl Worker {
             let db = m.positions()[*b.1 as usize].distance_squared(local);
             da.total_cmp(&db)
         }) else {
-            return self.error(out, seq, "piece", "the piece has no surface");
+            return error(out, Some(to), "piece", "the piece has no surface");
         };
         let radiance = o.radiance(None)[k];
         // The medium of a tet around the vertex, by name when measured.
@@ -342,16 +349,19 @@ impl Worker {
                 .find(|(n, _, _)| tet_diffusion::Medium::measured(n).ok() == Some(md))
                 .map(|(n, _, _)| n.to_string())
         });
-        out.broadcast(Out::Text(
-            json!({
-                "type": "probe", "seq": seq, "piece": piece, "vertex": v,
-                "material": name.unwrap_or_else(|| "mixed".into()),
-                "sigma_a": medium.map(|m| m.sigma_a),
-                "sigma_s_prime": medium.map(|m| m.sigma_s_prime),
-                "radiance": radiance,
-            })
-            .to_string(),
-        ));
+        out.reply(
+            to,
+            Out::Text(
+                json!({
+                    "type": "probe", "seq": to.seq, "piece": piece, "vertex": v,
+                    "material": name.unwrap_or_else(|| "mixed".into()),
+                    "sigma_a": medium.map(|m| m.sigma_a),
+                    "sigma_s_prime": medium.map(|m| m.sigma_s_prime),
+                    "radiance": radiance,
+                })
+                .to_string(),
+            ),
+        );
     }
 
     fn hello(&self) -> String {

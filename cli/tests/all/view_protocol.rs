@@ -814,3 +814,59 @@ async fn an_uploaded_environment_map_lights_the_object_and_is_saved_with_the_ses
     assert_eq!(kinds(&st), ["dir", "env"]);
     r.stop().await.unwrap();
 }
+
+/// Everything `s` is sent until nothing more comes for `quiet`.
+async fn drain(s: &mut Socket, quiet: Duration) -> Vec<Value> {
+    let mut texts = Vec::new();
+    while let Ok(Some(Ok(m))) = tokio::time::timeout(quiet, s.next()).await {
+        if let Message::Text(t) = m {
+            texts.push(serde_json::from_str(&t).unwrap());
+        }
+    }
+    texts
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn answers_go_to_the_asking_tab_and_the_shared_state_to_every_tab() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = server(dir.path()).await;
+    let (mut a, mut b) = (connect(&r).await, connect(&r).await);
+    let mut seen = Seen::default();
+    until(&mut a, "status", &mut seen).await;
+    until(&mut b, "status", &mut seen).await;
+    // A probe, a refused undo, an export and one that is refused because
+    // the file exists: each answered on a only.
+    std::fs::write(dir.path().join("taken.png"), b"mine").unwrap();
+    for m in [
+        json!({"seq": 1, "op": "probe", "piece": 0, "point": [0, 0, 0]}),
+        json!({"seq": 2, "op": "undo"}),
+        json!({"seq": 3, "op": "export", "kind": "png", "name": "a.png", "size": 32}),
+        json!({"seq": 4, "op": "export", "kind": "png", "name": "taken.png", "size": 32}),
+    ] {
+        send(&mut a, m).await;
+    }
+    let answers = drain(&mut a, Duration::from_secs(3)).await;
+    let kinds: Vec<(&str, u64)> = answers
+        .iter()
+        .filter_map(|v| Some((v["type"].as_str()?, v["seq"].as_u64()?)))
+        .collect();
+    for want in [("probe", 1), ("error", 2), ("export", 3), ("error", 4)] {
+        assert!(kinds.contains(&want), "a got {answers:?}");
+    }
+    let exists = answers.iter().find(|v| v["seq"] == 4).unwrap();
+    assert_eq!(exists["exists"], true, "{exists}");
+    let on_b = drain(&mut b, Duration::from_millis(500)).await;
+    assert!(
+        on_b.iter().all(|v| v["type"] == "status"),
+        "b got another tab's answers: {on_b:?}"
+    );
+    // An edit's status (the shared state) reaches both.
+    let paint = json!({"seq": 5, "op": "paint", "material": "apple", "radius": 0.1,
+                       "strength": 1, "points": [[0, 0, 0]]});
+    send(&mut a, paint).await;
+    for s in [&mut a, &mut b] {
+        let status = until(s, "status", &mut seen).await;
+        assert_eq!(status["seqs"], json!([5]), "{status}");
+    }
+    r.stop().await.unwrap();
+}

@@ -9,7 +9,10 @@ export class Connection {
   // answering"); `decode(buffer)` turns a binary frame into what
   // `onFrame` takes.
   constructor(app, decode, onText, onFrame, onState) {
-    this.seq = 0;
+    // Each page starts its numbers at random: the server's status lists
+    // the seqs it answered to every page, and two tabs that both counted
+    // from 1 would take each other's answers for their own.
+    this.seq = Math.floor(Math.random() * 2 ** 30);
     this.app = app; this.decode = decode;
     this.onText = onText; this.onFrame = onFrame; this.onState = onState;
     this.open();
