@@ -71,6 +71,7 @@ pub mod gpu;
 mod luminance;
 mod mip;
 mod paint;
+pub mod session;
 mod structure;
 mod texture;
 mod topology;

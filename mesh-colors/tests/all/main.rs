@@ -16,6 +16,7 @@ mod gpu;
 mod limits;
 mod paint;
 mod resolution;
+mod session;
 mod structure;
 mod texture;
 mod undo;

@@ -1,0 +1,646 @@
+//! The painting system's document (Sec. 5.1): mesh colours being painted,
+//! with the gestures a 3D paint tool offers — brush strokes (falloff
+//! hardness, pen pressure, mix / add / multiply / erase, X-mirror, only
+//! what the painter sees), fill of a connected part, the eyedropper, and
+//! the detail brush that raises or lowers face resolution where it
+//! passes — each one step of undo, and a log of edits that replays bit
+//! for bit.
+//!
+//! A [`PaintSession`] owns the colours and everything derived from them
+//! (the [`Painter`]'s spatial index, per-sample normals); a server or a
+//! script drives it with [`PaintSession::apply`] and reads back which
+//! samples changed ([`Changed`]) to update a GPU copy incrementally.
+//! Undo keeps deltas ([`crate::undo`]), never copies of the colours.
+//!
+//! Painting "what the user sees" (Blender's projected brush; painters'
+//! most common complaint is a brush that paints through a thin wall) needs
+//! the eye: a stroke that carries [`Brush::eye`] touches only samples
+//! whose shading normal faces the eye and, with an [`Occluder`], that the
+//! eye sees unobstructed. The occluder is the caller's (a BVH ray cast):
+//! this crate stays free of a ray tracer.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use crate::Error;
+use crate::paint::Painter;
+use crate::structure::{MeshColors, lattice_points};
+use crate::undo::{History, Recorder, Step};
+
+/// Answers whether the surface hides a point from an eye.
+pub trait Occluder: Send + Sync + std::fmt::Debug {
+    /// Whether the segment from `eye` to `point` meets the surface before
+    /// it reaches `point`'s neighbourhood (the implementor's tolerance
+    /// keeps the point's own face from hiding it).
+    fn blocked(&self, eye: Vec3, point: Vec3) -> bool;
+}
+
+/// How a brush combines its colour with a sample, by the weight `w` of its
+/// falloff at the sample (`x` the sample's value, `c` the brush's).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BrushMode {
+    /// `x + w (c − x)`: towards the colour.
+    Mix,
+    /// `x + w c`: accumulate (densities, masks).
+    Add,
+    /// `x (1 + w (c − 1))`: darken by the colour (1 leaves it).
+    Multiply,
+    /// `x + w (b − x)`, `b` the base colour: back to the start.
+    Erase,
+}
+
+/// What a stroke or a fill paints with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Brush {
+    /// How the colour is combined.
+    pub mode: BrushMode,
+    /// The values for channels `first_channel ..< first_channel +
+    /// color.len()` (RGB on channels 0–2, a scalar channel alone, …); the
+    /// other channels are untouched. Unused by [`BrushMode::Erase`] except
+    /// for which channels it restores.
+    pub color: Vec<f32>,
+    /// The first channel `color` paints.
+    pub first_channel: usize,
+    /// Scales the falloff weight, 0 to 1.
+    pub strength: f32,
+    /// The share of the radius painted at full weight, 0 (soft) to 1
+    /// (hard edge); beyond it the weight falls smoothly to 0 at the rim.
+    pub hardness: f32,
+    /// Also paint mirrored across the plane `x = mirror_x` (X symmetry).
+    pub mirror_x: Option<f32>,
+    /// Paint only samples whose normal faces this point and, with the
+    /// session's [`Occluder`], that it sees: the camera's position.
+    pub eye: Option<Vec3>,
+}
+
+impl Brush {
+    /// The falloff weight at distance `d` from a dab of radius `r` with
+    /// pen pressure `pressure`: `strength · pressure · (1 − s²)²`, with `s`
+    /// the distance beyond the hard core as a share of the soft rim (1 in
+    /// the core, 0 at and beyond `r`, zero slope at the rim).
+    pub fn weight(&self, d: f32, r: f32, pressure: f32) -> f32 {
+        let x = d / r;
+        if x >= 1.0 {
+            return 0.0;
+        }
+        let h = self.hardness;
+        let falloff = if x <= h {
+            1.0
+        } else {
+            let s = (x - h) / (1.0 - h);
+            let t = 1.0 - s * s;
+            t * t
+        };
+        self.strength * pressure * falloff
+    }
+
+    /// Checks the brush against colours of `channels` channels.
+    fn check(&self, channels: usize) -> Result<(), Error> {
+        let bad = |argument, reason| Err(Error::InvalidArgument { argument, reason });
+        if self.color.is_empty()
+            || self
+                .first_channel
+                .checked_add(self.color.len())
+                .is_none_or(|end| end > channels)
+        {
+            return bad("brush.color", "names channels the colours do not have");
+        }
+        if self.color.iter().any(|c| !c.is_finite()) {
+            return bad("brush.color", "is not finite");
+        }
+        if !(0.0..=1.0).contains(&self.strength) {
+            return bad("brush.strength", "must be within 0 to 1");
+        }
+        if !(0.0..=1.0).contains(&self.hardness) {
+            return bad("brush.hardness", "must be within 0 to 1");
+        }
+        if self.mirror_x.is_some_and(|m| !m.is_finite()) {
+            return bad("brush.mirror_x", "is not finite");
+        }
+        if self.eye.is_some_and(|e| !e.is_finite()) {
+            return bad("brush.eye", "is not finite");
+        }
+        Ok(())
+    }
+}
+
+/// One dab of a stroke: where the brush touched the surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dab {
+    /// The centre, on the surface, in the mesh's space.
+    pub center: Vec3,
+    /// The radius in the mesh's units (a page converts a screen-constant
+    /// size at the dab's depth).
+    pub radius: f32,
+    /// Pen pressure, 0 to 1 (1 for a mouse).
+    pub pressure: f32,
+}
+
+impl Dab {
+    fn check(&self) -> Result<(), Error> {
+        let bad = |argument, reason| Err(Error::InvalidArgument { argument, reason });
+        if !self.center.is_finite() {
+            return bad("dab.center", "is not finite");
+        }
+        if !(self.radius.is_finite() && self.radius > 0.0) {
+            return bad("dab.radius", "must be a positive length");
+        }
+        if !(0.0..=1.0).contains(&self.pressure) {
+            return bad("dab.pressure", "must be within 0 to 1");
+        }
+        Ok(())
+    }
+}
+
+/// One gesture, as the log keeps it: replaying the log on the starting
+/// colours gives the same colours bit for bit.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Edit {
+    /// A stroke: its dabs in order, one undo step.
+    Stroke {
+        /// The brush.
+        brush: Brush,
+        /// The dabs.
+        dabs: Vec<Dab>,
+    },
+    /// The connected part of the surface that contains `face` (faces
+    /// joined by edges), painted at full falloff weight.
+    Fill {
+        /// A face of the part.
+        face: usize,
+        /// The brush (its strength applies; radius and hardness do not).
+        brush: Brush,
+    },
+    /// The detail brush: every face within `radius` of `center` raised
+    /// (`levels > 0`) or lowered by `levels` resolution levels (Sec. 3.2:
+    /// the colours are resampled, shared edges stay continuous), within
+    /// `0..=`[`crate::MAX_LEVEL`].
+    Detail {
+        /// The centre, in the mesh's space.
+        center: Vec3,
+        /// The radius.
+        radius: f32,
+        /// Levels up (positive) or down (negative).
+        levels: i8,
+    },
+    /// Every face set to one resolution level.
+    Resolution {
+        /// The level (resolution `2^level`).
+        level: u8,
+    },
+    /// Undo the last step.
+    Undo,
+    /// Redo the last undone step.
+    Redo,
+}
+
+/// Which samples an edit changed, for an incremental upload.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub enum Changed {
+    /// Nothing.
+    #[default]
+    Nothing,
+    /// These samples' values (sorted, each once); the layout is the same.
+    Samples(Vec<u32>),
+    /// Face resolutions changed: the sample numbering is new.
+    Layout,
+}
+
+/// The mesh colours being painted, their history and their log (see the
+/// [module docs](self)).
+#[derive(Debug)]
+pub struct PaintSession {
+    positions: Vec<Vec3>,
+    colors: MeshColors,
+    base: Vec<f32>,
+    occluder: Option<Arc<dyn Occluder>>,
+    cell: f32,
+    painter: Painter,
+    normals: Vec<Vec3>,
+    history: History,
+    log: Vec<Edit>,
+}
+
+impl PaintSession {
+    /// A session on `colors` over a mesh with vertex `positions`; `base` is
+    /// the colour erase restores (one value per channel); `history` is the
+    /// number of undo steps kept; `occluder`, if any, hides what the eye
+    /// cannot see from strokes that carry one.
+    ///
+    /// # Errors
+    /// [`Error::ChannelMismatch`] for a `base` of the wrong length or too
+    /// few positions, [`Error::NonFinite`] for a non-finite position or
+    /// base value.
+    pub fn new(
+        positions: Vec<Vec3>,
+        colors: MeshColors,
+        base: Vec<f32>,
+        history: usize,
+        occluder: Option<Arc<dyn Occluder>>,
+    ) -> Result<Self, Error> {
+        if base.len() != colors.channels() {
+            return Err(Error::ChannelMismatch {
+                what: "base colour",
+                expected: colors.channels(),
+                got: base.len(),
+            });
+        }
+        if let Some(i) = base.iter().position(|b| !b.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "base colour channel",
+                index: i,
+            });
+        }
+        let cell = grid_cell(&positions, colors.topology().faces());
+        let painter = Painter::new(&colors, &positions, cell)?;
+        let normals = sample_normals(&colors, &positions);
+        Ok(Self {
+            positions,
+            colors,
+            base,
+            occluder,
+            cell,
+            painter,
+            normals,
+            history: History::new(history),
+            log: Vec::new(),
+        })
+    }
+
+    /// The colours as painted so far.
+    pub fn colors(&self) -> &MeshColors {
+        &self.colors
+    }
+
+    /// The vertex positions.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// The undo history.
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+
+    /// Every edit applied, in order (undo and redo included).
+    pub fn log(&self) -> &[Edit] {
+        &self.log
+    }
+
+    /// Applies one gesture and logs it; returns which samples changed.
+    /// An edit that fails changes nothing and is not logged.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] naming the field of a bad brush, dab or
+    /// level, [`Error::MissingFace`] for a fill of a face that does not
+    /// exist, and the errors of the resolution change.
+    pub fn apply(&mut self, edit: Edit) -> Result<Changed, Error> {
+        let changed = match &edit {
+            Edit::Stroke { brush, dabs } => self.stroke(brush, dabs)?,
+            Edit::Fill { face, brush } => self.fill(*face, brush)?,
+            Edit::Detail {
+                center,
+                radius,
+                levels,
+            } => self.detail(*center, *radius, *levels)?,
+            Edit::Resolution { level } => self.resolution(*level)?,
+            Edit::Undo => self.walk(true)?,
+            Edit::Redo => self.walk(false)?,
+        };
+        self.log.push(edit);
+        Ok(changed)
+    }
+
+    /// Replays `log` on a new session (the arguments of [`Self::new`]):
+    /// the colours come out bit for bit as the logged session left them.
+    ///
+    /// # Errors
+    /// As [`Self::new`], and the first failing edit's error with its
+    /// position in the log ([`Error::InvalidArgument`] is returned as is).
+    pub fn replay(
+        positions: Vec<Vec3>,
+        colors: MeshColors,
+        base: Vec<f32>,
+        history: usize,
+        occluder: Option<Arc<dyn Occluder>>,
+        log: &[Edit],
+    ) -> Result<Self, Error> {
+        let mut session = Self::new(positions, colors, base, history, occluder)?;
+        for edit in log {
+            session.apply(edit.clone())?;
+        }
+        Ok(session)
+    }
+
+    /// The colour under the eyedropper: the linear filter (Fig. 7) at
+    /// `barycentric` on `face`.
+    ///
+    /// # Errors
+    /// As [`MeshColors::linear`].
+    pub fn pick(&self, face: usize, barycentric: [f32; 3]) -> Result<Vec<f32>, Error> {
+        let mut out = vec![0.0; self.colors.channels()];
+        self.colors.linear(face, barycentric, &mut out)?;
+        Ok(out)
+    }
+
+    /// One stroke: every dab (and its mirror image) in order, one step.
+    fn stroke(&mut self, brush: &Brush, dabs: &[Dab]) -> Result<Changed, Error> {
+        brush.check(self.colors.channels())?;
+        for d in dabs {
+            d.check()?;
+        }
+        let mut recorder = Recorder::new(&self.colors);
+        let mut changed = Vec::new();
+        for d in dabs {
+            let mirrored = brush.mirror_x.map(|m| Dab {
+                center: Vec3::new(2.0 * m - d.center.x, d.center.y, d.center.z),
+                ..*d
+            });
+            for dab in std::iter::once(*d).chain(mirrored) {
+                self.dab(brush, &dab, &mut recorder, &mut changed)?;
+            }
+        }
+        Ok(self.finish(recorder, changed))
+    }
+
+    /// One dab: the samples within its radius that the eye (if any) sees.
+    fn dab(
+        &mut self,
+        brush: &Brush,
+        dab: &Dab,
+        recorder: &mut Recorder,
+        changed: &mut Vec<u32>,
+    ) -> Result<(), Error> {
+        let mut hits = Vec::new();
+        self.painter
+            .for_each_within(dab.center, dab.radius, |i, d| hits.push((i, d)));
+        // The grid's cells come in hash order: sort so the recorder, and
+        // the list of changes, are the same on every run.
+        hits.sort_unstable_by_key(|&(i, _)| i);
+        for (i, d) in hits {
+            if !self.seen(brush.eye, i) {
+                continue;
+            }
+            let w = brush.weight(d, dab.radius, dab.pressure);
+            self.blend(brush, i, w, recorder, changed)?;
+        }
+        Ok(())
+    }
+
+    /// Whether sample `i` is painted from `eye`: facing it and unhidden.
+    fn seen(&self, eye: Option<Vec3>, i: usize) -> bool {
+        let Some(eye) = eye else {
+            return true;
+        };
+        let p = self.painter.sample_positions()[i];
+        if self.normals[i].dot(eye - p) <= 0.0 {
+            return false;
+        }
+        self.occluder.as_ref().is_none_or(|o| !o.blocked(eye, p))
+    }
+
+    /// Blends sample `i` with weight `w`, recording its old value first.
+    fn blend(
+        &mut self,
+        brush: &Brush,
+        i: usize,
+        w: f32,
+        recorder: &mut Recorder,
+        changed: &mut Vec<u32>,
+    ) -> Result<(), Error> {
+        let first = brush.first_channel;
+        let base = &self.base[first..first + brush.color.len()];
+        let Some(s) = self.colors.sample(i) else {
+            return Ok(());
+        };
+        let old = &s[first..first + brush.color.len()];
+        let new: Vec<f32> = old
+            .iter()
+            .zip(&brush.color)
+            .zip(base)
+            .map(|((&x, &c), &b)| match brush.mode {
+                BrushMode::Mix => x + w * (c - x),
+                BrushMode::Add => x + w * c,
+                BrushMode::Multiply => x * (1.0 + w * (c - 1.0)),
+                BrushMode::Erase => x + w * (b - x),
+            })
+            .collect();
+        if new.iter().zip(old).all(|(a, b)| a.to_bits() == b.to_bits()) {
+            return Ok(());
+        }
+        if recorder.record(&self.colors, i)? {
+            changed.push(i as u32);
+        }
+        if let Some(s) = self.colors.sample_mut(i) {
+            s[first..first + new.len()].copy_from_slice(&new);
+        }
+        Ok(())
+    }
+
+    /// Closes a paint step: pushes its delta, sorts the changed samples.
+    fn finish(&mut self, recorder: Recorder, mut changed: Vec<u32>) -> Changed {
+        if recorder.is_empty() {
+            return Changed::Nothing;
+        }
+        self.history.push(Step::Paint(recorder.finish()));
+        changed.sort_unstable();
+        Changed::Samples(changed)
+    }
+
+    /// Fills the connected part of the surface containing `face`.
+    fn fill(&mut self, face: usize, brush: &Brush) -> Result<Changed, Error> {
+        brush.check(self.colors.channels())?;
+        let count = self.colors.face_count();
+        if face >= count {
+            return Err(Error::MissingFace { face, count });
+        }
+        let part = connected_part(&self.colors, face);
+        let mut samples = Vec::new();
+        for f in part {
+            let r = self.colors.face_resolution(f).unwrap_or(1);
+            samples.extend(lattice_points(r).filter_map(|a| self.colors.lattice_index(f, a)));
+        }
+        samples.sort_unstable();
+        samples.dedup();
+        let mut recorder = Recorder::new(&self.colors);
+        let mut changed = Vec::new();
+        for i in samples {
+            self.blend(brush, i, brush.strength, &mut recorder, &mut changed)?;
+        }
+        Ok(self.finish(recorder, changed))
+    }
+
+    /// The detail brush: faces within `radius` of `center` up or down.
+    fn detail(&mut self, center: Vec3, radius: f32, levels: i8) -> Result<Changed, Error> {
+        Dab {
+            center,
+            radius,
+            pressure: 1.0,
+        }
+        .check()?;
+        let faces = self.colors.topology().faces();
+        let changes: Vec<(usize, u32)> = (0..faces.len())
+            .filter(|&f| {
+                let [a, b, c] = faces[f].map(|v| self.positions[v as usize]);
+                distance_to_triangle(center, a, b, c) <= radius
+            })
+            .filter_map(|f| {
+                let level = i32::from(self.colors.face_level(f)?);
+                let to = (level + i32::from(levels)).clamp(0, i32::from(crate::MAX_LEVEL));
+                (to != level).then_some((f, 1u32 << to))
+            })
+            .collect();
+        self.resample(&changes)
+    }
+
+    /// Every face to resolution `2^level`.
+    fn resolution(&mut self, level: u8) -> Result<Changed, Error> {
+        if level > crate::MAX_LEVEL {
+            return Err(Error::InvalidArgument {
+                argument: "level",
+                reason: "is above the finest level mesh colours allow",
+            });
+        }
+        let changes: Vec<(usize, u32)> = (0..self.colors.face_count())
+            .filter(|&f| self.colors.face_level(f) != Some(level))
+            .map(|f| (f, 1u32 << level))
+            .collect();
+        self.resample(&changes)
+    }
+
+    /// Applies resolution changes as one step and re-indexes the samples.
+    fn resample(&mut self, changes: &[(usize, u32)]) -> Result<Changed, Error> {
+        if changes.is_empty() {
+            return Ok(Changed::Nothing);
+        }
+        let change = self.colors.set_face_resolutions(changes)?;
+        self.history.push(Step::Resolution(change));
+        self.reindex()?;
+        Ok(Changed::Layout)
+    }
+
+    /// Undo (`back`) or redo one step.
+    fn walk(&mut self, back: bool) -> Result<Changed, Error> {
+        let step = if back {
+            self.history.undo(&mut self.colors)?
+        } else {
+            self.history.redo(&mut self.colors)?
+        };
+        let changed = match step {
+            None => Changed::Nothing,
+            Some(Step::Paint(d)) => {
+                Changed::Samples(d.runs().iter().flat_map(|&(s, n)| s..s + n).collect())
+            }
+            Some(Step::Resolution(_)) => Changed::Layout,
+        };
+        if changed == Changed::Layout {
+            self.reindex()?;
+        }
+        Ok(changed)
+    }
+
+    /// Rebuilds what depends on the sample numbering.
+    fn reindex(&mut self) -> Result<(), Error> {
+        self.painter = Painter::new(&self.colors, &self.positions, self.cell)?;
+        self.normals = sample_normals(&self.colors, &self.positions);
+        Ok(())
+    }
+}
+
+/// A grid cell of about a typical brush: 1/50 of the bounding box's
+/// diagonal (1 for an empty or degenerate mesh).
+fn grid_cell(positions: &[Vec3], faces: &[[u32; 3]]) -> f32 {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for &v in faces.iter().flatten() {
+        if let Some(&p) = positions.get(v as usize) {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    let cell = (hi - lo).length() / 50.0;
+    if cell.is_finite() && cell > 0.0 {
+        cell
+    } else {
+        1.0
+    }
+}
+
+/// Each sample's shading normal: the area-weighted vertex normals
+/// interpolated at its site (what the page shades with).
+fn sample_normals(colors: &MeshColors, positions: &[Vec3]) -> Vec<Vec3> {
+    let faces = colors.topology().faces();
+    let mut vertex = vec![Vec3::ZERO; positions.len()];
+    for f in faces {
+        let [a, b, c] = f.map(|v| positions[v as usize]);
+        // The cross product's length is twice the area: area-weighted.
+        let n = (b - a).cross(c - a);
+        for &v in f {
+            vertex[v as usize] += n;
+        }
+    }
+    colors
+        .sites()
+        .iter()
+        .map(|s| {
+            let Some(f) = faces.get(s.face as usize) else {
+                return Vec3::ZERO;
+            };
+            let mut n = Vec3::ZERO;
+            for (b, &v) in s.barycentric.iter().zip(f) {
+                n += *b as f32 * vertex[v as usize];
+            }
+            n.normalize_or_zero()
+        })
+        .collect()
+}
+
+/// The faces joined to `face` through shared edges, in increasing order.
+fn connected_part(colors: &MeshColors, face: usize) -> Vec<usize> {
+    let t = colors.topology();
+    let mut seen = vec![false; t.faces().len()];
+    let mut stack = vec![face];
+    seen[face] = true;
+    let mut part = Vec::new();
+    while let Some(f) = stack.pop() {
+        part.push(f);
+        for &e in &t.face_edges()[f] {
+            for &g in &t.edge_faces()[e as usize] {
+                let g = g as usize;
+                if g < seen.len() && !seen[g] {
+                    seen[g] = true;
+                    stack.push(g);
+                }
+            }
+        }
+    }
+    part.sort_unstable();
+    part
+}
+
+/// The distance from `q` to triangle `abc`: to its plane when `q`
+/// projects inside it (on the inner side of all three edges), else to the
+/// nearest edge.
+fn distance_to_triangle(q: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+    let n = (b - a).cross(c - a);
+    let inside = [(a, b), (b, c), (c, a)]
+        .iter()
+        .all(|&(p, r)| (r - p).cross(q - p).dot(n) >= 0.0);
+    let area2 = n.length();
+    if inside && area2 > 0.0 {
+        return (q - a).dot(n).abs() / area2;
+    }
+    [(a, b), (b, c), (c, a)]
+        .iter()
+        .map(|&(p, r)| {
+            let d = r - p;
+            let t = if d.length_squared() > 0.0 {
+                ((q - p).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (p + d * t).distance(q)
+        })
+        .fold(f32::INFINITY, f32::min)
+}
