@@ -220,6 +220,15 @@ pub struct PaintSession {
     normals: Vec<Vec3>,
     history: History,
     log: Vec<Edit>,
+    open: Option<OpenStroke>,
+}
+
+/// A stroke being painted dab by dab ([`PaintSession::begin_stroke`]).
+#[derive(Debug)]
+struct OpenStroke {
+    brush: Brush,
+    dabs: Vec<Dab>,
+    recorder: Recorder,
 }
 
 impl PaintSession {
@@ -265,6 +274,7 @@ impl PaintSession {
             normals,
             history: History::new(history),
             log: Vec::new(),
+            open: None,
         })
     }
 
@@ -288,14 +298,80 @@ impl PaintSession {
         &self.log
     }
 
+    /// Starts a stroke painted as its dabs arrive (a pointer being
+    /// dragged): [`Self::add_dabs`] paints them, [`Self::end_stroke`]
+    /// makes the stroke one undo step and logs it as one
+    /// [`Edit::Stroke`], which replays to the same colours. A stroke still
+    /// open is ended first.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] naming the brush's bad field.
+    pub fn begin_stroke(&mut self, brush: Brush) -> Result<(), Error> {
+        brush.check(self.colors.channels())?;
+        self.end_stroke();
+        self.open = Some(OpenStroke {
+            brush,
+            dabs: Vec::new(),
+            recorder: Recorder::new(&self.colors),
+        });
+        Ok(())
+    }
+
+    /// Paints `dabs` with the open stroke's brush; returns the samples
+    /// they changed (each once per call).
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] for a bad dab (none of `dabs` is painted
+    /// then) or when no stroke is open.
+    pub fn add_dabs(&mut self, dabs: &[Dab]) -> Result<Changed, Error> {
+        for d in dabs {
+            d.check()?;
+        }
+        let Some(mut open) = self.open.take() else {
+            return Err(Error::InvalidArgument {
+                argument: "dabs",
+                reason: "arrived with no stroke begun",
+            });
+        };
+        let mut changed = Vec::new();
+        let result = self.paint_dabs(&open.brush, dabs, &mut open.recorder, &mut changed);
+        open.dabs.extend_from_slice(dabs);
+        self.open = Some(open);
+        result?;
+        changed.sort_unstable();
+        changed.dedup();
+        Ok(if changed.is_empty() {
+            Changed::Nothing
+        } else {
+            Changed::Samples(changed)
+        })
+    }
+
+    /// Ends the open stroke, if any: one undo step (none when it changed
+    /// nothing) and one logged [`Edit::Stroke`].
+    pub fn end_stroke(&mut self) {
+        let Some(open) = self.open.take() else {
+            return;
+        };
+        if !open.recorder.is_empty() {
+            self.history.push(Step::Paint(open.recorder.finish()));
+        }
+        self.log.push(Edit::Stroke {
+            brush: open.brush,
+            dabs: open.dabs,
+        });
+    }
+
     /// Applies one gesture and logs it; returns which samples changed.
-    /// An edit that fails changes nothing and is not logged.
+    /// An edit that fails changes nothing and is not logged. A stroke
+    /// still open ([`Self::begin_stroke`]) is ended first.
     ///
     /// # Errors
     /// [`Error::InvalidArgument`] naming the field of a bad brush, dab or
     /// level, [`Error::MissingFace`] for a fill of a face that does not
     /// exist, and the errors of the resolution change.
     pub fn apply(&mut self, edit: Edit) -> Result<Changed, Error> {
+        self.end_stroke();
         let changed = match &edit {
             Edit::Stroke { brush, dabs } => self.stroke(brush, dabs)?,
             Edit::Fill { face, brush } => self.fill(*face, brush)?,
@@ -352,16 +428,28 @@ impl PaintSession {
         }
         let mut recorder = Recorder::new(&self.colors);
         let mut changed = Vec::new();
+        self.paint_dabs(brush, dabs, &mut recorder, &mut changed)?;
+        Ok(self.finish(recorder, changed))
+    }
+
+    /// Paints `dabs` (and their mirror images) in order.
+    fn paint_dabs(
+        &mut self,
+        brush: &Brush,
+        dabs: &[Dab],
+        recorder: &mut Recorder,
+        changed: &mut Vec<u32>,
+    ) -> Result<(), Error> {
         for d in dabs {
             let mirrored = brush.mirror_x.map(|m| Dab {
                 center: Vec3::new(2.0 * m - d.center.x, d.center.y, d.center.z),
                 ..*d
             });
             for dab in std::iter::once(*d).chain(mirrored) {
-                self.dab(brush, &dab, &mut recorder, &mut changed)?;
+                self.dab(brush, &dab, recorder, changed)?;
             }
         }
-        Ok(self.finish(recorder, changed))
+        Ok(())
     }
 
     /// One dab: the samples within its radius that the eye (if any) sees.
@@ -429,9 +517,8 @@ impl PaintSession {
         if new.iter().zip(old).all(|(a, b)| a.to_bits() == b.to_bits()) {
             return Ok(());
         }
-        if recorder.record(&self.colors, i)? {
-            changed.push(i as u32);
-        }
+        recorder.record(&self.colors, i)?;
+        changed.push(i as u32);
         if let Some(s) = self.colors.sample_mut(i) {
             s[first..first + new.len()].copy_from_slice(&new);
         }
@@ -445,6 +532,7 @@ impl PaintSession {
         }
         self.history.push(Step::Paint(recorder.finish()));
         changed.sort_unstable();
+        changed.dedup();
         Changed::Samples(changed)
     }
 

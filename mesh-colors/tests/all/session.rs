@@ -602,3 +602,64 @@ fn bad_gestures_are_refused_by_name_and_change_nothing() {
         Err(Error::ChannelMismatch { .. })
     ));
 }
+
+#[test]
+fn a_stroke_painted_as_its_dabs_arrive_is_one_step_that_replays_alike() {
+    let mut rng = Rng(21);
+    let dabs: Vec<Dab> = (0..12)
+        .map(|k| Dab {
+            center: Vec3::new(0.1 * k as f32 - 0.6, 0.2, 0.9).normalize(),
+            radius: 0.2,
+            pressure: 0.5 + 0.5 * rng.f32(),
+        })
+        .collect();
+    let mut b = brush(BrushMode::Mix, [0.9, 0.2, 0.1]);
+    b.mirror_x = Some(0.0);
+    let mut live = session(4);
+    let start = live.colors().clone();
+    live.begin_stroke(b.clone()).unwrap();
+    let mut union = Vec::new();
+    for chunk in dabs.chunks(5) {
+        let before = bits(live.colors());
+        match live.add_dabs(chunk).unwrap() {
+            Changed::Samples(list) => {
+                // Exactly the samples this chunk changed.
+                let c = live.colors().channels();
+                let after = bits(live.colors());
+                for i in 0..live.colors().sample_count() {
+                    let differs = before[i * c..(i + 1) * c] != after[i * c..(i + 1) * c];
+                    assert_eq!(
+                        differs,
+                        list.binary_search(&(i as u32)).is_ok(),
+                        "sample {i}"
+                    );
+                }
+                union.extend(list);
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+    assert!(
+        live.add_dabs(&[Dab {
+            radius: 0.0,
+            ..dabs[0]
+        }])
+        .is_err()
+    );
+    live.end_stroke();
+    assert_eq!(live.history().undo_len(), 1);
+    assert_eq!(
+        live.log(),
+        &[Edit::Stroke {
+            brush: b.clone(),
+            dabs: dabs.clone()
+        }]
+    );
+    let mut whole = session(4);
+    whole.apply(Edit::Stroke { brush: b, dabs }).unwrap();
+    assert_eq!(bits(whole.colors()), bits(live.colors()));
+    live.apply(Edit::Undo).unwrap();
+    assert_eq!(live.colors(), &start);
+    // Dabs with no stroke begun are refused.
+    assert!(live.add_dabs(&[]).is_err());
+}
