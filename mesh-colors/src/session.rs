@@ -24,6 +24,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use crate::Error;
+use crate::edit::ResolutionChange;
 use crate::paint::Painter;
 use crate::structure::{MeshColors, lattice_points};
 use crate::undo::{History, Recorder, Step};
@@ -203,8 +204,9 @@ pub enum Changed {
     Nothing,
     /// These samples' values (sorted, each once); the layout is the same.
     Samples(Vec<u32>),
-    /// Face resolutions changed: the sample numbering is new.
-    Layout,
+    /// These faces' resolutions changed (sorted): the sample numbering is
+    /// new.
+    Layout(Vec<usize>),
 }
 
 /// The mesh colours being painted, their history and their log (see the
@@ -603,9 +605,10 @@ impl PaintSession {
             return Ok(Changed::Nothing);
         }
         let change = self.colors.set_face_resolutions(changes)?;
+        let faces = resampled(&change);
         self.history.push(Step::Resolution(change));
         self.reindex()?;
-        Ok(Changed::Layout)
+        Ok(Changed::Layout(faces))
     }
 
     /// Undo (`back`) or redo one step.
@@ -620,9 +623,9 @@ impl PaintSession {
             Some(Step::Paint(d)) => {
                 Changed::Samples(d.runs().iter().flat_map(|&(s, n)| s..s + n).collect())
             }
-            Some(Step::Resolution(_)) => Changed::Layout,
+            Some(Step::Resolution(r)) => Changed::Layout(resampled(r)),
         };
-        if changed == Changed::Layout {
+        if let Changed::Layout(_) = changed {
             self.reindex()?;
         }
         Ok(changed)
@@ -634,6 +637,13 @@ impl PaintSession {
         self.normals = sample_normals(&self.colors, &self.positions);
         Ok(())
     }
+}
+
+/// The faces a resolution change resampled, sorted.
+fn resampled(change: &ResolutionChange) -> Vec<usize> {
+    let mut faces: Vec<usize> = change.faces().map(|(f, _, _)| f).collect();
+    faces.sort_unstable();
+    faces
 }
 
 /// A grid cell of about a typical brush: 1/50 of the bounding box's

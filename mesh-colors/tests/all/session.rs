@@ -244,7 +244,7 @@ fn the_changed_samples_are_exactly_those_whose_bits_changed() {
                 assert_eq!(list, differ);
             }
             Changed::Nothing => assert_eq!(before, bits(s.colors())),
-            Changed::Layout => assert!(layout),
+            Changed::Layout(faces) => assert!(layout && !faces.is_empty()),
         }
     }
 }
@@ -486,7 +486,10 @@ fn the_detail_brush_raises_the_faces_it_touches_and_undo_restores_them() {
             levels: 1,
         })
         .unwrap();
-    assert_eq!(changed, Changed::Layout);
+    assert!(
+        matches!(&changed, Changed::Layout(f) if !f.is_empty()),
+        "{changed:?}"
+    );
     let t = s.colors().topology().clone();
     let mut raised = 0;
     for (f, face) in t.faces().iter().enumerate() {
@@ -503,6 +506,13 @@ fn the_detail_brush_raises_the_faces_it_touches_and_undo_restores_them() {
         }
     }
     assert!(raised > 0);
+    let Changed::Layout(listed) = changed else {
+        unreachable!()
+    };
+    let up: Vec<usize> = (0..t.faces().len())
+        .filter(|&f| s.colors().face_level(f) == Some(3))
+        .collect();
+    assert_eq!(listed, up);
     assert!(s.colors().sample_count() > start.sample_count());
     s.apply(Edit::Undo).unwrap();
     assert_eq!(s.colors(), &start);
