@@ -25,6 +25,52 @@ pub(crate) fn edge_level_offset(l: u8) -> usize {
     (1usize << l) - 1 - l as usize
 }
 
+/// Which faces and edges meet at each vertex, in the orders
+/// [`MipMap::new`] uses.
+struct Adjacency {
+    vf_start: Vec<u32>,
+    vf: Vec<u32>,
+    vertex_edges: Vec<Vec<u32>>,
+}
+
+impl Adjacency {
+    fn new(t: &crate::Topology) -> Self {
+        let nv = t.vertex_count;
+        let mut vf_start = vec![0u32; nv + 1];
+        for face in &t.faces {
+            for &v in face {
+                vf_start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..nv {
+            vf_start[v + 1] += vf_start[v];
+        }
+        let mut vf = vec![0u32; vf_start[nv] as usize];
+        let mut fill = vf_start.clone();
+        for (f, face) in t.faces.iter().enumerate() {
+            for &v in face {
+                vf[fill[v as usize] as usize] = f as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); nv];
+        for (e, &[a, b]) in t.edges.iter().enumerate() {
+            vertex_edges[a as usize].push(e as u32);
+            vertex_edges[b as usize].push(e as u32);
+        }
+        Self {
+            vf_start,
+            vf,
+            vertex_edges,
+        }
+    }
+
+    /// The faces around vertex `v`.
+    fn faces_of(&self, v: usize) -> &[u32] {
+        &self.vf[self.vf_start[v] as usize..self.vf_start[v + 1] as usize]
+    }
+}
+
 /// The primitives one level of [`MipMap::refresh`] recomputes.
 struct Subset {
     faces: Vec<usize>,
@@ -391,31 +437,8 @@ impl MipMap {
         let c = colors.channels;
         let t = &colors.topology;
         let (nv, nf) = (t.vertex_count, t.faces.len());
-        // Vertex → faces (CSR) and vertex → edges (in MipMap::new's order,
-        // so that Eq. 6 sums in the same order).
-        let mut vf_start = vec![0u32; nv + 1];
-        for face in &t.faces {
-            for &v in face {
-                vf_start[v as usize + 1] += 1;
-            }
-        }
-        for v in 0..nv {
-            vf_start[v + 1] += vf_start[v];
-        }
-        let mut vf = vec![0u32; vf_start[nv] as usize];
-        let mut fill = vf_start.clone();
-        for (f, face) in t.faces.iter().enumerate() {
-            for &v in face {
-                vf[fill[v as usize] as usize] = f as u32;
-                fill[v as usize] += 1;
-            }
-        }
-        let faces_of = |v: usize| &vf[vf_start[v] as usize..vf_start[v + 1] as usize];
-        let mut vertex_edges: Vec<Vec<u32>> = vec![Vec::new(); nv];
-        for (e, &[a, b]) in t.edges.iter().enumerate() {
-            vertex_edges[a as usize].push(e as u32);
-            vertex_edges[b as usize].push(e as u32);
-        }
+        let adjacency = Adjacency::new(t);
+        let faces_of = |v: usize| adjacency.faces_of(v);
         // Copy the new finest values, and mark their faces.
         let mut dirty = vec![false; nf];
         let mut list: Vec<usize> = Vec::new();
@@ -456,6 +479,166 @@ impl MipMap {
                 self.data[at * c..(at + 1) * c].copy_from_slice(value);
             }
         }
+        Ok(self.recompute(colors, &adjacency, dirty, list))
+    }
+
+    /// Brings the pyramid up to date after the resolutions of `faces`
+    /// changed ([`MeshColors::set_face_resolutions`] or
+    /// [`MeshColors::revert_resolutions`]; pass the faces of its
+    /// [`crate::edit::ResolutionChange::faces`]). Every other primitive
+    /// keeps its levels (moved once to the new layout); the faces given,
+    /// the edges and vertices whose resolution changed, and the rings
+    /// around them that [`MipMap::refresh`] describes are recomputed. The
+    /// result equals [`MipMap::new`] of `colors` bit for bit.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] naming `colors` when they are on another
+    /// mesh or have other channels, or `faces` when it leaves out a face
+    /// whose resolution differs; [`Error::MissingFace`] for a face out of
+    /// range. Nothing changes then.
+    pub fn refresh_resolutions(
+        &mut self,
+        colors: &MeshColors,
+        faces: &[usize],
+    ) -> Result<(), Error> {
+        if colors.channels != self.colors.channels || colors.topology != self.colors.topology {
+            return Err(Error::InvalidArgument {
+                argument: "colors",
+                reason: "are not on this pyramid's mesh or have other channels",
+            });
+        }
+        let nf = colors.face_level.len();
+        let mut listed = vec![false; nf];
+        for &f in faces {
+            if f >= nf {
+                return Err(Error::MissingFace { face: f, count: nf });
+            }
+            listed[f] = true;
+        }
+        if (0..nf).any(|f| !listed[f] && colors.face_level[f] != self.colors.face_level[f]) {
+            return Err(Error::InvalidArgument {
+                argument: "faces",
+                reason: "leaves out a face whose resolution changed",
+            });
+        }
+        let old = std::mem::replace(self, MipMap::zeroed(colors.clone()));
+        let c = colors.channels;
+        let t = &colors.topology;
+        let adjacency = Adjacency::new(t);
+        let mut dirty = vec![false; nf];
+        let mut list: Vec<usize> = Vec::new();
+        let mut mark = |f: usize| {
+            if !dirty[f] {
+                dirty[f] = true;
+                list.push(f);
+            }
+        };
+        let put = |data: &mut Vec<f32>, to: usize, from: &[f32]| {
+            data[to * c..to * c + from.len()].copy_from_slice(from);
+        };
+        for v in 0..t.vertex_count {
+            let (was, now) = (old.colors.vertex_level[v], colors.vertex_level[v]);
+            let at = old.vertex_offset[v] * c;
+            if was == now {
+                let len = (now as usize + 1) * c;
+                put(
+                    &mut self.data,
+                    self.vertex_offset[v],
+                    &old.data[at..at + len],
+                );
+            } else {
+                let to = self.vertex_offset[v] + now as usize;
+                put(&mut self.data, to, &colors.samples[v * c..(v + 1) * c]);
+                for &f in adjacency.faces_of(v) {
+                    mark(f as usize);
+                }
+            }
+        }
+        // An edge of a face given may have been resampled even at its old
+        // resolution (coarsened and refined again in one batch).
+        let mut near = vec![false; t.edges.len()];
+        for f in (0..nf).filter(|&f| listed[f]) {
+            for e in t.face_edges[f] {
+                near[e as usize] = true;
+            }
+        }
+        for (e, &close) in near.iter().enumerate() {
+            let (was, now) = (old.colors.edge_level[e], colors.edge_level[e]);
+            if was == now && !close {
+                let (at, len) = (old.edge_offset[e] * c, edge_level_offset(now + 1) * c);
+                put(&mut self.data, self.edge_offset[e], &old.data[at..at + len]);
+            } else {
+                let (at, len) = (colors.edge_offset[e] * c, ((1usize << now) - 1) * c);
+                let to = self.edge_offset[e] + edge_level_offset(now);
+                put(&mut self.data, to, &colors.samples[at..at + len]);
+                for &f in &t.edge_faces[e] {
+                    if f != NO_FACE {
+                        mark(f as usize);
+                    }
+                }
+            }
+        }
+        for (f, &given) in listed.iter().enumerate() {
+            let n = colors.face_level[f];
+            if given {
+                let (at, len) = (
+                    colors.face_offset[f] * c,
+                    samples_per_face(1 << n) as usize * c,
+                );
+                let to = self.face_offset[f] + FACE_LEVEL_OFFSET[n as usize];
+                put(&mut self.data, to, &colors.samples[at..at + len]);
+                mark(f);
+            } else {
+                let (at, len) = (
+                    old.face_offset[f] * c,
+                    FACE_LEVEL_OFFSET[n as usize + 1] * c,
+                );
+                put(&mut self.data, self.face_offset[f], &old.data[at..at + len]);
+            }
+        }
+        // The caches move too; the recomputed faces' are rewritten below.
+        let mut next = 0;
+        let mut offsets = Vec::with_capacity(nf);
+        for &n in &colors.face_level {
+            offsets.push(next);
+            next += FLAT_SLOT_OFFSET[n as usize + 2];
+        }
+        let mut flat = vec![0.0f32; next * c];
+        for f in (0..nf).filter(|&f| !listed[f]) {
+            let len = FLAT_SLOT_OFFSET[colors.face_level[f] as usize + 2] * c;
+            let at = old.flat_offset[f] * c;
+            flat[offsets[f] * c..offsets[f] * c + len].copy_from_slice(&old.flat[at..at + len]);
+        }
+        self.corner_level = t
+            .faces
+            .iter()
+            .map(|face| {
+                face.iter()
+                    .map(|&v| colors.vertex_level[v as usize])
+                    .max()
+                    .unwrap_or(0)
+            })
+            .collect();
+        self.flat_offset = offsets;
+        self.flat = flat;
+        self.recompute(colors, &adjacency, dirty, list);
+        Ok(())
+    }
+
+    /// Recomputes the levels below the finest of the faces `list` (marked
+    /// in `dirty`) and one more ring of faces per level, then their
+    /// caches; returns the value spans rewritten (see
+    /// [`MipMap::refresh`]). The finest values must be in place.
+    fn recompute(
+        &mut self,
+        colors: &MeshColors,
+        adjacency: &Adjacency,
+        mut dirty: Vec<bool>,
+        mut list: Vec<usize>,
+    ) -> Vec<(usize, usize)> {
+        let t = &colors.topology;
+        let faces_of = |v: usize| adjacency.faces_of(v);
+        let vertex_edges = &adjacency.vertex_edges;
         // One ring more per level, then that level of the ring's
         // primitives.
         let grow = |dirty: &mut Vec<bool>, list: &mut Vec<usize>| {
@@ -475,7 +658,7 @@ impl MipMap {
         for l in (0..top).rev() {
             grow(&mut dirty, &mut list);
             let subset = Subset::of(colors, &list, l);
-            self.build_level(l, &vertex_edges, Some(&subset));
+            self.build_level(l, vertex_edges, Some(&subset));
         }
         // The spans rewritten: every primitive of the faces reached.
         let mut spans: Vec<(usize, usize)> = Vec::new();
@@ -510,7 +693,7 @@ impl MipMap {
             self.fill_face_cache(f, self.flat_offset[f], &mut flat);
         }
         self.flat = flat;
-        Ok(merged)
+        merged
     }
 
     /// A lookup at query level `q` of a point inside face `f`, from the

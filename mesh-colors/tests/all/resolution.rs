@@ -208,3 +208,52 @@ fn bad_requests_name_the_element_and_change_nothing() {
     .to_string();
     assert!(text.contains("face 7"), "{text}");
 }
+
+#[test]
+fn the_mip_map_follows_a_resolution_change_as_a_rebuild_would() {
+    let mut rng = Rng(77);
+    for round in 0..30 {
+        let mut mc = random_colors(&mut rng);
+        let mut mip = mc.mip_map();
+        let changes = random_changes(&mc, &mut rng);
+        let change = mc.set_face_resolutions(&changes).unwrap();
+        let faces: Vec<usize> = change.faces().map(|f| f.0).collect();
+        mip.refresh_resolutions(&mc, &faces).unwrap();
+        let want = mc.mip_map();
+        assert_eq!(mip.colors(), want.colors(), "round {round}: colours");
+        let (a, b) = (mip.data(), want.data());
+        assert_eq!(a.len(), b.len());
+        let bad: Vec<usize> = (0..a.len())
+            .filter(|&i| a[i].to_bits() != b[i].to_bits())
+            .collect();
+        assert!(
+            bad.is_empty(),
+            "round {round}: {} values differ, first {:?}",
+            bad.len(),
+            &bad[..bad.len().min(10)]
+        );
+        assert!(mip == want, "round {round}: the caches differ");
+        mc.revert_resolutions(&change).unwrap();
+        mip.refresh_resolutions(&mc, &faces).unwrap();
+        assert_eq!(mip, mc.mip_map(), "round {round}: reverted");
+    }
+    // Leaving out a changed face, or another mesh, is refused by name.
+    let mut mc = random_colors(&mut rng);
+    let mut mip = mc.mip_map();
+    let before = mip.clone();
+    let f = (0..mc.face_count())
+        .find(|&f| mc.face_resolution(f) != Some(8))
+        .unwrap();
+    mc.set_face_resolutions(&[(f, 8)]).unwrap();
+    let e = mip.refresh_resolutions(&mc, &[]).unwrap_err();
+    assert!(e.to_string().contains("`faces`"), "{e}");
+    assert!(matches!(
+        mip.refresh_resolutions(&mc, &[mc.face_count()]),
+        Err(Error::MissingFace { .. })
+    ));
+    let (positions, faces) = support::grid(9, 0.0);
+    let other = MeshColors::uniform(Topology::new(positions.len(), &faces).unwrap(), 2, 3).unwrap();
+    let e = mip.refresh_resolutions(&other, &[0]).unwrap_err();
+    assert!(e.to_string().contains("`colors`"), "{e}");
+    assert_eq!(mip, before);
+}
