@@ -27,7 +27,7 @@ fn sphere(n: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     ];
     let mut positions: Vec<Vec3> = Vec::new();
     let mut faces = Vec::new();
-    let mut index = |p: Vec3, positions: &mut Vec<Vec3>| -> u32 {
+    let index = |p: Vec3, positions: &mut Vec<Vec3>| -> u32 {
         let p = p.normalize();
         if let Some(i) = positions.iter().position(|q| q.distance(p) < 1e-5) {
             return i as u32;
