@@ -3,6 +3,7 @@
 mod blue_noise;
 mod density;
 mod emitter;
+mod luminaire;
 mod multi;
 mod robustness;
 mod stability;
