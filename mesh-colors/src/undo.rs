@@ -7,10 +7,20 @@
 //! A [`Recorder`] collects a stroke's old values as [`Painter::paint_recorded`]
 //! (or the caller, through [`Recorder::record`]) changes samples;
 //! [`Recorder::finish`] turns it into a [`Delta`]: sorted runs of sample
-//! indices and their values, `4 · channels` bytes per touched sample plus
-//! 8 bytes per run. [`Delta::undo`] and [`Delta::redo`] *swap* the stored
-//! values with the colours' ones, so one copy serves both directions and
-//! both are exact. [`History`] keeps a bounded list of steps of either kind.
+//! indices (8 bytes a run) and their values, compressed without loss.
+//! [`Delta::undo`] and [`Delta::redo`] *swap* the stored values with the
+//! colours' ones, so one copy serves both directions and both are exact.
+//!
+//! **Value coding**: each value's bits are XORed with the same channel of
+//! the previous sample in run order (0 before the first); the result is
+//! stored in 0, 2, 3 or 4 little-endian bytes (its low bytes, the fewest
+//! that hold it, 1 rounded up to 2), with a 2-bit length code per channel
+//! packed into `⌈channels / 4⌉` tag bytes per sample. Neighbouring
+//! samples of a painted surface are alike, so a sample typically costs
+//! 1 + 2–3 bytes per channel instead of 4 (a flat base colour: the tag
+//! byte alone); unrelated values cost one tag byte more than raw `f32`s.
+//!
+//! [`History`] keeps a bounded list of steps of either kind.
 //!
 //! Deltas hold sample indices, which a resolution change renumbers: undo
 //! and redo must run in history order (last in, first out), which
@@ -119,7 +129,8 @@ impl Recorder {
             channels: c,
             sample_count: self.sample_count,
             runs,
-            values,
+            count: order.len(),
+            coded: encode(&values, c),
             undone: false,
         }
     }
@@ -151,8 +162,10 @@ pub struct Delta {
     sample_count: usize,
     /// Sorted, disjoint, non-adjacent runs `(first sample, length)`.
     runs: Vec<(u32, u32)>,
-    /// `channels` values per sample, in run order.
-    values: Vec<f32>,
+    /// Samples in the runs.
+    count: usize,
+    /// `channels` values per sample, in run order, coded (module docs).
+    coded: Vec<u8>,
     undone: bool,
 }
 
@@ -190,13 +203,17 @@ impl Delta {
         }
         fits(self.channels, self.sample_count, colors)?;
         let c = self.channels;
+        let stored = decode(&self.coded, self.count, c);
+        let mut current = Vec::with_capacity(stored.len());
         let mut at = 0;
         let samples = colors.samples_mut();
         for &(start, len) in &self.runs {
             let (start, len) = (start as usize * c, len as usize * c);
-            samples[start..start + len].swap_with_slice(&mut self.values[at..at + len]);
+            current.extend_from_slice(&samples[start..start + len]);
+            samples[start..start + len].copy_from_slice(&stored[at..at + len]);
             at += len;
         }
+        self.coded = encode(&current, c);
         self.undone = !undone;
         Ok(())
     }
@@ -214,7 +231,7 @@ impl Delta {
 
     /// The number of samples the stroke changed.
     pub fn samples(&self) -> usize {
-        self.values.len() / self.channels.max(1)
+        self.count
     }
 
     /// Whether the stroke changed nothing.
@@ -222,13 +239,71 @@ impl Delta {
         self.runs.is_empty()
     }
 
-    /// Heap bytes this delta holds: `4 · channels` per sample, 8 per run,
-    /// and the struct.
+    /// Heap bytes this delta holds: the coded values (module docs), 8 per
+    /// run, and the struct.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<Self>()
             + self.runs.capacity() * std::mem::size_of::<(u32, u32)>()
-            + self.values.capacity() * std::mem::size_of::<f32>()
+            + self.coded.capacity()
     }
+}
+
+/// Bytes stored for a value whose XOR with its predecessor is `x`.
+#[inline]
+fn coded_len(x: u32) -> (u8, usize) {
+    match x {
+        0 => (0, 0),
+        1..=0xFFFF => (1, 2),
+        0x1_0000..=0xFF_FFFF => (2, 3),
+        _ => (3, 4),
+    }
+}
+
+/// Codes `values` (`c` per sample) as the module documentation says.
+fn encode(values: &[f32], c: usize) -> Vec<u8> {
+    let tags = c.div_ceil(4);
+    let mut out = Vec::with_capacity(values.len() * 3);
+    let mut prev = [0u32; crate::MAX_CHANNELS];
+    for sample in values.chunks_exact(c) {
+        let tag_at = out.len();
+        out.resize(tag_at + tags, 0);
+        for (ch, &v) in sample.iter().enumerate() {
+            let bits = v.to_bits();
+            let x = bits ^ prev[ch];
+            prev[ch] = bits;
+            let (code, len) = coded_len(x);
+            out[tag_at + ch / 4] |= code << (2 * (ch % 4));
+            out.extend_from_slice(&x.to_le_bytes()[..len]);
+        }
+    }
+    out.shrink_to_fit();
+    out
+}
+
+/// The inverse of [`encode`] for `count` samples of `c` values.
+fn decode(coded: &[u8], count: usize, c: usize) -> Vec<f32> {
+    let tags = c.div_ceil(4);
+    let mut out = Vec::with_capacity(count * c);
+    let mut prev = [0u32; crate::MAX_CHANNELS];
+    let mut at = 0;
+    for _ in 0..count {
+        let tag = at;
+        at += tags;
+        for (ch, p) in prev.iter_mut().enumerate().take(c) {
+            let code = coded
+                .get(tag + ch / 4)
+                .map_or(0, |t| (t >> (2 * (ch % 4))) & 3);
+            let len = [0, 2, 3, 4][code as usize];
+            let mut word = [0u8; 4];
+            if let Some(bytes) = coded.get(at..at + len) {
+                word[..len].copy_from_slice(bytes);
+            }
+            at += len;
+            *p ^= u32::from_le_bytes(word);
+            out.push(f32::from_bits(*p));
+        }
+    }
+    out
 }
 
 /// One undoable gesture.
