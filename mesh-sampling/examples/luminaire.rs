@@ -66,8 +66,8 @@ use mesh_sampling::{Emission, EmissionTexture, Emitter, EmitterOptions, Strategy
 mod luminaire;
 
 use luminaire::{
-    Config, FLOOR, Irradiance, Measured, Receiver, Row, Shape, compare, folded, generated_textures,
-    paired_rate, peak_over_mean, rectangle_with,
+    Config, FLOOR, Irradiance, Measured, QuadratureCheck, Receiver, Row, Shape, compare, folded,
+    generated_textures, paired_rate, peak_over_mean, rectangle_with,
 };
 
 /// Samples per pixel of the pictures.
@@ -367,6 +367,10 @@ fn run() -> Result<(), String> {
     );
     let mut all_rows: Vec<Row> = Vec::new();
     let mut measured: Vec<(usize, Measured)> = Vec::new();
+    // The rectangle's irradiance does not depend on its tessellation (its
+    // UVs are linear on the plane): one reference per texture, made with
+    // the first tessellation, serves the others.
+    let mut shared: Vec<(usize, usize, luminaire::Reference, Option<QuadratureCheck>)> = Vec::new();
     for (c, case) in cases.iter().enumerate() {
         let (tname, texture) = &textures[case.texture];
         eprintln!(
@@ -374,7 +378,26 @@ fn run() -> Result<(), String> {
             case.shape.name,
             case.shape.triangles()
         );
-        let m = luminaire::measure(&case.shape, texture, tname, &config, PICTURE_SPP)?;
+        let reuse = shared
+            .iter()
+            .find(|s| case.shape.planar && s.0 == case.texture);
+        let m = luminaire::measure(
+            &case.shape,
+            texture,
+            tname,
+            &config,
+            PICTURE_SPP,
+            reuse.map(|s| (&s.2, s.3)),
+        )?;
+        let made_with = reuse.map(|s| s.1);
+        if case.shape.planar && made_with.is_none() {
+            shared.push((
+                case.texture,
+                case.shape.triangles(),
+                m.reference.clone(),
+                m.quadrature,
+            ));
+        }
         let r = &m.reference;
         // Converged: the two seeds agree within their noise, and the
         // reference's own rel MSE (a quarter of theirs) is at most 5% of
@@ -399,10 +422,12 @@ fn run() -> Result<(), String> {
         });
         let _ = writeln!(
             refs_table,
-            "| {} | {tname} | {} | {:.1} | {:.2e} ({:.2e}) | {quad} |",
+            "| {} | {tname} | {} | {} | {:.2e} ({:.2e}) | {quad} |",
             case.shape.name,
             case.shape.triangles(),
-            r.seconds,
+            made_with.map_or(format!("{:.1}", r.seconds), |t| format!(
+                "the {t} triangles' reference"
+            )),
             r.agreement,
             r.predicted_agreement
         );
@@ -414,13 +439,14 @@ fn run() -> Result<(), String> {
         });
         let _ = writeln!(
             json,
-            "{{\"kind\": \"reference\", \"scene\": \"{}\", \"texture\": \"{tname}\", \"triangles\": {}, \"strategy\": \"texture-exact\", \"spp\": {}, \"seeds\": 2, \"seconds\": {:.3}, \"seeds_rel_mse\": {:.6e}, \"seeds_rel_mse_predicted\": {:.6e}{quad_json}}}",
+            "{{\"kind\": \"reference\", \"scene\": \"{}\", \"texture\": \"{tname}\", \"triangles\": {}, \"strategy\": \"texture-exact\", \"spp\": {}, \"seeds\": 2, \"seconds\": {:.3}, \"seeds_rel_mse\": {:.6e}, \"seeds_rel_mse_predicted\": {:.6e}{quad_json}{}}}",
             case.shape.name,
             case.shape.triangles(),
             config.reference_spp,
             r.seconds,
             r.agreement,
-            r.predicted_agreement
+            r.predicted_agreement,
+            made_with.map_or(String::new(), |t| format!(", \"made_with_triangles\": {t}"))
         );
         if let Some(q) = m.quadrature
             && q.max_z > 5.0
@@ -814,14 +840,19 @@ fn targets(
         }
     }
     for (scene, s, r) in rates {
-        if *s == Strategy::Texture || *s == Strategy::TextureExact {
-            line(
-                format!("light samples/s per thread, {} / area, {scene}", s.name()),
-                "≥ 0.65×".into(),
-                format!("{r:.2}×"),
-                Some(*r >= 0.65),
-            );
-        }
+        // The target is the paper's (Sec. 5.2) for its subdivision; the
+        // exact strategy's rejection step is shown beside it.
+        let (target, met) = match s {
+            Strategy::Texture => ("≥ 0.65×", Some(*r >= 0.65)),
+            Strategy::TextureExact => ("(none: rejection on top)", None),
+            _ => continue,
+        };
+        line(
+            format!("light samples/s per thread, {} / area, {scene}", s.name()),
+            target.into(),
+            format!("{r:.2}×"),
+            met,
+        );
     }
     t
 }

@@ -697,6 +697,7 @@ pub(crate) fn measure(
     texture_name: &str,
     config: &Config,
     picture_spp: usize,
+    shared: Option<(&Reference, Option<QuadratureCheck>)>,
 ) -> Result<Measured, String> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(config.threads)
@@ -708,6 +709,19 @@ pub(crate) fn measure(
     };
     let receiver = &config.receiver;
     let (exact, _) = build(shape, emission, "texture-exact")?;
+    if let Some((reference, quadrature)) = shared {
+        return measure_rows(
+            shape,
+            emission,
+            texture_name,
+            config,
+            picture_spp,
+            &pool,
+            constant_radiance(&exact, shape),
+            reference.clone(),
+            quadrature,
+        );
+    }
     let reference = make_reference(&exact, receiver, config.reference_spp, config.seed ^ 0xA5A5)?;
     let quadrature = shape.planar.then(|| {
         let lattice: Vec<(usize, usize)> = (0..4)
@@ -738,6 +752,36 @@ pub(crate) fn measure(
     });
     let floor_radiance = constant_radiance(&exact, shape);
     drop(exact);
+    measure_rows(
+        shape,
+        emission,
+        texture_name,
+        config,
+        picture_spp,
+        &pool,
+        floor_radiance,
+        reference,
+        quadrature,
+    )
+}
+
+/// [`measure`] with the reference made: the floor's reference and the rows.
+#[expect(
+    clippy::too_many_arguments,
+    reason = "one private step of measure, called twice"
+)]
+fn measure_rows(
+    shape: &Shape,
+    emission: Emission<'_>,
+    texture_name: &str,
+    config: &Config,
+    picture_spp: usize,
+    pool: &rayon::ThreadPool,
+    floor_radiance: f64,
+    reference: Reference,
+    quadrature: Option<QuadratureCheck>,
+) -> Result<Measured, String> {
+    let receiver = &config.receiver;
     let floor_rgb = vec![[floor_radiance as f32; 3]; shape.triangles()];
     let floor_emission = Emission::PerFace(&floor_rgb);
     let floor_reference = if shape.planar {
@@ -800,7 +844,7 @@ pub(crate) fn measure(
             rel_var,
         };
         for &spp in &config.spps {
-            let (image, seconds) = timed(&pool, &emitter, config, spp);
+            let (image, seconds) = timed(pool, &emitter, config, spp);
             rows.push(row("equal-spp", spp, seconds, &image));
             if spp == largest {
                 per_spp.push((name, seconds / spp as f64, rel_var));
@@ -822,7 +866,7 @@ pub(crate) fn measure(
             }
             let spp = ((budget / seconds_per_spp).round() as usize).clamp(1, 1 << 16);
             let (emitter, build_seconds) = build(shape, emission, name)?;
-            let (image, seconds) = timed(&pool, &emitter, config, spp);
+            let (image, seconds) = timed(pool, &emitter, config, spp);
             rows.push(Row {
                 scene: shape.name.clone(),
                 texture: texture_name.into(),

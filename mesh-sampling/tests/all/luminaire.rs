@@ -36,7 +36,7 @@ fn estimates_agree_with_the_reference_within_noise() {
     let config = config();
     for shape in [&rectangle, &blob] {
         for (name, texture) in &textures {
-            let m = measure(shape, texture, name, &config, 16).unwrap();
+            let m = measure(shape, texture, name, &config, 16, None).unwrap();
             let r = &m.reference;
             assert!(
                 r.agreement <= 1.5 * r.predicted_agreement,
