@@ -71,6 +71,62 @@ impl Adjacency {
     }
 }
 
+/// Per-primitive offsets (in values) of the pyramid of `colors`:
+/// vertices, edges, faces, and the total.
+fn pyramid_offsets(colors: &MeshColors) -> (Vec<usize>, Vec<usize>, Vec<usize>, usize) {
+    let mut next = 0usize;
+    let mut place = |len: usize| {
+        let at = next;
+        next += len;
+        at
+    };
+    let vertex_offset: Vec<usize> = colors
+        .vertex_level
+        .iter()
+        .map(|&n| place(n as usize + 1))
+        .collect();
+    let edge_offset: Vec<usize> = colors
+        .edge_level
+        .iter()
+        .map(|&n| place(edge_level_offset(n + 1)))
+        .collect();
+    let face_offset: Vec<usize> = colors
+        .face_level
+        .iter()
+        .map(|&n| place(FACE_LEVEL_OFFSET[n as usize + 1]))
+        .collect();
+    (vertex_offset, edge_offset, face_offset, next)
+}
+
+/// Moves the segments `(old offset, new offset, length, keep)` (in values
+/// of `c` floats, in layout order: both offsets increase and the new
+/// segments do not overlap) of `buf` in place to a layout of `total`
+/// values; segments not kept are left for the caller to write. Segments
+/// moving towards the front go first, front to back, then those moving
+/// towards the back, back to front: neither overwrites a segment still to
+/// be moved. Only a grown tail is newly allocated.
+fn move_segments(
+    buf: &mut Vec<f32>,
+    c: usize,
+    segments: &[(usize, usize, usize, bool)],
+    total: usize,
+) {
+    if buf.len() < total * c {
+        buf.resize(total * c, 0.0);
+    }
+    for &(from, to, len, keep) in segments {
+        if keep && to < from {
+            buf.copy_within(from * c..(from + len) * c, to * c);
+        }
+    }
+    for &(from, to, len, keep) in segments.iter().rev() {
+        if keep && to > from {
+            buf.copy_within(from * c..(from + len) * c, to * c);
+        }
+    }
+    buf.truncate(total * c);
+}
+
 /// The primitives one level of [`MipMap::refresh`] recomputes.
 struct Subset {
     faces: Vec<usize>,
@@ -239,37 +295,9 @@ impl MipMap {
 
     /// The layout for `colors` with every value zero.
     pub(crate) fn zeroed(colors: MeshColors) -> Self {
-        let c = colors.channels;
-        let mut next = 0usize;
-        let vertex_offset: Vec<usize> = colors
-            .vertex_level
-            .iter()
-            .map(|&n| {
-                let at = next;
-                next += n as usize + 1;
-                at
-            })
-            .collect();
-        let edge_offset: Vec<usize> = colors
-            .edge_level
-            .iter()
-            .map(|&n| {
-                let at = next;
-                next += edge_level_offset(n + 1);
-                at
-            })
-            .collect();
-        let face_offset: Vec<usize> = colors
-            .face_level
-            .iter()
-            .map(|&n| {
-                let at = next;
-                next += FACE_LEVEL_OFFSET[n as usize + 1];
-                at
-            })
-            .collect();
+        let (vertex_offset, edge_offset, face_offset, next) = pyramid_offsets(&colors);
         MipMap {
-            data: vec![0.0; next * c],
+            data: vec![0.0; next * colors.channels],
             vertex_offset,
             edge_offset,
             face_offset,
@@ -521,7 +549,6 @@ impl MipMap {
                 reason: "leaves out a face whose resolution changed",
             });
         }
-        let old = std::mem::replace(self, MipMap::zeroed(colors.clone()));
         let c = colors.channels;
         let t = &colors.topology;
         let adjacency = Adjacency::new(t);
@@ -533,27 +560,6 @@ impl MipMap {
                 list.push(f);
             }
         };
-        let put = |data: &mut Vec<f32>, to: usize, from: &[f32]| {
-            data[to * c..to * c + from.len()].copy_from_slice(from);
-        };
-        for v in 0..t.vertex_count {
-            let (was, now) = (old.colors.vertex_level[v], colors.vertex_level[v]);
-            let at = old.vertex_offset[v] * c;
-            if was == now {
-                let len = (now as usize + 1) * c;
-                put(
-                    &mut self.data,
-                    self.vertex_offset[v],
-                    &old.data[at..at + len],
-                );
-            } else {
-                let to = self.vertex_offset[v] + now as usize;
-                put(&mut self.data, to, &colors.samples[v * c..(v + 1) * c]);
-                for &f in adjacency.faces_of(v) {
-                    mark(f as usize);
-                }
-            }
-        }
         // An edge of a face given may have been resampled even at its old
         // resolution (coarsened and refined again in one batch).
         let mut near = vec![false; t.edges.len()];
@@ -562,53 +568,78 @@ impl MipMap {
                 near[e as usize] = true;
             }
         }
-        for (e, &close) in near.iter().enumerate() {
-            let (was, now) = (old.colors.edge_level[e], colors.edge_level[e]);
-            if was == now && !close {
-                let (at, len) = (old.edge_offset[e] * c, edge_level_offset(now + 1) * c);
-                put(&mut self.data, self.edge_offset[e], &old.data[at..at + len]);
-            } else {
-                let (at, len) = (colors.edge_offset[e] * c, ((1usize << now) - 1) * c);
-                let to = self.edge_offset[e] + edge_level_offset(now);
-                put(&mut self.data, to, &colors.samples[at..at + len]);
-                for &f in &t.edge_faces[e] {
-                    if f != NO_FACE {
-                        mark(f as usize);
-                    }
+        // Which primitives keep their levels (and move), in layout order.
+        let old = &self.colors;
+        let keep_vertex: Vec<bool> = (0..t.vertex_count)
+            .map(|v| old.vertex_level[v] == colors.vertex_level[v])
+            .collect();
+        let keep_edge: Vec<bool> = (0..t.edges.len())
+            .map(|e| old.edge_level[e] == colors.edge_level[e] && !near[e])
+            .collect();
+        let (vo, eo, fo, total) = pyramid_offsets(colors);
+        let mut segments = Vec::with_capacity(vo.len() + eo.len() + fo.len());
+        for v in 0..vo.len() {
+            let len = colors.vertex_level[v] as usize + 1;
+            segments.push((self.vertex_offset[v], vo[v], len, keep_vertex[v]));
+        }
+        for e in 0..eo.len() {
+            let len = edge_level_offset(colors.edge_level[e] + 1);
+            segments.push((self.edge_offset[e], eo[e], len, keep_edge[e]));
+        }
+        for f in 0..fo.len() {
+            let len = FACE_LEVEL_OFFSET[colors.face_level[f] as usize + 1];
+            segments.push((self.face_offset[f], fo[f], len, !listed[f]));
+        }
+        move_segments(&mut self.data, c, &segments, total);
+        let mut segments = Vec::with_capacity(nf);
+        let mut next = 0;
+        let mut flat_offset = Vec::with_capacity(nf);
+        for (f, &n) in colors.face_level.iter().enumerate() {
+            let len = FLAT_SLOT_OFFSET[n as usize + 2];
+            segments.push((self.flat_offset[f], next, len, !listed[f]));
+            flat_offset.push(next);
+            next += len;
+        }
+        move_segments(&mut self.flat, c, &segments, next);
+        (self.vertex_offset, self.edge_offset, self.face_offset) = (vo, eo, fo);
+        self.flat_offset = flat_offset;
+        // The finest values of the primitives that did not move.
+        for v in (0..t.vertex_count).filter(|&v| !keep_vertex[v]) {
+            let at = (self.vertex_offset[v] + colors.vertex_level[v] as usize) * c;
+            self.data[at..at + c].copy_from_slice(&colors.samples[v * c..(v + 1) * c]);
+            for &f in adjacency.faces_of(v) {
+                mark(f as usize);
+            }
+        }
+        for e in (0..t.edges.len()).filter(|&e| !keep_edge[e]) {
+            let n = colors.edge_level[e];
+            let (from, len) = (colors.edge_offset[e] * c, ((1usize << n) - 1) * c);
+            let at = (self.edge_offset[e] + edge_level_offset(n)) * c;
+            self.data[at..at + len].copy_from_slice(&colors.samples[from..from + len]);
+            for &f in &t.edge_faces[e] {
+                if f != NO_FACE {
+                    mark(f as usize);
                 }
             }
         }
-        for (f, &given) in listed.iter().enumerate() {
+        for f in (0..nf).filter(|&f| listed[f]) {
             let n = colors.face_level[f];
-            if given {
-                let (at, len) = (
-                    colors.face_offset[f] * c,
-                    samples_per_face(1 << n) as usize * c,
-                );
-                let to = self.face_offset[f] + FACE_LEVEL_OFFSET[n as usize];
-                put(&mut self.data, to, &colors.samples[at..at + len]);
-                mark(f);
-            } else {
-                let (at, len) = (
-                    old.face_offset[f] * c,
-                    FACE_LEVEL_OFFSET[n as usize + 1] * c,
-                );
-                put(&mut self.data, self.face_offset[f], &old.data[at..at + len]);
-            }
+            let (from, len) = (
+                colors.face_offset[f] * c,
+                samples_per_face(1 << n) as usize * c,
+            );
+            let at = (self.face_offset[f] + FACE_LEVEL_OFFSET[n as usize]) * c;
+            self.data[at..at + len].copy_from_slice(&colors.samples[from..from + len]);
+            mark(f);
         }
-        // The caches move too; the recomputed faces' are rewritten below.
-        let mut next = 0;
-        let mut offsets = Vec::with_capacity(nf);
-        for &n in &colors.face_level {
-            offsets.push(next);
-            next += FLAT_SLOT_OFFSET[n as usize + 2];
-        }
-        let mut flat = vec![0.0f32; next * c];
-        for f in (0..nf).filter(|&f| !listed[f]) {
-            let len = FLAT_SLOT_OFFSET[colors.face_level[f] as usize + 2] * c;
-            let at = old.flat_offset[f] * c;
-            flat[offsets[f] * c..offsets[f] * c + len].copy_from_slice(&old.flat[at..at + len]);
-        }
+        // The colours themselves, reusing their allocations.
+        let mine = &mut self.colors;
+        mine.samples.clone_from(&colors.samples);
+        mine.face_level.clone_from(&colors.face_level);
+        mine.edge_level.clone_from(&colors.edge_level);
+        mine.vertex_level.clone_from(&colors.vertex_level);
+        mine.edge_offset.clone_from(&colors.edge_offset);
+        mine.face_offset.clone_from(&colors.face_offset);
         self.corner_level = t
             .faces
             .iter()
@@ -619,8 +650,6 @@ impl MipMap {
                     .unwrap_or(0)
             })
             .collect();
-        self.flat_offset = offsets;
-        self.flat = flat;
         self.recompute(colors, &adjacency, dirty, list);
         Ok(())
     }
