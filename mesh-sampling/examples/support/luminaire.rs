@@ -553,7 +553,7 @@ pub(crate) fn constant_radiance(emitter: &Emitter<'_>, shape: &Shape) -> f64 {
     emitter.power() / std::f64::consts::PI / shape.area()
 }
 
-/// The strategies of a row: the emitter's four, and `constant-floor`.
+/// The name of the constant floor's rows (beside the four strategies' names).
 pub(crate) const FLOOR: &str = "constant-floor";
 
 /// A measured row.
@@ -604,8 +604,8 @@ pub(crate) struct Config {
     pub(crate) repeats: usize,
     /// Equal-time rows: the budget is `texture`'s time at the largest spp.
     pub(crate) equal_time: bool,
-    /// The rayon pool the rows are rendered on (references and quadrature
-    /// use the caller's).
+    /// Threads of the pool the rows are rendered on (references and
+    /// quadrature use the caller's pool).
     pub(crate) threads: usize,
 }
 
@@ -686,7 +686,9 @@ fn timed(
 
 /// Every strategy on `shape` with `texture`: the reference (texture-exact,
 /// two seeds), the quadrature check (rectangle), the constant floor's
-/// reference, and the rows at each spp and at equal time.
+/// reference, and the rows at each spp and at equal time. `shared` is a
+/// reference (and its quadrature check) made before for the same
+/// irradiance, used instead of a new one.
 ///
 /// # Errors
 /// An emitter that cannot be built, a reference pixel that is not
