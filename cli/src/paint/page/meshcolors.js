@@ -1,0 +1,588 @@
+// Mesh colours on the GPU (Yuksel, Keyser & House 2010, Sec. 5.3): every
+// sample and MIP level of a mesh_colors::gpu::GpuLayout in an RGBA32F
+// texture, its per-face table in an RGBA32UI texture, and a fragment shader
+// that filters per face exactly as the CPU filters do. The formulas are the
+// ones gpu.rs's module documentation states (steps 1-4 below), with the
+// products and sums of GpuLayout::lookup associated as there, so the GPU's
+// value equals the CPU's to an ulp or two (the parity test,
+// cli/tests/all/paint_shader.rs, holds the 8-bit output within 1/255).
+//
+// Geometry: unindexed triangles, three vertices per face in face order, so
+// the face id is gl_VertexID / 3 and corner k of a face gets the
+// barycentric e_k. No attribute but the position is needed, and a face's
+// table entry is fetched once per fragment by that flat id.
+//
+// Usage:
+//   const mc = new MeshColorsRenderer(gl);
+//   mc.setMesh(positions, triangles);      // Float32Array xyz, Uint32Array abc
+//   mc.setLayout(parts);                   // {width, channels, samples, faces}
+//   mc.updateRects(changes, parts);        // after GpuLayout::update
+//   mc.draw(viewProj, { filter: 'trilinear' });
+//   const hit = mc.pick(viewProj, x, y);  // face and barycentrics under a pixel
+
+// Face table words (gpu.rs, "Face table"): w0 = F, w1..w3 = V_k, w4..w6 =
+// E_k, w7 = packed levels and edge directions.
+const VS = `#version 300 es
+in vec3 position;
+uniform mat4 viewProj;
+flat out int vFace;
+out vec3 vBary;
+void main() {
+  // drawArrays from 0: vertex 3f + k is corner k of face f.
+  vFace = gl_VertexID / 3;
+  int k = gl_VertexID - 3 * vFace;
+  vBary = vec3(k == 0, k == 1, k == 2);
+  gl_Position = viewProj * vec4(position, 1.0);
+}`;
+
+const FS = `
+precision highp float;
+precision highp int;
+precision highp sampler2D;
+precision highp usampler2D;
+
+uniform sampler2D samples;   // RGBA32F, GpuLayout::sample_texels
+uniform usampler2D faces;    // RGBA32UI, GpuLayout::face_texels
+uniform int perValue;        // P = ceil(channels / 4) texels per value
+uniform int group;           // which texel of a value is shown (channel / 4)
+uniform int filterMode;      // 0 nearest, 1 linear, 2 level, 3 trilinear, 4 anisotropic
+uniform int level;           // the level of filterMode 2
+uniform int maxSamples;      // anisotropic probes at most
+uniform int display;         // 0 RGB of the group, 1 grey of one component, 2 heat map of it
+uniform int component;       // the component (channel % 4) displays 1 and 2 show
+uniform vec2 heatRange;      // the values mapped to the ends of the heat map
+uniform int outputMode;      // 0 colour; 1 pick: face, barycentrics and their derivatives
+uniform bool tagAlpha;       // alpha = (face id mod 255 + 1) / 255, never 0 (lets a
+                             // reader of the canvas tell which face a pixel shows; tests)
+
+flat in int vFace;
+in vec3 vBary;
+layout(location = 0) out vec4 out0;
+layout(location = 1) out vec4 out1;
+layout(location = 2) out vec4 out2;
+
+const int FINEST = 255;      // query level: every primitive at its finest
+const int MAX_LEVEL = 10;    // mesh_colors::MAX_LEVEL
+const int MAX_PROBES = 64;   // mesh_colors::MAX_PROBES
+
+// One face's table entry, decoded once per fragment (View::decode).
+struct Face {
+  uint F; uint V[3]; uint E[3];
+  int n; int vl[3]; int el[3];
+  bool fwd[3];               // edge k runs canonically from corner k to k + 1
+};
+Face face;
+
+void decode(int f) {
+  int w = textureSize(faces, 0).x;
+  int t = 2 * f;
+  uvec4 a = texelFetch(faces, ivec2(t % w, t / w), 0);
+  uvec4 b = texelFetch(faces, ivec2((t + 1) % w, (t + 1) / w), 0);
+  uint bits = b.w;
+  face.F = a.x;
+  face.V = uint[3](a.y, a.z, a.w);
+  face.E = uint[3](b.x, b.y, b.z);
+  face.n = min(int(bits & 15u), MAX_LEVEL);
+  for (int k = 0; k < 3; k++) {
+    face.vl[k] = min(int((bits >> (4 + 4 * k)) & 15u), MAX_LEVEL);
+    // An edge is never finer than its face (as the CPU clamps it).
+    face.el[k] = min(int((bits >> (16 + 4 * k)) & 15u), face.n);
+#ifdef TWIN_EDGE_DIRECTION
+    face.fwd[k] = true;      // the wrong twin: every edge read from corner k
+#else
+    face.fwd[k] = (bits & (1u << (28 + k))) != 0u;
+#endif
+  }
+}
+
+// Pyramid value i's shown texel: linear texel index t = i * P + group at
+// (t % W, t / W), W the texture's width (WebGL2 has no texture buffers).
+vec4 value(uint i) {
+  uint w = uint(textureSize(samples, 0).x);
+#ifdef TWIN_ROW_WIDTH
+  w -= 1u;                   // the wrong twin: rows one texel short
+#endif
+  uint t = i * uint(perValue) + uint(group);
+  return texelFetch(samples, ivec2(int(t % w), int(t / w)), 0);
+}
+
+// Offsets of a level within an edge's and a face's levels (mip.rs):
+// sum over m < l of 2^m - 1, and of (2^m - 1)(2^m - 2) / 2.
+uint edgeLevelOffset(int l) { return uint((1 << l) - 1 - l); }
+uint faceLevelOffset(int l) {
+  uint o = 0u;
+  for (int m = 2; m < l; m++) { uint r = uint(1 << m); o += (r - 1u) * (r - 2u) / 2u; }
+  return o;
+}
+// Interior sample C_ij of a face of resolution r (structure.rs).
+uint interiorIndex(uint r, uint i, uint j) { return (i - 1u) * (r - 1u) - (i - 1u) * i / 2u + (j - 1u); }
+
+// A lookup resolves to weighted pyramid values, "taps": a corner is one, a
+// point of an edge one or two (a face finer than its edge interpolates the
+// edge's nodes: the continuity rule). Indices are resolved first and
+// fetched in one place (levelValue) because GLSL inlines every call: a
+// fetch at each of the CPU's call sites made a program that SwiftShader
+// took seconds to compile, for the same arithmetic.
+struct Taps { uint i[2]; float w[2]; int n; };
+
+Taps one(uint i, float w) { return Taps(uint[2](i, 0u), float[2](w, 0.0), 1); }
+Taps two(uint i, float wi, uint j, float wj) { return Taps(uint[2](i, j), float[2](wi, wj), 2); }
+
+// Corner k seen at query level q (its own level, at most).
+uint cornerIndex(int k, int q) { return face.V[k] + uint(min(q, face.vl[k])); }
+
+// Node i of edge k at edge level le: its canonical start vertex (i = 0),
+// its end vertex (i = 2^le) or its sample i.
+uint nodeIndex(int k, int q, int le, uint i) {
+  int k1 = (k + 1) % 3;
+  if (i == 0u) return cornerIndex(face.fwd[k] ? k : k1, q);
+  if (i == uint(1 << le)) return cornerIndex(face.fwd[k] ? k1 : k, q);
+  return face.E[k] + edgeLevelOffset(le) + i - 1u;
+}
+
+// Edge k at canonical lattice position p / 2^lp (a lattice point of a
+// face of level lp on it), weight w: a node, or two when the edge is
+// coarser than the face (step 3).
+Taps edgeTaps(int k, int q, int lp, uint p, float w, bool nearest) {
+  int le = min(q, face.el[k]);
+  int d = lp - le;
+  uint i = p >> uint(d);
+  uint rem = p & uint((1 << d) - 1);
+  if (rem == 0u) return one(nodeIndex(k, q, le, i), w);
+  if (nearest) return one(nodeIndex(k, q, le, i + (2u * rem >= uint(1 << d) ? 1u : 0u)), w);
+  float fr = float(rem) / float(1 << d);
+  return two(nodeIndex(k, q, le, i), w * (1.0 - fr), nodeIndex(k, q, le, i + 1u), w * fr);
+}
+
+// A point on edge k at canonical parameter t (step 1): the nodes around it.
+Taps placeEdgeTaps(int k, float t, int q, bool nearest) {
+  int le = min(q, face.el[k]);
+  uint re = uint(1 << le);
+  float x = t * float(re);
+  uint i = min(uint(x), re - 1u);
+  float fr = x - float(i);
+  if (nearest) return one(nodeIndex(k, q, le, i + (fr >= 0.5 ? 1u : 0u)), 1.0);
+  return two(nodeIndex(k, q, le, i), 1.0 - fr, nodeIndex(k, q, le, i + 1u), fr);
+}
+
+// Lattice point a (a.x + a.y + a.z = 2^lf) with weight w (step 3): a
+// corner, a point of an edge, or the interior sample C_{a.x a.y} of level lf.
+Taps latticeTaps(int q, int lf, uvec3 a, float w, bool nearest) {
+  uint r = uint(1 << lf);
+  for (int k = 0; k < 3; k++) if (a[k] == r) return one(cornerIndex(k, q), w);
+  for (int m = 0; m < 3; m++) {
+    if (a[m] == 0u) {
+      int k = (m + 1) % 3;
+      uint t = a[(k + 1) % 3];
+      return edgeTaps(k, q, lf, face.fwd[k] ? t : r - t, w, nearest);
+    }
+  }
+  return one(face.F + faceLevelOffset(lf) + interiorIndex(r, a.x, a.y), w);
+}
+
+// Where a point lies (step 1): kind 0 corner k, 1 edge k at canonical
+// parameter t, 2 inside with clamped barycentrics c.
+struct Place { int kind; int k; float t; vec3 c; };
+
+Place place(vec3 b) {
+  vec3 c = vec3(b.x > 0.0 ? b.x : 0.0, b.y > 0.0 ? b.y : 0.0, b.z > 0.0 ? b.z : 0.0);
+  int zeros = int(c.x == 0.0) + int(c.y == 0.0) + int(c.z == 0.0);
+  if (zeros == 0) return Place(2, 0, 0.0, c);
+  if (zeros == 3) return Place(2, 0, 0.0, vec3(1.0));
+  if (zeros == 2) return Place(0, c.x > 0.0 ? 0 : (c.y > 0.0 ? 1 : 2), 0.0, c);
+  int m = c.x == 0.0 ? 0 : (c.y == 0.0 ? 1 : 2);
+  int k = (m + 1) % 3, k1 = (k + 1) % 3;
+  float cs = face.fwd[k] ? c[k] : c[k1];
+  float ce = face.fwd[k] ? c[k1] : c[k];
+  return Place(1, k, ce / (cs + ce), c);
+}
+
+// The lattice triangle of resolution r around c (step 2, Fig. 7): its
+// three points and weights.
+void lattice3(vec3 c, uint r, out uvec3 p[3], out vec3 w) {
+  float s = float(r) / (c.x + c.y + c.z);
+  float x = c.x * s, y = c.y * s;
+  uint i = min(uint(x), r - 1u);
+  uint j = min(uint(y), r - 1u - i);
+  float fx = x - float(i), fy = y - float(j);
+  uint k = r - i - j;
+  if (fx + fy <= 1.0 || k == 1u) {
+    p = uvec3[3](uvec3(i, j, k), uvec3(i + 1u, j, k - 1u), uvec3(i, j + 1u, k - 1u));
+    w = vec3(1.0 - fx - fy, fx, fy);
+  } else {
+    p = uvec3[3](uvec3(i + 1u, j + 1u, k - 2u), uvec3(i + 1u, j, k - 1u), uvec3(i, j + 1u, k - 1u));
+    w = vec3(fx + fy - 1.0, 1.0 - fy, 1.0 - fx);
+  }
+}
+
+// Steps 1-3 at query level q. The products associate as the CPU's: for
+// nearest, linear and most MIP lookups each tap adds (w_t x node weight) x
+// value; where the CPU's MIP map reads its per-face cache of lattice
+// values (a MIP lookup inside, at q <= n or at least the corners' finest
+// level), each lattice value is formed first, then weighted.
+vec4 levelValue(Place at, int q, bool nearest, bool mipOrder) {
+  int cornerLevel = max(face.vl[0], max(face.vl[1], face.vl[2]));
+  bool cached = mipOrder && at.kind == 2 && !(q > face.n && q < cornerLevel);
+  int lf = min(q, face.n);
+  uvec3 p[3];
+  vec3 w = vec3(1.0, 0.0, 0.0);
+  int points = 1, best = 0;
+  if (at.kind == 2) {
+    lattice3(at.c, uint(1 << lf), p, w);
+    points = 3;
+    // Nearest: the largest weight, the first on a tie.
+    best = (w.x >= w.y && w.x >= w.z) ? 0 : (w.y >= w.z ? 1 : 2);
+  }
+  vec4 acc = vec4(0.0);
+  for (int t = 0; t < points; t++) {
+    if (nearest && t != best) continue;
+    Taps tp;
+    if (at.kind == 0) tp = one(cornerIndex(at.k, q), 1.0);
+    else if (at.kind == 1) tp = placeEdgeTaps(at.k, at.t, q, nearest);
+    else tp = latticeTaps(q, lf, p[t], cached || nearest ? 1.0 : w[t], nearest);
+    vec4 v = vec4(0.0);
+    for (int j = 0; j < tp.n; j++) {
+      vec4 x = tp.w[j] * value(tp.i[j]);
+      if (cached) v += x; else acc += x;
+    }
+    if (cached) acc += w[t] * v;
+  }
+  return acc;
+}
+
+// The level of a footprint w in barycentric units: -log2 w in [0, MAX_LEVEL]
+// (mip.rs's level_of_footprint; the finest for w <= 0 or NaN).
+float levelOfFootprint(float w) {
+  if (!(w > 0.0)) return float(MAX_LEVEL);
+  return clamp(-log2(w), 0.0, float(MAX_LEVEL));
+}
+
+// One probe at level lambda (step 4): the two levels around it blended,
+// only where they differ for the primitive the point lies on (so both
+// faces agree on a shared edge). Nearest and linear are lambda = FINEST,
+// a MIP level lambda = that level: one level each (frac = 0).
+vec4 probe(vec3 b, float lambda, bool nearest, bool mipOrder) {
+  Place at = place(b);
+  int top = at.kind == 0 ? face.vl[at.k] : (at.kind == 1 ? face.el[at.k] : face.n);
+  float l0 = floor(lambda);
+  float frac = lambda - l0;
+  int l = int(l0);
+  int levels = (l >= top || frac == 0.0) ? 1 : 2;
+  vec4 v = vec4(0.0);
+  for (int j = 0; j < levels; j++) {
+    vec4 x = levelValue(at, l + j, nearest, mipOrder);
+    v = j == 0 ? x : (1.0 - frac) * v + frac * x;
+  }
+  return v;
+}
+
+// A barycentric displacement's length on the equilateral triangle of unit
+// edge (where the sample lattice is regular).
+float metric(vec3 d) {
+  float x = d.x + 0.5 * d.y, y = d.y * 0.8660254;
+  return sqrt(x * x + y * y);
+}
+
+// The filtered value at the fragment. The screen derivatives dx = db/dx,
+// dy = db/dy are the change of the barycentrics from one pixel to the next.
+// Trilinear: the CPU's footprint (MipMap::trilinear's argument, the
+// fraction of the face's edge a pixel covers) is the longer of the pixel's
+// two axes measured by metric, GL's isotropic rho. Anisotropic (Sec. 4.3)
+// takes the derivatives themselves (MipMap::anisotropic's db_dx, db_dy):
+// up to maxSamples probes along the longer axis, clamped into the face, at
+// the level of the shorter axis. One probe call site for all filters
+// keeps the program small (see Taps).
+vec4 filtered(vec3 b, vec3 dx, vec3 dy) {
+  bool nearest = filterMode == 0, mipOrder = filterMode >= 2;
+  float lambda = filterMode <= 1 ? float(FINEST)
+    : filterMode == 2 ? float(level)
+    : levelOfFootprint(max(metric(dx), metric(dy)));
+  float n = 1.0;
+  vec3 axis = vec3(0.0);
+  if (filterMode == 4) {
+    float lx = metric(dx), ly = metric(dy);
+    float major = lx >= ly ? lx : ly;
+    float minor = lx >= ly ? ly : lx;
+    axis = lx >= ly ? dx : dy;
+    float maxN = float(clamp(maxSamples, 1, MAX_PROBES));
+    n = minor > 0.0 ? clamp(ceil(major / minor), 1.0, maxN) : maxN;
+    lambda = levelOfFootprint(max(major / n, minor));
+  }
+  int count = int(n);
+  vec4 sum = vec4(0.0);
+  for (int k = 0; k < count; k++) {
+    vec3 p = b;
+    if (count > 1) {
+      float t = (float(k) + 0.5) / n - 0.5;
+      p = b + t * axis;
+      p = vec3(p.x > 0.0 ? p.x : 0.0, p.y > 0.0 ? p.y : 0.0, p.z > 0.0 ? p.z : 0.0);
+    }
+    sum += probe(p, lambda, nearest, mipOrder);
+  }
+  return count > 1 ? sum / n : sum;
+}
+
+// The workspace's sRGB encoding (trilux_io::image::linear_to_srgb, and
+// view's gl.js): clamped to [0, 1] first.
+float srgb(float x) {
+  x = clamp(x, 0.0, 1.0);
+  return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
+}
+
+// A heat map for a scalar channel: five sRGB stops (dark blue, purple, red,
+// orange, pale yellow), linear between them; values clamped to the range.
+vec3 heat(float v) {
+  float s = clamp((v - heatRange.x) / (heatRange.y - heatRange.x), 0.0, 1.0) * 4.0;
+  vec3 stops[5] = vec3[5](vec3(0.05, 0.03, 0.2), vec3(0.45, 0.1, 0.55), vec3(0.85, 0.2, 0.3),
+                          vec3(0.98, 0.6, 0.1), vec3(0.99, 0.97, 0.65));
+  int i = min(int(s), 3);
+  return mix(stops[i], stops[i + 1], s - float(i));
+}
+
+void main() {
+  // Derivatives first, in uniform control flow (they are undefined in a
+  // branch some fragments of a quad skip).
+  vec3 dx = dFdx(vBary), dy = dFdy(vBary);
+  if (outputMode == 1) {
+    out0 = vec4(float(vFace), vBary);
+    out1 = vec4(dx, 0.0);
+    out2 = vec4(dy, 0.0);
+    return;
+  }
+  decode(vFace);
+  vec4 v = filtered(vBary, dx, dy);
+  vec3 rgb;
+  if (display == 0) rgb = vec3(srgb(v.r), srgb(v.g), srgb(v.b));
+  else if (display == 1) rgb = vec3(srgb(v[component]));
+  else rgb = heat(v[component]);
+  out0 = vec4(rgb, tagAlpha ? float(vFace % 255 + 1) / 255.0 : 1.0);
+}`;
+
+/** The shaders' sources; `defines` (names) go after the version line. */
+export function sources(defines = []) {
+  const head = '#version 300 es\n' + defines.map((d) => `#define ${d}\n`).join('');
+  return { vertex: VS, fragment: head + FS };
+}
+
+/** The filters and their shader codes. */
+export const FILTERS = { nearest: 0, linear: 1, level: 2, trilinear: 3, anisotropic: 4 };
+const DISPLAYS = { color: 0, grey: 1, heat: 2 };
+
+function compile(gl, type, text) {
+  const s = gl.createShader(type);
+  gl.shaderSource(s, text);
+  gl.compileShader(s);
+  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
+  return s;
+}
+
+function link(gl, defines) {
+  const src = sources(defines);
+  const p = gl.createProgram();
+  gl.attachShader(p, compile(gl, gl.VERTEX_SHADER, src.vertex));
+  gl.attachShader(p, compile(gl, gl.FRAGMENT_SHADER, src.fragment));
+  gl.linkProgram(p);
+  if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p));
+  return p;
+}
+
+// Texture formats of the two layout textures (gpu.rs, "Textures").
+const SAMPLES = (gl) => ({ internal: gl.RGBA32F, format: gl.RGBA, type: gl.FLOAT, unit: 0 });
+const FACES = (gl) => ({ internal: gl.RGBA32UI, format: gl.RGBA_INTEGER, type: gl.UNSIGNED_INT, unit: 1 });
+
+export class MeshColorsRenderer {
+  /**
+   * gl: a WebGL2 context. defines: extra shader defines (the tests' wrong
+   * twins TWIN_EDGE_DIRECTION and TWIN_ROW_WIDTH).
+   */
+  constructor(gl, { defines = [] } = {}) {
+    this.gl = gl;
+    this.program = link(gl, defines);
+    this.loc = {};
+    for (const u of ['viewProj', 'samples', 'faces', 'perValue', 'group', 'filterMode', 'level', 'maxSamples',
+      'display', 'component', 'heatRange', 'outputMode', 'tagAlpha'])
+      this.loc[u] = gl.getUniformLocation(this.program, u);
+    this.vao = gl.createVertexArray();
+    this.buffer = gl.createBuffer();
+    this.textures = { samples: gl.createTexture(), faces: gl.createTexture() };
+    this.count = 0;
+    this.layout = null;
+    this.pickTarget = null;
+  }
+
+  /**
+   * The mesh: positions (xyz per vertex) and triangles (three vertex ids
+   * per face, face f = triangle f of the mesh colours' topology), expanded
+   * to three vertices per face so that gl_VertexID / 3 is the face.
+   */
+  setMesh(positions, triangles) {
+    const corners = new Float32Array(triangles.length * 3);
+    for (let i = 0; i < triangles.length; i++) corners.set(positions.subarray(3 * triangles[i], 3 * triangles[i] + 3), 3 * i);
+    this.setCorners(corners);
+  }
+
+  /** Corner positions already expanded: nine floats per face. */
+  setCorners(corners) {
+    const gl = this.gl;
+    gl.bindVertexArray(this.vao);
+    gl.bindBuffer(gl.ARRAY_BUFFER, this.buffer);
+    gl.bufferData(gl.ARRAY_BUFFER, corners, gl.STATIC_DRAW);
+    const l = gl.getAttribLocation(this.program, 'position');
+    gl.enableVertexAttribArray(l);
+    gl.vertexAttribPointer(l, 3, gl.FLOAT, false, 0, 0);
+    gl.bindVertexArray(null);
+    this.count = corners.length / 3;
+  }
+
+  /**
+   * A GpuLayout's parts: {width, channels, samples: Float32Array,
+   * faces: Uint32Array} (GpuParts; both arrays RGBA per texel, row-major,
+   * whole rows of `width` texels). Allocates both textures (texImage2D):
+   * at the start and whenever GpuLayout::update reports `resized`.
+   */
+  setLayout(parts) {
+    const gl = this.gl;
+    const w = parts.width;
+    this.layout = { width: w, channels: parts.channels, perValue: Math.ceil(parts.channels / 4) };
+    const upload = (tex, f, data) => {
+      gl.activeTexture(gl.TEXTURE0 + f.unit);
+      gl.bindTexture(gl.TEXTURE_2D, tex);
+      gl.pixelStorei(gl.UNPACK_ROW_LENGTH, 0);
+      gl.pixelStorei(gl.UNPACK_ALIGNMENT, 4);
+      gl.texImage2D(gl.TEXTURE_2D, 0, f.internal, w, data.length / (4 * w), 0, f.format, f.type, data);
+      // texelFetch reads exact texels; NEAREST keeps the texture complete
+      // (float and integer textures are not filterable).
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+      gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+    };
+    upload(this.textures.samples, SAMPLES(gl), parts.samples);
+    upload(this.textures.faces, FACES(gl), parts.faces);
+  }
+
+  /**
+   * Uploads the texel rectangles GpuLayout::update reported (Changes:
+   * {resized, samples: [rect], faces: [rect]}, rect = {x, y, width,
+   * height}) with texSubImage2D. A rectangle's texels come from its own
+   * `data` (width x height texels, row by row) when it has one, else from
+   * the whole new arrays in `parts` (the layout's linear index y * W + x).
+   */
+  updateRects(changes, parts) {
+    if (changes.resized) return this.setLayout(parts);
+    const gl = this.gl;
+    const send = (tex, f, rects, whole) => {
+      if (!rects || !rects.length) return;
+      gl.activeTexture(gl.TEXTURE0 + f.unit);
+      gl.bindTexture(gl.TEXTURE_2D, tex);
+      for (const r of rects) {
+        const own = r.data !== undefined;
+        gl.pixelStorei(gl.UNPACK_ROW_LENGTH, own ? r.width : this.layout.width);
+        const src = own ? r.data : whole;
+        const offset = own ? 0 : 4 * (r.y * this.layout.width + r.x);
+        gl.texSubImage2D(gl.TEXTURE_2D, 0, r.x, r.y, r.width, r.height, f.format, f.type, src, offset);
+      }
+      gl.pixelStorei(gl.UNPACK_ROW_LENGTH, 0);
+    };
+    send(this.textures.samples, SAMPLES(gl), changes.samples, parts && parts.samples);
+    send(this.textures.faces, FACES(gl), changes.faces, parts && parts.faces);
+  }
+
+  /**
+   * Draws the mesh into the bound framebuffer (viewport and clearing are
+   * the caller's). viewProj: column-major 4x4. opts: filter (a FILTERS
+   * name), level (for 'level'), maxSamples (anisotropic, default 8),
+   * display ('color' the RGB of channels 0-2, 'grey' or 'heat' of
+   * `channel`), channel, range ([lo, hi] of the heat map), tagAlpha.
+   */
+  draw(viewProj, opts = {}) {
+    const gl = this.gl, loc = this.loc;
+    const channel = opts.channel || 0;
+    this.bind(viewProj);
+    gl.uniform1i(loc.outputMode, 0);
+    gl.uniform1i(loc.filterMode, FILTERS[opts.filter || 'linear']);
+    gl.uniform1i(loc.level, opts.level || 0);
+    gl.uniform1i(loc.maxSamples, opts.maxSamples || 8);
+    gl.uniform1i(loc.display, DISPLAYS[opts.display || 'color']);
+    // RGB shows the first texel's .rgb; one channel is its texel's component.
+    gl.uniform1i(loc.group, (opts.display || 'color') === 'color' ? 0 : Math.floor(channel / 4));
+    gl.uniform1i(loc.component, channel % 4);
+    gl.uniform2fv(loc.heatRange, opts.range || [0, 1]);
+    gl.uniform1i(loc.tagAlpha, opts.tagAlpha ? 1 : 0);
+    this.drawArrays();
+  }
+
+  /**
+   * The pick pass into the bound framebuffer, whose colour attachments 0-2
+   * are RGBA32F (EXT_color_buffer_float): (face, b0, b1, b2), (db/dx, 0),
+   * (db/dy, 0); where nothing is drawn they keep the clear value.
+   */
+  drawPick(viewProj) {
+    this.bind(viewProj);
+    this.gl.uniform1i(this.loc.outputMode, 1);
+    this.drawArrays();
+  }
+
+  /**
+   * Face and barycentrics under pixel (x, y) (from the bottom left, in
+   * drawing-buffer pixels) of a drawing of `width` x `height`, or null
+   * over the background: the eyedropper's and the brush's query.
+   */
+  pick(viewProj, x, y, width, height) {
+    const gl = this.gl;
+    const t = this.pickFramebuffer(width, height);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, t.fb);
+    gl.viewport(0, 0, width, height);
+    gl.clearBufferfv(gl.COLOR, 0, [-1, 0, 0, 0]);
+    gl.clear(gl.DEPTH_BUFFER_BIT);
+    this.drawPick(viewProj);
+    const px = new Float32Array(4);
+    gl.readBuffer(gl.COLOR_ATTACHMENT0);
+    gl.readPixels(x, y, 1, 1, gl.RGBA, gl.FLOAT, px);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    return px[0] < 0 ? null : { face: px[0], b: [px[1], px[2], px[3]] };
+  }
+
+  /** The pick pass's framebuffer of this size (made once, kept). */
+  pickFramebuffer(width, height) {
+    const gl = this.gl;
+    if (this.pickTarget && this.pickTarget.width === width && this.pickTarget.height === height) return this.pickTarget;
+    if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('picking needs EXT_color_buffer_float');
+    const fb = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    const attachments = [0, 1, 2].map((i) => {
+      const tex = gl.createTexture();
+      gl.bindTexture(gl.TEXTURE_2D, tex);
+      gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, width, height);
+      gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0 + i, gl.TEXTURE_2D, tex, 0);
+      return gl.COLOR_ATTACHMENT0 + i;
+    });
+    const depth = gl.createRenderbuffer();
+    gl.bindRenderbuffer(gl.RENDERBUFFER, depth);
+    gl.renderbufferStorage(gl.RENDERBUFFER, gl.DEPTH_COMPONENT24, width, height);
+    gl.framebufferRenderbuffer(gl.FRAMEBUFFER, gl.DEPTH_ATTACHMENT, gl.RENDERBUFFER, depth);
+    gl.drawBuffers(attachments);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    this.pickTarget = { fb, width, height };
+    return this.pickTarget;
+  }
+
+  bind(viewProj) {
+    const gl = this.gl, loc = this.loc;
+    gl.useProgram(this.program);
+    gl.enable(gl.DEPTH_TEST);
+    gl.uniformMatrix4fv(loc.viewProj, false, viewProj);
+    gl.uniform1i(loc.samples, SAMPLES(gl).unit);
+    gl.uniform1i(loc.faces, FACES(gl).unit);
+    gl.uniform1i(loc.perValue, this.layout ? this.layout.perValue : 1);
+    gl.activeTexture(gl.TEXTURE0 + SAMPLES(gl).unit);
+    gl.bindTexture(gl.TEXTURE_2D, this.textures.samples);
+    gl.activeTexture(gl.TEXTURE0 + FACES(gl).unit);
+    gl.bindTexture(gl.TEXTURE_2D, this.textures.faces);
+  }
+
+  drawArrays() {
+    const gl = this.gl;
+    gl.bindVertexArray(this.vao);
+    gl.drawArrays(gl.TRIANGLES, 0, this.count);
+    gl.bindVertexArray(null);
+  }
+}
