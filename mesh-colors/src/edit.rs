@@ -18,7 +18,8 @@ use glam::Vec3;
 use crate::Error;
 use crate::filter::{FINEST, Store, edge_point, eval, lattice};
 use crate::structure::{
-    MeshColors, lattice_points, level_of, sample_position, samples_per_edge, samples_per_face,
+    MeshColors, lattice_points, level_of, move_segments, sample_position, samples_per_edge,
+    samples_per_face,
 };
 use crate::topology::NO_FACE;
 use crate::topology::Topology;
@@ -724,7 +725,7 @@ impl MeshColors {
     /// Rewrites the sample array after the levels of the primitives in
     /// `faces` and `edges` changed: those get the given values (at their
     /// new level), the others keep theirs. The samples before the first
-    /// such primitive stay in place; the rest move once.
+    /// such primitive stay in place; the rest move once, in place.
     fn relayout(&mut self, faces: &HashMap<usize, Vec<f32>>, edges: &HashMap<usize, Vec<f32>>) {
         let c = self.channels;
         let first_edge = edges.keys().copied().min();
@@ -734,31 +735,29 @@ impl MeshColors {
             (None, Some(f)) => (self.edge_offset.len(), f, self.face_offset[f]),
             (None, None) => return,
         };
-        let tail = self.samples.split_off(start * c);
+        // Each primitive from there on moves (kept) or is rewritten.
+        let mut segments = Vec::new();
         let mut next = start;
         for e in e0..self.edge_offset.len() {
             let n = samples_per_edge(1 << self.edge_level[e]) as usize;
-            match edges.get(&e) {
-                Some(v) => self.samples.extend_from_slice(v),
-                None => {
-                    let from = (self.edge_offset[e] - start) * c;
-                    self.samples.extend_from_slice(&tail[from..from + n * c]);
-                }
-            }
+            segments.push((self.edge_offset[e], next, n, !edges.contains_key(&e)));
             self.edge_offset[e] = next;
             next += n;
         }
         for f in f0..self.face_offset.len() {
             let n = samples_per_face(1 << self.face_level[f]) as usize;
-            match faces.get(&f) {
-                Some(v) => self.samples.extend_from_slice(v),
-                None => {
-                    let from = (self.face_offset[f] - start) * c;
-                    self.samples.extend_from_slice(&tail[from..from + n * c]);
-                }
-            }
+            segments.push((self.face_offset[f], next, n, !faces.contains_key(&f)));
             self.face_offset[f] = next;
             next += n;
+        }
+        move_segments(&mut self.samples, c, &segments, next);
+        for (&e, v) in edges {
+            let at = self.edge_offset[e] * c;
+            self.samples[at..at + v.len()].copy_from_slice(v);
+        }
+        for (&f, v) in faces {
+            let at = self.face_offset[f] * c;
+            self.samples[at..at + v.len()].copy_from_slice(v);
         }
     }
 

@@ -3,7 +3,7 @@
 //! anisotropic filtering from screen-space derivatives (Sec. 4.3).
 
 use crate::filter::{FINEST, Place, Store, check, edge_point, eval_at, lattice, place, triangle};
-use crate::structure::{MeshColors, interior_index, samples_per_face};
+use crate::structure::{MeshColors, interior_index, move_segments, samples_per_face};
 use crate::topology::NO_FACE;
 use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
 
@@ -96,35 +96,6 @@ fn pyramid_offsets(colors: &MeshColors) -> (Vec<usize>, Vec<usize>, Vec<usize>, 
         .map(|&n| place(FACE_LEVEL_OFFSET[n as usize + 1]))
         .collect();
     (vertex_offset, edge_offset, face_offset, next)
-}
-
-/// Moves the segments `(old offset, new offset, length, keep)` (in values
-/// of `c` floats, in layout order: both offsets increase and the new
-/// segments do not overlap) of `buf` in place to a layout of `total`
-/// values; segments not kept are left for the caller to write. Segments
-/// moving towards the front go first, front to back, then those moving
-/// towards the back, back to front: neither overwrites a segment still to
-/// be moved. Only a grown tail is newly allocated.
-fn move_segments(
-    buf: &mut Vec<f32>,
-    c: usize,
-    segments: &[(usize, usize, usize, bool)],
-    total: usize,
-) {
-    if buf.len() < total * c {
-        buf.resize(total * c, 0.0);
-    }
-    for &(from, to, len, keep) in segments {
-        if keep && to < from {
-            buf.copy_within(from * c..(from + len) * c, to * c);
-        }
-    }
-    for &(from, to, len, keep) in segments.iter().rev() {
-        if keep && to > from {
-            buf.copy_within(from * c..(from + len) * c, to * c);
-        }
-    }
-    buf.truncate(total * c);
 }
 
 /// The primitives one level of [`MipMap::refresh`] recomputes.

@@ -444,3 +444,32 @@ pub(crate) fn interior_index(r: u32, i: u32, j: u32) -> usize {
 pub fn lattice_points(r: u32) -> impl Iterator<Item = [u32; 3]> {
     (0..=r).flat_map(move |i| (0..=r - i).map(move |j| [i, j, r - i - j]))
 }
+
+/// Moves the segments `(old offset, new offset, length, keep)` (in values
+/// of `c` floats, in layout order: both offsets increase and the new
+/// segments do not overlap) of `buf` in place to a layout of `total`
+/// values; segments not kept are left for the caller to write. Segments
+/// moving towards the front go first, front to back, then those moving
+/// towards the back, back to front: neither overwrites a segment still to
+/// be moved. Only a grown tail is newly allocated.
+pub(crate) fn move_segments(
+    buf: &mut Vec<f32>,
+    c: usize,
+    segments: &[(usize, usize, usize, bool)],
+    total: usize,
+) {
+    if buf.len() < total * c {
+        buf.resize(total * c, 0.0);
+    }
+    for &(from, to, len, keep) in segments {
+        if keep && to < from {
+            buf.copy_within(from * c..(from + len) * c, to * c);
+        }
+    }
+    for &(from, to, len, keep) in segments.iter().rev() {
+        if keep && to > from {
+            buf.copy_within(from * c..(from + len) * c, to * c);
+        }
+    }
+    buf.truncate(total * c);
+}
