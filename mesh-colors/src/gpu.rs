@@ -52,7 +52,7 @@
 //! an edge at `E_k + (2^l − 1 − l) + s − 1` (`l ≤ el_k`); interior sample
 //! `C_ij` (`i, j ≥ 1`, `i + j < 2^l`) of level `l` of the face at
 //! `F + O(l) + (i − 1)(2^l − 1) − (i − 1)i/2 + (j − 1)`, with
-//! `O(l) = Σ_{m<l} (2^m − 1)(2^m − 2)/2` (0, 0, 0, 1, 22, 127, …).
+//! `O(l) = Σ_{m<l} (2^m − 1)(2^m − 2)/2` (0, 0, 0, 3, 24, 129, …).
 //!
 //! # The lookup, as the shader computes it
 //!

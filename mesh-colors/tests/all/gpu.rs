@@ -376,3 +376,87 @@ fn a_stroke_refreshes_the_pyramid_and_texels_near_it_as_a_rebuild_would() {
     let e = layout.refresh(&mip, &[(0, values + 1)]).unwrap_err();
     assert!(e.to_string().contains("`spans`"), "{e}");
 }
+
+#[test]
+fn the_documented_addresses_find_the_values() {
+    // The module documentation's formulas, applied by hand to the packed
+    // arrays: a face's level-l interior sample, an edge's sample and a
+    // corner's level, against the MIP map's own lookups at lattice points.
+    let mc = mixed(30, 3);
+    let mip = mc.mip_map();
+    let layout = GpuLayout::new(&mip, 127).unwrap();
+    let (w, tex, table) = (
+        layout.width() as usize,
+        layout.sample_texels(),
+        layout.face_texels(),
+    );
+    let fetch = |i: usize| {
+        let (x, y) = (i % w, i / w);
+        let at = (y * w + x) * 4;
+        [tex[at], tex[at + 1], tex[at + 2]]
+    };
+    let o = |l: u32| -> usize {
+        (0..l)
+            .map(|m| mesh_colors::samples_per_face(1 << m) as usize)
+            .sum()
+    };
+    assert_eq!((0..6).map(o).collect::<Vec<_>>(), [0, 0, 0, 3, 24, 129]);
+    let mut checked = 0;
+    let mut out = [0.0f32; 3];
+    for f in 0..mc.face_count() {
+        let words = &table[f * FACE_WORDS..(f + 1) * FACE_WORDS];
+        let n = words[7] & 0xF;
+        assert_eq!(1 << n, mc.face_resolution(f).unwrap());
+        for l in 0..=n {
+            let r = 1u32 << l;
+            for i in 1..r {
+                for j in 1..r - i {
+                    let idx = ((i - 1) * (r - 1) - (i - 1) * i / 2 + (j - 1)) as usize;
+                    let got = fetch(words[0] as usize + o(l) + idx);
+                    let b = [
+                        i as f32 / r as f32,
+                        j as f32 / r as f32,
+                        (r - i - j) as f32 / r as f32,
+                    ];
+                    mip.at_level(f, b, l as u8, &mut out).unwrap();
+                    assert_eq!(got, out, "face {f} level {l} sample ({i}, {j})");
+                    checked += 1;
+                }
+            }
+        }
+        for k in 0..3 {
+            let vl = (words[7] >> (4 + 4 * k)) & 0xF;
+            let mut b = [0.0; 3];
+            b[k] = 1.0;
+            for l in 0..=vl {
+                mip.at_level(f, b, l as u8, &mut out).unwrap();
+                assert_eq!(
+                    fetch(words[1 + k] as usize + l as usize),
+                    out,
+                    "corner {k} of face {f}"
+                );
+            }
+            let el = (words[7] >> (16 + 4 * k)) & 0xF;
+            let forward = words[7] & (1 << (28 + k)) != 0;
+            let r = 1u32 << el;
+            for s in 1..r {
+                // Sample s from the edge's smaller vertex.
+                let t = s as f32 / r as f32;
+                let mut b = [0.0; 3];
+                let (start, end) = if forward {
+                    (k, (k + 1) % 3)
+                } else {
+                    ((k + 1) % 3, k)
+                };
+                b[start] = 1.0 - t;
+                b[end] = t;
+                mip.at_level(f, b, el as u8, &mut out).unwrap();
+                let at =
+                    words[4 + k] as usize + ((1usize << el) - 1 - el as usize) + s as usize - 1;
+                assert_eq!(fetch(at), out, "edge {k} of face {f}, sample {s}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 1000, "{checked}");
+}
