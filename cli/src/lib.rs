@@ -54,6 +54,8 @@ mod density;
 mod error;
 pub mod mesh;
 pub mod output;
+#[cfg(feature = "paint")]
+pub mod paint;
 mod points;
 pub mod preview;
 pub mod shapes;

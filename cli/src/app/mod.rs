@@ -19,6 +19,8 @@ mod demo;
 mod diffuse;
 mod info;
 mod ops;
+#[cfg(feature = "paint")]
+mod paint;
 mod sample;
 mod tetra;
 #[cfg(feature = "view")]
@@ -150,6 +152,8 @@ enum Command {
     Bench(bench::Args),
     #[cfg(feature = "view")]
     View(view::Args),
+    #[cfg(feature = "paint")]
+    Paint(paint::Args),
 }
 
 /// What every subcommand gets: the shared flags, progress, timings.
@@ -249,6 +253,8 @@ pub(crate) fn run() -> ExitCode {
         Command::Bench(args) => bench::run(&mut context, args),
         #[cfg(feature = "view")]
         Command::View(args) => view::run(&mut context, args),
+        #[cfg(feature = "paint")]
+        Command::Paint(args) => paint::run(&mut context, args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -518,4 +524,23 @@ pub(crate) fn with_threads<T: Send>(
 /// A path for display in summaries.
 pub(crate) fn shown(path: &Path) -> String {
     path.display().to_string()
+}
+
+/// Opens `url` in the system's browser (the web apps' `--open`).
+#[cfg(feature = "web")]
+pub(crate) fn open_browser(url: &str) {
+    let command = if cfg!(target_os = "macos") {
+        "open"
+    } else if cfg!(windows) {
+        "explorer"
+    } else {
+        "xdg-open"
+    };
+    if std::process::Command::new(command)
+        .arg(url)
+        .spawn()
+        .is_err()
+    {
+        eprintln!("could not start {command}; open the URL yourself");
+    }
 }

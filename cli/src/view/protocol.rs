@@ -500,23 +500,7 @@ fn missing(field: &str) -> BadField {
 /// A plain file name with the kind's extension: no folder, no leading
 /// dot, at most 128 characters of letters, digits, `-`, `_`, `.`.
 fn check_name(name: &str, kind: ExportKind) -> Parsed<()> {
-    let ok = !name.is_empty()
-        && name.len() <= 128
-        && !name.starts_with('.')
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
-    if !ok {
-        return Err(BadField::new(
-            "name",
-            "expected a plain file name (letters, digits, - _ .), no folder",
-        ));
-    }
-    let ext = kind.extension();
-    if !name.to_ascii_lowercase().ends_with(&format!(".{ext}")) {
-        return Err(BadField::new("name", format!("must end in .{ext}")));
-    }
-    Ok(())
+    crate::web::json::file_name(name, kind.extension())
 }
 
 /// A binary frame: the header, then `payload`.

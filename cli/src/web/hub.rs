@@ -94,6 +94,28 @@ impl Outbox {
         state.slots.insert(slot, messages);
     }
 
+    /// Broadcasts `message` and adds it to the end of slot `slot`: a
+    /// change that pages apply on top of the slot (paint's texel updates
+    /// during a stroke), under the same lock as a page's join, so that a
+    /// page that connects meanwhile gets it exactly once.
+    pub fn append(&self, slot: usize, message: Out) {
+        let mut state = self.hub.lock();
+        let _ = self.hub.all.send(message.clone());
+        state.slots.entry(slot).or_default().push(message);
+    }
+
+    /// Replaces slot `slot` with `messages` without sending them: state
+    /// every page already has (a slot and its appended changes, folded
+    /// into one message), kept for pages that connect later.
+    pub fn keep(&self, slot: usize, messages: Vec<Out>) {
+        self.hub.lock().slots.insert(slot, messages);
+    }
+
+    /// The number of messages slot `slot` holds.
+    pub fn slot_len(&self, slot: usize) -> usize {
+        self.hub.lock().slots.get(&slot).map_or(0, Vec::len)
+    }
+
     /// Sends `message` to every connected page (not kept for later ones).
     pub fn broadcast(&self, message: Out) {
         let _ = self.hub.all.send(message);

@@ -148,6 +148,31 @@ pub fn nonzero(v: DVec3, field: &str) -> Parsed<DVec3> {
     Ok(v)
 }
 
+/// A plain file name ending in `.ext` (any case): letters, digits,
+/// `-`, `_` and `.`, at most 128 bytes, no folder and no hidden file, so
+/// a page can only name files inside the export folder.
+///
+/// # Errors
+/// `name`: what is wrong with it.
+pub fn file_name(name: &str, ext: &str) -> Parsed<()> {
+    let plain = !name.is_empty()
+        && name.len() <= 128
+        && !name.starts_with('.')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+    if !plain {
+        return Err(BadField::new(
+            "name",
+            "expected a plain file name (letters, digits, - _ .), no folder",
+        ));
+    }
+    if !name.to_ascii_lowercase().ends_with(&format!(".{ext}")) {
+        return Err(BadField::new("name", format!("must end in .{ext}")));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -22,6 +22,8 @@ struct Echo {
 enum Request {
     Echo(String),
     Publish(String),
+    Append(String),
+    Fold,
     Panic,
 }
 
@@ -48,6 +50,8 @@ impl App for Echo {
         match m.op {
             "echo" => Ok(Request::Echo(text()?)),
             "publish" => Ok(Request::Publish(text()?)),
+            "append" => Ok(Request::Append(text()?)),
+            "fold" => Ok(Request::Fold),
             "panic" => Ok(Request::Panic),
             other => Err(BadField::new("op", format!("unknown op {other:?}"))),
         }
@@ -73,6 +77,17 @@ impl App for Echo {
                 self.published += 1;
                 let m = json!({"type": "published", "text": text, "n": self.published});
                 out.publish(0, vec![Out::Text(m.to_string())]);
+            }
+            Request::Append(text) => {
+                out.append(
+                    1,
+                    Out::Text(json!({"type": "appended", "text": text}).to_string()),
+                );
+            }
+            Request::Fold => {
+                let folded = json!({"type": "folded", "from": out.slot_len(1)});
+                out.keep(1, vec![Out::Text(folded.to_string())]);
+                out.reply(to, Out::Text(json!({"type": "done"}).to_string()));
             }
             Request::Panic => panic!("the echo app was asked to panic"),
         }
@@ -156,6 +171,33 @@ async fn a_page_starts_from_the_snapshot_in_slot_order() {
         next(&mut b, Duration::from_secs(20)).await,
         Some(Message::Binary(_))
     ));
+    r.stop().await.unwrap();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn appended_changes_reach_every_page_once_and_folding_sends_nothing() {
+    let r = start().await;
+    let mut a = opened(&r).await;
+    send(&mut a, json!({"seq": 1, "op": "append", "text": "d1"})).await;
+    assert_eq!(text(&mut a).await["text"], "d1");
+    // A page that connects now: hello, the frame, then the change.
+    let mut b = opened(&r).await;
+    assert!(matches!(
+        next(&mut b, Duration::from_secs(20)).await,
+        Some(Message::Binary(_))
+    ));
+    assert_eq!(text(&mut b).await["text"], "d1");
+    send(&mut a, json!({"seq": 2, "op": "fold"})).await;
+    // The fold answers the asking page only and broadcasts nothing.
+    assert_eq!(text(&mut a).await["type"], "done");
+    assert!(next(&mut b, Duration::from_millis(300)).await.is_none());
+    // A later page gets the folded slot in place of frame and change.
+    let mut c = opened(&r).await;
+    let folded = text(&mut c).await;
+    assert_eq!(
+        (folded["type"].clone(), folded["from"].clone()),
+        ("folded".into(), 2.into())
+    );
     r.stop().await.unwrap();
 }
 

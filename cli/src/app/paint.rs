@@ -1,0 +1,304 @@
+//! `trilux paint`: the command that loads a surface and its colours and
+//! starts the painting server of `trilux::paint`.
+
+use std::path::{Path, PathBuf};
+
+use mesh_colors::MeshColors;
+use serde_json::{Value, json};
+use trilux::ColorMesh;
+use trilux::paint::{Document, Options};
+use trilux_io::mesh::TriMesh;
+
+use super::ops::colors::load_for;
+use super::{Context, Result, arg_error, file_error};
+
+/// Samples a flat start aims at (the resolution is chosen from the face
+/// count): detailed enough to paint at once, light enough to upload fast.
+const START_SAMPLES: usize = 400_000;
+
+#[derive(Debug, clap::Args)]
+#[command(
+    about = "Paint colours on a 3D model in the browser, no UVs needed (Mesh Colors)",
+    after_help = "Examples:\n  trilux paint                                   # a built-in model\n  trilux paint ../shared/data/meshes/spot.obj --open\n  trilux paint cow.obj --colors cow.meshcolors --channels roughness\n  trilux paint cow.obj --replay session.json\n\nIt prints a URL with a secret token; open it in a browser on this machine.\nPress ? on the page for the tools and keys. Ctrl+C stops the server (the colours are autosaved)."
+)]
+pub(crate) struct Args {
+    /// The surface: .obj, .gltf, .glb or .ply, UVs or none; none: a
+    /// built-in model.
+    pub(crate) mesh: Option<PathBuf>,
+    /// Start from these mesh colours (made for this mesh).
+    #[arg(long, value_name = "F.meshcolors", conflicts_with = "texture")]
+    pub(crate) colors: Option<PathBuf>,
+    /// Start from this texture, converted (the mesh needs UVs); by default
+    /// the mesh's own texture when it has one.
+    #[arg(long, value_name = "IMAGE")]
+    pub(crate) texture: Option<PathBuf>,
+    /// The face resolution of a flat start, a power of two (default: from
+    /// the mesh's size, about 400,000 samples).
+    #[arg(long, value_name = "R", value_parser = resolution)]
+    pub(crate) resolution: Option<u32>,
+    /// Scalar channels to paint besides colour, comma-separated (e.g.
+    /// density,roughness), each shown as a heat map.
+    #[arg(long, value_name = "NAMES", value_delimiter = ',')]
+    pub(crate) channels: Vec<String>,
+    /// Replay a session file the page exported (its edits, on this mesh).
+    #[arg(long, value_name = "SESSION.json")]
+    pub(crate) replay: Option<PathBuf>,
+    /// Port (default: a free one; the URL printed names it).
+    #[arg(long, default_value_t = 0, hide_default_value = true)]
+    pub(crate) port: u16,
+    /// Address to listen on; anything but 127.0.0.1 exposes the model to
+    /// the network (the token still guards it).
+    #[arg(long, default_value = "127.0.0.1")]
+    pub(crate) host: std::net::IpAddr,
+    /// Open the page in the system's browser.
+    #[arg(long)]
+    pub(crate) open: bool,
+    /// Folder saves, exports and the autosave are written to.
+    #[arg(long, value_name = "DIR", default_value = ".")]
+    pub(crate) export_dir: PathBuf,
+}
+
+fn resolution(text: &str) -> std::result::Result<u32, String> {
+    let r: u32 = text.parse().map_err(|e| format!("{e}"))?;
+    let max = 1u32 << mesh_colors::MAX_LEVEL;
+    if !r.is_power_of_two() || r > max {
+        return Err(format!("expected a power of two from 1 to {max}"));
+    }
+    Ok(r)
+}
+
+pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
+    check_channels(&args.channels)?;
+    if !args.export_dir.is_dir() {
+        return Err(file_error(
+            &args.export_dir,
+            "no such folder (for --export-dir)",
+        ));
+    }
+    let doc = load(context, &args)?;
+    let log = match &args.replay {
+        Some(path) => Some(read_session(path, &doc)?),
+        None => None,
+    };
+    let autosave = args
+        .export_dir
+        .join(format!("{}.autosave.meshcolors", stem(&args.mesh)));
+    if autosave.exists() && args.colors.as_deref() != Some(autosave.as_path()) {
+        eprintln!(
+            "note: {} holds colours autosaved by an earlier trilux paint of this model; resume with --colors {} (it is replaced at the next autosave)",
+            autosave.display(),
+            autosave.display()
+        );
+    }
+    if !args.host.is_loopback() {
+        eprintln!(
+            "warning: listening on {}: other machines that can reach it may open the page (with its token)",
+            args.host
+        );
+    }
+    let faces = doc.surface.faces.len();
+    let options = Options {
+        host: args.host,
+        port: args.port,
+        export_dir: args.export_dir.clone(),
+        autosave: Some(autosave),
+        ..Default::default()
+    };
+    let runtime = tokio::runtime::Runtime::new()
+        .map_err(|e| super::invalid(format!("the server's runtime: {e}")))?;
+    runtime.block_on(async move {
+        let running = trilux::paint::start(doc, log, options)
+            .await
+            .map_err(super::invalid)?;
+        let url = running.url();
+        if context.json {
+            println!(
+                "{}",
+                json!({"command": "paint", "url": url, "faces": faces})
+            );
+        } else {
+            println!("trilux paint: {faces} faces; open {url}  (Ctrl+C stops)");
+        }
+        if args.open {
+            super::open_browser(&url);
+        }
+        running
+            .wait(true)
+            .await
+            .map_err(|e| super::invalid(format!("the server: {e}")))
+    })
+}
+
+/// Channel names: plain words, none repeated, not "color".
+fn check_channels(names: &[String]) -> Result<()> {
+    for (k, n) in names.iter().enumerate() {
+        let plain = !n.is_empty()
+            && n.len() <= 32
+            && n.chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+        if !plain || n == "color" || names[..k].contains(n) {
+            return Err(arg_error(
+                format!("--channels {}", names.join(",")),
+                format!(
+                    "{n:?}: a channel needs a new plain name (letters, digits, - _), not \"color\""
+                ),
+            ));
+        }
+    }
+    if 3 + names.len() > mesh_colors::MAX_CHANNELS {
+        return Err(arg_error(
+            format!("--channels {}", names.join(",")),
+            format!("at most {} scalar channels", mesh_colors::MAX_CHANNELS - 3),
+        ));
+    }
+    Ok(())
+}
+
+/// The file name's stem, `model` for the built-in one.
+fn stem(mesh: &Option<PathBuf>) -> String {
+    mesh.as_ref()
+        .and_then(|p| p.file_stem())
+        .map_or_else(|| "model".to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+/// The surface and its starting colours, as the arguments say.
+fn load(context: &mut Context, args: &Args) -> Result<Document> {
+    let mesh = match &args.mesh {
+        Some(path) => super::read_mesh(context, path)?,
+        None => trilux::shapes::blob(4),
+    };
+    let shown = args.mesh.as_ref().map_or_else(
+        || "the built-in model".to_string(),
+        |p| p.display().to_string(),
+    );
+    let (surface, colors, start) = start_colors(context, args, &mesh)?;
+    if surface.detached > 0 {
+        eprintln!(
+            "warning: {shown}: {} triangles are not joined to their neighbours (a third face on an edge, or degenerate): they are painted on their own",
+            surface.detached
+        );
+    }
+    let colors = with_scalars(colors, args.channels.len())?;
+    let mut base = vec![0.8f32; 3];
+    base.extend(std::iter::repeat_n(0.0, args.channels.len()));
+    let source = json!({
+        "mesh": args.mesh.as_ref().map(|p| p.display().to_string()),
+        "colors": args.colors.as_ref().map(|p| p.display().to_string()),
+        "texture": args.texture.as_ref().map(|p| p.display().to_string()),
+        "start": start,
+        "channels": args.channels,
+    });
+    Ok(Document {
+        surface,
+        colors,
+        base,
+        scalars: args.channels.clone(),
+        source,
+    })
+}
+
+/// The welded surface and its colours from `--colors`, a texture, or a
+/// flat base colour; and how they started (for the session file).
+fn start_colors(
+    context: &mut Context,
+    args: &Args,
+    mesh: &TriMesh,
+) -> Result<(ColorMesh, MeshColors, Value)> {
+    let mesh_path = args.mesh.as_deref().unwrap_or(Path::new("model"));
+    if let Some(path) = &args.colors {
+        let (surface, colors) = context.step("reading the mesh colours", || {
+            load_for(mesh, mesh_path, path)
+        })?;
+        return Ok((surface, colors, json!("colors")));
+    }
+    let texture = match &args.texture {
+        Some(path) => Some(super::read_image(context, path, false)?),
+        None => None,
+    };
+    let has_texture = texture.is_some()
+        || mesh
+            .materials
+            .iter()
+            .any(|m| m.diffuse_image.is_some() || m.diffuse_texture.is_some());
+    if has_texture && mesh.uvs.is_some() {
+        let (surface, colors) = context
+            .step("converting the texture to mesh colours", || {
+                trilux::to_mesh_colors(mesh, texture.as_ref(), &Default::default())
+            })
+            .map_err(|e| super::at(mesh_path.display(), e))?;
+        return Ok((surface, colors, json!("texture")));
+    }
+    if texture.is_some() {
+        return Err(file_error(
+            mesh_path,
+            "the mesh has no UVs, so --texture cannot be converted; leave it out to paint on a flat colour",
+        ));
+    }
+    let surface = ColorMesh::new(mesh).map_err(|e| super::at(mesh_path.display(), e))?;
+    let r = args
+        .resolution
+        .unwrap_or_else(|| flat_resolution(surface.faces.len()));
+    let topology = surface
+        .topology()
+        .map_err(|e| super::at(mesh_path.display(), e))?;
+    let mut colors = MeshColors::uniform(topology, r, 3)
+        .map_err(|e| arg_error(format!("--resolution {r}"), e))?;
+    colors.samples_mut().fill(0.8);
+    Ok((
+        surface,
+        colors,
+        json!({"flat": [0.8, 0.8, 0.8], "resolution": r}),
+    ))
+}
+
+/// The power of two that gives about [`START_SAMPLES`] samples on `faces`
+/// faces (a face of resolution R holds about R²/2), 1 to 64.
+fn flat_resolution(faces: usize) -> u32 {
+    let per_face = START_SAMPLES as f64 / faces.max(1) as f64;
+    let r = (2.0 * per_face).sqrt();
+    let level = r.log2().round().clamp(0.0, 6.0) as u32;
+    1 << level
+}
+
+/// `colors` with `scalars` more channels, 0 to start.
+fn with_scalars(colors: MeshColors, scalars: usize) -> Result<MeshColors> {
+    if scalars == 0 {
+        return Ok(colors);
+    }
+    let c = colors.channels();
+    let resolutions: Vec<u32> = (0..colors.face_count())
+        .map(|f| colors.face_resolution(f).unwrap_or(1))
+        .collect();
+    let mut wide = MeshColors::new(colors.topology().clone(), &resolutions, c + scalars)?;
+    for (to, from) in wide
+        .samples_mut()
+        .chunks_mut(c + scalars)
+        .zip(colors.samples().chunks(c))
+    {
+        to[..c].copy_from_slice(from);
+    }
+    Ok(wide)
+}
+
+/// The edits of a paint session file, for `doc`.
+fn read_session(path: &Path, doc: &Document) -> Result<Vec<mesh_colors::session::Edit>> {
+    super::check_input(path)?;
+    let text = std::fs::read_to_string(path).map_err(|e| file_error(path, e))?;
+    let (_, edits) = trilux::paint::session_file::from_json(&text, &doc.scalars, doc.mirror_x())
+        .map_err(|e| file_error(path, e))?;
+    Ok(edits)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_flat_start_aims_at_a_few_hundred_thousand_samples() {
+        assert_eq!(flat_resolution(5856), 16);
+        assert_eq!(flat_resolution(1), 64);
+        assert_eq!(flat_resolution(10_000_000), 1);
+        assert_eq!(resolution("8"), Ok(8));
+        assert!(resolution("6").is_err() && resolution("x").is_err());
+    }
+}

@@ -1,0 +1,332 @@
+// trilux paint's page: the camera and the brush run here at display rate;
+// the colours live on the server, which sends back the texels a stroke
+// changed. The mesh colours are drawn by the paper's real-time shader
+// (meshcolors.js, Sec. 5.3).
+
+import { Camera } from './camera.js';
+import { Connection } from './net.js';
+import { readHeader } from './frame.js';
+import { fitCanvas } from './glutil.js';
+import { MeshColorsRenderer } from './meshcolors.js';
+
+const $ = (id) => document.getElementById(id);
+const canvas = $('view');
+const gl = canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: true });
+
+// Everything the tests read is on window.trilux.
+const state = window.trilux = {
+  hello: null, status: null, camera: null, tool: 'paint', frames: 0, ready: false,
+  mesh: null, layout: null, pendingFaces: null, picked: null, errors: [], exported: [],
+};
+const renderer = gl ? new MeshColorsRenderer(gl) : null;
+let dirty = true;
+let pickDirty = true;
+
+// ---- the connection ---------------------------------------------------
+
+function decode(buffer) {
+  const h = readHeader(buffer, 'TLXM', 1);
+  return { ...h, payload: buffer.slice(16) };
+}
+
+const net = new Connection('paint', decode, onText, onFrame, (s) => { $('busy').textContent = s === 'connected' ? '' : s; });
+
+function onText(m) {
+  if (m.type === 'hello') {
+    state.hello = m;
+    if (!state.camera) state.camera = new Camera(m.bounds[0], m.bounds[1]);
+    fillChannels(m.channels);
+    fillLevels(m.max_level);
+  } else if (m.type === 'status') {
+    state.status = m;
+    showStatus(m);
+  } else if (m.type === 'pick') {
+    state.picked = m.color;
+    if (state.channelIndex() === 0) $('color').value = toHex(m.color);
+    else $('value').value = m.color[2 + state.channelIndex()];
+  } else if (m.type === 'export') {
+    state.exported.push(m.path);
+    flash('written: ' + m.path);
+  } else if (m.type === 'error') {
+    state.errors.push(m);
+    if (m.exists && pendingExport && confirm(m.message + '. Replace it?')) pendingExport(true);
+    else flash(m.field + ': ' + m.message);
+  }
+}
+
+function onFrame(f) {
+  if (f.kind === 1) {
+    const positions = new Float32Array(f.payload, 0, 3 * f.a);
+    const triangles = new Uint32Array(f.payload, 12 * f.a, 3 * f.b);
+    state.mesh = { positions, triangles };
+    renderer.setMesh(positions, triangles);
+  } else if (f.kind === 2) {
+    state.pendingFaces = new Uint32Array(f.payload);
+  } else if (f.kind === 3) {
+    state.layout = { width: f.a, channels: state.hello.channels.length + 2, samples: new Float32Array(f.payload), faces: state.pendingFaces };
+    renderer.setLayout(state.layout);
+  } else if (f.kind === 4) {
+    renderer.updateRects({ resized: false, samples: readRects(f), faces: [] }, null);
+  }
+  dirty = true;
+}
+
+// Kind 4: per rectangle x, y, w, h (u32), then its w·h RGBA32F texels.
+function readRects(f) {
+  const rects = [];
+  let at = 0;
+  const v = new DataView(f.payload);
+  for (let i = 0; i < f.a; i++) {
+    const [x, y, width, height] = [0, 1, 2, 3].map((k) => v.getUint32(at + 4 * k, true));
+    at += 16;
+    rects.push({ x, y, width, height, data: new Float32Array(f.payload.slice(at, at + 16 * width * height)) });
+    at += 16 * width * height;
+  }
+  return rects;
+}
+
+// ---- the panel --------------------------------------------------------
+
+function fillChannels(channels) {
+  const sel = $('channel');
+  if (sel.options.length) return;
+  channels.forEach((c, k) => sel.add(new Option(c, k)));
+}
+state.channelIndex = () => Number($('channel').value || 0);
+
+function fillLevels(max) {
+  const sel = $('level');
+  if (sel.options.length) return;
+  for (let l = 0; l <= max; l++) sel.add(new Option(`${1 << l} (level ${l})`, l));
+}
+
+function showStatus(s) {
+  const mb = (b) => (b / 1048576).toFixed(1) + ' MB';
+  $('stats').textContent = `${s.samples.toLocaleString()} samples · ${mb(s.memory)} · finest level ${s.finest_level}` +
+    ` · undo ${s.undo} (${mb(s.undo_memory)}) · redo ${s.redo}`;
+  const list = $('history');
+  list.textContent = '';
+  s.history.forEach((h, k) => {
+    const li = document.createElement('li');
+    li.textContent = h;
+    if (k >= s.undo) li.className = 'undone';
+    list.appendChild(li);
+  });
+}
+
+let flashTimer = 0;
+function flash(text) {
+  $('busy').textContent = text;
+  clearTimeout(flashTimer);
+  flashTimer = setTimeout(() => { $('busy').textContent = ''; }, 4000);
+}
+
+const srgbToLinear = (c) => (c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4);
+const linearToSrgb = (c) => (c <= 0.0031308 ? 12.92 * c : 1.055 * c ** (1 / 2.4) - 0.055);
+function fromHex(hex) {
+  return [1, 3, 5].map((i) => srgbToLinear(parseInt(hex.slice(i, i + 2), 16) / 255));
+}
+function toHex(rgb) {
+  return '#' + rgb.slice(0, 3).map((c) => Math.round(255 * Math.min(1, Math.max(0, linearToSrgb(c))))
+    .toString(16).padStart(2, '0')).join('');
+}
+
+// The brush message: mode, channel and values from the panel.
+function brush(tool) {
+  const k = state.channelIndex();
+  const channel = k === 0 ? 'color' : state.hello.channels[k];
+  const color = k === 0 ? fromHex($('color').value) : [Number($('value').value)];
+  return {
+    mode: tool === 'erase' ? 'erase' : $('blend').value, channel, color,
+    strength: Number($('strength').value), hardness: Number($('hardness').value),
+    mirror: $('mirror').checked, eye: $('seen').checked ? state.camera.eye() : null,
+  };
+}
+
+function setTool(t) {
+  state.tool = t;
+  document.querySelectorAll('#tools button').forEach((b) => b.classList.toggle('on', b.dataset.tool === t));
+}
+document.querySelectorAll('#tools button').forEach((b) => b.addEventListener('click', () => setTool(b.dataset.tool)));
+setTool('paint');
+
+// ---- picking ----------------------------------------------------------
+
+// The pick pass is redrawn only when the camera moved: painting changes
+// colours, not which face is under a pixel.
+function pickAt(clientX, clientY) {
+  if (!state.layout || !state.mesh) return null;
+  const w = canvas.width, h = canvas.height;
+  const x = Math.floor(clientX * w / canvas.clientWidth), y = h - 1 - Math.floor(clientY * h / canvas.clientHeight);
+  if (x < 0 || y < 0 || x >= w || y >= h) return null;
+  const t = renderer.pickFramebuffer(w, h);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, t.fb);
+  if (pickDirty) {
+    gl.viewport(0, 0, w, h);
+    gl.clearBufferfv(gl.COLOR, 0, [-1, 0, 0, 0]);
+    gl.clear(gl.DEPTH_BUFFER_BIT);
+    renderer.drawPick(state.camera.viewProj(w / h));
+    pickDirty = false;
+  }
+  const px = new Float32Array(4);
+  gl.readBuffer(gl.COLOR_ATTACHMENT0);
+  gl.readPixels(x, y, 1, 1, gl.RGBA, gl.FLOAT, px);
+  gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  if (px[0] < 0) return null;
+  const face = Math.round(px[0]);
+  const b = [px[1], px[2], px[3]];
+  const s = b[0] + b[1] + b[2] || 1;
+  const bary = b.map((v) => Math.max(0, v / s));
+  const P = state.mesh.positions, T = state.mesh.triangles;
+  const point = [0, 1, 2].map((c) => [0, 1, 2].reduce((acc, k) => acc + bary[k] * P[3 * T[3 * face + k] + c], 0));
+  return { face, bary, point };
+}
+
+// The brush radius in model units at `point`: screen pixels converted at
+// its depth, or the model-unit slider.
+function worldRadius(point) {
+  const r = Number($('radius').value);
+  const cam = state.camera;
+  if ($('worldRadius').checked) return r * cam.radius / 200;
+  const e = cam.eye(), f = cam.forward();
+  const depth = (point[0] - e[0]) * f[0] + (point[1] - e[1]) * f[1] + (point[2] - e[2]) * f[2];
+  return r * 2 * depth * Math.tan(cam.fov / 2) / canvas.clientHeight;
+}
+
+// ---- strokes ----------------------------------------------------------
+
+let drag = null;
+state.pickAt = (x, y) => pickAt(x, y);
+
+canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+canvas.addEventListener('pointerdown', (e) => {
+  canvas.setPointerCapture(e.pointerId);
+  if (e.button !== 0 || e.altKey) { drag = { kind: 'camera', x: e.clientX, y: e.clientY, pan: e.shiftKey }; return; }
+  const hit = pickAt(e.clientX, e.clientY);
+  if (!hit) { drag = { kind: 'camera', x: e.clientX, y: e.clientY, pan: e.shiftKey }; return; }
+  const tool = state.tool;
+  if (tool === 'pick') { net.send('pick', { face: hit.face, barycentric: hit.bary }); return; }
+  if (tool === 'fill') { net.send('fill', { face: hit.face, brush: brush(tool) }); return; }
+  if (tool === 'detail') {
+    net.send('detail', { center: hit.point, radius: worldRadius(hit.point), levels: e.shiftKey ? -1 : 1 });
+    return;
+  }
+  net.send('begin', { brush: brush(tool) });
+  drag = { kind: 'stroke', x: e.clientX, y: e.clientY };
+  net.send('dabs', { dabs: [dab(hit, e)] });
+});
+
+function dab(hit, e) {
+  const pressure = e.pointerType === 'mouse' || !e.pressure ? 1 : Math.min(1, e.pressure);
+  return [...hit.point, worldRadius(hit.point), pressure];
+}
+
+canvas.addEventListener('pointermove', (e) => {
+  showBrush(e);
+  if (!drag) return;
+  if (drag.kind === 'camera') {
+    const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+    if (drag.pan) state.camera.pan(dx, dy, canvas.clientHeight); else state.camera.orbit(dx, dy);
+    drag.x = e.clientX; drag.y = e.clientY;
+    dirty = pickDirty = true;
+    return;
+  }
+  // Dabs every `spacing` of the radius along the pointer's path in
+  // screen space, however fast it moves: no gaps.
+  const step = Math.max(1, Number($('radius').value) * Number($('spacing').value));
+  const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+  const n = Math.floor(Math.hypot(dx, dy) / step);
+  const dabs = [];
+  for (let i = 1; i <= n; i++) {
+    const x = drag.x + dx * i / n, y = drag.y + dy * i / n;
+    const hit = pickAt(x, y);
+    if (hit) dabs.push(dab(hit, e));
+  }
+  if (n > 0) { drag.x += dx; drag.y += dy; }
+  if (dabs.length) net.send('dabs', { dabs });
+});
+
+function endDrag() {
+  if (drag && drag.kind === 'stroke') net.send('end');
+  drag = null;
+}
+canvas.addEventListener('pointerup', endDrag);
+canvas.addEventListener('pointercancel', endDrag);
+canvas.addEventListener('wheel', (e) => {
+  e.preventDefault();
+  state.camera.zoom(Math.exp(e.deltaY * 0.001));
+  dirty = pickDirty = true;
+}, { passive: false });
+
+function showBrush(e) {
+  const el = $('brush');
+  const r = $('worldRadius').checked ? null : Number($('radius').value);
+  $('radiusText').textContent = $('worldRadius').checked ? '' : r + ' px';
+  if (!r || state.tool === 'fill' || state.tool === 'pick') { el.style.display = 'none'; return; }
+  el.style.display = 'block';
+  el.style.left = e.clientX + 'px'; el.style.top = e.clientY + 'px';
+  el.style.width = el.style.height = 2 * r + 'px';
+}
+
+// ---- keys and buttons -------------------------------------------------
+
+let pendingExport = null;
+function exportFile(op, fields) {
+  pendingExport = (overwrite) => net.send(op, { ...fields, overwrite });
+  pendingExport(false);
+}
+
+$('undo').onclick = () => net.send('undo');
+$('redo').onclick = () => net.send('redo');
+$('save').onclick = () => {
+  const name = prompt('Save the colours as (.meshcolors, in the export folder)', 'painted.meshcolors');
+  if (name) exportFile('save', { name });
+};
+$('export').onclick = () => {
+  const name = prompt('Export a GLB (the colours baked into a texture)', 'painted.glb');
+  if (name) exportFile('export', { kind: 'glb', name });
+};
+$('applyLevel').onclick = () => net.send('resolution', { level: Number($('level').value) });
+$('help').onclick = () => { $('helpbox').hidden = !$('helpbox').hidden; };
+$('filter').onchange = () => { dirty = true; };
+$('channel').onchange = () => { dirty = true; };
+
+addEventListener('keydown', (e) => {
+  if (e.target.tagName === 'INPUT' && e.target.type !== 'range' && e.target.type !== 'checkbox') return;
+  const k = e.key.toLowerCase();
+  if ((e.ctrlKey || e.metaKey) && k === 'z') { net.send(e.shiftKey ? 'redo' : 'undo'); e.preventDefault(); return; }
+  if ((e.ctrlKey || e.metaKey) && k === 'y') { net.send('redo'); e.preventDefault(); return; }
+  if ((e.ctrlKey || e.metaKey) && k === 's') { $('save').onclick(); e.preventDefault(); return; }
+  if (e.ctrlKey || e.metaKey) return;
+  const tools = { b: 'paint', e: 'erase', g: 'fill', i: 'pick', d: 'detail' };
+  if (tools[k]) setTool(tools[k]);
+  else if (k === 'x') $('mirror').checked = !$('mirror').checked;
+  else if (k === '[' || k === ']') {
+    const r = $('radius');
+    r.value = Math.max(2, Math.min(200, Number(r.value) * (k === ']' ? 1.25 : 0.8)));
+  } else if (e.key === '?') $('helpbox').hidden = !$('helpbox').hidden;
+});
+
+// ---- drawing ----------------------------------------------------------
+
+function frame() {
+  requestAnimationFrame(frame);
+  if (!gl || !state.layout || !state.camera) return;
+  fitCanvas(canvas);
+  if (!dirty) return;
+  dirty = false;
+  gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+  gl.viewport(0, 0, canvas.width, canvas.height);
+  gl.clearColor(0.106, 0.11, 0.122, 1);
+  gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+  const k = state.channelIndex();
+  renderer.draw(state.camera.viewProj(canvas.width / canvas.height), {
+    filter: $('filter').value,
+    display: k === 0 ? 'color' : 'heat', channel: k === 0 ? 0 : k + 2,
+  });
+  state.frames++;
+  state.ready = true;
+}
+if (!gl) flash('this browser has no WebGL2: trilux paint needs it');
+new ResizeObserver(() => { dirty = pickDirty = true; }).observe(canvas);
+requestAnimationFrame(frame);

@@ -1,0 +1,433 @@
+//! The thread that owns the paint session: it applies the page's
+//! requests and sends the texels they changed.
+//!
+//! Snapshot slots (what a page that connects is sent first, in order):
+//! 0 the hello, 1 the mesh, 2 the face table and the samples (then the
+//! texel updates of the stroke in progress, appended, folded back into
+//! one samples frame when the server is idle), 3 the status.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::time::{Duration, Instant};
+
+use axum::body::Bytes;
+use mesh_colors::MipMap;
+use mesh_colors::gpu::{GpuLayout, TexelRect};
+use mesh_colors::session::{Changed, Edit, PaintSession};
+use serde_json::json;
+
+use super::protocol::{ExportKind, Request};
+use super::{Document, LIMITS, MAGIC, Options, PAGE, VERSION};
+use crate::web::frame::{Header, put_f32, put_u32};
+use crate::web::{App, Idle, Inbox, Limits, Out, Outbox, ReplyTo};
+
+/// Widest texture row the page is sent (WebGL2 guarantees 2048).
+const TEXTURE_WIDTH: u32 = 2048;
+/// Edits between autosaves while painting.
+const AUTOSAVE_EVERY: usize = 5;
+/// A pause after which unsaved edits are autosaved.
+const AUTOSAVE_PAUSE: Duration = Duration::from_secs(10);
+
+const SLOT_HELLO: usize = 0;
+const SLOT_MESH: usize = 1;
+const SLOT_TEXTURES: usize = 2;
+const SLOT_STATUS: usize = 3;
+
+/// The paint app: the session and its GPU copy.
+pub(crate) struct Worker {
+    doc: Document,
+    session: PaintSession,
+    mip: MipMap,
+    gpu: GpuLayout,
+    export_dir: PathBuf,
+    autosave: Option<PathBuf>,
+    /// Edits since the last autosave.
+    unsaved: usize,
+    /// Texel updates appended to the textures' slot since it was last
+    /// folded.
+    appended: usize,
+    /// The seqs answered since the last status.
+    answered: Vec<u64>,
+    /// When the last request was handled (the autosave waits for a
+    /// pause).
+    last_request: Instant,
+}
+
+impl Worker {
+    /// The session over `doc` with `log` replayed, and its GPU layout.
+    pub(crate) fn new(
+        doc: Document,
+        log: Option<&[Edit]>,
+        options: Options,
+    ) -> Result<Self, String> {
+        let session = super::open_session(&doc, log.unwrap_or(&[]), options.history)?;
+        let mip = MipMap::new(session.colors().clone());
+        let gpu = GpuLayout::new(&mip, TEXTURE_WIDTH).map_err(|e| e.to_string())?;
+        Ok(Self {
+            doc,
+            session,
+            mip,
+            gpu,
+            export_dir: options.export_dir,
+            autosave: options.autosave,
+            unsaved: 0,
+            appended: 0,
+            answered: Vec::new(),
+            last_request: Instant::now(),
+        })
+    }
+
+    fn frame(kind: u8, a: u32, b: u32, payload: &[u8]) -> Out {
+        let header = Header {
+            magic: *MAGIC,
+            version: VERSION,
+            kind,
+            flags: 0,
+            tag: 0,
+            a,
+            b,
+        };
+        Out::Binary(Bytes::from(header.frame(payload)))
+    }
+
+    fn hello(&self) -> Out {
+        let (lo, hi) = self.doc.bounds();
+        let mut channels = vec!["color".to_string()];
+        channels.extend(self.doc.scalars.iter().cloned());
+        Out::Text(
+            json!({
+                "type": "hello", "app": "paint", "protocol": VERSION,
+                "bounds": [lo.to_array(), hi.to_array()],
+                "channels": channels, "base": self.doc.base,
+                "mirror_x": self.doc.mirror_x(),
+                "faces": self.doc.surface.faces.len(),
+                "max_level": mesh_colors::MAX_LEVEL,
+            })
+            .to_string(),
+        )
+    }
+
+    /// The welded surface: positions, then triangles (the page expands
+    /// them to unindexed corners, face id = vertex id / 3).
+    fn mesh(&self) -> Out {
+        let s = &self.doc.surface;
+        let mut payload = Vec::with_capacity(s.positions.len() * 12 + s.faces.len() * 12);
+        put_f32(&mut payload, s.positions.iter().flat_map(|p| p.to_array()));
+        put_u32(&mut payload, s.faces.iter().flatten().copied());
+        Self::frame(1, s.positions.len() as u32, s.faces.len() as u32, &payload)
+    }
+
+    fn textures(&self) -> Vec<Out> {
+        let w = self.gpu.width();
+        let mut faces = Vec::new();
+        put_u32(&mut faces, self.gpu.face_texels().iter().copied());
+        let mut samples = Vec::new();
+        put_f32(&mut samples, self.gpu.sample_texels().iter().copied());
+        vec![
+            Self::frame(2, w, self.gpu.face_height(), &faces),
+            Self::frame(3, w, self.gpu.sample_height(), &samples),
+        ]
+    }
+
+    /// The sample texels of `rects`, as absolute values.
+    fn sample_rects(&self, rects: &[TexelRect]) -> Out {
+        let w = self.gpu.width() as usize;
+        let texels = self.gpu.sample_texels();
+        let mut payload = Vec::new();
+        for r in rects {
+            put_u32(&mut payload, [r.x, r.y, r.width, r.height]);
+            for y in r.y..r.y + r.height {
+                let start = (y as usize * w + r.x as usize) * 4;
+                put_f32(
+                    &mut payload,
+                    texels[start..start + r.width as usize * 4].iter().copied(),
+                );
+            }
+        }
+        Self::frame(4, rects.len() as u32, w as u32, &payload)
+    }
+
+    fn status(&mut self) -> Out {
+        let h = self.session.history();
+        let colors = self.session.colors();
+        let finest = (0..colors.face_count())
+            .filter_map(|f| colors.face_level(f))
+            .max()
+            .unwrap_or(0);
+        let steps: Vec<&str> = h
+            .steps()
+            .map(|s| match s {
+                mesh_colors::undo::Step::Paint(_) => "paint",
+                mesh_colors::undo::Step::Resolution(_) => "detail",
+            })
+            .collect();
+        let seqs = std::mem::take(&mut self.answered);
+        Out::Text(
+            json!({
+                "type": "status", "seqs": seqs,
+                "samples": colors.sample_count(),
+                "memory": colors.memory_bytes(),
+                "undo_memory": h.memory_bytes(),
+                "finest_level": finest,
+                "undo": h.undo_len(), "redo": h.redo_len(), "history": steps,
+                "edits": self.session.log().len(),
+            })
+            .to_string(),
+        )
+    }
+
+    fn publish_status(&mut self, out: &Outbox) {
+        let status = self.status();
+        out.publish(SLOT_STATUS, vec![status]);
+    }
+
+    /// Sends what `changed` changed: texels, or the whole layout.
+    fn upload(&mut self, changed: Changed, out: &Outbox) -> Result<(), String> {
+        let colors = self.session.colors();
+        match changed {
+            Changed::Nothing => {}
+            Changed::Samples(list) => {
+                let runs = runs(&list);
+                let spans = self.mip.refresh(colors, &runs).map_err(|e| e.to_string())?;
+                let changes = self
+                    .gpu
+                    .refresh(&self.mip, &spans)
+                    .map_err(|e| e.to_string())?;
+                if !changes.samples.is_empty() {
+                    out.append(SLOT_TEXTURES, self.sample_rects(&changes.samples));
+                    self.appended += 1;
+                }
+            }
+            Changed::Layout(faces) => {
+                self.mip
+                    .refresh_resolutions(colors, &faces)
+                    .map_err(|e| e.to_string())?;
+                self.gpu.update(&self.mip).map_err(|e| e.to_string())?;
+                out.publish(SLOT_TEXTURES, self.textures());
+                self.appended = 0;
+            }
+        }
+        Ok(())
+    }
+
+    fn edit(
+        &mut self,
+        to: ReplyTo,
+        request: Request,
+        out: &Outbox,
+    ) -> Result<(), (String, String)> {
+        let field = |f: &'static str| move |e: String| (f.to_string(), e);
+        let scalars = self.doc.scalars.clone();
+        let mirror = self.doc.mirror_x();
+        let changed = match request {
+            Request::Begin(spec) => {
+                let brush = spec
+                    .resolve(&scalars, mirror)
+                    .map_err(|b| (b.field, b.problem))?;
+                self.session
+                    .begin_stroke(brush)
+                    .map_err(|e| ("brush".to_string(), e.to_string()))?;
+                Changed::Nothing
+            }
+            Request::Dabs(dabs) => self
+                .session
+                .add_dabs(&dabs)
+                .map_err(|e| ("dabs".to_string(), e.to_string()))?,
+            Request::End => {
+                self.session.end_stroke();
+                self.unsaved += 1;
+                Changed::Nothing
+            }
+            Request::Fill(face, spec) => {
+                let brush = spec
+                    .resolve(&scalars, mirror)
+                    .map_err(|b| (b.field, b.problem))?;
+                self.unsaved += 1;
+                self.session
+                    .apply(Edit::Fill { face, brush })
+                    .map_err(|e| ("face".to_string(), e.to_string()))?
+            }
+            Request::Edit(e) => {
+                self.unsaved += 1;
+                self.session
+                    .apply(e)
+                    .map_err(|e| ("op".to_string(), e.to_string()))?
+            }
+            Request::Pick(face, b) => {
+                let color = self
+                    .session
+                    .pick(face, b)
+                    .map_err(|e| ("face".to_string(), e.to_string()))?;
+                out.reply(
+                    to,
+                    Out::Text(json!({"type": "pick", "seq": to.seq, "color": color}).to_string()),
+                );
+                return Ok(());
+            }
+            Request::Save { name, overwrite } => {
+                let path = self.export_dir.join(&name);
+                self.save(&path, overwrite).map_err(field("name"))?;
+                self.exported(to, &path, out);
+                return Ok(());
+            }
+            Request::Export {
+                kind,
+                name,
+                overwrite,
+            } => {
+                let path = self.export_dir.join(&name);
+                self.export(kind, &path, overwrite).map_err(field("name"))?;
+                self.exported(to, &path, out);
+                return Ok(());
+            }
+        };
+        self.upload(changed, out).map_err(field("op"))
+    }
+
+    fn exported(&self, to: ReplyTo, path: &Path, out: &Outbox) {
+        out.reply(
+            to,
+            Out::Text(
+                json!({"type": "export", "seq": to.seq, "path": path.display().to_string()})
+                    .to_string(),
+            ),
+        );
+    }
+
+    /// Writes the colours as `.meshcolors`, atomically.
+    fn save(&self, path: &Path, overwrite: bool) -> Result<(), String> {
+        let colors = self.session.colors();
+        crate::output::write_atomic(path, overwrite, |tmp| {
+            mesh_colors::file::save(tmp, colors, None).map_err(crate::Error::from)
+        })
+        .map_err(|e| e.to_string())
+    }
+
+    fn export(&self, kind: ExportKind, path: &Path, overwrite: bool) -> Result<(), String> {
+        match kind {
+            ExportKind::Session => {
+                let v = super::session_file::to_json(
+                    &self.doc.source,
+                    self.session.log(),
+                    &self.doc.scalars,
+                );
+                crate::output::write_atomic(path, overwrite, |tmp| {
+                    std::fs::write(tmp, format!("{v:#}\n")).map_err(|source| crate::Error::File {
+                        path: tmp.to_path_buf(),
+                        source,
+                    })
+                })
+                .map_err(|e| e.to_string())
+            }
+            ExportKind::Glb | ExportKind::Obj => {
+                let atlas = mesh_colors::atlas::bake(
+                    self.session.colors(),
+                    &mesh_colors::atlas::Options::default(),
+                )
+                .map_err(|e| e.to_string())?;
+                let (baked, _) = crate::colors::atlas_mesh(&self.doc.surface, &atlas, None);
+                if kind == ExportKind::Glb {
+                    crate::output::write_gltf(path, overwrite, |tmp| baked.write(tmp)).map(drop)
+                } else {
+                    crate::output::write_atomic_files(path, overwrite, |tmp| Ok(baked.write(tmp)?))
+                        .map(drop)
+                }
+                .map_err(|e| e.to_string())
+            }
+        }
+    }
+
+    /// Writes the autosave when there is one and something to save.
+    fn autosave(&mut self) {
+        if self.unsaved == 0 {
+            return;
+        }
+        if let Some(path) = self.autosave.clone() {
+            match self.save(&path, true) {
+                Ok(()) => self.unsaved = 0,
+                Err(e) => eprintln!("trilux paint: the autosave failed: {e}"),
+            }
+        }
+    }
+}
+
+/// Sorted, distinct sample indices as runs `(first, count)`.
+fn runs(list: &[u32]) -> Vec<(u32, u32)> {
+    let mut runs: Vec<(u32, u32)> = Vec::new();
+    for &i in list {
+        match runs.last_mut() {
+            Some((start, n)) if *start + *n == i => *n += 1,
+            _ => runs.push((i, 1)),
+        }
+    }
+    runs
+}
+
+impl App for Worker {
+    const NAME: &'static str = "paint";
+    const PAGE: &'static [crate::web::Asset] = PAGE;
+    const LIMITS: Limits = LIMITS;
+    type Request = Request;
+
+    fn parse(m: &crate::web::Incoming<'_>) -> Result<Request, crate::web::BadField> {
+        super::protocol::parse(m)
+    }
+
+    fn begin(&mut self, out: &Outbox) {
+        out.publish(SLOT_HELLO, vec![self.hello()]);
+        out.publish(SLOT_MESH, vec![self.mesh()]);
+        out.publish(SLOT_TEXTURES, self.textures());
+        self.publish_status(out);
+    }
+
+    fn handle(&mut self, first: (ReplyTo, Request), inbox: &mut Inbox<Request>, out: &Outbox) {
+        let mut next = Some(first);
+        // Dabs already waiting are painted before the status goes out.
+        while let Some((to, request)) = next {
+            if let Err((field, message)) = self.edit(to, request, out) {
+                out.error(to, &field, &message);
+            }
+            self.answered.extend(to.seq);
+            next = inbox.try_next();
+        }
+        self.publish_status(out);
+        self.last_request = Instant::now();
+        if self.unsaved >= AUTOSAVE_EVERY {
+            self.autosave();
+        }
+    }
+
+    fn idle(&mut self, _cancel: &AtomicBool, out: &Outbox) -> Idle {
+        // Fold the stroke's texel updates into one samples frame for
+        // pages that connect later (every page has them already).
+        if self.appended > 0 {
+            out.keep(SLOT_TEXTURES, self.textures());
+            self.appended = 0;
+        }
+        if self.unsaved == 0 {
+            return Idle::Wait;
+        }
+        let waited = self.last_request.elapsed();
+        if waited >= AUTOSAVE_PAUSE {
+            self.autosave();
+            return Idle::Wait;
+        }
+        Idle::WaitAtMost(AUTOSAVE_PAUSE - waited)
+    }
+
+    fn stop(&mut self, _out: &Outbox) {
+        self.session.end_stroke();
+        self.autosave();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_join_consecutive_indices() {
+        assert_eq!(runs(&[1, 2, 3, 7, 9, 10]), vec![(1, 3), (7, 1), (9, 2)]);
+        assert!(runs(&[]).is_empty());
+    }
+}
