@@ -401,13 +401,58 @@ impl ResolutionChange {
     }
 }
 
+/// New samples of some primitives (faces or edges), by index: a slot per
+/// primitive, so that reads during a batch cost an array access.
+struct Overlay {
+    slot: Vec<u32>,
+    keys: Vec<usize>,
+    values: Vec<Vec<f32>>,
+}
+
+impl Overlay {
+    const NONE: u32 = u32::MAX;
+
+    fn new(n: usize) -> Self {
+        Self {
+            slot: vec![Self::NONE; n],
+            keys: Vec::new(),
+            values: Vec::new(),
+        }
+    }
+
+    #[inline]
+    fn get(&self, i: usize) -> Option<&[f32]> {
+        match self.slot[i] {
+            Self::NONE => None,
+            k => Some(&self.values[k as usize]),
+        }
+    }
+
+    #[inline]
+    fn contains(&self, i: usize) -> bool {
+        self.slot[i] != Self::NONE
+    }
+
+    /// Sets (or replaces) primitive `i`'s samples.
+    fn insert(&mut self, i: usize, values: Vec<f32>) {
+        match self.slot[i] {
+            Self::NONE => {
+                self.slot[i] = self.keys.len() as u32;
+                self.keys.push(i);
+                self.values.push(values);
+            }
+            k => self.values[k as usize] = values,
+        }
+    }
+}
+
 /// The mesh colours as a batch sees them between two of its steps: levels
 /// already updated in `mc`, the new samples of resampled faces and edges
 /// in the overlays, every other sample where it was.
 struct Staged<'a> {
     mc: &'a MeshColors,
-    faces: &'a HashMap<usize, Vec<f32>>,
-    edges: &'a HashMap<usize, Vec<f32>>,
+    faces: &'a Overlay,
+    edges: &'a Overlay,
 }
 
 impl Store for Staged<'_> {
@@ -422,7 +467,7 @@ impl Store for Staged<'_> {
     #[inline]
     fn edge_at(&self, e: usize, level: u8, s: u32) -> &[f32] {
         let c = self.mc.channels;
-        match self.edges.get(&e) {
+        match self.edges.get(e) {
             Some(values) => &values[(s as usize - 1) * c..s as usize * c],
             None => self.mc.edge_at(e, level, s),
         }
@@ -430,7 +475,7 @@ impl Store for Staged<'_> {
     #[inline]
     fn face_at(&self, f: usize, level: u8, idx: usize) -> &[f32] {
         let c = self.mc.channels;
-        match self.faces.get(&f) {
+        match self.faces.get(f) {
             Some(values) => &values[idx * c..(idx + 1) * c],
             None => self.mc.face_at(f, level, idx),
         }
@@ -509,8 +554,8 @@ impl MeshColors {
             edges: Vec::new(),
             edge_values: Vec::new(),
         };
-        let mut face_new: HashMap<usize, Vec<f32>> = HashMap::new();
-        let mut edge_new: HashMap<usize, Vec<f32>> = HashMap::new();
+        let mut face_new = Overlay::new(face_count);
+        let mut edge_new = Overlay::new(self.edge_level.len());
         let mut value = vec![0.0f32; c];
         let mut lowered = false;
         for &(f, n1) in &record.requests {
@@ -581,7 +626,7 @@ impl MeshColors {
             };
             // The record keeps each primitive's state before the batch,
             // taken when the batch first touches it.
-            if !face_new.contains_key(&f) {
+            if !face_new.contains(f) {
                 record.faces.push((f as u32, n0, n1));
                 let at = self.face_offset[f] * c;
                 let len = samples_per_face(1 << n0) as usize * c;
@@ -593,7 +638,7 @@ impl MeshColors {
             self.face_level[f] = n1;
             for ((e, le0, le1), v) in plan.into_iter().zip(edge_values) {
                 let Some(v) = v else { continue };
-                if !edge_new.contains_key(&e) {
+                if !edge_new.contains(e) {
                     record.edges.push((e as u32, le0, le1));
                     let at = self.edge_offset[e] * c;
                     let len = samples_per_edge(1 << le0) as usize * c;
@@ -658,7 +703,7 @@ impl MeshColors {
             }
         }
         let c = self.channels;
-        let mut face_old = HashMap::with_capacity(change.faces.len());
+        let mut face_old = Overlay::new(self.face_level.len());
         let mut at = 0;
         let mut lowered = false;
         for &(f, before, after) in &change.faces {
@@ -668,7 +713,7 @@ impl MeshColors {
             self.face_level[f as usize] = before;
             lowered |= before < after;
         }
-        let mut edge_old = HashMap::with_capacity(change.edges.len());
+        let mut edge_old = Overlay::new(self.edge_level.len());
         let mut at = 0;
         for &(e, before, _) in &change.edges {
             let len = samples_per_edge(1 << before) as usize * c;
@@ -726,10 +771,10 @@ impl MeshColors {
     /// `faces` and `edges` changed: those get the given values (at their
     /// new level), the others keep theirs. The samples before the first
     /// such primitive stay in place; the rest move once, in place.
-    fn relayout(&mut self, faces: &HashMap<usize, Vec<f32>>, edges: &HashMap<usize, Vec<f32>>) {
+    fn relayout(&mut self, faces: &Overlay, edges: &Overlay) {
         let c = self.channels;
-        let first_edge = edges.keys().copied().min();
-        let first_face = faces.keys().copied().min();
+        let first_edge = edges.keys.iter().copied().min();
+        let first_face = faces.keys.iter().copied().min();
         let (e0, f0, start) = match (first_edge, first_face) {
             (Some(e), _) => (e, 0, self.edge_offset[e]),
             (None, Some(f)) => (self.edge_offset.len(), f, self.face_offset[f]),
@@ -740,22 +785,22 @@ impl MeshColors {
         let mut next = start;
         for e in e0..self.edge_offset.len() {
             let n = samples_per_edge(1 << self.edge_level[e]) as usize;
-            segments.push((self.edge_offset[e], next, n, !edges.contains_key(&e)));
+            segments.push((self.edge_offset[e], next, n, !edges.contains(e)));
             self.edge_offset[e] = next;
             next += n;
         }
         for f in f0..self.face_offset.len() {
             let n = samples_per_face(1 << self.face_level[f]) as usize;
-            segments.push((self.face_offset[f], next, n, !faces.contains_key(&f)));
+            segments.push((self.face_offset[f], next, n, !faces.contains(f)));
             self.face_offset[f] = next;
             next += n;
         }
         move_segments(&mut self.samples, c, &segments, next);
-        for (&e, v) in edges {
+        for (&e, v) in edges.keys.iter().zip(&edges.values) {
             let at = self.edge_offset[e] * c;
             self.samples[at..at + v.len()].copy_from_slice(v);
         }
-        for (&f, v) in faces {
+        for (&f, v) in faces.keys.iter().zip(&faces.values) {
             let at = self.face_offset[f] * c;
             self.samples[at..at + v.len()].copy_from_slice(v);
         }
