@@ -66,6 +66,14 @@ impl App for Worker {
         protocol::parse_upload(bytes)
     }
 
+    /// A probe does not cancel the refinement: the page's brush sends one
+    /// every 150 ms while it hovers, and a cancelled refinement starts
+    /// over, so hovering could starve it. The probe waits for the
+    /// refinement instead.
+    fn interrupts(request: &Request) -> bool {
+        !matches!(request, Request::Probe { .. })
+    }
+
     fn begin(&mut self, out: &Outbox) {
         self.send_all(out, &[]);
     }
@@ -582,4 +590,21 @@ fn lights_json(s: &Session, envs: &session_file::EnvFiles) -> Value {
             })
             .collect(),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn probes_do_not_interrupt_the_refinement_and_edits_do() {
+        let probe = Request::Probe {
+            piece: 0,
+            point: DVec3::ZERO,
+        };
+        assert!(!Worker::interrupts(&probe));
+        assert!(Worker::interrupts(&Request::Undo));
+        let edit = Request::Edit(Edit::Recombine { a: 0, b: 1 }, None);
+        assert!(Worker::interrupts(&edit));
+    }
 }

@@ -14,10 +14,19 @@ use super::*;
 type Socket =
     tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
 
-/// Echoes text to the asking page, publishes to all, or panics.
+/// Echoes text to the asking page, publishes to all, or panics; `work`
+/// starts background work that a cancel restarts, `peek` answers without
+/// interrupting it.
 struct Echo {
     published: usize,
+    /// Steps of background work left.
+    work: u32,
+    /// How often the background work was cancelled and restarted.
+    restarts: u32,
 }
+
+/// Steps of the echo app's background work.
+const WORK: u32 = 20;
 
 enum Request {
     Echo(String),
@@ -25,6 +34,8 @@ enum Request {
     Append(String),
     Fold,
     Panic,
+    Work,
+    Peek,
 }
 
 impl App for Echo {
@@ -53,8 +64,33 @@ impl App for Echo {
             "append" => Ok(Request::Append(text()?)),
             "fold" => Ok(Request::Fold),
             "panic" => Ok(Request::Panic),
+            "work" => Ok(Request::Work),
+            "peek" => Ok(Request::Peek),
             other => Err(BadField::new("op", format!("unknown op {other:?}"))),
         }
+    }
+
+    fn interrupts(request: &Request) -> bool {
+        !matches!(request, Request::Peek)
+    }
+
+    fn idle(&mut self, cancel: &std::sync::atomic::AtomicBool, out: &Outbox) -> Idle {
+        if self.work == 0 {
+            return Idle::Wait;
+        }
+        std::thread::sleep(Duration::from_millis(10));
+        if cancel.load(std::sync::atomic::Ordering::SeqCst) {
+            // As view's refinement: cancelled work starts over.
+            self.restarts += 1;
+            self.work = WORK;
+            return Idle::Busy;
+        }
+        self.work -= 1;
+        if self.work == 0 {
+            let done = json!({"type": "done", "restarts": self.restarts});
+            out.broadcast(Out::Text(done.to_string()));
+        }
+        Idle::Busy
     }
 
     fn parse_binary(bytes: &[u8]) -> Result<(u64, Request), BadField> {
@@ -90,6 +126,8 @@ impl App for Echo {
                 out.reply(to, Out::Text(json!({"type": "done"}).to_string()));
             }
             Request::Panic => panic!("the echo app was asked to panic"),
+            Request::Work => (self.work, self.restarts) = (WORK, 0),
+            Request::Peek => out.reply(to, Out::Text(json!({"type": "peek"}).to_string())),
         }
     }
 }
@@ -103,7 +141,11 @@ async fn start() -> Running {
     bind(&serve, Echo::NAME)
         .await
         .unwrap()
-        .serve(Echo { published: 0 })
+        .serve(Echo {
+            published: 0,
+            work: 0,
+            restarts: 0,
+        })
         .unwrap()
 }
 
@@ -346,4 +388,30 @@ async fn a_panicking_app_ends_its_pages_connections() {
         }
     }
     r.stop().await.unwrap();
+}
+
+/// Sends `work`, then `op` 8 times 20 ms apart (while the work, 200 ms,
+/// goes on); how often the work restarted.
+async fn restarts_under(op: &str) -> u64 {
+    let r = start().await;
+    let mut s = opened(&r).await;
+    send(&mut s, json!({"seq": 1, "op": "work"})).await;
+    for seq in 2..10 {
+        send(&mut s, json!({"seq": seq, "op": op, "text": "t"})).await;
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    let done = loop {
+        let v = text(&mut s).await;
+        if v["type"] == "done" {
+            break v;
+        }
+    };
+    r.stop().await.unwrap();
+    done["restarts"].as_u64().unwrap()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn only_requests_the_app_calls_interrupting_cancel_its_background_work() {
+    assert_eq!(restarts_under("peek").await, 0);
+    assert!(restarts_under("echo").await > 0);
 }
