@@ -150,20 +150,46 @@ impl<R> Inbox<R> {
 /// The queue the connections put requests in.
 pub(crate) type Requests<R> = mpsc::Sender<(ReplyTo, R)>;
 
+/// The app's thread, seen from the server.
+#[derive(Debug)]
+pub(crate) struct Thread {
+    pub(crate) handle: std::thread::JoinHandle<()>,
+    /// The panic that ended it, if one did.
+    pub(crate) panic: Arc<Mutex<Option<String>>>,
+}
+
 /// Moves `app` onto its own thread (named after the app) and returns the
-/// queue of its requests. The thread ends when every sender is gone.
+/// queue of its requests. The thread ends when every sender is gone. If
+/// the app panics, the panic is kept and `on_panic` runs (it stops the
+/// server: a page would otherwise be told "reconnecting…" forever).
 pub(crate) fn spawn<A: App>(
     app: A,
     hub: Arc<Hub>,
     cancel: Arc<AtomicBool>,
-) -> Result<Requests<A::Request>, String> {
+    on_panic: impl FnOnce() + Send + 'static,
+) -> Result<(Requests<A::Request>, Thread), String> {
     let (requests, rx) = mpsc::channel();
     let out = Outbox { hub };
-    std::thread::Builder::new()
+    let panic = Arc::new(Mutex::new(None));
+    let kept = panic.clone();
+    let handle = std::thread::Builder::new()
         .name(format!("trilux-{}-session", A::NAME))
-        .spawn(move || run(app, Inbox { rx }, &out, &cancel))
+        .spawn(move || {
+            let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                run(app, Inbox { rx }, &out, &cancel);
+            }));
+            if let Err(payload) = ran {
+                let what = payload
+                    .downcast_ref::<&str>()
+                    .map(|s| (*s).to_string())
+                    .or_else(|| payload.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "a panic without a message".into());
+                *kept.lock().unwrap_or_else(PoisonError::into_inner) = Some(what);
+                on_panic();
+            }
+        })
         .map_err(|e| format!("trilux {}: could not start its thread: {e}", A::NAME))?;
-    Ok(requests)
+    Ok((requests, Thread { handle, panic }))
 }
 
 /// The app's loop: requests in order, background work in between (see

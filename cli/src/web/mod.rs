@@ -262,9 +262,13 @@ impl Bound {
     /// When the thread cannot be started.
     pub fn serve<A: App>(self, app: A) -> Result<Running, String> {
         let (stop, stop_rx) = watch::channel(false);
+        let stop = Arc::new(stop);
         let hub = hub::Hub::new();
         let cancel = Arc::new(AtomicBool::new(false));
-        let requests = hub::spawn(app, hub.clone(), cancel.clone())?;
+        let stop_on_panic = stop.clone();
+        let (requests, thread) = hub::spawn(app, hub.clone(), cancel.clone(), move || {
+            let _ = stop_on_panic.send(true);
+        })?;
         let guard = guard::Guard::new(&self.token, self.host, self.addr, A::NAME);
         let router = socket::router::<A>(socket::Server {
             guard: Arc::new(guard),
@@ -277,18 +281,24 @@ impl Bound {
         });
         let mut stopped = stop_rx;
         let listener = self.listener;
+        let stop_on_exit = stop.clone();
         let task = tokio::spawn(async move {
-            axum::serve(listener, router)
+            let served = axum::serve(listener, router)
                 .with_graceful_shutdown(async move {
                     let _ = stopped.wait_for(|s| *s).await;
                 })
-                .await
+                .await;
+            // Ended by an I/O error too: whoever waits is told.
+            let _ = stop_on_exit.send(true);
+            served
         });
         Ok(Running {
             addr: self.addr,
             token: self.token,
+            name: A::NAME,
             stop,
             task,
+            thread: Some(thread),
         })
     }
 }
@@ -300,8 +310,10 @@ pub struct Running {
     pub addr: SocketAddr,
     /// The token every request needs.
     pub token: String,
-    stop: watch::Sender<bool>,
+    name: &'static str,
+    stop: Arc<watch::Sender<bool>>,
     task: tokio::task::JoinHandle<std::io::Result<()>>,
+    thread: Option<hub::Thread>,
 }
 
 impl Running {
@@ -313,23 +325,49 @@ impl Running {
     /// Stops the server (open pages are disconnected) and waits for it.
     ///
     /// # Errors
-    /// The server's I/O error, if it failed.
-    pub async fn stop(self) -> std::io::Result<()> {
+    /// The server's I/O error, if it failed; a panic of the app's thread
+    /// (`trilux NAME: its session thread panicked: …`).
+    pub async fn stop(mut self) -> std::io::Result<()> {
         let _ = self.stop.send(true);
-        self.task.await.unwrap_or(Ok(()))
+        let served = (&mut self.task).await.unwrap_or(Ok(()));
+        let panic = self.thread.take().and_then(|t| {
+            if t.handle.is_finished() {
+                // Its panic, if any, was caught and kept below.
+                let _ = t.handle.join();
+            }
+            t.panic
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+                .take()
+        });
+        match panic {
+            Some(what) => Err(std::io::Error::other(format!(
+                "trilux {}: its session thread panicked: {what}",
+                self.name
+            ))),
+            None => served,
+        }
     }
 
-    /// Waits until the server stops (Ctrl+C when `ctrl_c`).
+    /// Waits until the server stops: asked to (Ctrl+C when `ctrl_c`), or
+    /// because the app's thread panicked or the server failed.
     ///
     /// # Errors
-    /// The server's I/O error.
+    /// As [`Running::stop`]; or no Ctrl+C handler.
     pub async fn wait(self, ctrl_c: bool) -> std::io::Result<()> {
-        if ctrl_c {
-            tokio::signal::ctrl_c().await?;
-            self.stop().await
-        } else {
-            self.task.await.unwrap_or(Ok(()))
+        let mut stopped = self.stop.subscribe();
+        let signal = async {
+            if ctrl_c {
+                tokio::signal::ctrl_c().await
+            } else {
+                std::future::pending().await
+            }
+        };
+        tokio::select! {
+            signalled = signal => signalled?,
+            _ = stopped.wait_for(|s| *s) => {}
         }
+        self.stop().await
     }
 }
 
