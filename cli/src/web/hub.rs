@@ -134,28 +134,64 @@ impl Outbox {
     }
 }
 
+/// What the app's thread is sent.
+pub(crate) enum Msg<R> {
+    /// A page's request.
+    Request(ReplyTo, R),
+    /// The server stops: run [`App::stop`] and end.
+    Stop,
+}
+
 /// The requests waiting for the app.
 #[derive(Debug)]
 pub struct Inbox<R> {
-    rx: mpsc::Receiver<(ReplyTo, R)>,
+    rx: mpsc::Receiver<Msg<R>>,
+    /// A stop came while the app was taking requests.
+    stopping: bool,
 }
 
 impl<R> Inbox<R> {
     /// The next request if one is already waiting.
     pub fn try_next(&mut self) -> Option<(ReplyTo, R)> {
-        self.rx.try_recv().ok()
+        match self.rx.try_recv() {
+            Ok(Msg::Request(to, r)) => Some((to, r)),
+            Ok(Msg::Stop) => {
+                self.stopping = true;
+                None
+            }
+            Err(_) => None,
+        }
+    }
+}
+
+impl<R> std::fmt::Debug for Msg<R> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Msg::Request(to, _) => write!(f, "Request({to:?})"),
+            Msg::Stop => write!(f, "Stop"),
+        }
     }
 }
 
 /// The queue the connections put requests in.
-pub(crate) type Requests<R> = mpsc::Sender<(ReplyTo, R)>;
+pub(crate) type Requests<R> = mpsc::Sender<Msg<R>>;
 
 /// The app's thread, seen from the server.
-#[derive(Debug)]
 pub(crate) struct Thread {
     pub(crate) handle: std::thread::JoinHandle<()>,
     /// The panic that ended it, if one did.
     pub(crate) panic: Arc<Mutex<Option<String>>>,
+    /// Asks it to stop: cancels background work, then [`App::stop`].
+    pub(crate) ask_stop: Box<dyn Fn() + Send + Sync>,
+}
+
+impl std::fmt::Debug for Thread {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Thread")
+            .field("handle", &self.handle)
+            .field("panic", &self.panic)
+            .finish_non_exhaustive()
+    }
 }
 
 /// Moves `app` onto its own thread (named after the app) and returns the
@@ -170,13 +206,22 @@ pub(crate) fn spawn<A: App>(
 ) -> Result<(Requests<A::Request>, Thread), String> {
     let (requests, rx) = mpsc::channel();
     let out = Outbox { hub };
+    let (stopper, stop_cancel) = (requests.clone(), cancel.clone());
+    let ask_stop = Box::new(move || {
+        stop_cancel.store(true, Ordering::SeqCst);
+        let _ = stopper.send(Msg::Stop);
+    });
     let panic = Arc::new(Mutex::new(None));
     let kept = panic.clone();
     let handle = std::thread::Builder::new()
         .name(format!("trilux-{}-session", A::NAME))
         .spawn(move || {
             let ran = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                run(app, Inbox { rx }, &out, &cancel);
+                let inbox = Inbox {
+                    rx,
+                    stopping: false,
+                };
+                run(app, inbox, &out, &cancel);
             }));
             if let Err(payload) = ran {
                 let what = payload
@@ -189,39 +234,47 @@ pub(crate) fn spawn<A: App>(
             }
         })
         .map_err(|e| format!("trilux {}: could not start its thread: {e}", A::NAME))?;
-    Ok((requests, Thread { handle, panic }))
+    Ok((
+        requests,
+        Thread {
+            handle,
+            panic,
+            ask_stop,
+        },
+    ))
 }
 
 /// The app's loop: requests in order, background work in between (see
-/// [`Idle`]).
+/// [`Idle`]), until the server stops (then [`App::stop`]).
 fn run<A: App>(mut app: A, mut inbox: Inbox<A::Request>, out: &Outbox, cancel: &AtomicBool) {
     app.begin(out);
     let mut next = Idle::Busy;
-    loop {
-        let request = match next {
+    while !inbox.stopping {
+        let message = match next {
             Idle::Busy => {
                 cancel.store(false, Ordering::SeqCst);
                 match inbox.rx.try_recv() {
-                    Ok(r) => Some(r),
+                    Ok(m) => Some(m),
                     Err(TryRecvError::Empty) => None,
                     Err(TryRecvError::Disconnected) => break,
                 }
             }
             Idle::Wait => match inbox.rx.recv() {
-                Ok(r) => Some(r),
+                Ok(m) => Some(m),
                 Err(_) => break,
             },
             Idle::WaitAtMost(d) => match inbox.rx.recv_timeout(d) {
-                Ok(r) => Some(r),
+                Ok(m) => Some(m),
                 Err(RecvTimeoutError::Timeout) => None,
                 Err(RecvTimeoutError::Disconnected) => break,
             },
         };
-        next = match request {
-            Some(first) => {
-                app.handle(first, &mut inbox, out);
+        next = match message {
+            Some(Msg::Request(to, r)) => {
+                app.handle((to, r), &mut inbox, out);
                 Idle::Busy
             }
+            Some(Msg::Stop) => break,
             None => app.idle(cancel, out),
         };
     }

@@ -176,7 +176,10 @@ pub trait App: Send + 'static {
         Idle::Wait
     }
 
-    /// Called once when the server stops (an autosave).
+    /// Called once when the server stops ([`Running::stop`], or Ctrl+C,
+    /// SIGTERM or SIGHUP in [`Running::wait`]), after background work was
+    /// cancelled: an autosave. [`Running::stop`] waits for it at most
+    /// [`STOP_WAIT`]. Not called after a panic.
     fn stop(&mut self, out: &Outbox) {
         let _ = out;
     }
@@ -303,6 +306,31 @@ impl Bound {
     }
 }
 
+/// How long [`Running::stop`] waits for the app's [`App::stop`].
+pub const STOP_WAIT: Duration = Duration::from_secs(10);
+
+/// Resolves on Ctrl+C, or on Unix on SIGTERM (a service manager, `kill`)
+/// or SIGHUP (the terminal closed).
+async fn stop_signal() -> std::io::Result<()> {
+    #[cfg(unix)]
+    {
+        use tokio::signal::unix::{SignalKind, signal};
+        let (mut term, mut hup) = (
+            signal(SignalKind::terminate())?,
+            signal(SignalKind::hangup())?,
+        );
+        tokio::select! {
+            pressed = tokio::signal::ctrl_c() => pressed,
+            _ = term.recv() => Ok(()),
+            _ = hup.recv() => Ok(()),
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        tokio::signal::ctrl_c().await
+    }
+}
+
 /// A running server.
 #[derive(Debug)]
 pub struct Running {
@@ -330,35 +358,44 @@ impl Running {
     pub async fn stop(mut self) -> std::io::Result<()> {
         let _ = self.stop.send(true);
         let served = (&mut self.task).await.unwrap_or(Ok(()));
-        let panic = self.thread.take().and_then(|t| {
-            if t.handle.is_finished() {
-                // Its panic, if any, was caught and kept below.
-                let _ = t.handle.join();
-            }
-            t.panic
-                .lock()
-                .unwrap_or_else(std::sync::PoisonError::into_inner)
-                .take()
-        });
+        let Some(thread) = self.thread.take() else {
+            return served;
+        };
+        // The app's last word (an autosave), bounded: a stop must not hang.
+        (thread.ask_stop)();
+        let handle = thread.handle;
+        let joined = tokio::task::spawn_blocking(move || handle.join());
+        let finished = tokio::time::timeout(STOP_WAIT, joined).await.is_ok();
+        let panic = thread
+            .panic
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take();
         match panic {
             Some(what) => Err(std::io::Error::other(format!(
                 "trilux {}: its session thread panicked: {what}",
                 self.name
             ))),
+            None if !finished => Err(std::io::Error::other(format!(
+                "trilux {}: its session thread did not stop within {} s; its last work may be lost",
+                self.name,
+                STOP_WAIT.as_secs()
+            ))),
             None => served,
         }
     }
 
-    /// Waits until the server stops: asked to (Ctrl+C when `ctrl_c`), or
-    /// because the app's thread panicked or the server failed.
+    /// Waits until the server stops: asked to (when `signals`, by
+    /// Ctrl+C, SIGTERM or SIGHUP), or because the app's thread panicked or
+    /// the server failed. The app's [`App::stop`] runs before it returns.
     ///
     /// # Errors
-    /// As [`Running::stop`]; or no Ctrl+C handler.
-    pub async fn wait(self, ctrl_c: bool) -> std::io::Result<()> {
+    /// As [`Running::stop`]; or the signal handlers could not be set.
+    pub async fn wait(self, signals: bool) -> std::io::Result<()> {
         let mut stopped = self.stop.subscribe();
         let signal = async {
-            if ctrl_c {
-                tokio::signal::ctrl_c().await
+            if signals {
+                stop_signal().await
             } else {
                 std::future::pending().await
             }

@@ -16,7 +16,7 @@ use axum::routing::get;
 use tokio::sync::{broadcast, watch};
 
 use super::guard::{Guard, MISSING_ORIGIN};
-use super::hub::{Hub, Requests};
+use super::hub::{Hub, Msg, Requests};
 use super::{App, ConnId, Limits, Out, ReplyTo, assets, json};
 
 /// What every request handler of app `A` shares.
@@ -253,7 +253,10 @@ fn submit<A: App>(s: &Server<A>, conn: ConnId, seq: Option<u64>, request: A::Req
     if A::interrupts(&request) {
         s.cancel.store(true, Ordering::SeqCst);
     }
-    match s.requests.send((ReplyTo { conn, seq }, request)) {
+    match s
+        .requests
+        .send(Msg::Request(ReplyTo { conn, seq }, request))
+    {
         Ok(()) => Flow::Continue,
         Err(_) => Flow::Close,
     }

@@ -18,6 +18,8 @@ type Socket =
 /// starts background work that a cancel restarts, `peek` answers without
 /// interrupting it.
 struct Echo {
+    /// Set by [`App::stop`].
+    stopped: Arc<std::sync::atomic::AtomicBool>,
     published: usize,
     /// Steps of background work left.
     work: u32,
@@ -102,6 +104,11 @@ impl App for Echo {
         out.publish(1, vec![Out::Binary(Bytes::from_static(b"frame"))]);
     }
 
+    fn stop(&mut self, _: &Outbox) {
+        self.stopped
+            .store(true, std::sync::atomic::Ordering::SeqCst);
+    }
+
     fn handle(&mut self, first: (ReplyTo, Request), _: &mut Inbox<Request>, out: &Outbox) {
         let (to, request) = first;
         match request {
@@ -133,6 +140,11 @@ impl App for Echo {
 }
 
 async fn start() -> Running {
+    start_with(Arc::default()).await
+}
+
+/// The echo app, which sets `stopped` when it stops.
+async fn start_with(stopped: Arc<std::sync::atomic::AtomicBool>) -> Running {
     let serve = Serve {
         host: IpAddr::from([127, 0, 0, 1]),
         port: 0,
@@ -142,6 +154,7 @@ async fn start() -> Running {
         .await
         .unwrap()
         .serve(Echo {
+            stopped,
             published: 0,
             work: 0,
             restarts: 0,
@@ -411,4 +424,16 @@ async fn restarts_under(op: &str) -> u64 {
 async fn only_requests_the_app_calls_interrupting_cancel_its_background_work() {
     assert_eq!(restarts_under("peek").await, 0);
     assert!(restarts_under("echo").await > 0);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn stopping_the_server_runs_the_apps_stop_even_while_it_works() {
+    let stopped = Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let r = start_with(stopped.clone()).await;
+    let mut s = opened(&r).await;
+    // Long background work is under way when the server stops.
+    send(&mut s, json!({"seq": 1, "op": "work"})).await;
+    tokio::time::sleep(Duration::from_millis(30)).await;
+    r.stop().await.unwrap();
+    assert!(stopped.load(std::sync::atomic::Ordering::SeqCst));
 }
