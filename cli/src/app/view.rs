@@ -264,8 +264,8 @@ pub(crate) fn write_vtu(session: &Session, path: &Path, overwrite: bool) -> tril
 /// Writes the pieces as TetGen `path` (.node) and its .ele, each atomic.
 fn write_tet(session: &Session, path: &Path, overwrite: bool) -> std::result::Result<(), String> {
     let ele = path.with_extension("ele");
-    for p in [path, ele.as_path()] {
-        trilux::output::check_new(p, overwrite).map_err(|e| e.to_string())?;
+    for p in ExportKind::Tet.files(path) {
+        trilux::output::check_new(&p, overwrite).map_err(|e| e.to_string())?;
     }
     let mesh = merged(session);
     let tmp = trilux::output::temporary_name(path);

@@ -145,6 +145,15 @@ impl ExportKind {
             Self::Session => "json",
         }
     }
+
+    /// The files an export to `path` writes: `path`, and for a tet mesh
+    /// the `.ele` beside the `.node`.
+    pub fn files(self, path: &std::path::Path) -> Vec<std::path::PathBuf> {
+        match self {
+            Self::Tet => vec![path.to_path_buf(), path.with_extension("ele")],
+            _ => vec![path.to_path_buf()],
+        }
+    }
 }
 
 fn rgb(v: Option<&Value>, field: &str) -> Parsed<[f64; 3]> {

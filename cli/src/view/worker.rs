@@ -234,29 +234,28 @@ impl Worker {
                 view,
             } => {
                 let path = self.export_dir.join(&name);
-                let result = match kind {
-                    ExportKind::Session => {
-                        let log = self.session.log();
-                        session_file::write(&path, &self.source, &log, &self.envs, view, overwrite)
-                    }
-                    ExportKind::Glb => write_glb(&self.session, &path, size, view, overwrite),
+                // A file in the way is found before writing, by the files
+                // the kind writes (a tet export's .ele too), so that the
+                // page asks whether to replace it: the command line's
+                // "pass --force" means nothing there.
+                let taken = kind.files(&path).into_iter().find(|f| f.exists());
+                let result = match (taken, overwrite) {
+                    (Some(file), false) => Err(Refused::Exists(file)),
                     _ => self
-                        .exporter
-                        .export(&self.session, kind, &path, size, view, overwrite),
+                        .export(kind, &path, size, view, overwrite)
+                        .map_err(Refused::Failed),
                 };
                 match result {
                     Ok(()) => out.reply(to, Out::Text(
                         json!({"type": "export", "seq": seq, "path": path.display().to_string()})
                             .to_string(),
                     )),
-                    Err(e) => {
-                        let exists = path.exists() && !overwrite;
-                        // The page asks whether to replace the file: the
-                        // command line's "pass --force" means nothing there.
-                        let message = if exists {
-                            format!("{}: the file exists", path.display())
-                        } else {
-                            e.to_string()
+                    Err(refused) => {
+                        let (message, exists) = match refused {
+                            Refused::Exists(file) => {
+                                (format!("{}: the file exists", file.display()), true)
+                            }
+                            Refused::Failed(e) => (e, false),
                         };
                         let extra = [("exists", json!(exists))];
                         let e = json::error_with(to.seq, "name", &message, &extra);
@@ -264,6 +263,27 @@ impl Worker {
                     }
                 }
             }
+        }
+    }
+
+    /// Writes the export `kind` to `path`.
+    fn export(
+        &self,
+        kind: ExportKind,
+        path: &std::path::Path,
+        size: u32,
+        view: Option<DVec3>,
+        overwrite: bool,
+    ) -> Result<(), String> {
+        match kind {
+            ExportKind::Session => {
+                let log = self.session.log();
+                session_file::write(path, &self.source, &log, &self.envs, view, overwrite)
+            }
+            ExportKind::Glb => write_glb(&self.session, path, size, view, overwrite),
+            _ => self
+                .exporter
+                .export(&self.session, kind, path, size, view, overwrite),
         }
     }
 
@@ -462,6 +482,14 @@ impl Worker {
         .to_string();
         out.publish(STATUS, vec![Out::Text(status)]);
     }
+}
+
+/// Why an export was not written.
+enum Refused {
+    /// A file it would write exists (the page may ask to replace it).
+    Exists(PathBuf),
+    /// The writer's error.
+    Failed(String),
 }
 
 /// The export of kind `glb`: the pieces' boundary surfaces with their

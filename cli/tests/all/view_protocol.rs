@@ -870,3 +870,42 @@ async fn answers_go_to_the_asking_tab_and_the_shared_state_to_every_tab() {
     }
     r.stop().await.unwrap();
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_tet_exports_ele_in_the_way_asks_to_replace_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = server(dir.path()).await;
+    let mut s = connect(&r).await;
+    let mut seen = Seen::default();
+    until(&mut s, "status", &mut seen).await;
+    // Only the .ele of the pair exists: still a file the export replaces.
+    std::fs::write(dir.path().join("mesh.ele"), b"old").unwrap();
+    let export = json!({"seq": 1, "op": "export", "kind": "tet", "name": "mesh.node"});
+    send(&mut s, export).await;
+    let e = until(&mut s, "error", &mut seen).await;
+    assert_eq!(
+        (e["seq"].clone(), e["exists"].clone()),
+        (json!(1), json!(true)),
+        "{e}"
+    );
+    let message = e["message"].as_str().unwrap();
+    assert!(message.ends_with("mesh.ele: the file exists"), "{message}");
+    assert!(!dir.path().join("mesh.node").exists());
+    // The page's "replace" sends it again with overwrite.
+    let export = json!({"seq": 2, "op": "export", "kind": "tet", "name": "mesh.node",
+                        "overwrite": true});
+    send(&mut s, export).await;
+    assert_eq!(until(&mut s, "export", &mut seen).await["seq"], 2);
+    // A writer's own failure is not taken for an existing file.
+    std::fs::create_dir(dir.path().join("sub.png")).unwrap();
+    let export = json!({"seq": 3, "op": "export", "kind": "png", "name": "sub.png",
+                        "overwrite": true});
+    send(&mut s, export).await;
+    let e = until(&mut s, "error", &mut seen).await;
+    assert_eq!(
+        (e["seq"].clone(), e["exists"].clone()),
+        (json!(3), json!(false)),
+        "{e}"
+    );
+    r.stop().await.unwrap();
+}
