@@ -216,7 +216,6 @@ impl Worker {
         request: Request,
         out: &Outbox,
     ) -> Result<(), (String, String)> {
-        let field = |f: &'static str| move |e: String| (f.to_string(), e);
         let scalars = self.doc.scalars.clone();
         let mirror = self.doc.mirror_x();
         let changed = match request {
@@ -266,8 +265,8 @@ impl Worker {
             }
             Request::Save { name, overwrite } => {
                 let path = self.export_dir.join(&name);
-                self.save(&path, overwrite).map_err(field("name"))?;
-                self.exported(to, &path, out);
+                let result = self.save(&path, overwrite);
+                self.exported(to, &path, result, out);
                 return Ok(());
             }
             Request::Export {
@@ -276,34 +275,40 @@ impl Worker {
                 overwrite,
             } => {
                 let path = self.export_dir.join(&name);
-                self.export(kind, &path, overwrite).map_err(field("name"))?;
-                self.exported(to, &path, out);
+                let result = self.export(kind, &path, overwrite);
+                self.exported(to, &path, result, out);
                 return Ok(());
             }
         };
-        self.upload(changed, out).map_err(field("op"))
+        self.upload(changed, out).map_err(|e| ("op".to_string(), e))
     }
 
-    fn exported(&self, to: ReplyTo, path: &Path, out: &Outbox) {
-        out.reply(
-            to,
-            Out::Text(
-                json!({"type": "export", "seq": to.seq, "path": path.display().to_string()})
-                    .to_string(),
+    /// Answers a save or export: its path, or an error that says whether
+    /// the file was in the way (the page then asks to replace it).
+    fn exported(&self, to: ReplyTo, path: &Path, result: crate::Result<()>, out: &Outbox) {
+        let text = match result {
+            Ok(()) => json!({"type": "export", "seq": to.seq, "path": path.display().to_string()})
+                .to_string(),
+            Err(crate::Error::Exists(p)) => crate::web::json::error_with(
+                to.seq,
+                "name",
+                &format!("{}: the file exists", p.display()),
+                &[("exists", json!(true))],
             ),
-        );
+            Err(e) => crate::web::json::error(to.seq, "name", &e.to_string()),
+        };
+        out.reply(to, Out::Text(text));
     }
 
     /// Writes the colours as `.meshcolors`, atomically.
-    fn save(&self, path: &Path, overwrite: bool) -> Result<(), String> {
+    fn save(&self, path: &Path, overwrite: bool) -> crate::Result<()> {
         let colors = self.session.colors();
         crate::output::write_atomic(path, overwrite, |tmp| {
             mesh_colors::file::save(tmp, colors, None).map_err(crate::Error::from)
         })
-        .map_err(|e| e.to_string())
     }
 
-    fn export(&self, kind: ExportKind, path: &Path, overwrite: bool) -> Result<(), String> {
+    fn export(&self, kind: ExportKind, path: &Path, overwrite: bool) -> crate::Result<()> {
         match kind {
             ExportKind::Session => {
                 let v = super::session_file::to_json(
@@ -317,14 +322,12 @@ impl Worker {
                         source,
                     })
                 })
-                .map_err(|e| e.to_string())
             }
             ExportKind::Glb | ExportKind::Obj => {
                 let atlas = mesh_colors::atlas::bake(
                     self.session.colors(),
                     &mesh_colors::atlas::Options::default(),
-                )
-                .map_err(|e| e.to_string())?;
+                )?;
                 let (baked, _) = crate::colors::atlas_mesh(&self.doc.surface, &atlas, None);
                 if kind == ExportKind::Glb {
                     crate::output::write_gltf(path, overwrite, |tmp| baked.write(tmp)).map(drop)
@@ -332,7 +335,6 @@ impl Worker {
                     crate::output::write_atomic_files(path, overwrite, |tmp| Ok(baked.write(tmp)?))
                         .map(drop)
                 }
-                .map_err(|e| e.to_string())
             }
         }
     }
