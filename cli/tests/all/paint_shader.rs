@@ -269,6 +269,71 @@ fn write_scene(dir: &Path, colors: &MeshColors, positions: &[Vec3], layout: &Gpu
     std::fs::write(dir.join("meta.json"), meta.to_string()).unwrap();
 }
 
+/// A stroke's worth of change: every sample of the faces whose centre
+/// lies in a small cap (its edges and corners too, shared with the
+/// neighbours) set to one colour. Returns the faces.
+fn stroke(colors: &mut MeshColors, positions: &[Vec3]) -> Vec<usize> {
+    let faces: Vec<usize> = (0..colors.face_count())
+        .filter(|&f| {
+            let t = colors.topology().faces()[f];
+            let c = t.iter().map(|&v| positions[v as usize]).sum::<Vec3>() / 3.0;
+            (c - Vec3::new(0.55, 0.35, 0.7)).length() < 0.3
+        })
+        .collect();
+    for &f in &faces {
+        let r = colors.face_resolution(f).unwrap();
+        for a in mesh_colors::lattice_points(r) {
+            if let Some(i) = colors.lattice_index(f, a) {
+                colors
+                    .sample_mut(i)
+                    .unwrap()
+                    .copy_from_slice(&[0.9, 0.1, 0.6, 1.0, 0.3]);
+            }
+        }
+    }
+    faces
+}
+
+/// The layout after `stroke`, and the texel rectangles `GpuLayout::update`
+/// reports, written for the script's update step (`update.json`,
+/// `samples2.f32`, `faces2.u32`).
+fn write_update(dir: &Path, layout: &GpuLayout, colors: &MeshColors) -> GpuLayout {
+    let mut updated = layout.clone();
+    let changes = updated.update(&colors.mip_map()).unwrap();
+    assert!(
+        !changes.resized && !changes.samples.is_empty(),
+        "{changes:?}"
+    );
+    let changed: u32 = changes.samples.iter().map(|r| r.width * r.height).sum();
+    let all = (layout.sample_texels().len() / 4) as u32;
+    assert!(
+        changed * 4 < all,
+        "the stroke changed {changed} of {all} texels"
+    );
+    let rects = |rs: &[mesh_colors::gpu::TexelRect]| -> Vec<Value> {
+        rs.iter()
+            .map(|r| json!({"x": r.x, "y": r.y, "width": r.width, "height": r.height}))
+            .collect()
+    };
+    let update = json!({
+        "resized": changes.resized,
+        "samples": rects(&changes.samples),
+        "faces": rects(&changes.faces),
+    });
+    std::fs::write(dir.join("update.json"), update.to_string()).unwrap();
+    write_le(
+        dir.join("samples2.f32"),
+        updated.sample_texels(),
+        f32::to_le_bytes,
+    );
+    write_le(
+        dir.join("faces2.u32"),
+        updated.face_texels(),
+        u32::to_le_bytes,
+    );
+    updated
+}
+
 /// One pixel of the pick pass.
 struct Pick {
     face: f32,
@@ -396,12 +461,16 @@ fn the_mesh_colour_shader_matches_the_cpu_filters_in_chromium() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     write_scene(dir, &colors, &positions, &layout, SIZE);
+    let mut stroked = colors.clone();
+    let painted = stroke(&mut stroked, &positions);
+    assert!(painted.len() >= 3, "{painted:?}");
+    let updated = write_update(dir, &layout, &stroked);
     let shots = h.root.join("target/paint-shader");
     std::fs::create_dir_all(&shots).unwrap();
     let v = h.run(dir, &["--shots", shots.to_str().unwrap()]);
     assert_eq!(v["errors"], 0, "{v:#}");
     let picks = read_picks(&dir.join("pick.f32"));
-    let mut canvases = std::collections::HashMap::new();
+    let mut canvases: std::collections::HashMap<&str, Vec<u8>> = std::collections::HashMap::new();
     for (name, filter, _) in passes() {
         let canvas = std::fs::read(dir.join(format!("{name}.rgba8"))).unwrap();
         let t = compare(&layout, &picks, &canvas, name, filter);
@@ -424,22 +493,44 @@ fn the_mesh_colour_shader_matches_the_cpu_filters_in_chromium() {
         }
         canvases.insert(name, canvas);
     }
+    // After the stroke: only the changed rectangles went up
+    // (texSubImage2D), and the picture equals the CPU's on the new layout
+    // everywhere, painted or not.
+    for (name, filter) in [
+        ("after_linear", Filter::Linear),
+        ("after_trilinear", passes()[4].1),
+    ] {
+        let canvas = std::fs::read(dir.join(format!("{name}.rgba8"))).unwrap();
+        let t = compare(&updated, &picks, &canvas, name, filter);
+        eprintln!(
+            "paint shader parity: {name:>20}: {} pixels compared, {} skipped, max difference {}/255, {} over 1/255",
+            t.compared, t.skipped, t.max_diff, t.over
+        );
+        assert!(
+            t.max_diff <= 1 && t.skipped * 100 <= t.covered,
+            "{name}: {t:?}"
+        );
+        canvases.insert(name, canvas);
+    }
+    assert!(differ_from(&canvases["after_linear"], &canvases["linear"]) > 500);
     // The scene exercises what it claims: texel detail (nearest differs
     // from linear), MIP levels coarser than the finest (trilinear differs
     // from linear), anisotropy (anisotropic differs from trilinear).
-    let differ = |a: &str, b: &str| {
-        canvases[a]
-            .chunks_exact(4)
-            .zip(canvases[b].chunks_exact(4))
-            .filter(|(x, y)| x[..3].iter().zip(&y[..3]).any(|(p, q)| p.abs_diff(*q) > 2))
-            .count()
-    };
+    let differ = |a: &str, b: &str| differ_from(&canvases[a], &canvases[b]);
     assert!(differ("nearest", "linear") > 5_000);
     assert!(differ("trilinear", "linear") > 5_000);
     assert!(differ("anisotropic", "trilinear") > 1_000);
     if std::env::var_os("TRILUX_PAINT_BENCH").is_some() {
         bench(&h, dir, &colors, &positions, &layout);
     }
+}
+
+/// Pixels where two canvases differ by more than 2/255 in some channel.
+fn differ_from(a: &[u8], b: &[u8]) -> usize {
+    a.chunks_exact(4)
+        .zip(b.chunks_exact(4))
+        .filter(|(x, y)| x[..3].iter().zip(&y[..3]).any(|(p, q)| p.abs_diff(*q) > 2))
+        .count()
 }
 
 /// Table I: the shader's frame time against the baked atlas drawn as a

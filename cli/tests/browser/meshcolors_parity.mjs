@@ -17,7 +17,10 @@
 // alpha = face id mod 255 + 1, background 0) and reads the canvas back to DIR/<name>.rgba8;
 // once, the pick pass (same program, same geometry) to DIR/pick.f32: per
 // pixel 12 floats (face or -1, b0, b1, b2, db/dx, 0, db/dy, 0). Rows
-// bottom-up, as readPixels gives them, in both. With --shots, PNGs of
+// bottom-up, as readPixels gives them, in both. Then a stroke: the texel
+// rectangles of DIR/update.json (GpuLayout::update's Changes) go up with
+// updateRects from samples2.f32 and faces2.u32, and the linear and
+// trilinear canvases are read back again to after_<filter>.rgba8. With --shots, PNGs of
 // the nearest, linear and anisotropic passes (alpha 1) into SHOT_DIR.
 //
 // --bench: frame time of the mesh-colour shader against a plain 2D texture
@@ -103,6 +106,14 @@ window.parity = async () => {
   }
   gl.bindFramebuffer(gl.FRAMEBUFFER, null);
   await put('pick.f32', out);
+  // A stroke: the changed rectangles only, from the new arrays.
+  const changes = await (await fetch('/data/update.json')).json();
+  r.updateRects(changes, { samples: await get('samples2.f32', Float32Array), faces: await get('faces2.u32', Uint32Array) });
+  for (const filter of ['linear', 'trilinear']) {
+    toCanvas({ filter }, true);
+    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    await put('after_' + filter + '.rgba8', px);
+  }
   return { renderer: gl.getParameter(gl.RENDERER), errors: gl.getError(), timings };
 };
 window.show = (name) => toCanvas(meta.passes.find((p) => p.name === name), false);

@@ -65,11 +65,19 @@ const int FINEST = 255;      // query level: every primitive at its finest
 const int MAX_LEVEL = 10;    // mesh_colors::MAX_LEVEL
 const int MAX_PROBES = 64;   // mesh_colors::MAX_PROBES
 
+// Component k of a vector, by selection: SwiftShader runs four fragments
+// at once, and a vector or array indexed by a per-fragment value costs far
+// more there than a choice between three values.
+uint pick(uvec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+int pick(ivec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+bool pick(bvec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+float pick(vec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
+
 // One face's table entry, decoded once per fragment (View::decode).
 struct Face {
-  uint F; uint V[3]; uint E[3];
-  int n; int vl[3]; int el[3];
-  bool fwd[3];               // edge k runs canonically from corner k to k + 1
+  uint F; uvec3 V; uvec3 E;
+  int n; ivec3 vl; ivec3 el;
+  bvec3 fwd;                 // edge k runs canonically from corner k to k + 1
 };
 Face face;
 
@@ -80,104 +88,49 @@ void decode(int f) {
   uvec4 b = texelFetch(faces, ivec2((t + 1) % w, (t + 1) / w), 0);
   uint bits = b.w;
   face.F = a.x;
-  face.V = uint[3](a.y, a.z, a.w);
-  face.E = uint[3](b.x, b.y, b.z);
+  face.V = a.yzw;
+  face.E = b.xyz;
   face.n = min(int(bits & 15u), MAX_LEVEL);
-  for (int k = 0; k < 3; k++) {
-    face.vl[k] = min(int((bits >> (4 + 4 * k)) & 15u), MAX_LEVEL);
-    // An edge is never finer than its face (as the CPU clamps it).
-    face.el[k] = min(int((bits >> (16 + 4 * k)) & 15u), face.n);
+  uvec3 shift = uvec3(0u, 4u, 8u);
+  face.vl = min(ivec3((uvec3(bits) >> (shift + 4u)) & 15u), ivec3(MAX_LEVEL));
+  // An edge is never finer than its face (as the CPU clamps it).
+  face.el = min(ivec3((uvec3(bits) >> (shift + 16u)) & 15u), ivec3(face.n));
 #ifdef TWIN_EDGE_DIRECTION
-    face.fwd[k] = true;      // the wrong twin: every edge read from corner k
+  face.fwd = bvec3(true);    // the wrong twin: every edge read from corner k
 #else
-    face.fwd[k] = (bits & (1u << (28 + k))) != 0u;
+  face.fwd = notEqual(uvec3(bits) & (uvec3(1u) << uvec3(28u, 29u, 30u)), uvec3(0u));
 #endif
-  }
 }
 
 // Pyramid value i's shown texel: linear texel index t = i * P + group at
 // (t % W, t / W), W the texture's width (WebGL2 has no texture buffers).
+uint rowTexels;               // W, read once per fragment (main)
 vec4 value(uint i) {
-  uint w = uint(textureSize(samples, 0).x);
-#ifdef TWIN_ROW_WIDTH
-  w -= 1u;                   // the wrong twin: rows one texel short
-#endif
   uint t = i * uint(perValue) + uint(group);
-  return texelFetch(samples, ivec2(int(t % w), int(t / w)), 0);
+  return texelFetch(samples, ivec2(int(t % rowTexels), int(t / rowTexels)), 0);
 }
 
 // Offsets of a level within an edge's and a face's levels (mip.rs):
-// sum over m < l of 2^m - 1, and of (2^m - 1)(2^m - 2) / 2.
+// sum over m < l of 2^m - 1, and of (2^m - 1)(2^m - 2) / 2 in closed form
+// ((4^l - 1) / 3 - 3 (2^l - 1) + 2l) / 2 (0, 0, 0, 3, 24, 129, ...).
 uint edgeLevelOffset(int l) { return uint((1 << l) - 1 - l); }
 uint faceLevelOffset(int l) {
-  uint o = 0u;
-  for (int m = 2; m < l; m++) { uint r = uint(1 << m); o += (r - 1u) * (r - 2u) / 2u; }
-  return o;
+  uint quads = ((1u << uint(2 * l)) - 1u) / 3u;
+  return (quads + uint(2 * l) - 3u * (uint(1 << l) - 1u)) / 2u;
 }
 // Interior sample C_ij of a face of resolution r (structure.rs).
 uint interiorIndex(uint r, uint i, uint j) { return (i - 1u) * (r - 1u) - (i - 1u) * i / 2u + (j - 1u); }
 
-// A lookup resolves to weighted pyramid values, "taps": a corner is one, a
-// point of an edge one or two (a face finer than its edge interpolates the
-// edge's nodes: the continuity rule). Indices are resolved first and
-// fetched in one place (levelValue) because GLSL inlines every call: a
-// fetch at each of the CPU's call sites made a program that SwiftShader
-// took seconds to compile, for the same arithmetic.
-struct Taps { uint i[2]; float w[2]; int n; };
-
-Taps one(uint i, float w) { return Taps(uint[2](i, 0u), float[2](w, 0.0), 1); }
-Taps two(uint i, float wi, uint j, float wj) { return Taps(uint[2](i, j), float[2](wi, wj), 2); }
-
 // Corner k seen at query level q (its own level, at most).
-uint cornerIndex(int k, int q) { return face.V[k] + uint(min(q, face.vl[k])); }
+uint cornerIndex(int k, int q) { return pick(face.V, k) + uint(min(q, pick(face.vl, k))); }
 
 // Node i of edge k at edge level le: its canonical start vertex (i = 0),
 // its end vertex (i = 2^le) or its sample i.
 uint nodeIndex(int k, int q, int le, uint i) {
-  int k1 = (k + 1) % 3;
-  if (i == 0u) return cornerIndex(face.fwd[k] ? k : k1, q);
-  if (i == uint(1 << le)) return cornerIndex(face.fwd[k] ? k1 : k, q);
-  return face.E[k] + edgeLevelOffset(le) + i - 1u;
-}
-
-// Edge k at canonical lattice position p / 2^lp (a lattice point of a
-// face of level lp on it), weight w: a node, or two when the edge is
-// coarser than the face (step 3).
-Taps edgeTaps(int k, int q, int lp, uint p, float w, bool nearest) {
-  int le = min(q, face.el[k]);
-  int d = lp - le;
-  uint i = p >> uint(d);
-  uint rem = p & uint((1 << d) - 1);
-  if (rem == 0u) return one(nodeIndex(k, q, le, i), w);
-  if (nearest) return one(nodeIndex(k, q, le, i + (2u * rem >= uint(1 << d) ? 1u : 0u)), w);
-  float fr = float(rem) / float(1 << d);
-  return two(nodeIndex(k, q, le, i), w * (1.0 - fr), nodeIndex(k, q, le, i + 1u), w * fr);
-}
-
-// A point on edge k at canonical parameter t (step 1): the nodes around it.
-Taps placeEdgeTaps(int k, float t, int q, bool nearest) {
-  int le = min(q, face.el[k]);
-  uint re = uint(1 << le);
-  float x = t * float(re);
-  uint i = min(uint(x), re - 1u);
-  float fr = x - float(i);
-  if (nearest) return one(nodeIndex(k, q, le, i + (fr >= 0.5 ? 1u : 0u)), 1.0);
-  return two(nodeIndex(k, q, le, i), 1.0 - fr, nodeIndex(k, q, le, i + 1u), fr);
-}
-
-// Lattice point a (a.x + a.y + a.z = 2^lf) with weight w (step 3): a
-// corner, a point of an edge, or the interior sample C_{a.x a.y} of level lf.
-Taps latticeTaps(int q, int lf, uvec3 a, float w, bool nearest) {
-  uint r = uint(1 << lf);
-  for (int k = 0; k < 3; k++) if (a[k] == r) return one(cornerIndex(k, q), w);
-  for (int m = 0; m < 3; m++) {
-    if (a[m] == 0u) {
-      int k = (m + 1) % 3;
-      uint t = a[(k + 1) % 3];
-      return edgeTaps(k, q, lf, face.fwd[k] ? t : r - t, w, nearest);
-    }
-  }
-  return one(face.F + faceLevelOffset(lf) + interiorIndex(r, a.x, a.y), w);
+  bool fwd = pick(face.fwd, k), atStart = i == 0u, atEnd = i == uint(1 << le);
+  // The start is corner k on a forward edge, the end is then corner k + 1.
+  uint corner = cornerIndex(atStart == fwd ? k : (k + 1) % 3, q);
+  return atStart || atEnd ? corner : pick(face.E, k) + edgeLevelOffset(le) + i - 1u;
 }
 
 // Where a point lies (step 1): kind 0 corner k, 1 edge k at canonical
@@ -192,14 +145,14 @@ Place place(vec3 b) {
   if (zeros == 2) return Place(0, c.x > 0.0 ? 0 : (c.y > 0.0 ? 1 : 2), 0.0, c);
   int m = c.x == 0.0 ? 0 : (c.y == 0.0 ? 1 : 2);
   int k = (m + 1) % 3, k1 = (k + 1) % 3;
-  float cs = face.fwd[k] ? c[k] : c[k1];
-  float ce = face.fwd[k] ? c[k1] : c[k];
+  float cs = pick(face.fwd, k) ? pick(c, k) : pick(c, k1);
+  float ce = pick(face.fwd, k) ? pick(c, k1) : pick(c, k);
   return Place(1, k, ce / (cs + ce), c);
 }
 
 // The lattice triangle of resolution r around c (step 2, Fig. 7): its
 // three points and weights.
-void lattice3(vec3 c, uint r, out uvec3 p[3], out vec3 w) {
+void lattice3(vec3 c, uint r, out uvec3 p0, out uvec3 p1, out uvec3 p2, out vec3 w) {
   float s = float(r) / (c.x + c.y + c.z);
   float x = c.x * s, y = c.y * s;
   uint i = min(uint(x), r - 1u);
@@ -207,45 +160,74 @@ void lattice3(vec3 c, uint r, out uvec3 p[3], out vec3 w) {
   float fx = x - float(i), fy = y - float(j);
   uint k = r - i - j;
   if (fx + fy <= 1.0 || k == 1u) {
-    p = uvec3[3](uvec3(i, j, k), uvec3(i + 1u, j, k - 1u), uvec3(i, j + 1u, k - 1u));
+    p0 = uvec3(i, j, k); p1 = uvec3(i + 1u, j, k - 1u); p2 = uvec3(i, j + 1u, k - 1u);
     w = vec3(1.0 - fx - fy, fx, fy);
   } else {
-    p = uvec3[3](uvec3(i + 1u, j + 1u, k - 2u), uvec3(i + 1u, j, k - 1u), uvec3(i, j + 1u, k - 1u));
+    p0 = uvec3(i + 1u, j + 1u, k - 2u); p1 = uvec3(i + 1u, j, k - 1u); p2 = uvec3(i, j + 1u, k - 1u);
     w = vec3(fx + fy - 1.0, 1.0 - fy, 1.0 - fx);
   }
 }
 
-// Steps 1-3 at query level q. The products associate as the CPU's: for
-// nearest, linear and most MIP lookups each tap adds (w_t x node weight) x
-// value; where the CPU's MIP map reads its per-face cache of lattice
-// values (a MIP lookup inside, at q <= n or at least the corners' finest
-// level), each lattice value is formed first, then weighted.
+// Steps 1-3 at query level q: the value at one point of the face.
+//
+// The point resolves, per lattice point, to one or two weighted pyramid
+// values: a corner, an interior sample, or an edge's nodes i and i + 1 at
+// fraction fr (a face finer than its edge interpolates the edge: the
+// continuity rule; nearest takes the closer node, the upper on a tie).
+// Every case is computed and the right one selected rather than branched
+// to, and the fetch is in one place: SwiftShader runs four fragments in
+// lock step through every path any of them takes, and GLSL inlines every
+// call, so a shader shaped like the CPU's call graph (a fetch and an early
+// return at each call site) compiled for seconds and drew 20x slower, for
+// the same arithmetic.
+//
+// The products associate as the CPU's: for nearest, linear and most MIP
+// lookups each value adds (w_t x node weight) x value; where the CPU's MIP
+// map reads its per-face cache of lattice values (a MIP lookup inside, at
+// q <= n or at least the corners' finest level), each lattice value is
+// formed first, then weighted.
 vec4 levelValue(Place at, int q, bool nearest, bool mipOrder) {
-  int cornerLevel = max(face.vl[0], max(face.vl[1], face.vl[2]));
-  bool cached = mipOrder && at.kind == 2 && !(q > face.n && q < cornerLevel);
+  int cornerLevel = max(face.vl.x, max(face.vl.y, face.vl.z));
+  bool inside = at.kind == 2;
+  bool cached = mipOrder && inside && !(q > face.n && q < cornerLevel);
   int lf = min(q, face.n);
-  uvec3 p[3];
-  vec3 w = vec3(1.0, 0.0, 0.0);
-  int points = 1, best = 0;
-  if (at.kind == 2) {
-    lattice3(at.c, uint(1 << lf), p, w);
-    points = 3;
-    // Nearest: the largest weight, the first on a tie.
-    best = (w.x >= w.y && w.x >= w.z) ? 0 : (w.y >= w.z ? 1 : 2);
-  }
+  uint r = uint(1 << lf);
+  uvec3 p0, p1, p2;
+  vec3 w;
+  lattice3(at.c, r, p0, p1, p2, w);
+  // Nearest: the largest weight, the first on a tie.
+  int best = (w.x >= w.y && w.x >= w.z) ? 0 : (w.y >= w.z ? 1 : 2);
   vec4 acc = vec4(0.0);
-  for (int t = 0; t < points; t++) {
-    if (nearest && t != best) continue;
-    Taps tp;
-    if (at.kind == 0) tp = one(cornerIndex(at.k, q), 1.0);
-    else if (at.kind == 1) tp = placeEdgeTaps(at.k, at.t, q, nearest);
-    else tp = latticeTaps(q, lf, p[t], cached || nearest ? 1.0 : w[t], nearest);
+  for (int t = 0; t < (inside ? 3 : 1); t++) {
+    if (inside && nearest && t != best) continue;
+    uvec3 a = t == 0 ? p0 : (t == 1 ? p1 : p2);
+    float wt = !inside || cached || nearest ? 1.0 : pick(w, t);
+    bvec3 atCorner = equal(a, uvec3(r)), zero = equal(a, uvec3(0u));
+    bool isCorner = inside ? any(atCorner) : at.kind == 0;
+    bool isEdge = inside ? !isCorner && any(zero) : at.kind == 1;
+    int ck = inside ? (atCorner.x ? 0 : (atCorner.y ? 1 : 2)) : at.k;
+    int ek = inside ? (zero.x ? 1 : (zero.y ? 2 : 0)) : at.k;  // opposite the zero
+    int le = min(q, pick(face.el, ek));
+    // On the edge: a lattice point at canonical position p / 2^lf, exact
+    // in steps of the edge's 2^-le; a placed point at parameter at.t.
+    uint s = pick(a, (ek + 1) % 3);
+    uint p = pick(face.fwd, ek) ? s : r - s;
+    int d = max(lf - le, 0);
+    float x = at.t * float(1 << le);
+    uint i = inside ? p >> uint(d) : min(uint(x), uint(1 << le) - 1u);
+    float fr = inside ? float(p & uint((1 << d) - 1)) / float(1 << d) : x - float(i);
+    bool two = isEdge && !nearest && (fr != 0.0 || !inside);
+    uint i0 = isCorner ? cornerIndex(ck, q)
+      : isEdge ? nodeIndex(ek, q, le, i + (nearest && fr >= 0.5 ? 1u : 0u))
+      : face.F + faceLevelOffset(lf) + interiorIndex(r, a.x, a.y);
+    uint i1 = nodeIndex(ek, q, le, i + 1u);
+    vec2 tw = two ? vec2(wt * (1.0 - fr), wt * fr) : vec2(wt, 0.0);
     vec4 v = vec4(0.0);
-    for (int j = 0; j < tp.n; j++) {
-      vec4 x = tp.w[j] * value(tp.i[j]);
-      if (cached) v += x; else acc += x;
+    for (int j = 0; j < (two ? 2 : 1); j++) {
+      vec4 y = (j == 0 ? tw.x : tw.y) * value(j == 0 ? i0 : i1);
+      if (cached) v += y; else acc += y;
     }
-    if (cached) acc += w[t] * v;
+    if (cached) acc += pick(w, t) * v;
   }
   return acc;
 }
@@ -263,7 +245,7 @@ float levelOfFootprint(float w) {
 // a MIP level lambda = that level: one level each (frac = 0).
 vec4 probe(vec3 b, float lambda, bool nearest, bool mipOrder) {
   Place at = place(b);
-  int top = at.kind == 0 ? face.vl[at.k] : (at.kind == 1 ? face.el[at.k] : face.n);
+  int top = at.kind == 0 ? pick(face.vl, at.k) : (at.kind == 1 ? pick(face.el, at.k) : face.n);
   float l0 = floor(lambda);
   float frac = lambda - l0;
   int l = int(l0);
@@ -350,6 +332,10 @@ void main() {
     return;
   }
   decode(vFace);
+  rowTexels = uint(textureSize(samples, 0).x);
+#ifdef TWIN_ROW_WIDTH
+  rowTexels -= 1u;           // the wrong twin: rows one texel short
+#endif
   vec4 v = filtered(vBary, dx, dy);
   vec3 rgb;
   if (display == 0) rgb = vec3(srgb(v.r), srgb(v.g), srgb(v.b));
