@@ -18,7 +18,7 @@
 //   mc.setLayout(parts);                   // {width, channels, samples, faces}
 //   mc.updateRects(changes, parts);        // after GpuLayout::update
 //   mc.draw(viewProj, { filter: 'trilinear' });
-//   const hit = mc.pick(viewProj, x, y);  // face and barycentrics under a pixel
+//   const hit = mc.pick(viewProj, x, y, w, h);  // face and barycentrics under a pixel
 
 // Face table words (gpu.rs, "Face table"): w0 = F, w1..w3 = V_k, w4..w6 =
 // E_k, w7 = packed levels and edge directions.
@@ -273,7 +273,7 @@ float metric(vec3 d) {
 // takes the derivatives themselves (MipMap::anisotropic's db_dx, db_dy):
 // up to maxSamples probes along the longer axis, clamped into the face, at
 // the level of the shorter axis. One probe call site for all filters
-// keeps the program small (see Taps).
+// keeps the program small (see levelValue).
 vec4 filtered(vec3 b, vec3 dx, vec3 dy) {
   bool nearest = filterMode == 0, mipOrder = filterMode >= 2;
   float lambda = filterMode <= 1 ? float(FINEST)
