@@ -9,6 +9,7 @@ mod gltf_clients;
 mod gltf_out;
 mod help;
 mod info_warnings;
+mod paint_browser;
 mod paint_protocol;
 mod paint_shader;
 mod tet_cli;
