@@ -75,7 +75,7 @@ impl App for Worker {
     }
 
     fn begin(&mut self, out: &Outbox) {
-        self.send_all(out, &[]);
+        self.publish_all(out);
     }
 
     fn handle(&mut self, first: (ReplyTo, Request), inbox: &mut Inbox<Request>, out: &Outbox) {
@@ -107,7 +107,7 @@ impl Worker {
         match self.session.refine(cancel) {
             Ok((reports, true)) => {
                 self.send_radiance(out, true, 0);
-                self.send_status(out, &[], "refine", &reports, t, c, false);
+                publish_status(out, self.status(&[], "refine", &reports, t, c, false));
             }
             Ok((_, false)) => {}
             Err(e) => {
@@ -185,7 +185,7 @@ impl Worker {
         }
         self.send_radiance(out, !self.session.needs_refinement(), last);
         let coarse = self.session.needs_refinement();
-        self.send_status(out, &seqs, name, &reports, t, c, coarse);
+        publish_status(out, self.status(&seqs, name, &reports, t, c, coarse));
     }
 
     fn other(&mut self, out: &Outbox, to: ReplyTo, r: Request) {
@@ -194,7 +194,12 @@ impl Worker {
         let c = cpu_ms();
         match r {
             Request::Edit(..) => {}
-            Request::Hello => self.send_all(out, &[seq]),
+            // The page got the state when it connected (the snapshot):
+            // the answer is a status for its seq, to it alone.
+            Request::Hello => {
+                let status = self.status(&[seq], "hello", &[], t, c, false);
+                out.reply(to, Out::Text(status));
+            }
             Request::Undo | Request::Redo => {
                 let undo = matches!(r, Request::Undo);
                 let result = if undo {
@@ -209,7 +214,7 @@ impl Worker {
                         }
                         self.send_radiance(out, true, seq);
                         let name = if undo { "undo" } else { "redo" };
-                        self.send_status(out, &[seq], name, &[], t, c, false);
+                        publish_status(out, self.status(&[seq], name, &[], t, c, false));
                     }
                     Ok(None) => error(
                         out,
@@ -421,36 +426,37 @@ impl Worker {
         (lo, hi)
     }
 
-    /// Everything a page needs; the status answers `seqs` (a hello's).
-    fn send_all(&mut self, out: &Outbox, seqs: &[u64]) {
+    /// Everything a page needs, into the snapshot's slots.
+    fn publish_all(&mut self, out: &Outbox) {
         out.publish(HELLO, vec![Out::Text(self.hello())]);
         publish_surfaces(out, &self.session);
         self.send_radiance(out, !self.session.needs_refinement(), 0);
-        self.send_status(out, seqs, "hello", &[], Instant::now(), cpu_ms(), false);
+        publish_status(
+            out,
+            self.status(&[], "hello", &[], Instant::now(), cpu_ms(), false),
+        );
     }
 
     fn send_radiance(&mut self, out: &Outbox, refined: bool, seq: u64) {
         publish_radiance(out, &self.session, refined, seq);
     }
 
-    #[expect(
-        clippy::too_many_arguments,
-        reason = "the status's parts, each from its caller"
-    )]
-    fn send_status(
-        &mut self,
-        out: &Outbox,
+    /// The status: `seqs` answered by `edit` (with its solve `reports`,
+    /// timed from `start` and `cpu_start`), the session's counts, history
+    /// and memory.
+    fn status(
+        &self,
         seqs: &[u64],
         edit: &str,
         reports: &[SolveReport],
         start: Instant,
         cpu_start: f64,
         coarse: bool,
-    ) {
+    ) -> String {
         let s = &self.session;
         let (done, redo) = s.history();
         let memory = s.undo_memory();
-        let status = json!({
+        json!({
             "type": "status",
             "seqs": seqs,
             "edit": edit,
@@ -479,8 +485,7 @@ impl Worker {
             "hierarchy_builds": s.pieces().iter().map(|o| o.hierarchy_builds()).collect::<Vec<_>>(),
             "lights": lights_json(s, &self.envs),
         })
-        .to_string();
-        out.publish(STATUS, vec![Out::Text(status)]);
+        .to_string()
     }
 }
 
@@ -490,6 +495,11 @@ enum Refused {
     Exists(PathBuf),
     /// The writer's error.
     Failed(String),
+}
+
+/// Sends the status to every page and keeps it for later ones.
+fn publish_status(out: &Outbox, status: String) {
+    out.publish(STATUS, vec![Out::Text(status)]);
 }
 
 /// The export of kind `glb`: the pieces' boundary surfaces with their

@@ -909,3 +909,29 @@ async fn a_tet_exports_ele_in_the_way_asks_to_replace_it() {
     );
     r.stop().await.unwrap();
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_pages_hello_is_answered_by_a_status_to_it_alone_not_the_whole_state_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = server(dir.path()).await;
+    let (mut a, mut b) = (connect(&r).await, connect(&r).await);
+    let mut seen = Seen::default();
+    // The snapshot: hello, the surface, the radiance, the status.
+    until(&mut a, "status", &mut seen).await;
+    assert_eq!((seen.surfaces, seen.radiance), (1, 1));
+    // The first solve's refinement, to both.
+    for s in [&mut a, &mut b] {
+        drain(s, Duration::from_secs(1)).await;
+    }
+    send(&mut a, json!({"seq": 9, "op": "hello"})).await;
+    let mut after = Seen::default();
+    let status = until(&mut a, "status", &mut after).await;
+    assert_eq!(status["seqs"], json!([9]), "{status}");
+    assert_eq!(
+        (after.texts.len(), after.surfaces, after.radiance),
+        (1, 0, 0)
+    );
+    let on_b = drain(&mut b, Duration::from_millis(500)).await;
+    assert!(on_b.is_empty(), "b got {on_b:?}");
+    r.stop().await.unwrap();
+}
