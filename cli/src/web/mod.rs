@@ -96,8 +96,8 @@ pub struct Limits {
     pub text: usize,
     /// Largest binary message, bytes (0: none accepted).
     pub binary: usize,
-    /// Text messages per second a connection may send on average, and in
-    /// a burst.
+    /// Messages (text or binary) per second a connection may send on
+    /// average, and in a burst.
     pub rate: (f64, f64),
 }
 

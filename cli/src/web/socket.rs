@@ -109,8 +109,10 @@ async fn websocket<A: App>(
     if !headers.contains_key(header::ORIGIN) {
         return (StatusCode::FORBIDDEN, MISSING_ORIGIN).into_response();
     }
-    // Binary messages (uploads) are the only large ones; text is held to
-    // its limit below.
+    // The socket buffers a message up to the larger limit before it
+    // knows its kind (tungstenite has one limit for both): an app with no
+    // binary messages buffers no more than its text limit; a text
+    // message between the two limits is refused below, after buffering.
     let largest = A::LIMITS.binary.max(A::LIMITS.text);
     let conn = s.next_conn.fetch_add(1, Ordering::Relaxed);
     ws.max_message_size(largest)
@@ -203,10 +205,14 @@ impl Bucket {
     }
 }
 
+/// The error of a message over the rate limit.
+const DROPPED: &str = "too many messages; this one was dropped";
+
 /// One message from the page: a request is queued for the app; anything
 /// wrong is answered with an error naming the field, and the connection
-/// goes on. Binary messages are not rate-limited: the app's
-/// [`App::parse_binary`] checks them instead.
+/// goes on. Text and binary messages take from one rate bucket; the
+/// app's [`App::parse_binary`] checks a binary message's size and
+/// content.
 async fn receive<A: App>(
     socket: &mut WebSocket,
     s: &Server<A>,
@@ -223,6 +229,9 @@ async fn receive<A: App>(
         Message::Text(t) => t,
         Message::Close(_) => return Flow::Close,
         Message::Ping(_) | Message::Pong(_) => return Flow::Continue,
+        Message::Binary(_) if !bucket.take() => {
+            return reply(socket, json::error(None, "(rate)", DROPPED)).await;
+        }
         Message::Binary(b) => {
             return match A::parse_binary(&b) {
                 Ok((seq, request)) => submit(s, conn, Some(seq), request),
@@ -234,7 +243,7 @@ async fn receive<A: App>(
     // The sequence number of a message refused as a whole, when it has one.
     let seq = value.as_ref().ok().and_then(json::seq_of);
     if !bucket.take() {
-        let dropped = json::error(seq, "(rate)", "too many messages; this one was dropped");
+        let dropped = json::error(seq, "(rate)", DROPPED);
         return reply(socket, dropped).await;
     }
     let parsed = value.and_then(|v| {

@@ -339,6 +339,22 @@ async fn a_flood_is_refused_by_rate_per_connection() {
         echoed >= 10 && dropped >= 10,
         "{echoed} echoed, {dropped} dropped"
     );
+    // Binary messages take from the same bucket.
+    tokio::time::sleep(Duration::from_secs(1)).await;
+    for _ in 0..40 {
+        s.send(Message::Binary(vec![1u8; 8].into())).await.unwrap();
+    }
+    let mut binary_dropped = 0;
+    for _ in 0..40 {
+        let m = text(&mut s).await;
+        if m["field"] == "(rate)" {
+            binary_dropped += 1;
+        }
+    }
+    assert!(
+        binary_dropped >= 10,
+        "{binary_dropped} binary messages dropped"
+    );
     // Another page has its own bucket.
     let mut other = opened(&r).await;
     send(&mut other, json!({"seq": 1, "op": "echo", "text": "mine"})).await;
