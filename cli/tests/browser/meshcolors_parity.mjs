@@ -245,10 +245,14 @@ const logs = [];
 try {
   const page = await browser.newPage({ viewport: { width: 1200, height: 1200 } });
   page.on('console', (m) => logs.push(m.text()));
+  // An error on the page (a module that does not load, a shader that
+  // does not compile) ends the run at once instead of at the timeout.
+  const failed = new Promise((_, reject) => page.on('pageerror', (e) => reject(e)));
+  failed.catch(() => {});
   page.on('pageerror', (e) => logs.push('pageerror: ' + e.message));
   out.launch_ms = Date.now() - started;
   await page.goto(`http://127.0.0.1:${server.address().port}/`);
-  await page.waitForFunction(() => window.ready === true, null, { timeout: 60000 });
+  await Promise.race([page.waitForFunction(() => window.ready === true, null, { timeout: 60000 }), failed]);
   out.ready_ms = Date.now() - started;
   if (bench) {
     out.bench = await page.evaluate((n) => window.bench(n), 40);
