@@ -290,6 +290,7 @@ $('applyLevel').onclick = () => net.send('resolution', { level: Number($('level'
 $('help').onclick = () => { $('helpbox').hidden = !$('helpbox').hidden; };
 $('filter').onchange = () => { dirty = true; };
 $('channel').onchange = () => { dirty = true; };
+$('shade').onchange = () => { dirty = true; };
 
 addEventListener('keydown', (e) => {
   if (e.target.tagName === 'INPUT' && e.target.type !== 'range' && e.target.type !== 'checkbox') return;
@@ -323,6 +324,7 @@ function frame() {
   renderer.draw(state.camera.viewProj(canvas.width / canvas.height), {
     filter: $('filter').value,
     display: k === 0 ? 'color' : 'heat', channel: k === 0 ? 0 : k + 2,
+    shade: $('shade').checked ? 0.6 : 0, eye: state.camera.eye(),
   });
   state.frames++;
   state.ready = true;

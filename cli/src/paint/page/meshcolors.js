@@ -27,7 +27,9 @@ in vec3 position;
 uniform mat4 viewProj;
 flat out int vFace;
 out vec3 vBary;
+out vec3 vWorld;
 void main() {
+  vWorld = position;
   // drawArrays from 0: vertex 3f + k is corner k of face f.
   vFace = gl_VertexID / 3;
   int k = gl_VertexID - 3 * vFace;
@@ -57,6 +59,9 @@ uniform bool tagAlpha;       // alpha = (face id mod 255 + 1) / 255, never 0 (le
 
 flat in int vFace;
 in vec3 vBary;
+in vec3 vWorld;
+uniform float shade;         // 0: the colours as stored; > 0: lit by a headlight,
+uniform vec3 eye;            // darker by up to shade where the surface turns away
 layout(location = 0) out vec4 out0;
 layout(location = 1) out vec4 out1;
 layout(location = 2) out vec4 out2;
@@ -337,10 +342,18 @@ void main() {
   rowTexels -= 1u;           // the wrong twin: rows one texel short
 #endif
   vec4 v = filtered(vBary, dx, dy);
+  // The painter's view lit from the eye, so the shape reads (the parity
+  // test and exports see shade = 0: the colours alone). The face's own
+  // normal from screen derivatives: flat per face, no attribute needed.
+  float light = 1.0;
+  if (shade > 0.0) {
+    vec3 n = normalize(cross(dFdx(vWorld), dFdy(vWorld)));
+    light = 1.0 - shade * (1.0 - abs(dot(n, normalize(eye - vWorld))));
+  }
   vec3 rgb;
-  if (display == 0) rgb = vec3(srgb(v.r), srgb(v.g), srgb(v.b));
-  else if (display == 1) rgb = vec3(srgb(v[component]));
-  else rgb = heat(v[component]);
+  if (display == 0) rgb = vec3(srgb(light * v.r), srgb(light * v.g), srgb(light * v.b));
+  else if (display == 1) rgb = vec3(srgb(light * v[component]));
+  else rgb = light * heat(v[component]);
   out0 = vec4(rgb, tagAlpha ? float(vFace % 255 + 1) / 255.0 : 1.0);
 }`;
 
@@ -386,7 +399,7 @@ export class MeshColorsRenderer {
     this.program = link(gl, defines);
     this.loc = {};
     for (const u of ['viewProj', 'samples', 'faces', 'perValue', 'group', 'filterMode', 'level', 'maxSamples',
-      'display', 'component', 'heatRange', 'outputMode', 'tagAlpha'])
+      'display', 'component', 'heatRange', 'outputMode', 'tagAlpha', 'shade', 'eye'])
       this.loc[u] = gl.getUniformLocation(this.program, u);
     this.vao = gl.createVertexArray();
     this.buffer = gl.createBuffer();
@@ -477,7 +490,9 @@ export class MeshColorsRenderer {
    * the caller's). viewProj: column-major 4x4. opts: filter (a FILTERS
    * name), level (for 'level'), maxSamples (anisotropic, default 8),
    * display ('color' the RGB of channels 0-2, 'grey' or 'heat' of
-   * `channel`), channel, range ([lo, hi] of the heat map), tagAlpha.
+   * `channel`), channel, range ([lo, hi] of the heat map), tagAlpha,
+   * shade (0 to 1: how much darker a face turned away from `eye` is; 0,
+   * the default, draws the colours alone) and eye (the camera's position).
    */
   draw(viewProj, opts = {}) {
     const gl = this.gl, loc = this.loc;
@@ -493,6 +508,8 @@ export class MeshColorsRenderer {
     gl.uniform1i(loc.component, channel % 4);
     gl.uniform2fv(loc.heatRange, opts.range || [0, 1]);
     gl.uniform1i(loc.tagAlpha, opts.tagAlpha ? 1 : 0);
+    gl.uniform1f(loc.shade, opts.shade || 0);
+    gl.uniform3fv(loc.eye, opts.eye || [0, 0, 0]);
     this.drawArrays();
   }
 
