@@ -25,6 +25,8 @@ mod sample;
 mod tetra;
 #[cfg(feature = "view")]
 mod view;
+#[cfg(feature = "web")]
+mod web;
 
 pub(crate) type Result<T> = std::result::Result<T, Error>;
 

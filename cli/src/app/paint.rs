@@ -90,12 +90,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             autosave.display()
         );
     }
-    if !args.host.is_loopback() {
-        eprintln!(
-            "warning: listening on {}: other machines that can reach it may open the page (with its token)",
-            args.host
-        );
-    }
+    super::web::warn_host(args.host);
     let faces = doc.surface.faces.len();
     let options = Options {
         host: args.host,
@@ -104,29 +99,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         autosave: Some(autosave),
         ..Default::default()
     };
-    let runtime = tokio::runtime::Runtime::new()
-        .map_err(|e| super::invalid(format!("the server's runtime: {e}")))?;
-    runtime.block_on(async move {
-        let running = trilux::paint::start(doc, log, options)
-            .await
-            .map_err(super::invalid)?;
-        let url = running.url();
-        if context.json {
-            println!(
-                "{}",
-                json!({"command": "paint", "url": url, "faces": faces})
-            );
-        } else {
-            println!("trilux paint: {faces} faces; open {url}  (Ctrl+C stops)");
-        }
-        if args.open {
-            super::open_browser(&url);
-        }
-        running
-            .wait(true)
-            .await
-            .map_err(|e| super::invalid(format!("the server: {e}")))
-    })
+    let start = trilux::paint::start(doc, log, options);
+    super::web::serve(context, "paint", (faces, "faces"), args.open, start)
 }
 
 /// Channel names: plain words, none repeated, not "color".

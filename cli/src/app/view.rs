@@ -331,20 +331,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             "no such folder (for --export-dir)",
         ));
     }
-    if !args.host.is_loopback() {
-        eprintln!(
-            "warning: listening on {}: other machines that can reach it may open the page (with its token)",
-            args.host
-        );
-        // The printed URL holds the unspecified address, which only works
-        // on this machine.
-        if args.host.is_unspecified() {
-            eprintln!(
-                "note: from another machine, use this machine's IP address in place of {} in the URL",
-                args.host
-            );
-        }
-    }
+    super::web::warn_host(args.host);
     let options = trilux::view::Options {
         host: args.host,
         port: args.port,
@@ -352,30 +339,9 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         environments,
         ..Default::default()
     };
-    let runtime = tokio::runtime::Runtime::new()
-        .map_err(|e| super::invalid(format!("the server's runtime: {e}")))?;
     let tets = object.mesh().tets().len();
-    runtime.block_on(async move {
-        let running = trilux::view::start(object, source, log, options, Box::new(Cli))
-            .await
-            .map_err(super::invalid)?;
-        let url = running.url();
-        if context.json {
-            println!(
-                "{}",
-                json!({"command": "view", "url": url, "tetrahedra": tets})
-            );
-        } else {
-            println!("trilux view: {tets} tetrahedra; open {url}  (Ctrl+C stops)");
-        }
-        if args.open {
-            open_browser(&url);
-        }
-        running
-            .wait(true)
-            .await
-            .map_err(|e| super::invalid(format!("the server: {e}")))
-    })
+    let start = trilux::view::start(object, source, log, options, Box::new(Cli));
+    super::web::serve(context, "view", (tets, "tetrahedra"), args.open, start)
 }
 
 /// Copies the environment maps a replayed session file names into the
@@ -389,22 +355,4 @@ fn copy_environments(session: &Path, envs: &EnvFiles, export_dir: &Path) -> Resu
         }
     }
     Ok(())
-}
-
-/// Asks the desktop to open `url` (xdg-open, open, or start).
-fn open_browser(url: &str) {
-    let command = if cfg!(target_os = "macos") {
-        "open"
-    } else if cfg!(windows) {
-        "explorer"
-    } else {
-        "xdg-open"
-    };
-    if std::process::Command::new(command)
-        .arg(url)
-        .spawn()
-        .is_err()
-    {
-        eprintln!("could not start {command}; open the URL yourself");
-    }
 }
