@@ -12,13 +12,11 @@ use std::time::Duration;
 use futures_util::{SinkExt, StreamExt};
 use serde_json::{Value, json};
 use tokio_tungstenite::tungstenite::Message;
-use tokio_tungstenite::tungstenite::client::IntoClientRequest;
 use trilux::ColorMesh;
 use trilux::mesh_colors::MeshColors;
 use trilux::paint::{Document, Options, Running};
 
-type Socket =
-    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+use crate::common::web::{Socket, send};
 
 /// The built-in blob at resolution 8, grey, with a `density` channel.
 fn document() -> Document {
@@ -48,14 +46,7 @@ async fn server(dir: &std::path::Path) -> Running {
 }
 
 async fn connect(r: &Running) -> Socket {
-    let mut request = format!("ws://{}/{}/ws", r.addr, r.token)
-        .into_client_request()
-        .unwrap();
-    let origin = format!("http://{}", r.addr);
-    request
-        .headers_mut()
-        .insert("Origin", origin.parse().unwrap());
-    tokio_tungstenite::connect_async(request).await.unwrap().0
+    crate::common::web::connect(&r.addr.to_string(), &r.token).await
 }
 
 /// What came: JSON messages and the binary frames' kinds.
@@ -88,10 +79,6 @@ async fn until(s: &mut Socket, kind: &str, seen: &mut Seen) -> Value {
             _ => {}
         }
     }
-}
-
-async fn send(s: &mut Socket, v: Value) {
-    s.send(Message::Text(v.to_string().into())).await.unwrap();
 }
 
 /// The status answering `seq`.

@@ -11,15 +11,12 @@ use futures_util::{SinkExt, StreamExt};
 use serde_json::{Value, json};
 use tet_diffusion::glam::DVec3;
 use tet_diffusion::{Light, Session};
-use tokio::io::{AsyncReadExt, AsyncWriteExt};
-use tokio_tungstenite::tungstenite::client::IntoClientRequest;
 use tokio_tungstenite::tungstenite::{self, Message};
 use trilux::view::protocol::{self, ExportKind};
 use trilux::view::session_file;
 use trilux::view::{Exporter, Options, Running, builtin};
 
-type Socket =
-    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+use crate::common::web::{self, Socket, send, send_raw};
 
 /// Writes a small text file for pictures (the real renderer is the
 /// binary's), atomically, refusing to overwrite.
@@ -80,19 +77,11 @@ async fn connect_with(
     token: &str,
     origin: Option<&str>,
 ) -> Result<Socket, tungstenite::Error> {
-    let url = format!("ws://{}/{}/ws", r.addr, token);
-    let mut request = url.into_client_request()?;
-    if let Some(o) = origin {
-        request.headers_mut().insert("Origin", o.parse().unwrap());
-    }
-    tokio_tungstenite::connect_async(request)
-        .await
-        .map(|(s, _)| s)
+    web::connect_with(&r.addr.to_string(), token, origin).await
 }
 
 async fn connect(r: &Running) -> Socket {
-    let origin = format!("http://{}", r.addr);
-    connect_with(r, &r.token, Some(&origin)).await.unwrap()
+    web::connect(&r.addr.to_string(), &r.token).await
 }
 
 /// Reads messages until a JSON one of type `kind` (others are kept in
@@ -163,31 +152,8 @@ enum Frame {
     Radiance(u64),
 }
 
-async fn send(s: &mut Socket, v: Value) {
-    s.send(Message::Text(v.to_string().into())).await.unwrap();
-}
-
-async fn send_raw(s: &mut Socket, text: String) -> Result<(), tungstenite::Error> {
-    s.send(Message::Text(text.into())).await
-}
-
-/// A raw HTTP/1.1 GET; returns the status code and body.
 async fn get(r: &Running, path: &str, host: &str, origin: Option<&str>) -> (u16, String) {
-    // A server on every interface (0.0.0.0) is reached through loopback.
-    let mut to = r.addr;
-    if to.ip().is_unspecified() {
-        to.set_ip(std::net::Ipv4Addr::LOCALHOST.into());
-    }
-    let mut c = tokio::net::TcpStream::connect(to).await.unwrap();
-    let origin = origin.map_or(String::new(), |o| format!("Origin: {o}\r\n"));
-    let req = format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n{origin}Connection: close\r\n\r\n");
-    c.write_all(req.as_bytes()).await.unwrap();
-    let mut out = Vec::new();
-    c.read_to_end(&mut out).await.unwrap();
-    let text = String::from_utf8_lossy(&out).to_string();
-    let code = text[9..12].parse().unwrap();
-    let body = text.split_once("\r\n\r\n").map_or("", |x| x.1).to_string();
-    (code, body)
+    web::get(r.addr, path, host, origin).await
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

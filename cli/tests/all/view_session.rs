@@ -11,13 +11,11 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
-use futures_util::{SinkExt, StreamExt};
+use futures_util::StreamExt;
 use serde_json::{Value, json};
 use tokio_tungstenite::tungstenite::Message;
-use tokio_tungstenite::tungstenite::client::IntoClientRequest;
 
-type Socket =
-    tokio_tungstenite::WebSocketStream<tokio_tungstenite::MaybeTlsStream<tokio::net::TcpStream>>;
+use crate::common::web::{Socket, connect, send};
 
 fn trilux() -> Command {
     Command::new(env!("CARGO_BIN_EXE_trilux"))
@@ -51,16 +49,6 @@ fn view(dir: &Path, args: &[&str]) -> (Child, String, String) {
     )
 }
 
-async fn connect(addr: &str, token: &str) -> Socket {
-    let mut request = format!("ws://{addr}/{token}/ws")
-        .into_client_request()
-        .unwrap();
-    request
-        .headers_mut()
-        .insert("Origin", format!("http://{addr}").parse().unwrap());
-    tokio_tungstenite::connect_async(request).await.unwrap().0
-}
-
 /// The next JSON message for which `pick` holds (binary frames and other
 /// messages are skipped); an error message fails the test.
 async fn until(s: &mut Socket, pick: impl Fn(&Value) -> bool) -> Value {
@@ -78,10 +66,6 @@ async fn until(s: &mut Socket, pick: impl Fn(&Value) -> bool) -> Value {
             }
         }
     }
-}
-
-async fn send(s: &mut Socket, v: Value) {
-    s.send(Message::Text(v.to_string().into())).await.unwrap();
 }
 
 fn status_of(seq: u64) -> impl Fn(&Value) -> bool {

@@ -9,6 +9,9 @@ use std::path::PathBuf;
 
 use assert_cmd::Command;
 
+#[cfg(feature = "web")]
+pub(crate) mod web;
+
 /// The `trilux` binary of this package, which cargo builds once before
 /// the tests (no nested `cargo build`).
 pub(crate) fn trilux_bin() -> PathBuf {
