@@ -82,8 +82,7 @@ fn three_script() -> Option<(PathBuf, String)> {
         if Command::new("node").arg("--version").output().is_err() {
             return Err("no node".into());
         }
-        let script = dir.join("three_gltf.mjs");
-        std::fs::copy(root().join("cli/tests/browser/three_gltf.mjs"), &script).unwrap();
+        let script = crate::common::browser_script("three_gltf.mjs");
         Ok((script, browser))
     });
     match found {

@@ -104,8 +104,7 @@ async fn the_page_paints_picks_adds_detail_undoes_saves_and_exports_in_chromium(
     if Command::new("node").arg("--version").output().is_err() {
         return missing("no node");
     }
-    let script = root.join("target/browser-e2e/paint.mjs");
-    std::fs::copy(root.join("cli/tests/browser/paint.mjs"), &script).unwrap();
+    let script = crate::common::browser_script("paint.mjs");
     let tmp = tempfile::tempdir().unwrap();
     let shots = std::env::var("TRILUX_SCREENSHOTS")
         .map(PathBuf::from)

@@ -82,13 +82,7 @@ impl Harness {
         if Command::new("node").arg("--version").output().is_err() {
             return Err("no node".into());
         }
-        // Beside node_modules, so that its import of playwright-core resolves.
-        let script = root.join("target/browser-e2e/meshcolors_parity.mjs");
-        std::fs::copy(
-            root.join("cli/tests/browser/meshcolors_parity.mjs"),
-            &script,
-        )
-        .unwrap();
+        let script = crate::common::browser_script("meshcolors_parity.mjs");
         Ok(Self {
             browser,
             script,

@@ -41,11 +41,7 @@ async fn the_page_cuts_paints_relights_undoes_and_redoes_in_chromium() {
         return missing("no node");
     }
     let script_dir = root.join("target/browser-e2e");
-    std::fs::copy(
-        root.join("cli/tests/browser/e2e.mjs"),
-        script_dir.join("e2e.mjs"),
-    )
-    .unwrap();
+    crate::common::browser_script("e2e.mjs");
     let shots = tempfile::tempdir().unwrap();
     let dir = std::env::var("TRILUX_SCREENSHOTS")
         .map(PathBuf::from)

@@ -3,14 +3,10 @@
 // environment map, a GLB export, screenshot. Prints one JSON object with what it saw; the Rust test
 // asserts on it. Usage: node e2e.mjs URL SCREENSHOT_DIR [first-frame]
 // (first-frame: only load the page and time its first frame with radiance).
-import { chromium } from 'playwright-core';
+import { launch } from './lib.mjs';
 
 const [url, dir, only] = process.argv.slice(2);
-const browser = await chromium.launch({
-  executablePath: process.env.TRILUX_BROWSER || '/usr/bin/chromium',
-  args: ['--headless', '--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader-webgl',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
-});
+const browser = await launch();
 const out = { steps: {} };
 const consoleErrors = [];
 try {

@@ -29,7 +29,7 @@
 // each timed with gl.finish(). Prints {bench: {...}}.
 //
 // Prints one JSON object on stdout; {error} when something failed.
-import { chromium } from 'playwright-core';
+import { launch } from './lib.mjs';
 import { createServer } from 'node:http';
 import { readFile, writeFile } from 'node:fs/promises';
 import path from 'node:path';
@@ -234,11 +234,7 @@ function serve() {
 }
 
 const server = await serve();
-const browser = await chromium.launch({
-  executablePath: process.env.TRILUX_BROWSER || '/usr/bin/chromium',
-  args: ['--headless', '--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader-webgl',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
-});
+const browser = await launch();
 const out = {};
 const started = Date.now();
 const logs = [];

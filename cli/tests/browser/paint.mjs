@@ -3,14 +3,10 @@
 // a GLB export through the page's buttons. Prints one JSON object with
 // what it saw; the Rust test (cli/tests/all/paint_browser.rs) asserts on
 // it. Usage: node paint.mjs URL SCREENSHOT_DIR [load-only]
-import { chromium } from 'playwright-core';
+import { launch } from './lib.mjs';
 
 const [url, dir, only] = process.argv.slice(2);
-const browser = await chromium.launch({
-  executablePath: process.env.TRILUX_BROWSER || '/usr/bin/chromium',
-  args: ['--headless', '--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader-webgl',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
-});
+const browser = await launch();
 const out = { steps: {} };
 const consoleErrors = [];
 try {

@@ -57,7 +57,7 @@
 //                left), rgba: [r, g, b, a] }] (--at and --world in the
 //                order given, then the grid row by row from the top),
 //     screenshot: PATH, console: [messages of the page], error?: string }
-import { chromium } from 'playwright-core';
+import { launch } from './lib.mjs';
 import { readFile } from 'node:fs/promises';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -225,11 +225,7 @@ const under = (root, rel) => {
 };
 
 const out = { console: [] };
-const browser = await chromium.launch({
-  executablePath: process.env.TRILUX_BROWSER || '/usr/bin/chromium',
-  args: ['--headless', '--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader-webgl',
-    '--disable-background-networking', '--disable-component-update', '--disable-sync', '--no-first-run'],
-});
+const browser = await launch();
 try {
   const tab = await browser.newPage({ viewport: { width: opts.size, height: opts.size }, deviceScaleFactor: 1 });
   tab.on('console', (m) => out.console.push(`${m.type()}: ${m.text()}`));

@@ -107,3 +107,20 @@ pub(crate) fn no_partial_files(dir: &Path) {
         assert!(!name.contains(".partial"), "left behind: {name}");
     }
 }
+
+/// Copies the browser script `name` from `cli/tests/browser/`, and the
+/// `lib.mjs` it imports, into `target/browser-e2e` (beside node_modules,
+/// so that their import of playwright-core resolves); the script's path
+/// there.
+pub(crate) fn browser_script(name: &str) -> PathBuf {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let (from, to) = (
+        root.join("cli/tests/browser"),
+        root.join("target/browser-e2e"),
+    );
+    for file in ["lib.mjs", name] {
+        std::fs::copy(from.join(file), to.join(file))
+            .unwrap_or_else(|e| panic!("copying {file} into {}: {e}", to.display()));
+    }
+    to.join(name)
+}
