@@ -344,3 +344,11 @@ async fn bad_messages_get_an_error_naming_the_field_and_change_nothing() {
     );
     r.stop().await.unwrap();
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_web_cores_guard_holds_for_paint() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = server(dir.path()).await;
+    crate::common::web::check_guard(r.addr, &r.token, "paint").await;
+    r.stop().await.unwrap();
+}

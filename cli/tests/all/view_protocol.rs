@@ -901,3 +901,11 @@ async fn a_pages_hello_is_answered_by_a_status_to_it_alone_not_the_whole_state_a
     assert!(on_b.is_empty(), "b got {on_b:?}");
     r.stop().await.unwrap();
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_web_cores_guard_holds_for_view() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = server(dir.path()).await;
+    web::check_guard(r.addr, &r.token, "view").await;
+    r.stop().await.unwrap();
+}

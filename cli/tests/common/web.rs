@@ -71,3 +71,48 @@ pub(crate) async fn get(
     let body = text.split_once("\r\n\r\n").map_or("", |x| x.1).to_string();
     (code, body)
 }
+
+/// The checks every web app's server must pass, whatever the app: the
+/// token (404 in the app's words without it, the token never in the
+/// body), `/TOKEN` redirected to `/TOKEN/`, a foreign `Host` or
+/// `Origin` refused (403), and a WebSocket only with the token and this
+/// server's `Origin`. `app` is the app's name (`view`).
+pub(crate) async fn check_guard(addr: SocketAddr, token: &str, app: &str) {
+    let host = addr.to_string();
+    let wrong = "f".repeat(token.len());
+    for path in [
+        "/".to_string(),
+        "/index.html".into(),
+        format!("/{wrong}/"),
+        format!("/{wrong}/net.js"),
+    ] {
+        let (code, body) = get(addr, &path, &host, None).await;
+        assert_eq!(code, 404, "{path}");
+        assert!(
+            body.starts_with(&format!("trilux {app}: this address needs the full URL")),
+            "{path}: {body}"
+        );
+        assert!(!body.contains(token), "{path}: the body reveals the token");
+    }
+    assert_eq!(get(addr, &format!("/{token}"), &host, None).await.0, 308);
+    for file in ["", "index.html", "net.js", "camera.js", "base.css"] {
+        let (code, _) = get(addr, &format!("/{token}/{file}"), &host, None).await;
+        assert_eq!(code, 200, "/TOKEN/{file}");
+    }
+    let (code, body) = get(addr, &format!("/{token}/"), "evil.example:80", None).await;
+    assert_eq!(code, 403);
+    assert!(
+        body.starts_with(&format!("trilux {app}: wrong Host header")),
+        "{body}"
+    );
+    let foreign = Some("http://evil.example");
+    assert_eq!(
+        get(addr, &format!("/{token}/"), &host, foreign).await.0,
+        403
+    );
+    let origin = format!("http://{host}");
+    assert!(connect_with(&host, &wrong, Some(&origin)).await.is_err());
+    assert!(connect_with(&host, token, foreign).await.is_err());
+    assert!(connect_with(&host, token, None).await.is_err());
+    assert!(connect_with(&host, token, Some(&origin)).await.is_ok());
+}
