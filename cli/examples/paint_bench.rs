@@ -97,7 +97,7 @@ fn document() -> (String, Document) {
         }
         None => {
             let surface = ColorMesh::new(&trilux::shapes::blob(5)).unwrap();
-            let mut colors = MeshColors::uniform(surface.topology().unwrap(), 16, 3).unwrap();
+            let mut colors = MeshColors::uniform(surface.topology().unwrap(), 8, 3).unwrap();
             colors.samples_mut().fill(0.8);
             ("the built-in blob".to_string(), surface, colors)
         }
@@ -147,11 +147,20 @@ fn main() {
         request
             .headers_mut()
             .insert("Origin", format!("http://{}", running.addr).parse().unwrap());
-        let socket = tokio_tungstenite::connect_async(request).await.unwrap().0;
+        // The whole samples texture comes first: tens of MB, as a page
+        // takes it.
+        let config = tokio_tungstenite::tungstenite::protocol::WebSocketConfig::default()
+            .max_message_size(Some(1 << 30))
+            .max_frame_size(Some(1 << 30));
+        let socket = tokio_tungstenite::connect_async_with_config(request, Some(config), false)
+            .await
+            .unwrap()
+            .0;
         let mut c = Client { socket, seq: 0 };
         let brush = json!({"mode": "mix", "channel": "color", "color": [0.9, 0.1, 0.1],
                            "strength": 1.0, "hardness": 0.5, "mirror": false, "eye": null});
-        let radius = 0.02 * diagonal;
+        // A brush of 1 % of the diagonal.
+        let radius = 0.01 * diagonal;
         let dab = |k: usize| {
             let p = positions[(k * 7919) % positions.len()];
             json!([p.x, p.y, p.z, radius, 1.0])
@@ -179,12 +188,19 @@ fn main() {
         let seq = c.send("end", json!({})).await;
         c.status(seq).await;
 
-        // 50 strokes of 20 dabs: undo memory against the colours'.
+        // 50 strokes of 20 dabs a quarter radius apart (each 5 radii, 5 %
+        // of the diagonal, long): undo memory against the colours'.
         let mut status = Value::Null;
         for s in 0..50 {
             let seq = c.send("begin", json!({"brush": brush})).await;
             c.status(seq).await;
-            let dabs: Vec<Value> = (0..20).map(|k| dab(5000 + 20 * s + k)).collect();
+            let start = positions[(s * 7919) % positions.len()];
+            let dabs: Vec<Value> = (0..20)
+                .map(|k| {
+                    let p = start + glam::Vec3::new(0.25 * radius * k as f32, 0.0, 0.0);
+                    json!([p.x, p.y, p.z, radius, 1.0])
+                })
+                .collect();
             c.send("dabs", json!({"dabs": dabs})).await;
             let seq = c.send("end", json!({})).await;
             status = c.status(seq).await.0;
