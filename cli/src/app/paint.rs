@@ -43,16 +43,8 @@ pub(crate) struct Args {
     /// Replay a session file the page exported (its edits, on this mesh).
     #[arg(long, value_name = "SESSION.json")]
     pub(crate) replay: Option<PathBuf>,
-    /// Port (default: a free one; the URL printed names it).
-    #[arg(long, default_value_t = 0, hide_default_value = true)]
-    pub(crate) port: u16,
-    /// Address to listen on; anything but 127.0.0.1 exposes the model to
-    /// the network (the token still guards it).
-    #[arg(long, default_value = "127.0.0.1")]
-    pub(crate) host: std::net::IpAddr,
-    /// Open the page in the system's browser.
-    #[arg(long)]
-    pub(crate) open: bool,
+    #[command(flatten)]
+    pub(crate) serve: super::web::ServeArgs,
     /// Folder saves, exports and the autosave are written to.
     #[arg(long, value_name = "DIR", default_value = ".")]
     pub(crate) export_dir: PathBuf,
@@ -90,17 +82,17 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             autosave.display()
         );
     }
-    super::web::warn_host(args.host);
+    super::web::warn_host(args.serve.host);
     let faces = doc.surface.faces.len();
     let options = Options {
-        host: args.host,
-        port: args.port,
+        host: args.serve.host,
+        port: args.serve.port,
         export_dir: args.export_dir.clone(),
         autosave: Some(autosave),
         ..Default::default()
     };
     let start = trilux::paint::start(doc, log, options);
-    super::web::serve(context, "paint", (faces, "faces"), args.open, start)
+    super::web::serve(context, "paint", (faces, "faces"), args.serve.open, start)
 }
 
 /// Channel names: plain words, none repeated, not "color".

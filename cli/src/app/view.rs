@@ -32,18 +32,8 @@ pub(crate) struct Args {
     /// under 5 units, as for scans in metres; 1 otherwise).
     #[arg(long, value_name = "X", allow_negative_numbers = true, value_parser = super::args::unit_mm)]
     pub(crate) unit_mm: Option<f64>,
-    /// Port (default: a free one; the URL printed names it).
-    // 0 asks the system for a free port; clap's "[default: 0]" would read
-    // as a port number.
-    #[arg(long, default_value_t = 0, hide_default_value = true)]
-    pub(crate) port: u16,
-    /// Address to listen on; anything but 127.0.0.1 exposes the object to
-    /// the network (the token still guards it).
-    #[arg(long, default_value = "127.0.0.1")]
-    pub(crate) host: std::net::IpAddr,
-    /// Open the page in the system's browser.
-    #[arg(long)]
-    pub(crate) open: bool,
+    #[command(flatten)]
+    pub(crate) serve: super::web::ServeArgs,
     /// Start from a session file the page exported (its source and edits).
     // The file names its own mesh, material and unit: given beside it they
     // would be ignored, so they are refused (as `diffuse --session` does).
@@ -331,17 +321,23 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             "no such folder (for --export-dir)",
         ));
     }
-    super::web::warn_host(args.host);
+    super::web::warn_host(args.serve.host);
     let options = trilux::view::Options {
-        host: args.host,
-        port: args.port,
+        host: args.serve.host,
+        port: args.serve.port,
         export_dir: args.export_dir.clone(),
         environments,
         ..Default::default()
     };
     let tets = object.mesh().tets().len();
     let start = trilux::view::start(object, source, log, options, Box::new(Cli));
-    super::web::serve(context, "view", (tets, "tetrahedra"), args.open, start)
+    super::web::serve(
+        context,
+        "view",
+        (tets, "tetrahedra"),
+        args.serve.open,
+        start,
+    )
 }
 
 /// Copies the environment maps a replayed session file names into the

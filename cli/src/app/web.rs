@@ -1,7 +1,7 @@
 //! What `trilux view` and `trilux paint` share on the command line around
-//! the web core (`trilux::web`): the warnings about the address, the URL
-//! line (or its `--json`), opening the browser, and waiting until the
-//! server stops.
+//! the web core (`trilux::web`): `--port`, `--host` and `--open`, the
+//! warnings about the address, the URL line (or its `--json`), opening
+//! the browser, and waiting until the server stops.
 
 use std::future::Future;
 use std::net::IpAddr;
@@ -9,6 +9,23 @@ use std::net::IpAddr;
 use serde_json::{Map, Value};
 
 use super::{Context, Result, invalid};
+
+/// Where a web app listens and whether its page is opened.
+#[derive(Debug, clap::Args)]
+pub(crate) struct ServeArgs {
+    /// Port (default: a free one; the URL printed names it).
+    // 0 asks the system for a free port; clap's "[default: 0]" would read
+    // as a port number.
+    #[arg(long, default_value_t = 0, hide_default_value = true)]
+    pub(crate) port: u16,
+    /// Address to listen on; anything but 127.0.0.1 exposes the page to
+    /// the network (the token still guards it).
+    #[arg(long, default_value = "127.0.0.1")]
+    pub(crate) host: IpAddr,
+    /// Open the page in the system's browser.
+    #[arg(long)]
+    pub(crate) open: bool,
+}
 
 /// Warns when `host` lets other machines reach the page.
 pub(crate) fn warn_host(host: IpAddr) {
