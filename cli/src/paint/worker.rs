@@ -46,6 +46,9 @@ pub(crate) struct Worker {
     /// Texel updates appended to the textures' slot since it was last
     /// folded.
     appended: usize,
+    /// A stroke is being painted (its updates are folded after it ends:
+    /// folding copies the whole texture).
+    stroke_open: bool,
     /// The seqs answered since the last status.
     answered: Vec<u64>,
     /// When the last request was handled (the autosave waits for a
@@ -72,6 +75,7 @@ impl Worker {
             autosave: options.autosave,
             unsaved: 0,
             appended: 0,
+            stroke_open: false,
             answered: Vec::new(),
             last_request: Instant::now(),
         })
@@ -218,6 +222,8 @@ impl Worker {
     ) -> Result<(), (String, String)> {
         let scalars = self.doc.scalars.clone();
         let mirror = self.doc.mirror_x();
+        // Any request but dabs ends a stroke (the session ends it too).
+        self.stroke_open = matches!(request, Request::Begin(_) | Request::Dabs(_));
         let changed = match request {
             Request::Begin(spec) => {
                 let brush = spec
@@ -402,7 +408,7 @@ impl App for Worker {
     fn idle(&mut self, _cancel: &AtomicBool, out: &Outbox) -> Idle {
         // Fold the stroke's texel updates into one samples frame for
         // pages that connect later (every page has them already).
-        if self.appended > 0 {
+        if self.appended > 0 && !self.stroke_open {
             out.keep(SLOT_TEXTURES, self.textures());
             self.appended = 0;
         }
