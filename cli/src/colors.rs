@@ -354,7 +354,8 @@ pub fn to_mesh_colors(
 
 /// A baked atlas as a mesh and an image to write: one vertex per triangle
 /// corner (the atlas gives every face its own UVs) at the welded
-/// positions, the corners' normals when the surface has them, the atlas
+/// positions, the corners' normals (the file's, else the welded surface's
+/// smooth area-weighted ones), the atlas
 /// UVs as they are (glTF convention, like every `TriMesh`; the OBJ writer
 /// converts), and one material whose texture is `texture_file`. Triangle
 /// `f` is triangle `f` of the surface.
@@ -370,10 +371,19 @@ pub fn atlas_mesh(
         positions.extend(face.map(|v| surface.positions[v as usize]));
         uvs.extend_from_slice(corner_uvs);
     }
-    let normals = surface
-        .corner_normals
-        .as_ref()
-        .map(|n| n.iter().flatten().copied().collect());
+    // The file's own normals, else smooth ones of the welded surface: a
+    // viewer given none shades every face flat.
+    let normals = Some(match &surface.corner_normals {
+        Some(n) => n.iter().flatten().copied().collect(),
+        None => {
+            let smooth = crate::shapes::vertex_normals(&surface.positions, &surface.faces);
+            surface
+                .faces
+                .iter()
+                .flat_map(|f| f.map(|v| smooth[v as usize]))
+                .collect()
+        }
+    });
     let image = texture_image(&atlas.texture);
     let material = Material {
         name: "atlas".into(),

@@ -250,8 +250,10 @@ fn with_scalars(colors: MeshColors, scalars: usize) -> Result<MeshColors> {
 fn read_session(path: &Path, doc: &Document) -> Result<Vec<mesh_colors::session::Edit>> {
     super::check_input(path)?;
     let text = std::fs::read_to_string(path).map_err(|e| file_error(path, e))?;
-    let (_, edits) = trilux::paint::session_file::from_json(&text, &doc.scalars, doc.mirror_x())
-        .map_err(|e| file_error(path, e))?;
+    let (source, edits) =
+        trilux::paint::session_file::from_json(&text, &doc.scalars, doc.mirror_x())
+            .map_err(|e| file_error(path, e))?;
+    trilux::paint::session_file::check_replays_on(&source, doc).map_err(|e| file_error(path, e))?;
     Ok(edits)
 }
 

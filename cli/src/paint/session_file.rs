@@ -22,15 +22,73 @@ pub const FORMAT: &str = "trilux-paint-session";
 /// The `version` field.
 pub const VERSION: u64 = 1;
 
-/// The file's JSON: `source` and the edits, brushes named by `scalars`
-/// (the scalar channels' names).
-pub fn to_json(source: &Value, edits: &[Edit], scalars: &[String]) -> Value {
+/// The file's JSON: the document's source, stamped with what its edits
+/// replay on ([`stamp`]), and the edits, brushes named by the document's
+/// scalar channels.
+pub fn to_json(doc: &super::Document, edits: &[Edit]) -> Value {
+    let mut source = doc.source.clone();
+    if let Some(o) = source.as_object_mut() {
+        o.insert("replays_on".into(), stamp(doc));
+    }
     json!({
         "format": FORMAT,
         "version": VERSION,
         "source": source,
-        "edits": edits.iter().map(|e| edit(e, scalars)).collect::<Vec<_>>(),
+        "edits": edits.iter().map(|e| edit(e, &doc.scalars)).collect::<Vec<_>>(),
     })
+}
+
+/// What a log replays on, bit for bit: the surface's connectivity (its
+/// fingerprint) and the starting colours (their layout and a hash of
+/// their bits).
+pub fn stamp(doc: &super::Document) -> Value {
+    let f = doc.colors.topology().fingerprint();
+    // FNV-1a over the sample bits: the same start, the same hash.
+    let hash = doc
+        .colors
+        .samples()
+        .iter()
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, x| {
+            (h ^ u64::from(x.to_bits())).wrapping_mul(0x0100_0000_01b3)
+        });
+    json!({
+        "vertices": f.vertices, "faces": f.faces,
+        "topology_hash": format!("{:016x}", f.topology_hash),
+        "samples": doc.colors.sample_count(), "channels": doc.colors.channels(),
+        "colors_hash": format!("{hash:016x}"),
+    })
+}
+
+/// Checks that a session file's `source` was stamped for `doc`: the log
+/// replays to the same colours only on the surface and starting colours
+/// it was made on.
+///
+/// # Errors
+/// What differs, in words.
+pub fn check_replays_on(source: &Value, doc: &super::Document) -> Result<(), String> {
+    let Some(theirs) = source.get("replays_on") else {
+        return Err("source.replays_on: missing (not a session trilux paint wrote)".into());
+    };
+    let ours = stamp(doc);
+    let same = |keys: &[&str]| keys.iter().all(|k| theirs.get(*k) == ours.get(*k));
+    if !same(&["vertices", "faces", "topology_hash"]) {
+        return Err(format!(
+            "the session was painted on a surface of {} vertices and {} faces, not this one ({} and {}, or the same counts with other faces): replay it on the mesh it was made on",
+            theirs["vertices"], theirs["faces"], ours["vertices"], ours["faces"]
+        ));
+    }
+    if !same(&["samples", "channels", "colors_hash"]) {
+        return Err(format!(
+            "the session started from other colours ({} samples of {} channels, hash {}; here {} of {}, hash {}): start from the same --colors, --texture, --resolution and --channels",
+            theirs["samples"],
+            theirs["channels"],
+            theirs["colors_hash"],
+            ours["samples"],
+            ours["channels"],
+            ours["colors_hash"]
+        ));
+    }
+    Ok(())
 }
 
 fn edit(e: &Edit, scalars: &[String]) -> Value {
@@ -193,11 +251,37 @@ mod tests {
             Edit::Undo,
             Edit::Redo,
         ];
-        let source = json!({"mesh": "spot.obj"});
-        let text = to_json(&source, &edits, &scalars).to_string();
+        let surface = crate::ColorMesh::new(&crate::shapes::blob(1)).unwrap();
+        let colors = mesh_colors::MeshColors::uniform(surface.topology().unwrap(), 2, 4).unwrap();
+        let doc = super::super::Document {
+            surface,
+            colors,
+            base: vec![0.0; 4],
+            scalars: scalars.clone(),
+            source: json!({"mesh": "spot.obj"}),
+        };
+        let text = to_json(&doc, &edits).to_string();
         let (s, back) = from_json(&text, &scalars, 0.5).unwrap();
-        assert_eq!(s, source);
+        assert_eq!(s["mesh"], "spot.obj");
         assert_eq!(back, edits);
+        assert_eq!(check_replays_on(&s, &doc), Ok(()));
+        // Other starting colours, another surface: refused, in words.
+        let mut other = doc.clone();
+        other.colors.samples_mut()[5] = 1.0;
+        assert!(
+            check_replays_on(&s, &other)
+                .unwrap_err()
+                .contains("other colours")
+        );
+        other.surface = crate::ColorMesh::new(&crate::shapes::blob(2)).unwrap();
+        other.colors =
+            mesh_colors::MeshColors::uniform(other.surface.topology().unwrap(), 2, 4).unwrap();
+        assert!(
+            check_replays_on(&s, &other)
+                .unwrap_err()
+                .contains("not this one")
+        );
+        assert!(check_replays_on(&json!({}), &doc).is_err());
     }
 
     #[test]

@@ -66,6 +66,8 @@ impl Worker {
         let session = super::open_session(&doc, log.unwrap_or(&[]), options.history)?;
         let mip = MipMap::new(session.colors().clone());
         let gpu = GpuLayout::new(&mip, TEXTURE_WIDTH).map_err(|e| e.to_string())?;
+        // Replayed edits are not saved anywhere yet: the autosave keeps them.
+        let unsaved = log.map_or(0, <[Edit]>::len);
         Ok(Self {
             doc,
             session,
@@ -73,7 +75,7 @@ impl Worker {
             gpu,
             export_dir: options.export_dir,
             autosave: options.autosave,
-            unsaved: 0,
+            unsaved,
             appended: 0,
             stroke_open: false,
             answered: Vec::new(),
@@ -317,11 +319,7 @@ impl Worker {
     fn export(&self, kind: ExportKind, path: &Path, overwrite: bool) -> crate::Result<()> {
         match kind {
             ExportKind::Session => {
-                let v = super::session_file::to_json(
-                    &self.doc.source,
-                    self.session.log(),
-                    &self.doc.scalars,
-                );
+                let v = super::session_file::to_json(&self.doc, self.session.log());
                 crate::output::write_atomic(path, overwrite, |tmp| {
                     std::fs::write(tmp, format!("{v:#}\n")).map_err(|source| crate::Error::File {
                         path: tmp.to_path_buf(),

@@ -252,6 +252,12 @@ async fn paint_detail_undo_save_and_replay_through_the_protocol() {
     let doc = document();
     let (_, log) =
         trilux::paint::session_file::from_json(&text, &doc.scalars, doc.mirror_x()).unwrap();
+    let (source, _) =
+        trilux::paint::session_file::from_json(&text, &doc.scalars, doc.mirror_x()).unwrap();
+    assert_eq!(
+        trilux::paint::session_file::check_replays_on(&source, &doc),
+        Ok(())
+    );
     assert_eq!(log.len(), 5);
     let replayed = trilux::paint::open_session(&doc, &log, 10).unwrap();
     let bits = |c: &MeshColors| c.samples().iter().map(|x| x.to_bits()).collect::<Vec<_>>();

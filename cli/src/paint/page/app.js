@@ -40,6 +40,8 @@ function onText(m) {
   } else if (m.type === 'status') {
     state.status = m;
     showStatus(m);
+    // The global resolution offers the finest level now in use.
+    if (!state.levelSet) { $('level').value = m.finest_level; state.levelSet = true; }
   } else if (m.type === 'pick') {
     state.picked = m.color;
     if (state.channelIndex() === 0) $('color').value = toHex(m.color);
@@ -279,17 +281,35 @@ function exportFile(op, fields) {
 $('undo').onclick = () => net.send('undo');
 $('redo').onclick = () => net.send('redo');
 $('save').onclick = () => {
-  const name = prompt('Save the colours as (.meshcolors, in the export folder)', 'painted.meshcolors');
+  const name = askName('Save the colours as (.meshcolors, in the export folder)', 'painted.meshcolors', 'meshcolors');
   if (name) exportFile('save', { name });
 };
+// A name for `ext`, with the extension added when left out.
+function askName(text, suggested, ext) {
+  const name = prompt(text, suggested);
+  if (!name) return null;
+  return name.toLowerCase().endsWith('.' + ext) ? name : name + '.' + ext;
+}
 $('export').onclick = () => {
-  const name = prompt('Export a GLB (the colours baked into a texture)', 'painted.glb');
+  const name = askName('Export a GLB (the colours baked into a texture)', 'painted.glb', 'glb');
   if (name) exportFile('export', { kind: 'glb', name });
+};
+$('exportObj').onclick = () => {
+  const name = askName('Export OBJ + MTL + PNG (the colours baked into a texture)', 'painted.obj', 'obj');
+  if (name) exportFile('export', { kind: 'obj', name });
+};
+$('exportSession').onclick = () => {
+  const name = askName('Export the session (every edit; trilux paint MESH --replay FILE)', 'session.json', 'json');
+  if (name) exportFile('export', { kind: 'session', name });
 };
 $('applyLevel').onclick = () => net.send('resolution', { level: Number($('level').value) });
 $('help').onclick = () => { $('helpbox').hidden = !$('helpbox').hidden; };
 $('filter').onchange = () => { dirty = true; };
-$('channel').onchange = () => { dirty = true; };
+$('channel').onchange = () => {
+  const scalar = state.channelIndex() !== 0;
+  $('colorRow').hidden = scalar; $('valueRow').hidden = !scalar;
+  dirty = true;
+};
 $('shade').onchange = () => { dirty = true; };
 
 addEventListener('keydown', (e) => {
