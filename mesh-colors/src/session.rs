@@ -631,8 +631,11 @@ impl PaintSession {
         Ok(changed)
     }
 
-    /// Rebuilds what depends on the sample numbering.
+    /// Rebuilds what depends on the sample numbering (and returns the
+    /// spare capacity the change left, so the memory reported is what the
+    /// colours need).
     fn reindex(&mut self) -> Result<(), Error> {
+        self.colors.shrink_to_fit();
         self.painter = Painter::new(&self.colors, &self.positions, self.cell)?;
         self.normals = sample_normals(&self.colors, &self.positions);
         Ok(())

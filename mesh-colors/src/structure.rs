@@ -244,6 +244,16 @@ impl MeshColors {
                 * std::mem::size_of::<usize>()
     }
 
+    /// Gives back the spare capacity a resolution change left (the sample
+    /// array grows as samples are inserted), so that
+    /// [`memory_bytes`](Self::memory_bytes) is what the colours need. One
+    /// copy of the samples at most.
+    pub fn shrink_to_fit(&mut self) {
+        self.samples.shrink_to_fit();
+        self.edge_offset.shrink_to_fit();
+        self.face_offset.shrink_to_fit();
+    }
+
     /// All samples, mutable.
     pub fn samples_mut(&mut self) -> &mut [f32] {
         &mut self.samples

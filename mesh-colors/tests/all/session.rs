@@ -514,6 +514,13 @@ fn the_detail_brush_raises_the_faces_it_touches_and_undo_restores_them() {
         .collect();
     assert_eq!(listed, up);
     assert!(s.colors().sample_count() > start.sample_count());
+    // The memory reported is what the samples need, not spare capacity.
+    let need = 4 * s.colors().channels() * s.colors().sample_count();
+    assert!(
+        s.colors().memory_bytes() < need + need / 4,
+        "{} for {need}",
+        s.colors().memory_bytes()
+    );
     s.apply(Edit::Undo).unwrap();
     assert_eq!(s.colors(), &start);
     // Lowered below the coarsest level: nothing to do.
