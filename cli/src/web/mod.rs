@@ -54,6 +54,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 use axum::body::Bytes;
+use axum::serve::ListenerExt;
 use tokio::sync::watch;
 
 pub mod assets;
@@ -283,7 +284,12 @@ impl Bound {
             app: std::marker::PhantomData,
         });
         let mut stopped = stop_rx;
-        let listener = self.listener;
+        // Small messages go out at once: with Nagle's algorithm a frame
+        // and the status after it wait for the page's delayed ACK (40 ms
+        // a round trip on Linux), which a brush stroke feels.
+        let listener = self.listener.tap_io(|tcp| {
+            let _ = tcp.set_nodelay(true);
+        });
         let stop_on_exit = stop.clone();
         let task = tokio::spawn(async move {
             let served = axum::serve(listener, router)
