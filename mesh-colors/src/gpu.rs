@@ -119,7 +119,7 @@
 use crate::filter::triangle;
 use crate::mip::{FACE_LEVEL_OFFSET, MipMap, edge_level_offset, level_of_footprint};
 use crate::structure::interior_index;
-use crate::{Error, MAX_CHANNELS, MAX_LEVEL, MAX_PROBES};
+use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
 
 /// Words per face in the face table (two `RGBA32UI` texels).
 pub const FACE_WORDS: usize = 8;
@@ -831,41 +831,8 @@ impl<'a> View<'a> {
         max_samples: u32,
         out: &mut [f32],
     ) {
-        let metric = |d: [f32; 3]| {
-            let (x, y) = (d[0] + 0.5 * d[1], d[1] * 0.866_025_4);
-            (x * x + y * y).sqrt()
-        };
-        let (lx, ly) = (metric(db_dx), metric(db_dy));
-        let (major, minor, axis) = if lx >= ly {
-            (lx, ly, db_dx)
-        } else {
-            (ly, lx, db_dy)
-        };
-        let max_n = max_samples.clamp(1, MAX_PROBES) as f32;
-        let n = if minor > 0.0 {
-            (major / minor).ceil().clamp(1.0, max_n)
-        } else {
-            max_n
-        };
-        let lambda = level_of_footprint((major / n).max(minor));
-        if n <= 1.0 {
-            self.trilinear(b, lambda, out);
-            return;
-        }
-        let c = out.len();
-        let mut sum = [0.0f32; MAX_CHANNELS];
-        let mut probe = [0.0f32; MAX_CHANNELS];
-        let (sum, probe) = (&mut sum[..c], &mut probe[..c]);
-        for k in 0..n as u32 {
-            let t = (k as f32 + 0.5) / n - 0.5;
-            let p = [0, 1, 2].map(|m| (b[m] + t * axis[m]).max(0.0));
-            self.trilinear(p, lambda, probe);
-            for (s, &x) in sum.iter_mut().zip(probe.iter()) {
-                *s += x;
-            }
-        }
-        for (o, &s) in out.iter_mut().zip(sum.iter()) {
-            *o = s / n;
-        }
+        crate::mip::anisotropic_probes(b, db_dx, db_dy, max_samples, out, |p, lambda, o| {
+            self.trilinear(p, lambda, o);
+        });
     }
 }

@@ -948,45 +948,71 @@ impl MipMap {
         out: &mut [f32],
     ) -> Result<(), Error> {
         check(&self.colors, face, out)?;
-        let metric = |d: [f32; 3]| {
-            let (x, y) = (d[0] + 0.5 * d[1], d[1] * 0.866_025_4);
-            (x * x + y * y).sqrt()
-        };
-        let (lx, ly) = (metric(db_dx), metric(db_dy));
-        let (major, minor, axis) = if lx >= ly {
-            (lx, ly, db_dx)
-        } else {
-            (ly, lx, db_dy)
-        };
-        let max_n = max_samples.clamp(1, MAX_PROBES) as f32;
-        let n = if minor > 0.0 {
-            (major / minor).ceil().clamp(1.0, max_n)
-        } else {
-            max_n
-        };
-        let width = (major / n).max(minor);
-        let lambda = level_of_footprint(width);
         let c = self.colors.channels;
-        if n <= 1.0 {
-            self.trilinear_unchecked(face, b, lambda, out);
-            return Ok(());
-        }
-        let mut acc = [0.0f32; MAX_CHANNELS];
-        let mut probe = [0.0f32; MAX_CHANNELS];
-        let (sum, probe) = (&mut acc[..c], &mut probe[..c]);
-        let count = n as u32;
-        for k in 0..count {
-            let t = (k as f32 + 0.5) / n - 0.5;
-            let p = [0, 1, 2].map(|m| (b[m] + t * axis[m]).max(0.0));
-            self.trilinear_unchecked(face, p, lambda, probe);
-            for (s, &x) in sum.iter_mut().zip(probe.iter()) {
-                *s += x;
-            }
-        }
-        for (o, &s) in out.iter_mut().zip(sum.iter()) {
-            *o = s / n;
-        }
+        anisotropic_probes(
+            b,
+            db_dx,
+            db_dy,
+            max_samples,
+            &mut out[..c],
+            |p, lambda, o| {
+                self.trilinear_unchecked(face, p, lambda, o);
+            },
+        );
         Ok(())
+    }
+}
+
+/// Anisotropic filtering (Sec. 4.3) around a trilinear lookup
+/// `trilinear(b, λ, out)`: the longer of the screen derivatives `∂b/∂x`,
+/// `∂b/∂y` (lengths on the equilateral triangle) is the major axis; `N =
+/// ⌈major / minor⌉` probes (1 to `max_samples`, at most [`MAX_PROBES`])
+/// spaced along it at the level of `max(major / N, minor)`, averaged. The
+/// CPU filter and the GPU layout's reference lookup share it, so they
+/// agree to the bit.
+pub(crate) fn anisotropic_probes(
+    b: [f32; 3],
+    db_dx: [f32; 3],
+    db_dy: [f32; 3],
+    max_samples: u32,
+    out: &mut [f32],
+    mut trilinear: impl FnMut([f32; 3], f32, &mut [f32]),
+) {
+    let metric = |d: [f32; 3]| {
+        let (x, y) = (d[0] + 0.5 * d[1], d[1] * 0.866_025_4);
+        (x * x + y * y).sqrt()
+    };
+    let (lx, ly) = (metric(db_dx), metric(db_dy));
+    let (major, minor, axis) = if lx >= ly {
+        (lx, ly, db_dx)
+    } else {
+        (ly, lx, db_dy)
+    };
+    let max_n = max_samples.clamp(1, MAX_PROBES) as f32;
+    let n = if minor > 0.0 {
+        (major / minor).ceil().clamp(1.0, max_n)
+    } else {
+        max_n
+    };
+    let lambda = level_of_footprint((major / n).max(minor));
+    if n <= 1.0 {
+        trilinear(b, lambda, out);
+        return;
+    }
+    let c = out.len();
+    let mut sum = [0.0f32; MAX_CHANNELS];
+    let mut probe = [0.0f32; MAX_CHANNELS];
+    let (sum, probe) = (&mut sum[..c], &mut probe[..c]);
+    for k in 0..n as u32 {
+        let t = (k as f32 + 0.5) / n - 0.5;
+        let p = [0, 1, 2].map(|m| (b[m] + t * axis[m]).max(0.0));
+        trilinear(p, lambda, probe);
+        for (s, &x) in sum.iter_mut().zip(probe.iter()) {
+            *s += x;
+        }
+    }
+    for (o, &s) in out.iter_mut().zip(sum.iter()) {
+        *o = s / n;
     }
 }
 
