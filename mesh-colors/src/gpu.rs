@@ -147,7 +147,7 @@ pub enum Filter {
         db_dx: [f32; 3],
         /// Screen-space derivative of the barycentrics along y.
         db_dy: [f32; 3],
-        /// The most probes (capped at [`MAX_PROBES`]).
+        /// The most probes (capped at [`MAX_PROBES`](crate::MAX_PROBES)).
         max_samples: u32,
     },
 }

@@ -26,7 +26,9 @@ use crate::bvh::{Aabb, Bvh};
 use crate::winding::{WindingNumber, solid_angle};
 
 /// Distances between the stuffed boundary and the input surface, in the
-/// surface's length unit (see the [module docs](self)).
+/// surface's length unit, sampled on both surfaces (deterministically:
+/// stratified by area, plus the vertices when there are no more of them
+/// than samples), the input only where it encloses volume.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SurfaceDistance {
     /// The symmetric Hausdorff distance: the larger of
