@@ -10,29 +10,14 @@
 
 use std::time::Instant;
 
+// The tests' meshes: the flat grid is theirs with no bump.
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use mesh_colors::glam::Vec3;
 use mesh_colors::gpu::GpuLayout;
 use mesh_colors::undo::{History, Recorder, Step};
 use mesh_colors::{Blend, Brush, MeshColors, Painter, Topology};
-
-/// An `n × n` grid of the unit square, two triangles per cell.
-fn grid(n: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let mut positions = Vec::new();
-    for y in 0..=n {
-        for x in 0..=n {
-            positions.push(Vec3::new(x as f32 / n as f32, y as f32 / n as f32, 0.0));
-        }
-    }
-    let at = |x: u32, y: u32| y * (n + 1) + x;
-    let mut faces = Vec::new();
-    for y in 0..n {
-        for x in 0..n {
-            faces.push([at(x, y), at(x + 1, y), at(x, y + 1)]);
-            faces.push([at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)]);
-        }
-    }
-    (positions, faces)
-}
 
 /// Median milliseconds of five runs of `f`.
 fn median_ms(mut f: impl FnMut()) -> f64 {
@@ -48,7 +33,7 @@ fn median_ms(mut f: impl FnMut()) -> f64 {
 }
 
 fn main() -> Result<(), mesh_colors::Error> {
-    let (positions, faces) = grid(120);
+    let (positions, faces) = support::grid(120, 0.0);
     let topology = Topology::new(positions.len(), &faces)?;
     let mut colors = MeshColors::uniform(topology, 8, 3)?;
     for (i, x) in colors.samples_mut().iter_mut().enumerate() {

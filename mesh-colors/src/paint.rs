@@ -81,6 +81,17 @@ impl Painter {
     /// [`Error::ChannelMismatch`] if `positions` is shorter than the vertex
     /// count, [`Error::NonFinite`] for a non-finite position or cell size.
     pub fn new(colors: &MeshColors, positions: &[Vec3], cell: f32) -> Result<Self, Error> {
+        Self::with_sites(colors, positions, &colors.sites(), cell)
+    }
+
+    /// [`Painter::new`] with the colours' [`MeshColors::sites`] already
+    /// computed (the paint session needs them for its normals too).
+    pub(crate) fn with_sites(
+        colors: &MeshColors,
+        positions: &[Vec3],
+        sites: &[crate::structure::Site],
+        cell: f32,
+    ) -> Result<Self, Error> {
         let t = colors.topology();
         if positions.len() < t.vertex_count() {
             return Err(Error::ChannelMismatch {
@@ -101,8 +112,7 @@ impl Painter {
                 index: 0,
             });
         }
-        let sample_positions: Vec<Vec3> = colors
-            .sites()
+        let sample_positions: Vec<Vec3> = sites
             .iter()
             .enumerate()
             .map(|(i, s)| {

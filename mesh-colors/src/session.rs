@@ -26,7 +26,7 @@ use glam::Vec3;
 use crate::Error;
 use crate::edit::ResolutionChange;
 use crate::paint::Painter;
-use crate::structure::{MeshColors, lattice_points};
+use crate::structure::{MeshColors, Site, lattice_points};
 use crate::undo::{History, Recorder, Step};
 
 /// Answers whether the surface hides a point from an eye.
@@ -264,8 +264,9 @@ impl PaintSession {
             });
         }
         let cell = grid_cell(&positions, colors.topology().faces());
-        let painter = Painter::new(&colors, &positions, cell)?;
-        let normals = sample_normals(&colors, &positions);
+        let sites = colors.sites();
+        let painter = Painter::with_sites(&colors, &positions, &sites, cell)?;
+        let normals = sample_normals(&colors, &positions, &sites);
         Ok(Self {
             positions,
             colors,
@@ -636,8 +637,10 @@ impl PaintSession {
     /// colours need).
     fn reindex(&mut self) -> Result<(), Error> {
         self.colors.shrink_to_fit();
-        self.painter = Painter::new(&self.colors, &self.positions, self.cell)?;
-        self.normals = sample_normals(&self.colors, &self.positions);
+        // One pass over the samples' sites serves the grid and the normals.
+        let sites = self.colors.sites();
+        self.painter = Painter::with_sites(&self.colors, &self.positions, &sites, self.cell)?;
+        self.normals = sample_normals(&self.colors, &self.positions, &sites);
         Ok(())
     }
 }
@@ -670,7 +673,7 @@ fn grid_cell(positions: &[Vec3], faces: &[[u32; 3]]) -> f32 {
 
 /// Each sample's shading normal: the area-weighted vertex normals
 /// interpolated at its site (what the page shades with).
-fn sample_normals(colors: &MeshColors, positions: &[Vec3]) -> Vec<Vec3> {
+fn sample_normals(colors: &MeshColors, positions: &[Vec3], sites: &[Site]) -> Vec<Vec3> {
     let faces = colors.topology().faces();
     let mut vertex = vec![Vec3::ZERO; positions.len()];
     for f in faces {
@@ -681,8 +684,7 @@ fn sample_normals(colors: &MeshColors, positions: &[Vec3]) -> Vec<Vec3> {
             vertex[v as usize] += n;
         }
     }
-    colors
-        .sites()
+    sites
         .iter()
         .map(|s| {
             let Some(f) = faces.get(s.face as usize) else {

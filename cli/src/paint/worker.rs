@@ -216,21 +216,28 @@ impl Worker {
         Ok(())
     }
 
+    /// The session's brush for the page's: the channel by name, the
+    /// mirror plane of the mesh (worked out only when a brush is given,
+    /// not for every batch of dabs).
+    fn brush(
+        &self,
+        spec: &super::protocol::BrushSpec,
+    ) -> Result<mesh_colors::session::Brush, (String, String)> {
+        spec.resolve(&self.doc.scalars, self.doc.mirror_x())
+            .map_err(|b| (b.field, b.problem))
+    }
+
     fn edit(
         &mut self,
         to: ReplyTo,
         request: Request,
         out: &Outbox,
     ) -> Result<(), (String, String)> {
-        let scalars = self.doc.scalars.clone();
-        let mirror = self.doc.mirror_x();
         // Any request but dabs ends a stroke (the session ends it too).
         self.stroke_open = matches!(request, Request::Begin(_) | Request::Dabs(_));
         let changed = match request {
             Request::Begin(spec) => {
-                let brush = spec
-                    .resolve(&scalars, mirror)
-                    .map_err(|b| (b.field, b.problem))?;
+                let brush = self.brush(&spec)?;
                 self.session
                     .begin_stroke(brush)
                     .map_err(|e| ("brush".to_string(), e.to_string()))?;
@@ -246,9 +253,7 @@ impl Worker {
                 Changed::Nothing
             }
             Request::Fill(face, spec) => {
-                let brush = spec
-                    .resolve(&scalars, mirror)
-                    .map_err(|b| (b.field, b.problem))?;
+                let brush = self.brush(&spec)?;
                 self.unsaved += 1;
                 self.session
                     .apply(Edit::Fill { face, brush })
