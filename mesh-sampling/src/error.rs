@@ -240,6 +240,23 @@ pub enum Error {
         /// The channel's value.
         value: f32,
     },
+    /// A scatter's ceiling that is negative, NaN or infinite.
+    #[error("max_density must be finite and >= 0, got {0}")]
+    InvalidMaxDensity(f64),
+    /// A scatter's density outside `[0, max_density]` (or NaN) on a face.
+    #[error(
+        "the density on face {face} is {value}, outside [0, max_density = {max}]: raise \
+         max_density, or clamp to it"
+    )]
+    DensityOutOfRange {
+        /// The face.
+        face: usize,
+        /// The density found there (the face's largest weight, or the
+        /// value at a candidate point).
+        value: f64,
+        /// The ceiling, `max_density`.
+        max: f64,
+    },
     /// A triangle index that does not exist.
     #[error("there is no triangle {face}: the mesh has {count}")]
     NoSuchFace {

@@ -112,6 +112,7 @@ mod point;
 mod prefetch;
 mod projection;
 mod rejection;
+mod scatter;
 mod subdivision;
 mod texture;
 mod uniform;
@@ -138,6 +139,7 @@ pub use parallel::MAX_POINTS;
 pub use point::{SurfacePoint, uniform_barycentric};
 pub use projection::spherical_uvs;
 pub use rejection::RejectionSampler;
+pub use scatter::{Scatter, ScatterDensity, ScatterOptions, ScatterUpdate, scatter};
 pub use texture::{Channel, DensityTexture, Filter, MAX_INTEGRATION_CELLS, Wrap, luminance};
 pub use uniform::UniformSampler;
 
