@@ -240,6 +240,26 @@ pub enum Error {
         /// The channel's value.
         value: f32,
     },
+    /// A hair strand parameter that is NaN or out of range.
+    #[error("root {root}: strand {parameter} is {value}, but it must be {expected}")]
+    InvalidStrandParameter {
+        /// The root (index into the roots given).
+        root: usize,
+        /// The [`StrandParams`](crate::StrandParams) field.
+        parameter: &'static str,
+        /// Its value.
+        value: f32,
+        /// What it must be.
+        expected: &'static str,
+    },
+    /// A hair root a strand cannot grow from.
+    #[error("root {root} cannot grow a strand: {reason}")]
+    InvalidRoot {
+        /// The root (index into the roots given).
+        root: usize,
+        /// Why.
+        reason: &'static str,
+    },
     /// A scatter's ceiling that is negative, NaN or infinite.
     #[error("max_density must be finite and >= 0, got {0}")]
     InvalidMaxDensity(f64),

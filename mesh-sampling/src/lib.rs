@@ -103,6 +103,7 @@ mod blue_noise;
 mod density;
 mod emitter;
 mod error;
+mod hair;
 mod layout;
 mod mesh;
 mod multi;
@@ -131,6 +132,7 @@ pub use emitter::{
     Sides, Strategy, Toward, TriangleBounds,
 };
 pub use error::Error;
+pub use hair::{HairOptions, MAX_SEGMENTS, Root, StrandParams, Strands, grow_strands};
 pub use layout::{Layout, MAX_VALUE_SHIFT, MIN_THRESHOLD_BITS};
 pub use mesh::MeshRef;
 pub use multi::{MeshPoint, MultiDensitySampler, MultiMeshSampler};
