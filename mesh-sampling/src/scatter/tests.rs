@@ -282,6 +282,24 @@ fn bad_arguments_are_errors() {
     let w1: Vec<f32> = w.iter().map(|&x| x.min(1.0)).collect();
     let t = Scatter::new(mesh, Density::PerFace(&w1).into(), &clamped).unwrap();
     assert_eq!(s.points().len(), t.points().len());
+    // Weights at the ceiling interpolate to it, up to rounding: not an
+    // error, and every candidate is kept (as uniform density 1).
+    let ones = vec![1.0f32; positions.len()];
+    let full = Scatter::new(
+        mesh,
+        Density::PerVertex(&ones).into(),
+        &options(500.0, 1.0, 0),
+    )
+    .unwrap();
+    let all = Scatter::new(mesh, uniform, &options(500.0, 1.0, 0)).unwrap();
+    let same = |a: &Scatter<'_>, b: &Scatter<'_>| {
+        a.points().len() == b.points().len()
+            && a.points()
+                .iter()
+                .zip(b.points())
+                .all(|(p, q)| p.barycentric == q.barycentric)
+    };
+    assert!(same(&full, &all));
     // A function's NaN or negative value is an error even when clamping.
     let nan = |face: usize, _: [f32; 3]| if face == 3 { f32::NAN } else { 0.5 };
     let e = Scatter::new(mesh, ScatterDensity::Function(&nan), &clamped).unwrap_err();
@@ -498,4 +516,29 @@ fn positions_follow_a_per_vertex_gradient() {
     .unwrap();
     let wrong = chi_square(&histogram(&wrong), &probs, 5.0);
     assert!(wrong.p_value < 1e-6, "{wrong:?}");
+}
+
+#[test]
+fn updates_with_counts_rising_and_falling_in_any_mix_give_a_rebuild() {
+    let (positions, _, indices) = flat_grid(16);
+    let mesh = MeshRef::new(&positions, &indices);
+    let mut rng = SplitMix64(77);
+    let opts = options(20.0, 1.0, 3);
+    let mut weights = random_weights(&mut rng, indices.len());
+    let mut scatter = Scatter::new(mesh, Density::PerFace(&weights).into(), &opts).unwrap();
+    for step in 0..200 {
+        let faces: Vec<u32> = (0..1 + rng.below(12))
+            .map(|_| rng.below(indices.len() as u64) as u32)
+            .collect();
+        for &f in &faces {
+            // Zero, full, or anything between.
+            weights[f as usize] = [0.0, 1.0, rng.f32()][rng.below(3) as usize];
+        }
+        scatter
+            .update_faces(&faces, Density::PerFace(&weights).into())
+            .unwrap();
+        let rebuilt = Scatter::new(mesh, Density::PerFace(&weights).into(), &opts).unwrap();
+        assert!(scatter.points() == rebuilt.points(), "step {step}");
+        assert_eq!(scatter.offsets(), rebuilt.offsets(), "step {step}");
+    }
 }
