@@ -6,6 +6,9 @@
 //!   or glTF point clouds for sampled points, glTF vertex colours and
 //!   custom attributes for per-vertex results ([`mesh::gltf`]). One index
 //!   stream, materials with decoded glTF textures.
+//! - **Curves** ([`curves`]): hair strands as USD text (`BasisCurves` and
+//!   `Points`), Cem Yuksel's `.hair` and glTF lines with root points out;
+//!   `.hair` in.
 //! - **Images** ([`image`]): PNG, JPEG, Radiance HDR, OpenEXR in as linear
 //!   `f32` RGBA; PNG (8/16 bit) and EXR (f32/f16) out.
 //! - **Tetrahedral meshes** ([`tet`]): TetGen `.node`/`.ele` (+ `.face`),
@@ -47,6 +50,7 @@
 pub use glam;
 
 mod base64;
+pub mod curves;
 mod error;
 pub mod image;
 mod image_exr;

@@ -3,6 +3,7 @@
 #[path = "../support/mod.rs"]
 mod support;
 
+mod curves;
 mod fuzz_regressions;
 mod gltf;
 mod gltf_roundtrip;

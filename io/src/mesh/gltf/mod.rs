@@ -71,6 +71,7 @@ pub use read::{
     MAX_ACCESSOR_VALUES, MAX_ZERO_FILLED_ELEMENTS, Options, from_bytes, read, read_scene,
     read_scene_with, read_with, scene_from_bytes,
 };
+pub(crate) use write::write_curves;
 pub use write::{COLOR_SLACK, DEFAULT_MATERIAL, UNLIT_MATERIAL, write, write_points, write_with};
 
 /// Per-vertex values beyond positions, normals and UVs that glTF carries:

@@ -170,6 +170,107 @@ pub fn write_points(path: impl AsRef<Path>, points: &Points) -> Result<()> {
     doc.save(container)
 }
 
+/// The curves as one `LINES` primitive and their roots as a `POINTS`
+/// primitive ([`crate::curves::write_gltf`], which checks them first).
+pub(crate) fn write_curves(path: &Path, curves: &crate::curves::Curves) -> Result<()> {
+    let container = Container::of(path)?;
+    if let Some((c, f)) = curves
+        .faces
+        .iter()
+        .flatten()
+        .enumerate()
+        .find(|(_, f)| **f >= FACE_ID_LIMIT)
+    {
+        return Err(invalid(
+            path,
+            format!(
+                "curve {c}'s root lies on face {f}; glTF attributes hold face ids below 2^24 \
+                 exactly"
+            ),
+        ));
+    }
+    let mut doc = Document::new(path);
+    if !curves.points.is_empty() {
+        let data = VertexData {
+            colors: None,
+            attributes: curves
+                .widths
+                .iter()
+                .map(|w| super::Attribute {
+                    name: "WIDTH".into(),
+                    values: AttributeValues::Scalar(w.clone()),
+                })
+                .collect(),
+        };
+        let vertices = Vertices {
+            positions: &curves.points,
+            origin: DVec3::ZERO,
+            normals: None,
+            uvs: None,
+            uvs1: None,
+            data: &data,
+        };
+        let attributes = doc.vertices(&vertices)?;
+        let segments = curves.points.len() - curves.counts.len();
+        let mut pairs: Vec<[u32; 2]> = Vec::with_capacity(segments);
+        for (first, &count) in curves.offsets().into_iter().zip(&curves.counts) {
+            let first = first as u32;
+            pairs.extend((first..first + count - 1).map(|i| [i, i + 1]));
+        }
+        let indices = doc.index_pairs(&pairs, curves.points.len());
+        let lines = json::mesh::Primitive {
+            attributes,
+            extensions: None,
+            extras: Default::default(),
+            indices: Some(indices),
+            material: None,
+            mode: Valid(Mode::Lines),
+            targets: None,
+        };
+        doc.node("strands", lines, Vec3::ZERO);
+
+        let first = curves.offsets();
+        let roots: Vec<Vec3> = first.iter().map(|&i| curves.points[i]).collect();
+        let mut data = VertexData::default();
+        if let Some(faces) = &curves.faces {
+            data.attributes.push(super::Attribute {
+                name: FACE_ATTRIBUTE.into(),
+                values: AttributeValues::Scalar(faces.iter().map(|&f| f as f32).collect()),
+            });
+        }
+        if let Some(b) = &curves.barycentrics {
+            data.attributes.push(super::Attribute {
+                name: "BARYCENTRIC".into(),
+                values: AttributeValues::Vec3(b.iter().map(|&b| Vec3::from_array(b)).collect()),
+            });
+        }
+        let normals = match &curves.normals {
+            Some(n) => Some(unit_normals(path, n, &[], &roots)?),
+            None => None,
+        };
+        let vertices = Vertices {
+            positions: &roots,
+            origin: DVec3::ZERO,
+            normals: normals.as_deref(),
+            uvs: curves.uvs.as_deref(),
+            uvs1: None,
+            data: &data,
+        };
+        let attributes = doc.vertices(&vertices)?;
+        let points = json::mesh::Primitive {
+            attributes,
+            extensions: None,
+            extras: Default::default(),
+            indices: None,
+            material: None,
+            mode: Valid(Mode::Points),
+            targets: None,
+        };
+        doc.node("roots", points, Vec3::ZERO);
+    }
+    doc.save(container)
+}
+
 /// The name of the material given to triangles without one when the mesh
 /// has vertex colours: unlit (`KHR_materials_unlit`), white, double-sided.
 pub const UNLIT_MATERIAL: &str = "vertex colours (unlit)";
@@ -634,6 +735,24 @@ impl<'a> Document<'a> {
         };
         let view = self.view(&bytes, Some(Target::ElementArrayBuffer));
         self.accessor(view, 3 * triangles.len(), kind, Type::Scalar, None, None)
+    }
+
+    /// The index accessor of line segments (`u16` below 65 535 vertices).
+    fn index_pairs(&mut self, pairs: &[[u32; 2]], vertices: usize) -> Index<json::Accessor> {
+        let flat = pairs.iter().flatten();
+        let (bytes, kind): (Vec<u8>, _) = if vertices <= usize::from(u16::MAX) {
+            (
+                flat.flat_map(|&i| (i as u16).to_le_bytes()).collect(),
+                ComponentType::U16,
+            )
+        } else {
+            (
+                flat.flat_map(|i| i.to_le_bytes()).collect(),
+                ComponentType::U32,
+            )
+        };
+        let view = self.view(&bytes, Some(Target::ElementArrayBuffer));
+        self.accessor(view, 2 * pairs.len(), kind, Type::Scalar, None, None)
     }
 
     fn accessor(
