@@ -244,9 +244,9 @@ pub fn grow_strands(
     }
     let per = k as usize + 1;
     check_points(roots.len() as f64 * per as f64)?;
-    let mut points = vec![Vec3::ZERO; roots.len() * per];
+    let mut points = filled(roots.len() * per, Vec3::ZERO);
     let mut widths = options.widths.then(|| vec![0.0f32; roots.len() * per]);
-    let mut out_roots = vec![Root::default(); roots.len()];
+    let mut out_roots = filled(roots.len(), Root::default());
     let mut clump = vec![0.0f32; if options.clumps > 0 { roots.len() } else { 0 }];
 
     let grow_chunk = |c: usize, mut chunk: ChunkOut<'_>| -> Result<(), Error> {
@@ -304,6 +304,25 @@ pub fn grow_strands(
     })
 }
 
+/// `n` copies of `value`, written on all threads: `vec![value; n]` fills
+/// (and faults in) hundreds of megabytes on one thread, which for the
+/// strands of millions of roots took as long as growing them.
+fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
+    #[cfg(feature = "rayon")]
+    {
+        use rayon::prelude::*;
+        (0..n)
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .map(|_| value)
+            .collect()
+    }
+    #[cfg(not(feature = "rayon"))]
+    {
+        vec![value; n]
+    }
+}
+
 /// The unit direction a root's strand starts from.
 fn root_normal(root: &SurfacePoint, index: usize) -> Result<Vec3, Error> {
     if !root.position.is_finite() {
@@ -357,8 +376,11 @@ fn grow_one(origin: Vec3, normal: Vec3, p: &StrandParams, rng: &mut Pcg64Mcg, li
         let s = i as f32 / k;
         let mut at = origin + axis * (p.length * s) + (u * c_phi + v * s_phi) * (p.curl_radius * s);
         if p.noise > 0.0 {
-            let mut jitter = || unit(rng.next_u64()) as f32 * 2.0 - 1.0;
-            at += Vec3::new(jitter(), jitter(), jitter()) * (p.noise * s);
+            // Three 21-bit variates from one draw: ample for an offset.
+            let bits = rng.next_u64();
+            let jitter =
+                |k: u32| ((bits >> (21 * k)) & 0x1F_FFFF) as f32 * (2.0 / 2_097_152.0) - 1.0;
+            at += Vec3::new(jitter(0), jitter(1), jitter(2)) * (p.noise * s);
         }
         *slot = at;
         (c_phi, s_phi) = (
@@ -570,8 +592,16 @@ impl Grid {
                     }
                 }
             }
-            // Sites in rings further out are at least `ring · cell` away.
-            let reach = ring as f32 * self.cell;
+            // Sites outside the cube of rings 0..=ring lie beyond its
+            // faces: at least the distance from `p` to the nearest face.
+            let reach = (0..3)
+                .map(|a| {
+                    let lo = self.min[a] + (c[a] as f32 - ring as f32) * self.cell;
+                    let hi = self.min[a] + (c[a] + ring + 1) as f32 * self.cell;
+                    (p[a] - lo).min(hi - p[a])
+                })
+                .fold(f32::INFINITY, f32::min)
+                .max(ring as f32 * self.cell);
             if best.1 != usize::MAX && best.0 <= reach * reach {
                 break;
             }
