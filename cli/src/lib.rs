@@ -52,6 +52,7 @@
 pub mod colors;
 mod density;
 mod error;
+pub mod hair;
 pub mod mesh;
 pub mod output;
 #[cfg(feature = "paint")]

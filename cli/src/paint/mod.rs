@@ -21,6 +21,8 @@
 //! | 2 face table | width, height | `RGBA32UI` texels (4 u32 each) |
 //! | 3 samples | width, height | `RGBA32F` texels (4 f32 each) |
 //! | 4 sample texels | rectangles, width | per rectangle `x, y, w, h` (u32), then its `w·h` texels |
+//! | 5 scatter points | points, 0 | positions (3 f32 each) |
+//! | 6 strands | strands, points per strand | polylines' points (3 f32 each), strand by strand |
 //!
 //! Kind 4 carries absolute values: applied twice it changes nothing.
 
@@ -41,6 +43,8 @@ use crate::colors::ColorMesh;
 use crate::web::{self, Asset, Limits};
 
 pub mod protocol;
+mod reach;
+pub mod scatter;
 pub mod session_file;
 mod worker;
 
@@ -65,6 +69,7 @@ pub const PAGE: &[Asset] = &[
     Asset::css("style.css", include_str!("page/style.css")),
     Asset::js("app.js", include_str!("page/app.js")),
     Asset::js("meshcolors.js", include_str!("page/meshcolors.js")),
+    Asset::js("points.js", include_str!("page/points.js")),
 ];
 
 /// What is painted: the welded surface, its colours, and how to name them.
@@ -84,6 +89,20 @@ pub struct Document {
 }
 
 impl Document {
+    /// The surface's area, in model units squared (the scatter panel's
+    /// rate is per unit area).
+    pub fn area(&self) -> f64 {
+        let s = &self.surface;
+        let at = |v: u32| s.positions.get(v as usize).map(|p| p.as_dvec3());
+        s.faces
+            .iter()
+            .filter_map(|&[a, b, c]| {
+                let (a, b, c) = (at(a)?, at(b)?, at(c)?);
+                Some(0.5 * (b - a).cross(c - a).length())
+            })
+            .sum()
+    }
+
     /// The X symmetry plane: the middle of the bounding box in x.
     pub fn mirror_x(&self) -> f32 {
         let (lo, hi) = self.bounds();

@@ -13,7 +13,8 @@
 //! | `undo`, `redo` | | one step |
 //! | `pick` | `face`, `barycentric` | the eyedropper: answers `{"type": "pick", "color"}` |
 //! | `save` | `name` (`.meshcolors`), `overwrite` | writes the colours |
-//! | `export` | `kind` (`glb`, `obj`, `session`), `name`, `overwrite` | bakes an atlas (GLB, or OBJ + MTL + PNG) or writes the session log |
+//! | `export` | `kind` (`glb`, `obj`, `session`, `points`, `strands`), `name`, `overwrite` | bakes an atlas (GLB, or OBJ + MTL + PNG), writes the session log, the scatter's points (`.glb` or `.ply`) or its strands (`.usda`, `.glb` or `.hair`) |
+//! | `scatter` | see [`ScatterSpec`](super::scatter::ScatterSpec) | points (and strands) where a channel is painted, following every stroke |
 //!
 //! A `brush` is `{"mode": "mix" | "add" | "multiply" | "erase", "channel":
 //! "color" | a scalar channel's name, "color": [r, g, b] or [v], "strength",
@@ -51,6 +52,8 @@ pub enum Request {
         /// Replace an existing file.
         overwrite: bool,
     },
+    /// Scatter points by a channel (and grow strands), or stop.
+    Scatter(super::scatter::ScatterSpec),
     /// Write an export.
     Export {
         /// What.
@@ -132,15 +135,21 @@ pub enum ExportKind {
     Obj,
     /// The session: source and edit log (replays with `--replay`).
     Session,
+    /// The scatter's points (`.glb` or `.ply`).
+    Points,
+    /// The scatter's strands (`.usda`, `.glb` or `.hair`).
+    Strands,
 }
 
 impl ExportKind {
-    /// The file extension.
-    pub fn extension(self) -> &'static str {
+    /// The file extensions it writes.
+    pub fn extensions(self) -> &'static [&'static str] {
         match self {
-            ExportKind::Glb => "glb",
-            ExportKind::Obj => "obj",
-            ExportKind::Session => "json",
+            ExportKind::Glb => &["glb"],
+            ExportKind::Obj => &["obj"],
+            ExportKind::Session => &["json"],
+            ExportKind::Points => &["glb", "ply"],
+            ExportKind::Strands => &["usda", "glb", "hair"],
         }
     }
 }
@@ -167,6 +176,7 @@ pub fn parse(m: &Incoming<'_>) -> Parsed<Request> {
         "undo" => Request::Edit(Edit::Undo),
         "redo" => Request::Edit(Edit::Redo),
         "pick" => Request::Pick(face(o)?, barycentric(get(o, "barycentric")?)?),
+        "scatter" => Request::Scatter(super::scatter::parse(o)?),
         "save" => Request::Save {
             name: file_name(get(o, "name")?, "meshcolors")?,
             overwrite: overwrite(o)?,
@@ -176,11 +186,18 @@ pub fn parse(m: &Incoming<'_>) -> Parsed<Request> {
                 Some("glb") => ExportKind::Glb,
                 Some("obj") => ExportKind::Obj,
                 Some("session") => ExportKind::Session,
-                _ => return Err(BadField::new("kind", "expected glb, obj or session")),
+                Some("points") => ExportKind::Points,
+                Some("strands") => ExportKind::Strands,
+                _ => {
+                    return Err(BadField::new(
+                        "kind",
+                        "expected glb, obj, session, points or strands",
+                    ));
+                }
             };
             Request::Export {
                 kind,
-                name: file_name(get(o, "name")?, kind.extension())?,
+                name: file_name_of(get(o, "name")?, kind.extensions())?,
                 overwrite: overwrite(o)?,
             }
         }
@@ -188,7 +205,7 @@ pub fn parse(m: &Incoming<'_>) -> Parsed<Request> {
             return Err(BadField::new(
                 "op",
                 format!(
-                    "unknown op {:?} (begin, dabs, end, fill, detail, resolution, undo, redo, pick, save, export)",
+                    "unknown op {:?} (begin, dabs, end, fill, detail, resolution, undo, redo, pick, scatter, save, export)",
                     m.op
                 ),
             ));
@@ -373,6 +390,29 @@ fn file_name(v: &Value, ext: &str) -> Parsed<String> {
         .ok_or_else(|| BadField::new("name", "expected a file name"))?;
     crate::web::json::file_name(name, ext)?;
     Ok(name.to_string())
+}
+
+/// A plain file name ending in one of `extensions` (the first one's
+/// error when none fits).
+fn file_name_of(v: &Value, extensions: &[&str]) -> Parsed<String> {
+    let name = v
+        .as_str()
+        .ok_or_else(|| BadField::new("name", "expected a file name"))?;
+    let lower = name.to_ascii_lowercase();
+    let ext = extensions
+        .iter()
+        .find(|e| lower.ends_with(&format!(".{e}")))
+        .unwrap_or(&extensions[0]);
+    if extensions.len() > 1 && !lower.ends_with(&format!(".{ext}")) {
+        return Err(BadField::new(
+            "name",
+            format!(
+                "{name:?}: expected a name ending in .{}",
+                extensions.join(", .")
+            ),
+        ));
+    }
+    file_name(v, ext)
 }
 
 #[cfg(test)]

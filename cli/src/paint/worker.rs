@@ -4,7 +4,8 @@
 //! Snapshot slots (what a page that connects is sent first, in order):
 //! 0 the hello, 1 the mesh, 2 the face table and the samples (then the
 //! texel updates of the stroke in progress, appended, folded back into
-//! one samples frame when the server is idle), 3 the status.
+//! one samples frame when the server is idle), 3 the status, 4 the
+//! scatter panel's points and strands.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -17,6 +18,7 @@ use mesh_colors::session::{Changed, Edit, PaintSession};
 use serde_json::json;
 
 use super::protocol::{ExportKind, Request};
+use super::scatter::{ScatterState, Updated};
 use super::{Document, LIMITS, MAGIC, Options, PAGE, VERSION};
 use crate::web::frame::{Header, put_f32, put_u32};
 use crate::web::{App, Idle, Inbox, Limits, Out, Outbox, ReplyTo};
@@ -32,6 +34,10 @@ const SLOT_HELLO: usize = 0;
 const SLOT_MESH: usize = 1;
 const SLOT_TEXTURES: usize = 2;
 const SLOT_STATUS: usize = 3;
+const SLOT_SCATTER: usize = 4;
+/// While a stroke goes on, the scatter's points are sent at most this
+/// often (a million points is 12 MB a frame); its end sends them at once.
+const SCATTER_EVERY: Duration = Duration::from_millis(60);
 
 /// The paint app: the session and its GPU copy.
 pub(crate) struct Worker {
@@ -54,6 +60,12 @@ pub(crate) struct Worker {
     /// When the last request was handled (the autosave waits for a
     /// pause).
     last_request: Instant,
+    /// The scatter panel, when the page asked for points.
+    scatter: Option<ScatterState>,
+    /// Points changed since they were last sent.
+    scatter_dirty: bool,
+    /// When they were last sent.
+    scatter_sent: Instant,
 }
 
 impl Worker {
@@ -80,6 +92,9 @@ impl Worker {
             stroke_open: false,
             answered: Vec::new(),
             last_request: Instant::now(),
+            scatter: None,
+            scatter_dirty: false,
+            scatter_sent: Instant::now(),
         })
     }
 
@@ -107,6 +122,7 @@ impl Worker {
                 "channels": channels, "base": self.doc.base,
                 "mirror_x": self.doc.mirror_x(),
                 "faces": self.doc.surface.faces.len(),
+                "area": self.doc.area(),
                 "max_level": mesh_colors::MAX_LEVEL,
             })
             .to_string(),
@@ -177,6 +193,9 @@ impl Worker {
                 "finest_level": finest,
                 "undo": h.undo_len(), "redo": h.redo_len(), "history": steps,
                 "edits": self.session.log().len(),
+                "points": self.scatter.as_ref().map_or(0, |s| s.points().len()),
+                "strands": self.scatter.as_ref().and_then(|s| s.strands()).map_or(0, |s| s.len()),
+                "scatter_ms": self.scatter.as_ref().map_or(0.0, |s| s.last_ms),
             })
             .to_string(),
         )
@@ -193,6 +212,12 @@ impl Worker {
         match changed {
             Changed::Nothing => {}
             Changed::Samples(list) => {
+                if let Some(scatter) = &mut self.scatter {
+                    let updated = scatter
+                        .samples_changed(&list, colors)
+                        .map_err(|(f, m)| format!("{f}: {m}"))?;
+                    self.scatter_dirty |= updated == Updated::Points;
+                }
                 let runs = runs(&list);
                 let spans = self.mip.refresh(colors, &runs).map_err(|e| e.to_string())?;
                 let changes = self
@@ -211,6 +236,12 @@ impl Worker {
                 self.gpu.update(&self.mip).map_err(|e| e.to_string())?;
                 out.publish(SLOT_TEXTURES, self.textures());
                 self.appended = 0;
+                if let Some(scatter) = &mut self.scatter {
+                    let updated = scatter
+                        .layout_changed(&self.doc.surface, colors, &self.doc.scalars)
+                        .map_err(|(f, m)| format!("{f}: {m}"))?;
+                    self.scatter_dirty |= updated == Updated::Points;
+                }
             }
         }
         Ok(())
@@ -264,6 +295,24 @@ impl Worker {
                 self.session
                     .apply(e)
                     .map_err(|e| ("op".to_string(), e.to_string()))?
+            }
+            Request::Scatter(spec) => {
+                let off = spec.mode == super::scatter::ScatterMode::Off;
+                self.scatter = if off {
+                    None
+                } else {
+                    Some(
+                        ScatterState::new(
+                            spec,
+                            &self.doc.surface,
+                            self.session.colors(),
+                            &self.doc.scalars,
+                        )
+                        .map_err(|b| (b.field, b.problem))?,
+                    )
+                };
+                self.scatter_dirty = true;
+                return Ok(());
             }
             Request::Pick(face, b) => {
                 let color = self
@@ -345,7 +394,67 @@ impl Worker {
                         .map(drop)
                 }
             }
+            ExportKind::Strands => {
+                let curves = self.curves()?;
+                let write = |tmp: &Path| trilux_io::curves::write(tmp, &curves);
+                if has_extension(path, "glb") {
+                    crate::output::write_gltf(path, overwrite, write).map(drop)
+                } else {
+                    crate::output::write_atomic(path, overwrite, |tmp| Ok(write(tmp)?))
+                }
+            }
+            ExportKind::Points => {
+                let cloud = self.point_cloud()?;
+                if has_extension(path, "glb") {
+                    let points = trilux_io::mesh::gltf::Points::from(&cloud);
+                    crate::output::write_gltf(path, overwrite, |tmp| {
+                        trilux_io::mesh::gltf::write_points(tmp, &points)
+                    })
+                    .map(drop)
+                } else {
+                    crate::output::write_atomic(path, overwrite, |tmp| {
+                        Ok(trilux_io::mesh::ply::write(
+                            tmp,
+                            &cloud,
+                            trilux_io::mesh::ply::Format::default(),
+                        )?)
+                    })
+                }
+            }
         }
+    }
+
+    /// The scatter's points as a point cloud: positions, normals, the
+    /// face each lies on, in the surface's frame (its origin restored).
+    fn point_cloud(&self) -> crate::Result<trilux_io::mesh::ply::PlyData> {
+        let points = self.scatter_points()?;
+        Ok(trilux_io::mesh::ply::PlyData {
+            positions: points.iter().map(|p| p.position).collect(),
+            origin: self.doc.surface.origin,
+            normals: Some(points.iter().map(|p| p.normal).collect()),
+            face_ids: Some(points.iter().map(|p| p.face).collect()),
+            ..Default::default()
+        })
+    }
+
+    /// Strands from every point of the scatter, as the panel's hair asks.
+    fn curves(&self) -> crate::Result<trilux_io::curves::Curves> {
+        let scatter = self.scatter.as_ref().ok_or_else(nothing_scattered)?;
+        let strands = scatter
+            .strands_from(self.session.colors(), usize::MAX)
+            .map_err(|b| crate::Error::Invalid(format!("{}: {}", b.field, b.problem)))?
+            .ok_or_else(|| {
+                crate::Error::Invalid("no strands: turn on hair in the scatter panel first".into())
+            })?;
+        Ok(crate::hair::curves(&strands))
+    }
+
+    /// The scatter's points, or an error when the panel has none.
+    fn scatter_points(&self) -> crate::Result<&[mesh_sampling::SurfacePoint]> {
+        self.scatter
+            .as_ref()
+            .map(|s| s.points())
+            .ok_or_else(nothing_scattered)
     }
 
     /// Writes the autosave when there is one and something to save.
@@ -360,6 +469,70 @@ impl Worker {
             }
         }
     }
+}
+
+impl Worker {
+    /// Count and blue-noise points are drawn again once a stroke ends (or
+    /// after any edit outside one).
+    fn follow_stroke_end(&mut self) -> Result<(), (String, String)> {
+        if self.stroke_open {
+            return Ok(());
+        }
+        if let Some(scatter) = &mut self.scatter {
+            let updated = scatter.stroke_ended(&self.doc.surface, self.session.colors())?;
+            self.scatter_dirty |= updated == Updated::Points;
+        }
+        Ok(())
+    }
+
+    /// Publishes the scatter's points and strands when they changed: at
+    /// once outside a stroke, at most every [`SCATTER_EVERY`] inside one.
+    fn send_scatter(&mut self, out: &Outbox) {
+        if !self.scatter_dirty || (self.stroke_open && self.scatter_sent.elapsed() < SCATTER_EVERY)
+        {
+            return;
+        }
+        out.publish(SLOT_SCATTER, self.scatter_frames());
+        self.scatter_dirty = false;
+        self.scatter_sent = Instant::now();
+    }
+
+    /// Kind 5, the points' positions; kind 6, the preview strands'
+    /// polylines (`a` strands of `b` points). No scatter: no points.
+    fn scatter_frames(&self) -> Vec<Out> {
+        let Some(scatter) = &self.scatter else {
+            return vec![Self::frame(5, 0, 0, &[])];
+        };
+        let points = scatter.points();
+        let mut payload = Vec::with_capacity(points.len() * 12);
+        put_f32(
+            &mut payload,
+            points.iter().flat_map(|p| p.position.to_array()),
+        );
+        let mut frames = vec![Self::frame(5, points.len() as u32, 0, &payload)];
+        if let Some(strands) = scatter.strands() {
+            let mut lines = Vec::with_capacity(strands.points.len() * 12);
+            put_f32(&mut lines, strands.points.iter().flat_map(|p| p.to_array()));
+            frames.push(Self::frame(
+                6,
+                strands.len() as u32,
+                strands.points_per_strand() as u32,
+                &lines,
+            ));
+        }
+        frames
+    }
+}
+
+fn nothing_scattered() -> crate::Error {
+    crate::Error::Invalid("nothing is scattered: choose a mode in the scatter panel first".into())
+}
+
+/// Whether `path` ends in `.ext` (any case).
+fn has_extension(path: &Path, ext: &str) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
 }
 
 /// Sorted, distinct sample indices as runs `(first, count)`.
@@ -392,6 +565,7 @@ impl App for Worker {
     }
 
     fn handle(&mut self, first: (ReplyTo, Request), inbox: &mut Inbox<Request>, out: &Outbox) {
+        let mut last = first.0;
         let mut next = Some(first);
         // Dabs already waiting are painted before the status goes out.
         while let Some((to, request)) = next {
@@ -399,8 +573,13 @@ impl App for Worker {
                 out.error(to, &field, &message);
             }
             self.answered.extend(to.seq);
+            last = to;
             next = inbox.try_next();
         }
+        if let Err((field, message)) = self.follow_stroke_end() {
+            out.error(last, &field, &message);
+        }
+        self.send_scatter(out);
         self.publish_status(out);
         self.last_request = Instant::now();
         if self.unsaved >= AUTOSAVE_EVERY {
@@ -409,6 +588,14 @@ impl App for Worker {
     }
 
     fn idle(&mut self, _cancel: &AtomicBool, out: &Outbox) -> Idle {
+        // Points held back during a stroke go out once it pauses.
+        if self.scatter_dirty {
+            let wait = SCATTER_EVERY.saturating_sub(self.scatter_sent.elapsed());
+            if !wait.is_zero() {
+                return Idle::WaitAtMost(wait);
+            }
+            self.send_scatter(out);
+        }
         // Fold the stroke's texel updates into one samples frame for
         // pages that connect later (every page has them already).
         if self.appended > 0 && !self.stroke_open {

@@ -26,6 +26,23 @@ fn missing(what: &str) {
     eprintln!("notice: the browser test of trilux paint is skipped: {what}");
 }
 
+/// The built-in blob at resolution 8, grey (with a `density` channel, 0,
+/// when `density`).
+fn document_with(colors: Option<MeshColors>, density: bool) -> Document {
+    let mut doc = document(colors);
+    if density {
+        let c = MeshColors::uniform(doc.surface.topology().unwrap(), 8, 4).unwrap();
+        let mut c = c;
+        for s in c.samples_mut().chunks_mut(4) {
+            s.copy_from_slice(&[0.8, 0.8, 0.8, 0.0]);
+        }
+        doc.colors = c;
+        doc.base = vec![0.8, 0.8, 0.8, 0.0];
+        doc.scalars = vec!["density".into()];
+    }
+    doc
+}
+
 /// The built-in blob at resolution 8, grey.
 fn document(colors: Option<MeshColors>) -> Document {
     let surface = ColorMesh::new(&trilux::shapes::blob(3)).unwrap();
@@ -88,23 +105,73 @@ async fn run(
     v
 }
 
-#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn the_page_paints_picks_adds_detail_undoes_saves_and_exports_in_chromium() {
+/// The browser, the script's path and a screenshot folder, or `None`
+/// (with the notice) when something is missing.
+fn setup(script: &str) -> Option<(String, PathBuf)> {
     let browser = std::env::var("TRILUX_BROWSER").unwrap_or_else(|_| "/usr/bin/chromium".into());
     if !Path::new(&browser).exists() {
-        return missing(&format!("no browser at {browser} (set TRILUX_BROWSER)"));
+        missing(&format!("no browser at {browser} (set TRILUX_BROWSER)"));
+        return None;
     }
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     if !root
         .join("target/browser-e2e/node_modules/playwright-core")
         .exists()
     {
-        return missing("playwright-core is not installed in target/browser-e2e (see .ci/run)");
+        missing("playwright-core is not installed in target/browser-e2e (see .ci/run)");
+        return None;
     }
     if Command::new("node").arg("--version").output().is_err() {
-        return missing("no node");
+        missing("no node");
+        return None;
     }
-    let script = crate::common::browser_script("paint.mjs");
+    Some((browser, crate::common::browser_script(script)))
+}
+
+/// The scatter panel in the page: rate mode shows nothing until the
+/// density is painted, a stroke of density grows orange points under
+/// it, strands appear, and both exports are written and valid.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_scatter_panel_follows_a_stroke_of_density_in_chromium() {
+    let Some((browser, script)) = setup("scatter.mjs") else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let shots = std::env::var("TRILUX_SCREENSHOTS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| tmp.path().to_path_buf());
+    let exports = tmp.path();
+    let doc = document_with(None, true);
+    let v = run(&script, &browser, &shots, exports, doc, "test").await;
+    assert_eq!(v["console_errors"], json!([]), "{v:#}");
+    let step = |s: &str| &v["steps"][s];
+    assert_eq!(step("rate")["points"], 0, "{v:#}");
+    assert_eq!(step("rate")["orange"], 0, "{v:#}");
+    let stroke = step("stroke");
+    assert!(stroke["points"].as_u64().unwrap() > 50, "{stroke}");
+    assert_eq!(stroke["points"], stroke["status"]["points"]);
+    assert!(stroke["orange"].as_u64().unwrap() > 20, "{stroke}");
+    assert!(
+        stroke["hud"].as_str().unwrap().contains("points"),
+        "{stroke}"
+    );
+    assert!(step("hair")["strands"].as_u64().unwrap() > 0, "{v:#}");
+    let glb = exports.join("page-points.glb");
+    let usda = exports.join("page-strands.usda");
+    assert_eq!(
+        step("export")["paths"],
+        json!([glb.display().to_string(), usda.display().to_string()])
+    );
+    test_support::gltf::validate(&glb);
+    let text = std::fs::read_to_string(&usda).unwrap();
+    assert!(text.contains("BasisCurves"), "{text}");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_page_paints_picks_adds_detail_undoes_saves_and_exports_in_chromium() {
+    let Some((browser, script)) = setup("paint.mjs") else {
+        return;
+    };
     let tmp = tempfile::tempdir().unwrap();
     let shots = std::env::var("TRILUX_SCREENSHOTS")
         .map(PathBuf::from)

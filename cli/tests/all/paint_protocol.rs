@@ -49,10 +49,14 @@ async fn connect(r: &Running) -> Socket {
     crate::common::web::connect(&r.addr.to_string(), &r.token).await
 }
 
-/// What came: JSON messages and the binary frames' kinds.
+/// What came: JSON messages and the binary frames' kinds; the last
+/// scatter points (kind 5) and strands header (kind 6: strands, points
+/// each).
 #[derive(Default)]
 struct Seen {
     frames: Vec<u8>,
+    points: Option<Vec<[f32; 3]>>,
+    strands: Option<(u32, u32)>,
 }
 
 /// The next JSON message of type `kind`; frames on the way are counted.
@@ -75,6 +79,20 @@ async fn until(s: &mut Socket, kind: &str, seen: &mut Seen) -> Value {
                 assert_eq!(&b[..4], b"TLXM");
                 assert_eq!(b[4], trilux::paint::VERSION);
                 seen.frames.push(b[5]);
+                let word = |i: usize| u32::from_le_bytes(b[i..i + 4].try_into().unwrap());
+                if b[5] == 5 {
+                    let xyz: Vec<f32> = b[16..]
+                        .chunks_exact(4)
+                        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                        .collect();
+                    assert_eq!(xyz.len(), 3 * word(8) as usize);
+                    seen.points = Some(xyz.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect());
+                    seen.strands = None;
+                }
+                if b[5] == 6 {
+                    assert_eq!(b.len() - 16, 12 * (word(8) * word(12)) as usize);
+                    seen.strands = Some((word(8), word(12)));
+                }
             }
             _ => {}
         }
@@ -356,5 +374,164 @@ async fn the_web_cores_guard_holds_for_paint() {
     let dir = tempfile::tempdir().unwrap();
     let r = server(dir.path()).await;
     crate::common::web::check_guard(r.addr, &r.token, "paint").await;
+    r.stop().await.unwrap();
+}
+
+/// The scatter panel through the protocol: points by rate where the
+/// density channel is painted, a second stroke elsewhere only adds points
+/// (the first stroke's stay bit for bit), undo gives the first set back,
+/// a count of blue-noise points, strands and their export, and bad
+/// requests named.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_scatter_follows_the_painted_density() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let r = server(d).await;
+    let mut s = connect(&r).await;
+    let mut seen = Seen::default();
+    let hello = until(&mut s, "hello", &mut seen).await;
+    let area = hello["area"].as_f64().unwrap();
+    assert!(area > 0.0);
+    until(&mut s, "status", &mut seen).await;
+
+    // Nothing painted yet: no points.
+    let rate = 4000.0 / area;
+    let scatter = json!({"seq": 1, "op": "scatter", "mode": "rate", "channel": "density",
+        "rate": rate, "seed": 3, "hair": {"length": 0.05, "segments": 4}});
+    send(&mut s, scatter).await;
+    let st = status_of(&mut s, 1, &mut seen).await;
+    assert_eq!(st["points"], 0);
+    assert_eq!(seen.points.as_deref().map(<[_]>::len), Some(0));
+
+    // A stroke of density 1 around vertex 0: points there.
+    let doc = document();
+    let mut density = brush();
+    density["channel"] = json!("density");
+    density["color"] = json!([1.0]);
+    let stroke = |seq: u64, p: glam::Vec3| {
+        [
+            json!({"seq": seq, "op": "begin", "brush": density.clone()}),
+            json!({"seq": seq + 1, "op": "dabs", "dabs": [[p.x, p.y, p.z, 0.4, 1.0]]}),
+            json!({"seq": seq + 2, "op": "end"}),
+        ]
+    };
+    let (p0, p1) = (doc.surface.positions[0], -doc.surface.positions[0]);
+    for m in stroke(2, p0) {
+        send(&mut s, m).await;
+    }
+    let st = status_of(&mut s, 4, &mut seen).await;
+    let first = seen.points.clone().unwrap();
+    assert!(first.len() > 20, "{} points", first.len());
+    assert_eq!(st["points"], first.len());
+    assert_eq!(seen.strands.unwrap().1, 5, "4 segments: 5 points a strand");
+    assert!(
+        first
+            .iter()
+            .all(|q| (glam::Vec3::from(*q) - p0).length() < 0.6),
+        "points only near the stroke"
+    );
+
+    // A stroke on the other side adds points and keeps the first ones.
+    for m in stroke(5, p1) {
+        send(&mut s, m).await;
+    }
+    status_of(&mut s, 7, &mut seen).await;
+    let second = seen.points.clone().unwrap();
+    assert!(second.len() > first.len());
+    let bits = |v: &[[f32; 3]]| -> std::collections::BTreeSet<[u32; 3]> {
+        v.iter().map(|p| p.map(f32::to_bits)).collect()
+    };
+    assert!(
+        bits(&first).is_subset(&bits(&second)),
+        "the first stroke's points stay"
+    );
+
+    // Undo: exactly the first set again.
+    send(&mut s, json!({"seq": 8, "op": "undo"})).await;
+    status_of(&mut s, 8, &mut seen).await;
+    assert_eq!(bits(seen.points.as_ref().unwrap()), bits(&first));
+
+    // Exports: the points as PLY, the strands as USD.
+    send(
+        &mut s,
+        json!({"seq": 9, "op": "export", "kind": "points", "name": "roots.ply"}),
+    )
+    .await;
+    until(&mut s, "export", &mut seen).await;
+    let ply = trilux::trilux_io::mesh::ply::read(d.join("roots.ply")).unwrap();
+    assert_eq!(ply.positions.len(), first.len());
+    send(
+        &mut s,
+        json!({"seq": 10, "op": "export", "kind": "strands", "name": "hair.usda"}),
+    )
+    .await;
+    until(&mut s, "export", &mut seen).await;
+    let usda = std::fs::read_to_string(d.join("hair.usda")).unwrap();
+    assert!(usda.contains("BasisCurves"), "{usda}");
+
+    // Blue noise by count: exactly that many.
+    send(
+        &mut s,
+        json!({"seq": 11, "op": "scatter", "mode": "blue_noise", "channel": "density",
+        "count": 300, "seed": 1}),
+    )
+    .await;
+    let st = status_of(&mut s, 11, &mut seen).await;
+    assert_eq!(st["points"], 300);
+    assert_eq!(seen.points.as_ref().unwrap().len(), 300);
+
+    // Bad requests name their field and keep the points.
+    let bad = [
+        (
+            json!({"mode": "rate", "channel": "density", "rate": -1}),
+            "rate",
+        ),
+        (
+            json!({"mode": "rate", "channel": "nope", "rate": 1}),
+            "channel",
+        ),
+        (json!({"mode": "sprinkle", "channel": "density"}), "mode"),
+        (
+            json!({"mode": "count", "channel": "density", "count": 0}),
+            "count",
+        ),
+        (
+            json!({"mode": "rate", "channel": "density", "rate": 1e12}),
+            "rate",
+        ),
+        (
+            json!({"mode": "count", "channel": "density", "count": 5,
+            "hair": {"length": 0.1, "segments": 0}}),
+            "hair.segments",
+        ),
+        (
+            json!({"mode": "count", "channel": "density", "count": 5,
+            "hair": {"length": 0.1, "segments": 2, "length_channel": "nope"}}),
+            "hair.length_channel",
+        ),
+    ];
+    for (k, (fields, field)) in bad.into_iter().enumerate() {
+        let seq = 20 + k as u64;
+        let mut m = fields.clone();
+        m["seq"] = json!(seq);
+        m["op"] = json!("scatter");
+        send(&mut s, m).await;
+        let e = error_of(&mut s, seq).await;
+        assert_eq!(e["field"], field, "{fields}: {e}");
+    }
+    send(
+        &mut s,
+        json!({"seq": 40, "op": "export", "kind": "strands", "name": "x.usda"}),
+    )
+    .await;
+    let e = error_of(&mut s, 40).await;
+    assert!(e["message"].as_str().unwrap().contains("strands"), "{e}");
+    send(
+        &mut s,
+        json!({"seq": 41, "op": "pick", "face": 0, "barycentric": [1, 0, 0]}),
+    )
+    .await;
+    let st = status_of(&mut s, 41, &mut seen).await;
+    assert_eq!(st["points"], 300, "the refused requests kept the points");
     r.stop().await.unwrap();
 }

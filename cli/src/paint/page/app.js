@@ -8,6 +8,7 @@ import { Connection } from './net.js';
 import { readHeader } from './frame.js';
 import { fitCanvas } from './glutil.js';
 import { MeshColorsRenderer } from './meshcolors.js';
+import { PointsLayer } from './points.js';
 
 const $ = (id) => document.getElementById(id);
 const canvas = $('view');
@@ -17,8 +18,13 @@ const gl = canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer
 const state = window.trilux = {
   hello: null, status: null, camera: null, tool: 'paint', frames: 0, ready: false,
   mesh: null, layout: null, pendingFaces: null, picked: null, errors: [], exported: [],
+  // The scatter: points and strands shown, frames received, and when the
+  // last points frame was drawn (performance.now(); tests time a stroke).
+  points: 0, strands: 0, scatterFrames: 0, pointsDrawnAt: 0,
 };
 const renderer = gl ? new MeshColorsRenderer(gl) : null;
+const layer = gl ? new PointsLayer(gl) : null;
+let pointsPending = false;
 let dirty = true;
 let pickDirty = true;
 
@@ -37,6 +43,7 @@ function onText(m) {
     if (!state.camera) state.camera = new Camera(m.bounds[0], m.bounds[1]);
     fillChannels(m.channels);
     fillLevels(m.max_level);
+    fillScatter(m);
   } else if (m.type === 'status') {
     state.status = m;
     showStatus(m);
@@ -69,6 +76,15 @@ function onFrame(f) {
     renderer.setLayout(state.layout);
   } else if (f.kind === 4) {
     renderer.updateRects({ resized: false, samples: readRects(f), faces: [] }, null);
+  } else if (f.kind === 5) {
+    layer.setPoints(new Float32Array(f.payload, 0, 3 * f.a));
+    // A points frame without strands after it clears the old ones.
+    layer.setStrands(new Float32Array(0), 0);
+    state.points = f.a; state.strands = 0; state.scatterFrames++;
+    pointsPending = true;
+  } else if (f.kind === 6) {
+    layer.setStrands(new Float32Array(f.payload, 0, 3 * f.a * f.b), f.b);
+    state.strands = f.a;
   }
   dirty = true;
 }
@@ -104,8 +120,10 @@ function fillLevels(max) {
 
 function showStatus(s) {
   const mb = (b) => (b / 1048576).toFixed(1) + ' MB';
+  const scatter = $('scatterMode').value === 'off' ? '' : ` · ${s.points.toLocaleString()} points` +
+    (s.strands ? ` (${s.strands.toLocaleString()} strands shown)` : '') + ` in ${s.scatter_ms.toFixed(1)} ms`;
   $('stats').textContent = `${s.samples.toLocaleString()} samples · ${mb(s.memory)} · finest level ${s.finest_level}` +
-    ` · undo ${s.undo} (${mb(s.undo_memory)}) · redo ${s.redo}`;
+    ` · undo ${s.undo} (${mb(s.undo_memory)}) · redo ${s.redo}` + scatter;
   const list = $('history');
   list.textContent = '';
   s.history.forEach((h, k) => {
@@ -270,6 +288,68 @@ function showBrush(e) {
   el.style.width = el.style.height = 2 * r + 'px';
 }
 
+// ---- the scatter panel ------------------------------------------------
+
+// The channels a density can come from; the first scalar channel (say
+// "density") is chosen, and the rate gives 100,000 points where value 1
+// covers the whole model.
+function fillScatter(hello) {
+  const sel = $('scatterChannel'), len = $('hairChannel');
+  if (sel.options.length) return;
+  hello.channels.forEach((c, k) => {
+    sel.add(new Option(k === 0 ? 'color (its brightness)' : c, c));
+    if (k > 0) len.add(new Option(c, c));
+  });
+  if (hello.channels.length > 1) sel.value = hello.channels[1];
+  state.area = hello.area;
+  $('rate').value = Number((1e5 / Math.max(hello.area, 1e-30)).toPrecision(3));
+  showRate();
+}
+
+function showRate() {
+  const full = Number($('rate').value) * (state.area || 0);
+  $('rateText').textContent = full > 0 ? `(${Math.round(full).toLocaleString()} if painted everywhere)` : '';
+}
+
+function diagonal() {
+  const [lo, hi] = state.hello.bounds;
+  return Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+}
+
+// The scatter request the panel describes.
+function scatterRequest() {
+  const mode = $('scatterMode').value;
+  const req = { mode, channel: $('scatterChannel').value, seed: Math.max(0, Math.floor(Number($('seed').value) || 0)) };
+  if (mode === 'rate') req.rate = Number($('rate').value);
+  if (mode === 'count' || mode === 'blue_noise') req.count = Math.max(1, Math.floor(Number($('count').value) || 1));
+  req.hair = $('hair').checked ? {
+    length: Number($('hairLength').value) * diagonal(),
+    segments: Math.max(1, Math.floor(Number($('hairSegments').value) || 1)),
+    length_channel: $('hairChannel').value || null,
+  } : null;
+  return req;
+}
+
+function showScatterRows() {
+  const mode = $('scatterMode').value, on = mode !== 'off';
+  $('rateRow').hidden = mode !== 'rate';
+  $('countRow').hidden = mode !== 'count' && mode !== 'blue_noise';
+  for (const id of ['seedRow', 'hairRow', 'sizeRow', 'scatterButtons']) $(id).hidden = !on;
+  $('hairBox').hidden = !on || !$('hair').checked;
+}
+
+// Typing in a number box waits for a pause; the rest sends at once.
+let scatterTimer = 0;
+function sendScatter() {
+  showScatterRows(); showRate();
+  clearTimeout(scatterTimer);
+  scatterTimer = setTimeout(() => { if (state.hello) net.send('scatter', scatterRequest()); }, 150);
+}
+state.scatter = (fields) => net.send('scatter', fields);
+for (const id of ['scatterMode', 'scatterChannel', 'hair', 'hairChannel', 'hairLength']) $(id).addEventListener('change', sendScatter);
+for (const id of ['rate', 'count', 'seed', 'hairSegments']) $(id).addEventListener('input', sendScatter);
+$('pointSize').addEventListener('input', () => { dirty = true; });
+
 // ---- keys and buttons -------------------------------------------------
 
 let pendingExport = null;
@@ -301,6 +381,14 @@ $('exportObj').onclick = () => {
 $('exportSession').onclick = () => {
   const name = askName('Export the session (every edit; trilux paint MESH --replay FILE)', 'session.json', 'json');
   if (name) exportFile('export', { kind: 'session', name });
+};
+$('exportPoints').onclick = () => {
+  const name = prompt('Export the points (.glb or .ply: position, normal, face)', 'points.glb');
+  if (name) exportFile('export', { kind: 'points', name });
+};
+$('exportStrands').onclick = () => {
+  const name = prompt('Export the strands (.usda, .glb or .hair)', 'strands.usda');
+  if (name) exportFile('export', { kind: 'strands', name });
 };
 $('applyLevel').onclick = () => net.send('resolution', { level: Number($('level').value) });
 $('help').onclick = () => { $('helpbox').hidden = !$('helpbox').hidden; };
@@ -341,11 +429,14 @@ function frame() {
   gl.clearColor(0.106, 0.11, 0.122, 1);
   gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
   const k = state.channelIndex();
-  renderer.draw(state.camera.viewProj(canvas.width / canvas.height), {
+  const viewProj = state.camera.viewProj(canvas.width / canvas.height);
+  renderer.draw(viewProj, {
     filter: $('filter').value,
     display: k === 0 ? 'color' : 'heat', channel: k === 0 ? 0 : k + 2,
     shade: $('shade').checked ? 0.6 : 0, eye: state.camera.eye(),
   });
+  layer.draw(viewProj, { size: Number($('pointSize').value) * devicePixelRatio });
+  if (pointsPending) { pointsPending = false; state.pointsDrawnAt = performance.now(); }
   state.frames++;
   state.ready = true;
 }
