@@ -17,7 +17,7 @@ use super::{Context, Result, arg_error, file_cause, file_error};
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Scatter random points on a mesh (uniform or with a density) and write a PLY or glTF point cloud",
-    after_help = "Examples:\n  trilux sample ../shared/data/meshes/spot.obj -n 1000000 \\\n      --density ../shared/data/textures/spot_texture.png -o spot.ply --preview spot.png\n  trilux sample ../shared/data/meshes/spot.obj --blue-noise --radius 0.01 -o spot_blue.ply\n  trilux sample ../shared/data/meshes/spot.obj -n 100000 -o spot_points.glb"
+    after_help = "Examples:\n  trilux sample ../shared/data/meshes/spot.obj -n 1000000 \\\n      --density ../shared/data/textures/spot_texture.png -o spot.ply --preview spot.png\n  trilux sample ../shared/data/meshes/spot.obj --blue-noise --radius 0.01 -o spot_blue.ply\n  trilux sample ../shared/data/meshes/spot.obj -n 100000 -o spot_points.glb\n  trilux sample ../shared/data/meshes/spot.obj --rate 2000 --density ../shared/data/textures/spot_texture.png -o spot_rate.ply"
 )]
 pub(crate) struct Args {
     /// The mesh: .obj, .gltf, .glb or .ply.
@@ -30,9 +30,27 @@ pub(crate) struct Args {
         long = "count",
         value_name = "N",
         allow_negative_numbers = true,
-        required_unless_present = "radius"
+        required_unless_present_any = ["radius", "rate"]
     )]
     pub(crate) count: Option<i64>,
+    /// Instead of -n: points per unit area (in the mesh's unit) where the
+    /// density is 1 (Blender's and Houdini's "density"), a Poisson process
+    /// of intensity rate × density whose points on a face depend only on
+    /// the seed, the face and the density there (a raised density only
+    /// adds points). The density is looked up exactly (no --method).
+    #[arg(
+        long,
+        value_name = "R",
+        allow_negative_numbers = true,
+        conflicts_with_all = ["count", "blue_noise", "method"]
+    )]
+    pub(crate) rate: Option<f64>,
+    /// With --rate: the density's ceiling, which fixes the candidates
+    /// (rate × M per unit area). Default: the density's own maximum (1
+    /// without a density); state it (1 for a [0, 1] channel) to keep the
+    /// points when the density is edited and sampled again.
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub(crate) max_density: Option<f64>,
     /// Blue noise: points that keep their distance (Poisson-disk), following
     /// the density, by weighted sample elimination (Yuksel 2015; --packing
     /// dense packs them closer), in progressive order (every prefix of N/2^k
@@ -164,7 +182,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
 /// density with channels.
 fn wanted(args: &Args) -> Result<Points> {
     let packing = args.packing.unwrap_or(PackingArg::Elimination).packing();
+    if let (Some(m), None) = (args.max_density, args.rate) {
+        return Err(arg_error(
+            format!("--max-density {m}"),
+            "the ceiling is of the density scattered by --rate: give --rate R",
+        ));
+    }
     let wanted = match (args.count, args.radius) {
+        _ if args.rate.is_some() => rate_points(args.rate, args.max_density)?,
         (Some(count), _) if count <= 0 || count.unsigned_abs() > MAX_POINTS => {
             return Err(arg_error(
                 format!("-n {count}"),
@@ -202,6 +227,24 @@ fn wanted(args: &Args) -> Result<Points> {
         ));
     }
     Ok(wanted)
+}
+
+/// `--rate R [--max-density M]`: both finite, the rate positive.
+fn rate_points(rate: Option<f64>, max_density: Option<f64>) -> Result<Points> {
+    let rate = rate.unwrap_or(f64::NAN);
+    if !(rate.is_finite() && rate > 0.0) {
+        return Err(arg_error(
+            format!("--rate {rate}"),
+            "the rate must be a positive number (points per unit area)",
+        ));
+    }
+    if let Some(m) = max_density.filter(|m| !(m.is_finite() && *m > 0.0)) {
+        return Err(arg_error(
+            format!("--max-density {m}"),
+            "the density's ceiling must be a positive number",
+        ));
+    }
+    Ok(Points::Rate { rate, max_density })
 }
 
 /// The method: `--method`, or by default subdivision with a density and
@@ -343,7 +386,9 @@ fn report(
     files: &[PathBuf],
 ) {
     let packing = args.packing.unwrap_or(PackingArg::Elimination);
-    let kind = if args.blue_noise {
+    let kind = if let Some(rate) = args.rate {
+        format!("rate {rate} per unit area")
+    } else if args.blue_noise {
         format!("{}, blue noise by {}", method.name(), packing.name())
     } else {
         method.name().to_string()
@@ -369,7 +414,9 @@ fn report(
         "mesh": super::shown(&args.mesh),
         "triangles": mesh.indices.len(),
         "points": points.len(),
-        "method": method.name(),
+        "method": if args.rate.is_some() { "rate" } else { method.name() },
+        "rate": args.rate,
+        "max_density": args.max_density,
         "blue_noise": args.blue_noise,
         "packing": args.blue_noise.then_some(packing.name()),
         "seed": args.seed,

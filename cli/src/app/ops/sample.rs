@@ -6,8 +6,9 @@ use std::path::Path;
 use clap::ValueEnum;
 use glam::Vec3;
 use mesh_sampling::{
-    BlueNoiseOptions, BlueNoiseTarget, Channel, Density, DensitySampler, Mode, Packing,
-    RejectionSampler, SurfaceArea, SurfacePoint, SurfaceSampler, UniformSampler, blue_noise,
+    BlueNoiseOptions, BlueNoiseTarget, Channel, Density, DensitySampler, MeshRef, Mode, Packing,
+    RejectionSampler, ScatterDensity, ScatterOptions, SurfaceArea, SurfacePoint, SurfaceSampler,
+    UniformSampler, blue_noise, scatter,
 };
 use trilux_io::mesh::TriMesh;
 
@@ -81,6 +82,54 @@ pub(crate) enum Points {
     /// Blue noise, progressive, by count or radius, packed by elimination
     /// or densely.
     BlueNoise(BlueNoiseTarget, Packing),
+    /// A Poisson process of `rate × density` points per unit area, with
+    /// the density's ceiling (`None`: its own maximum).
+    Rate { rate: f64, max_density: Option<f64> },
+}
+
+/// What a sampler draws: [`Points`] but the rate mode, which scatters
+/// instead.
+#[derive(Debug, Clone, Copy)]
+enum Draw {
+    Random(usize),
+    BlueNoise(BlueNoiseTarget, Packing),
+}
+
+/// Points by rate (`--rate`): the library's scatter of `source` on
+/// `mesh`, a mesh-colours density over its per-corner mesh (same faces).
+/// A density above `--max-density`, or a rate that asks for too many
+/// points, is an error of that argument.
+fn scatter_points(
+    mesh: MeshRef<'_>,
+    source: &Source,
+    rate: f64,
+    max_density: Option<f64>,
+    seed: u64,
+) -> Result<Vec<SurfacePoint>> {
+    let (mesh, density) = match source {
+        Source::Uniform => (mesh, ScatterDensity::Uniform),
+        Source::Texture(t) => (mesh, Density::Texture(t).into()),
+        Source::FaceWeights(w) => (mesh, Density::PerFace(w).into()),
+        Source::Atlas(d) => (d.mesh_ref(), Density::Texture(&d.texture).into()),
+    };
+    let options = ScatterOptions {
+        max_density,
+        seed,
+        ..ScatterOptions::new(rate)
+    };
+    scatter(mesh, density, &options).map_err(|e| match e {
+        mesh_sampling::Error::DensityOutOfRange { face, value, max } => arg_error(
+            format!("--max-density {max}"),
+            format!(
+                "the density on face {face} is {value}, above the ceiling (raise it, or leave it \
+                 out for the density's own maximum)"
+            ),
+        ),
+        mesh_sampling::Error::TooManyPoints { .. } => {
+            arg_error(format!("--rate {rate}"), e.to_string())
+        }
+        e => e.into(),
+    })
 }
 
 /// The blue-noise options of `trilux sample --blue-noise [--packing P]`:
@@ -103,12 +152,12 @@ pub(crate) fn blue_noise_options(packing: Packing) -> BlueNoiseOptions {
 /// `--radius`: the options themselves are the library's defaults.
 fn points_of<S: SurfaceSampler + SurfaceArea>(
     sampler: &S,
-    points: Points,
+    points: Draw,
     seed: u64,
 ) -> Result<Vec<SurfacePoint>> {
     match points {
-        Points::Random(n) => Ok(sampler.sample_n(seed, n)?),
-        Points::BlueNoise(target, packing) => {
+        Draw::Random(n) => Ok(sampler.sample_n(seed, n)?),
+        Draw::BlueNoise(target, packing) => {
             blue_noise(sampler, target, seed, &blue_noise_options(packing)).map_err(|e| match e {
                 mesh_sampling::Error::InvalidOption(problem) => {
                     arg_error(target_argument(target), problem)
@@ -148,6 +197,13 @@ pub(crate) fn draw_points(
     points: Points,
 ) -> Result<Vec<SurfacePoint>> {
     let base = trilux::mesh_ref(mesh);
+    let points = match points {
+        Points::Rate { rate, max_density } => {
+            return scatter_points(base, source, rate, max_density, seed);
+        }
+        Points::Random(n) => Draw::Random(n),
+        Points::BlueNoise(target, packing) => Draw::BlueNoise(target, packing),
+    };
     let (mesh_ref, texture) = match source {
         Source::Uniform => (base, None),
         Source::Texture(t) => (base, Some(t)),
@@ -162,10 +218,10 @@ pub(crate) fn draw_points(
     };
     match (method, points) {
         (Method::Uniform, _) => points_of(&UniformSampler::new(mesh_ref)?, points, seed),
-        (Method::Rejection, Points::Random(n)) => {
+        (Method::Rejection, Draw::Random(n)) => {
             Ok(RejectionSampler::new(mesh_ref, texture)?.sample_n(seed, n)?)
         }
-        (Method::Rejection, Points::BlueNoise(..)) => Err(arg_error(
+        (Method::Rejection, Draw::BlueNoise(..)) => Err(arg_error(
             "--method rejection",
             "blue noise draws its candidates by subdivision or exactly, not by rejection",
         )),
