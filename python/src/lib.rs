@@ -5,7 +5,7 @@
 //! | Python | Rust |
 //! |---|---|
 //! | `load`, `save`, `Mesh` | trilux-io meshes ([`mesh`]); glTF colours and attributes, in and out ([`gltf`]) |
-//! | `sample_surface`, `blue_noise`, `sample_surface_even` | mesh-sampling ([`sampling`]) |
+//! | `sample_surface`, `blue_noise`, `sample_surface_even`, `scatter` | mesh-sampling ([`sampling`]) |
 //! | `Distribution1D`, `Distribution2D` | discrete-sampling ([`discrete`]) |
 //! | `Emitter` | mesh-sampling's light sampling ([`emitter`]) |
 //! | `MeshColors` | mesh-colors via `trilux::to_mesh_colors` ([`colors`]) |
@@ -48,6 +48,7 @@ fn _trilux(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sampling::sample_surface, m)?)?;
     m.add_function(wrap_pyfunction!(sampling::blue_noise, m)?)?;
     m.add_function(wrap_pyfunction!(sampling::sample_surface_even, m)?)?;
+    m.add_function(wrap_pyfunction!(sampling::scatter, m)?)?;
     m.add_class::<discrete::Distribution1D>()?;
     m.add_class::<discrete::Distribution2D>()?;
     m.add_class::<emitter::Emitter>()?;

@@ -723,3 +723,114 @@ pub(crate) fn sample_surface_even<'py>(
     })?;
     Points::of(py, &points, origin, Want::default())?.into_tuple(py)
 }
+
+/// Points scattered by rate (mesh-sampling's `scatter`, the meaning of
+/// "density" in Blender's Distribute Points on Faces and Houdini's
+/// Scatter): a Poisson process of `rate × density` points per unit area
+/// (mesh units), so the count is random, about `rate × ∫ density dA`.
+///
+/// Each face draws Poisson(`rate × max_density × area`) candidates from
+/// its own stream, seeded by `seed` and the face index, each with a fixed
+/// threshold; a candidate is kept where the density beats it. So the
+/// points on a face depend only on the seed, the face and the density on
+/// it: editing the density elsewhere leaves them bit for bit, raising it
+/// only adds points and lowering it only removes them (state
+/// `max_density` for that: candidates depend on it).
+///
+/// `density`: an image array or file looked up at the UVs (`uv=`,
+/// `channel=` as for `sample_surface`); `face_density` `(m,)`: a density
+/// per face (points per unit area × value, unlike `sample_surface`'s
+/// `face_weight`); `vertex_density` `(n,)`: per vertex, linear over each
+/// face; none: density 1. `max_density`: the density's ceiling (default:
+/// its own maximum, 1 without a density); a value above it is an
+/// `InputError` naming the face, or with `clamp=True` counts as the
+/// ceiling.
+///
+/// Returns `(points, face_index)`, `(N, 3)` float64 and `(N,)` int64, in
+/// face order, and the optional arrays as `sample_surface` (the pdf is
+/// the intensity `rate × density` at each point, points per unit area).
+/// Bit for bit Rust's `mesh_sampling::scatter` with the same options; the
+/// same on any number of threads. The GIL is released.
+#[pyfunction]
+#[pyo3(signature = (mesh, rate, *, density = None, uv = None, channel = None, face_density = None,
+    vertex_density = None, max_density = None, clamp = false, seed = None,
+    return_barycentric = false, return_pdf = false, return_normal = false))]
+#[allow(clippy::too_many_arguments, reason = "the Python keyword arguments")]
+pub(crate) fn scatter<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, PyAny>,
+    rate: f64,
+    density: Option<&Bound<'py, PyAny>>,
+    uv: Option<&Bound<'py, PyAny>>,
+    channel: Option<&Bound<'py, PyAny>>,
+    face_density: Option<&Bound<'py, PyAny>>,
+    vertex_density: Option<&Bound<'py, PyAny>>,
+    max_density: Option<f64>,
+    clamp: bool,
+    seed: Option<Int>,
+    return_barycentric: bool,
+    return_pdf: bool,
+    return_normal: bool,
+) -> PyResult<Bound<'py, PyTuple>> {
+    let seed = arrays::seed(seed.as_ref())?;
+    let mesh = mesh_arg(mesh, uv)?;
+    let given = [density, face_density, vertex_density];
+    if given.iter().flatten().count() > 1 {
+        return Err(
+            Failure::input("give at most one of density, face_density and vertex_density").into(),
+        );
+    }
+    let density = match (face_density, vertex_density) {
+        (Some(w), _) => DensityArg::PerFace(weights(w, "face_density")?),
+        (_, Some(w)) => DensityArg::PerVertex(weights(w, "vertex_density")?),
+        _ => density_arg(density, channel, None, None)?,
+    };
+    if channel.is_some() && !matches!(density, DensityArg::Texture(_)) {
+        return Err(
+            Failure::input("channel: only with density (an image or an image file)").into(),
+        );
+    }
+    let want = Want {
+        barycentric: return_barycentric,
+        pdf: return_pdf,
+        normal: return_normal,
+    };
+    let options = mesh_sampling::ScatterOptions {
+        max_density,
+        clamp,
+        seed,
+        ..mesh_sampling::ScatterOptions::new(rate)
+    };
+    let origin = mesh.origin;
+    let points = detached(py, || {
+        let mesh_ref = trilux::mesh_ref(&mesh);
+        let density = match &density {
+            DensityArg::None => mesh_sampling::ScatterDensity::Uniform,
+            DensityArg::Texture(t) => Density::Texture(t).into(),
+            DensityArg::PerFace(w) => Density::PerFace(w).into(),
+            DensityArg::PerVertex(w) => Density::PerVertex(w).into(),
+        };
+        mesh_sampling::scatter(mesh_ref, density, &options).map_err(|e| scatter_failure(e, rate))
+    })?;
+    Points::of(py, &points, origin, want)?.into_tuple(py)
+}
+
+/// mesh-sampling's scatter errors in Python's words: the rate and the
+/// ceiling by their argument names.
+fn scatter_failure(e: mesh_sampling::Error, rate: f64) -> Failure {
+    use mesh_sampling::Error as E;
+    match e {
+        E::InvalidDensity(r) => Failure::input(format!(
+            "rate: {r} is not a finite number >= 0 (points per unit area)"
+        )),
+        E::InvalidMaxDensity(m) => {
+            Failure::input(format!("max_density: {m} is not a finite number >= 0"))
+        }
+        E::TooManyPoints { requested, budget } => Failure::input(format!(
+            "rate: {rate} per unit area asks for about {requested:.0} candidates (rate × \
+             max_density × area), more than one call returns (at most {budget}); lower the rate \
+             or max_density"
+        )),
+        e => e.into(),
+    }
+}

@@ -48,7 +48,7 @@ def test_signatures_match_the_stubs():
 
 
 def test_docstrings_give_shapes():
-    for name in ("sample_surface", "blue_noise", "tetrahedralize", "load_tets"):
+    for name in ("sample_surface", "blue_noise", "scatter", "tetrahedralize", "load_tets"):
         doc = getattr(trilux, name).__doc__
         assert "float64" in doc and "int64" in doc, name
 
@@ -79,7 +79,7 @@ def tuple_length(annotation):
 
 def test_every_combination_of_return_flags_has_a_literal_overload_and_a_bool_fallback():
     found = overloads()
-    assert set(found) == {"sample_surface", "blue_noise", "tetrahedralize", "load_tets"}, set(found)
+    assert set(found) == {"sample_surface", "blue_noise", "scatter", "tetrahedralize", "load_tets"}, set(found)
     for name, variants in found.items():
         flags = list(variants[0][0])
         literal = [v for v in variants if all(v[0][f] in ("True", "False") for f in flags)]
@@ -105,6 +105,7 @@ def test_the_literal_overloads_say_how_many_arrays_come_back(tmp_path):
     calls = {
         "sample_surface": lambda **flags: trilux.sample_surface((v, f), 5, seed=1, **flags),
         "blue_noise": lambda **flags: trilux.blue_noise((v, f), 5, seed=1, **flags),
+        "scatter": lambda **flags: trilux.scatter((v, f), 50.0, seed=1, **flags),
         "tetrahedralize": lambda **flags: trilux.tetrahedralize(octahedron, spacing=0.5, **flags),
         "load_tets": lambda **flags: trilux.load_tets(tmp_path / "o.mesh", **flags),
     }

@@ -30,6 +30,8 @@ def tour(path: str) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
     blue_all: Tuple[F64, I64, F64, F64, F64] = trilux.blue_noise(
         mesh, radius=0.1, return_barycentric=True, return_pdf=True, return_normal=True
     )
+    scattered: Tuple[F64, I64, F64] = trilux.scatter(mesh, 100.0, max_density=1.0, return_pdf=True)
+    del scattered
     # A plain bool gives one of the tuples: its length is checked at run time.
     flag: bool = len(path) > 3
     either = trilux.sample_surface(mesh, 10, return_pdf=flag)

@@ -35,6 +35,7 @@ from ._trilux import (
     save,
     save_points,
     save_tets,
+    scatter,
     tetrahedralize,
 )
 
@@ -62,5 +63,6 @@ __all__ = [
     "save",
     "save_points",
     "save_tets",
+    "scatter",
     "tetrahedralize",
 ]

@@ -496,6 +496,163 @@ class MeshColors:
     @property
     def faces(self) -> I64: ...
 
+# scatter: points by rate (a Poisson process of rate × density points per
+# unit area; the count is random); returns as sample_surface does, the pdf
+# being the intensity rate × density at each point.
+@overload
+def scatter(
+    mesh: MeshLike,
+    rate: float,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_density: Optional[ArrayLike] = None,
+    vertex_density: Optional[ArrayLike] = None,
+    max_density: Optional[float] = None,
+    clamp: bool = False,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64]: ...
+@overload
+def scatter(
+    mesh: MeshLike,
+    rate: float,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_density: Optional[ArrayLike] = None,
+    vertex_density: Optional[ArrayLike] = None,
+    max_density: Optional[float] = None,
+    clamp: bool = False,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64]: ...
+@overload
+def scatter(
+    mesh: MeshLike,
+    rate: float,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_density: Optional[ArrayLike] = None,
+    vertex_density: Optional[ArrayLike] = None,
+    max_density: Optional[float] = None,
+    clamp: bool = False,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[True],
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64, F64]: ...
+@overload
+def scatter(
+    mesh: MeshLike,
+    rate: float,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_density: Optional[ArrayLike] = None,
+    vertex_density: Optional[ArrayLike] = None,
+    max_density: Optional[float] = None,
+    clamp: bool = False,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[False] = False,
+    return_pdf: Literal[True],
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64, F64]: ...
+@overload
+def scatter(
+    mesh: MeshLike,
+    rate: float,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_density: Optional[ArrayLike] = None,
+    vertex_density: Optional[ArrayLike] = None,
+    max_density: Optional[float] = None,
+    clamp: bool = False,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64, F64]: ...
+@overload
+def scatter(
+    mesh: MeshLike,
+    rate: float,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_density: Optional[ArrayLike] = None,
+    vertex_density: Optional[ArrayLike] = None,
+    max_density: Optional[float] = None,
+    clamp: bool = False,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[False] = False,
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64, F64]: ...
+@overload
+def scatter(
+    mesh: MeshLike,
+    rate: float,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_density: Optional[ArrayLike] = None,
+    vertex_density: Optional[ArrayLike] = None,
+    max_density: Optional[float] = None,
+    clamp: bool = False,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[True],
+    return_normal: Literal[False] = False,
+) -> Tuple[F64, I64, F64, F64]: ...
+@overload
+def scatter(
+    mesh: MeshLike,
+    rate: float,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_density: Optional[ArrayLike] = None,
+    vertex_density: Optional[ArrayLike] = None,
+    max_density: Optional[float] = None,
+    clamp: bool = False,
+    seed: Optional[int] = None,
+    return_barycentric: Literal[True],
+    return_pdf: Literal[True],
+    return_normal: Literal[True],
+) -> Tuple[F64, I64, F64, F64, F64]: ...
+@overload
+def scatter(
+    mesh: MeshLike,
+    rate: float,
+    *,
+    density: Union[ArrayLike, PathLike, None] = None,
+    uv: Optional[ArrayLike] = None,
+    channel: Optional[Channel] = None,
+    face_density: Optional[ArrayLike] = None,
+    vertex_density: Optional[ArrayLike] = None,
+    max_density: Optional[float] = None,
+    clamp: bool = False,
+    seed: Optional[int] = None,
+    return_barycentric: bool = False,
+    return_pdf: bool = False,
+    return_normal: bool = False,
+) -> PointArrays: ...
+
 @overload
 def tetrahedralize(
     mesh: MeshLike,
