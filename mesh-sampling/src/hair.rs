@@ -236,6 +236,20 @@ pub fn grow_strands(
     options: &HairOptions,
     params: impl Fn(&SurfacePoint) -> StrandParams + Sync,
 ) -> Result<Strands, Error> {
+    grow_strands_with(roots, options, |_, root| params(root))
+}
+
+/// [`grow_strands`] with `params(index, root)`: for parameters held in
+/// per-root arrays (a length per root from a painted channel, a file or
+/// Python), indexed like `roots`.
+///
+/// # Errors
+/// As for [`grow_strands`].
+pub fn grow_strands_with(
+    roots: &[SurfacePoint],
+    options: &HairOptions,
+    params: impl Fn(usize, &SurfacePoint) -> StrandParams + Sync,
+) -> Result<Strands, Error> {
     let k = options.segments;
     if k == 0 || k > MAX_SEGMENTS {
         return Err(Error::InvalidOption(format!(
@@ -258,7 +272,7 @@ pub fn grow_strands(
             .enumerate()
         {
             let index = first + j;
-            let p = params(root);
+            let p = params(index, root);
             p.check(index)?;
             let normal = root_normal(root, index)?;
             *out_root = Root {

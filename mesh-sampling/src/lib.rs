@@ -132,7 +132,9 @@ pub use emitter::{
     Sides, Strategy, Toward, TriangleBounds,
 };
 pub use error::Error;
-pub use hair::{HairOptions, MAX_SEGMENTS, Root, StrandParams, Strands, grow_strands};
+pub use hair::{
+    HairOptions, MAX_SEGMENTS, Root, StrandParams, Strands, grow_strands, grow_strands_with,
+};
 pub use layout::{Layout, MAX_VALUE_SHIFT, MIN_THRESHOLD_BITS};
 pub use mesh::MeshRef;
 pub use multi::{MeshPoint, MultiDensitySampler, MultiMeshSampler};

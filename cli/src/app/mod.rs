@@ -17,6 +17,7 @@ mod bench;
 mod colors;
 mod demo;
 mod diffuse;
+mod hair;
 mod info;
 mod ops;
 #[cfg(feature = "paint")]

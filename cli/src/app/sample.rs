@@ -112,6 +112,8 @@ pub(crate) struct Args {
     /// Also render a PNG (or EXR) picture of the points on the mesh.
     #[arg(long, value_name = "OUT.png")]
     pub(crate) preview: Option<PathBuf>,
+    #[command(flatten)]
+    pub(crate) hair: super::hair::HairArgs,
 }
 
 /// The values of `--packing`.
@@ -140,7 +142,7 @@ impl PackingArg {
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let wanted = wanted(&args)?;
     let channel = args.channel.unwrap_or(ChannelArg::Luminance).channel();
-    super::check_output(context, "-o", &args.output, &["ply", "glb", "gltf"])?;
+    super::check_output(context, "-o", &args.output, args.hair.outputs())?;
     let gltf = super::extension(&args.output) != "ply";
     if gltf && args.ascii {
         return Err(arg_error(
@@ -173,6 +175,9 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             super::at(args.mesh.display(), e)
         }
     })?;
+    if args.hair.on() {
+        return super::hair::run(context, &args, &mesh, &points);
+    }
     let files = write(context, &args, &mesh, &points)?;
     report(context, &args, (&mesh, &points), method, &files);
     Ok(())

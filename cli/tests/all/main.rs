@@ -7,6 +7,7 @@ mod cli;
 mod cmd;
 mod gltf_clients;
 mod gltf_out;
+mod hair_cli;
 mod help;
 mod info_warnings;
 mod paint_browser;

@@ -1,0 +1,209 @@
+//! `trilux sample … --hair LEN[:SEGMENTS]`: strands in every format, read
+//! back; errors name their argument.
+
+use std::path::Path;
+
+use trilux_io::curves::hair;
+use trilux_io::glam::Vec3;
+
+use crate::common::{fails, json, run, torus_and_noise};
+
+fn torus(dir: &Path) -> String {
+    let (torus, _) = torus_and_noise(dir, [32, 16], 16);
+    torus.display().to_string()
+}
+
+#[test]
+fn hair_files_hold_one_strand_per_point_of_the_asked_length() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = torus(dir.path());
+    let report = json(
+        dir.path(),
+        &[
+            "sample", &mesh, "-n", "500", "--seed", "3", "--hair", "0.25:5", "-o", "h.hair",
+        ],
+    );
+    assert_eq!(report["strands"], 500);
+    assert_eq!(report["strand_points"], 3000);
+    let curves = hair::read(dir.path().join("h.hair")).unwrap();
+    assert_eq!(curves.counts, vec![6; 500]);
+    // Straight strands: each 0.25 long, its root on the torus (the points
+    // of the same seed without --hair).
+    for strand in curves.points.chunks(6) {
+        let length: f32 = strand.windows(2).map(|w| w[0].distance(w[1])).sum();
+        assert!((length - 0.25).abs() < 1e-4, "{length}");
+        let axis = (strand[5] - strand[0]).normalize();
+        assert!(
+            strand
+                .windows(2)
+                .all(|w| (w[1] - w[0]).normalize().dot(axis) > 0.9999)
+        );
+    }
+    assert!(
+        run(
+            dir.path(),
+            &["sample", &mesh, "-n", "500", "--seed", "3", "-o", "p.ply"]
+        )
+        .status
+        .success()
+    );
+    let cloud = trilux_io::mesh::ply::read(dir.path().join("p.ply")).unwrap();
+    let roots: Vec<Vec3> = curves.points.chunks(6).map(|s| s[0]).collect();
+    assert_eq!(
+        roots, cloud.positions,
+        "the roots are the points of the same seed"
+    );
+}
+
+#[test]
+fn usda_glb_and_ply_outputs_carry_the_strands_and_roots() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = torus(dir.path());
+    for out in ["h.usda", "h.glb", "h.gltf", "h.ply"] {
+        let report = json(
+            dir.path(),
+            &[
+                "sample",
+                &mesh,
+                "-n",
+                "200",
+                "--hair",
+                "0.1",
+                "--hair-curl",
+                "0.01:2",
+                "--hair-comb",
+                "0,1,0:30",
+                "--hair-clumps",
+                "20:0.5",
+                "-o",
+                out,
+            ],
+        );
+        assert_eq!(report["segments"], 8, "{out}");
+        assert_eq!(report["strand_points"], 1800, "{out}");
+    }
+    let usda = std::fs::read_to_string(dir.path().join("h.usda")).unwrap();
+    assert!(usda.contains("def BasisCurves \"strands\"") && usda.contains("def Points \"roots\""));
+    let counts = usda
+        .lines()
+        .find(|l| l.contains("curveVertexCounts"))
+        .unwrap();
+    let inner = &counts[counts.find("= [").unwrap() + 3..counts.rfind(']').unwrap()];
+    assert_eq!(inner.split(", ").collect::<Vec<_>>(), vec!["9"; 200]);
+    let scene = trilux_io::mesh::gltf::read_scene(dir.path().join("h.glb")).unwrap();
+    assert_eq!(scene.points.positions.len(), 200, "root points");
+    assert!(scene.points.faces.is_some());
+    let ply = trilux_io::mesh::ply::read(dir.path().join("h.ply")).unwrap();
+    assert_eq!(ply.positions.len(), 200);
+    assert!(ply.face_ids.is_some() && ply.normals.is_some());
+    let names: Vec<&str> = ply.scalars.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["bary0", "bary1", "bary2", "id"]);
+    let id = &ply.scalars[3].1;
+    assert!(id.iter().enumerate().all(|(i, &v)| v == i as f32));
+    for (k, (b0, (b1, b2))) in ply.scalars[0]
+        .1
+        .iter()
+        .zip(ply.scalars[1].1.iter().zip(&ply.scalars[2].1))
+        .enumerate()
+    {
+        assert!((b0 + b1 + b2 - 1.0).abs() < 1e-5, "point {k}");
+    }
+}
+
+#[test]
+fn the_same_seed_gives_the_same_strands_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = torus(dir.path());
+    let args = |threads: &str, out: &str| {
+        let ok = run(
+            dir.path(),
+            &[
+                "sample",
+                &mesh,
+                "-n",
+                "40000",
+                "--hair",
+                "0.1:4",
+                "--hair-curl",
+                "0.02:1.5",
+                "--hair-clumps",
+                "300:0.6",
+                "--threads",
+                threads,
+                "-o",
+                out,
+            ],
+        );
+        assert!(ok.status.success());
+    };
+    args("1", "one.hair");
+    args("2", "two.hair");
+    let one = std::fs::read(dir.path().join("one.hair")).unwrap();
+    assert_eq!(one, std::fs::read(dir.path().join("two.hair")).unwrap());
+}
+
+#[test]
+fn bad_hair_arguments_are_errors_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = torus(dir.path());
+    let cases: &[(&[&str], &[&str])] = &[
+        (&["--hair", "-1"], &["--hair -1", "positive"]),
+        (&["--hair", "nan"], &["--hair nan", "positive"]),
+        (&["--hair", "0.1:0"], &["--hair 0.1:0", "SEGMENTS"]),
+        (&["--hair", "0.1:99999"], &["--hair 0.1:99999", "4096"]),
+        (
+            &["--hair", "0.1", "--hair-curl", "x"],
+            &["--hair-curl x", "RADIUS:TURNS"],
+        ),
+        (
+            &["--hair", "0.1", "--hair-curl", "-1:2"],
+            &["--hair-curl -1:2", ">= 0"],
+        ),
+        (
+            &["--hair", "0.1", "--hair-comb", "0,0,0:10"],
+            &["--hair-comb 0,0,0:10"],
+        ),
+        (
+            &["--hair", "0.1", "--hair-comb", "0,1,0:200"],
+            &["--hair-comb 0,1,0:200"],
+        ),
+        (
+            &["--hair", "0.1", "--hair-clumps", "0:0.5"],
+            &["--hair-clumps 0:0.5", "CENTRES"],
+        ),
+        (
+            &["--hair", "0.1", "--hair-clumps", "10:1.5"],
+            &["--hair-clumps 10:1.5", "AMOUNT"],
+        ),
+    ];
+    for (extra, needles) in cases {
+        let mut args = vec!["sample", mesh.as_str(), "-n", "10", "-o", "x.usda"];
+        args.extend_from_slice(extra);
+        fails(dir.path(), &args, needles);
+    }
+    fails(
+        dir.path(),
+        &["sample", &mesh, "-n", "10", "--hair", "0.1", "-o", "x.obj"],
+        &["-o x.obj", ".usda"],
+    );
+    fails(
+        dir.path(),
+        &["sample", &mesh, "-n", "10", "-o", "x.usda"],
+        &["-o x.usda", ".ply"],
+    );
+    fails(
+        dir.path(),
+        &[
+            "sample",
+            &mesh,
+            "-n",
+            "10",
+            "--hair-curl",
+            "1:1",
+            "-o",
+            "x.usda",
+        ],
+        &["--hair"],
+    );
+    assert!(!dir.path().join("x.usda").exists());
+}
