@@ -6,6 +6,7 @@
 //! |---|---|
 //! | `load`, `save`, `Mesh` | trilux-io meshes ([`mesh`]); glTF colours and attributes, in and out ([`gltf`]) |
 //! | `sample_surface`, `blue_noise`, `sample_surface_even`, `scatter` | mesh-sampling ([`sampling`]) |
+//! | `grow_hair` | mesh-sampling's strands, trilux-io's curves ([`hair`]) |
 //! | `Distribution1D`, `Distribution2D` | discrete-sampling ([`discrete`]) |
 //! | `Emitter` | mesh-sampling's light sampling ([`emitter`]) |
 //! | `MeshColors` | mesh-colors via `trilux::to_mesh_colors` ([`colors`]) |
@@ -30,6 +31,7 @@ pub mod discrete;
 pub mod emitter;
 pub mod error;
 pub mod gltf;
+pub mod hair;
 pub mod mesh;
 pub mod points;
 pub mod sampling;
@@ -49,6 +51,7 @@ fn _trilux(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sampling::blue_noise, m)?)?;
     m.add_function(wrap_pyfunction!(sampling::sample_surface_even, m)?)?;
     m.add_function(wrap_pyfunction!(sampling::scatter, m)?)?;
+    m.add_function(wrap_pyfunction!(hair::grow_hair, m)?)?;
     m.add_class::<discrete::Distribution1D>()?;
     m.add_class::<discrete::Distribution2D>()?;
     m.add_class::<emitter::Emitter>()?;

@@ -653,6 +653,28 @@ def scatter(
     return_normal: bool = False,
 ) -> PointArrays: ...
 
+Scalars = Union[float, ArrayLike]
+
+def grow_hair(
+    mesh: MeshLike,
+    face_index: ArrayLike,
+    barycentric: ArrayLike,
+    length: Scalars,
+    *,
+    segments: int = 8,
+    comb: Optional[ArrayLike] = None,
+    comb_angle: Optional[Scalars] = None,
+    curl_radius: Optional[Scalars] = None,
+    curl_turns: Optional[Scalars] = None,
+    noise: Optional[Scalars] = None,
+    clumps: int = 0,
+    clump: Optional[Scalars] = None,
+    width: Optional[Scalars] = None,
+    tip_width: Optional[Scalars] = None,
+    seed: Optional[int] = None,
+    path: Optional[PathLike] = None,
+) -> dict[str, Any]: ...
+
 @overload
 def tetrahedralize(
     mesh: MeshLike,
