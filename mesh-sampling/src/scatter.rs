@@ -120,9 +120,11 @@ pub struct ScatterUpdate {
     pub faces: Vec<u32>,
     /// `None` when every recomputed face kept its number of points: only
     /// the ranges of `faces` were rewritten, in place. Otherwise the index
-    /// in [`Scatter::points`] from which points moved: everything before
-    /// it is unchanged except the ranges of `faces`, everything from it on
-    /// must be re-read.
+    /// in [`Scatter::points`] of the first face whose count changed:
+    /// before it, only the ranges of `faces` changed, and from it on the
+    /// points must be re-read (in memory, the update may have moved the
+    /// points before it instead, but [`Scatter::points`] indexes them as
+    /// before).
     pub moved_from: Option<usize>,
 }
 
@@ -236,9 +238,10 @@ fn check_weights(what: &'static str, w: &[f32], expected: usize) -> Result<(), E
 /// # Performance
 /// A build costs the candidates, `rate × max_density × area` of them
 /// (about 100 ns each on 2 cores, the `scatter` example); an update, the
-/// candidates of its faces, plus, when a face's count changed, a move in
-/// place of the points after it. Memory: 72 bytes a point, and a 64-byte
-/// frame and a 4-byte offset per face.
+/// candidates of its faces, plus, when a face's count changed, a move of
+/// the points on the smaller side of the edit (the buffer keeps about 6 %
+/// free on each side for that). Memory: 72 bytes a point and that room,
+/// and a 64-byte frame and a 4-byte offset per face.
 ///
 /// # Example
 /// ```
@@ -286,9 +289,19 @@ pub struct Scatter<'a> {
     seed: u64,
     clamp: bool,
     frames: Vec<Frame>,
-    points: Vec<SurfacePoint>,
-    /// `offsets[f]..offsets[f + 1]` are face `f`'s points.
+    /// The points are `buffer[base..base + len]`; the room on both sides
+    /// lets an update move whichever side of an edit holds fewer points.
+    buffer: Vec<SurfacePoint>,
+    base: usize,
+    len: usize,
+    /// `offsets[f]..offsets[f + 1]` are face `f`'s points (from `base`).
     offsets: Vec<u32>,
+}
+
+/// Free slots kept on each side of the points, for `len` points: about
+/// 6 %, so that most edits move points within the buffer.
+fn headroom(len: usize) -> usize {
+    len / 16 + 1024
 }
 
 impl<'a> Scatter<'a> {
@@ -314,6 +327,17 @@ impl<'a> Scatter<'a> {
         mesh: MeshRef<'a>,
         density: ScatterDensity<'_>,
         options: &ScatterOptions,
+    ) -> Result<Self, Error> {
+        Self::build(mesh, density, options, true)
+    }
+
+    /// [`new`](Self::new), with room on both sides of the points for
+    /// updates when `room`.
+    fn build(
+        mesh: MeshRef<'a>,
+        density: ScatterDensity<'_>,
+        options: &ScatterOptions,
+        room: bool,
     ) -> Result<Self, Error> {
         mesh.validate()?;
         let rate = options.rate;
@@ -344,7 +368,9 @@ impl<'a> Scatter<'a> {
             seed: options.seed,
             clamp: options.clamp,
             frames: Frame::all(&mesh),
-            points: Vec::new(),
+            buffer: Vec::new(),
+            base: 0,
+            len: 0,
             offsets: Vec::new(),
         };
         let chunks = map_faces(many, faces.div_ceil(FACE_CHUNK), |c| {
@@ -356,21 +382,24 @@ impl<'a> Scatter<'a> {
             }
             Ok((points, ends))
         });
-        let mut points = Vec::with_capacity(
-            chunks
-                .iter()
-                .map(|c| c.as_ref().map_or(0, |(p, _)| p.len()))
-                .sum(),
-        );
+        let len: usize = chunks
+            .iter()
+            .map(|c| c.as_ref().map_or(0, |(p, _)| p.len()))
+            .sum();
+        let pad = if room { headroom(len) } else { 0 };
+        let mut buffer = Vec::with_capacity(len + 2 * pad);
+        buffer.resize(pad, SurfacePoint::default());
         let mut offsets = Vec::with_capacity(faces + 1);
         offsets.push(0);
         for chunk in chunks {
             let (chunk_points, ends) = chunk?;
-            let base = points.len();
-            offsets.extend(ends.iter().map(|&e| (base + e) as u32));
-            points.extend_from_slice(&chunk_points);
+            let start = buffer.len() - pad;
+            offsets.extend(ends.iter().map(|&e| (start + e) as u32));
+            buffer.extend_from_slice(&chunk_points);
         }
-        scatter.points = points;
+        buffer.resize(len + 2 * pad, SurfacePoint::default());
+        scatter.buffer = buffer;
+        (scatter.base, scatter.len) = (pad, len);
         scatter.offsets = offsets;
         Ok(scatter)
     }
@@ -436,7 +465,7 @@ impl<'a> Scatter<'a> {
     /// holds only on those faces: the points are then exactly those
     /// [`Scatter::new`] gives with `density` and the same options (and
     /// the same ceiling). Costs the faces' candidates, plus, when a face's
-    /// count changed, moving the points after it (in place).
+    /// count changed, moving the points on one side of it (in place).
     ///
     /// # Errors
     /// [`Error::NoSuchFace`] for a face that is not a triangle of the mesh;
@@ -473,7 +502,8 @@ impl<'a> Scatter<'a> {
             None => {
                 for (&f, points) in faces.iter().zip(&fresh) {
                     let range = self.face_range(f as usize);
-                    self.points[range].copy_from_slice(points);
+                    let at = self.base + range.start;
+                    self.buffer[at..at + range.len()].copy_from_slice(points);
                 }
             }
             Some(_) => self.repack(&faces, &fresh),
@@ -481,14 +511,16 @@ impl<'a> Scatter<'a> {
         Ok(ScatterUpdate { faces, moved_from })
     }
 
-    /// Rewrites the point array in place with `fresh[k]` as the points of
-    /// `faces[k]` (sorted): the runs of faces in between shift by the
-    /// counts' change before them, and only runs that shift are moved.
+    /// Rewrites the points with `fresh[k]` as the points of `faces[k]`
+    /// (sorted): the runs of faces in between shift by the counts' change
+    /// before them. Within the buffer, the whole array may shift too, so
+    /// the run with the most points stays put and only the others move;
+    /// without room for that, the points go to a new buffer.
     fn repack(&mut self, faces: &[u32], fresh: &[Vec<SurfacePoint>]) {
         let at = |f: usize| self.offsets[f] as usize;
         // Run k: the unchanged faces before `faces[k]` (after the
         // previous one), the last run after the last face; each with its
-        // old range and its shift.
+        // old range and its shift (from `base`).
         let mut runs = Vec::with_capacity(faces.len() + 1);
         let mut starts = Vec::with_capacity(faces.len()); // new start of faces[k]
         let mut deltas = Vec::with_capacity(faces.len()); // its change of count
@@ -501,27 +533,17 @@ impl<'a> Scatter<'a> {
             shift += deltas[deltas.len() - 1];
             next = f + 1;
         }
-        runs.push((at(next)..self.points.len(), shift));
-        let len = self.points.len().wrapping_add_signed(shift);
-        if shift > 0 {
-            self.points.resize(len, SurfacePoint::default());
-        }
-        // A run moving right can only overwrite the old place of runs
-        // that also move right and lie after it (the order of the points
-        // is kept), so those go first, from the end; symmetrically, runs
-        // moving left go from the start.
-        for (range, shift) in runs.iter().rev().filter(|(_, s)| *s > 0) {
-            let to = range.start.wrapping_add_signed(*shift);
-            self.points.copy_within(range.clone(), to);
-        }
-        for (range, shift) in runs.iter().filter(|(_, s)| *s < 0) {
-            let to = range.start.wrapping_add_signed(*shift);
-            self.points.copy_within(range.clone(), to);
+        runs.push((at(next)..self.len, shift));
+        let len = self.len.wrapping_add_signed(shift);
+        match self.anchor(&runs, len) {
+            Some(anchor) => self.shift_runs(&runs, anchor),
+            None => self.regrow(&runs, len),
         }
         for (&start, points) in starts.iter().zip(fresh) {
-            self.points[start..start + points.len()].copy_from_slice(points);
+            let at = self.base + start;
+            self.buffer[at..at + points.len()].copy_from_slice(points);
         }
-        self.points.truncate(len);
+        self.len = len;
         // Offsets after the first changed face: shifted by the change of
         // the counts of the changed faces before them.
         let (mut k, mut shift) = (0, 0isize);
@@ -534,14 +556,71 @@ impl<'a> Scatter<'a> {
         }
     }
 
+    /// The shift of the runs that stay put: the one with the most points
+    /// among those for which the `len` new points fit in the buffer.
+    fn anchor(&self, runs: &[(Range<usize>, isize)], len: usize) -> Option<isize> {
+        let mut by_shift: Vec<(isize, usize)> = runs.iter().map(|(r, s)| (*s, r.len())).collect();
+        by_shift.sort_unstable();
+        by_shift.dedup_by(|b, a| {
+            let same = a.0 == b.0;
+            if same {
+                a.1 += b.1;
+            }
+            same
+        });
+        by_shift.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        by_shift.into_iter().map(|(s, _)| s).find(|&s| {
+            self.base
+                .checked_add_signed(-s)
+                .is_some_and(|base| base + len <= self.buffer.len())
+        })
+    }
+
+    /// Moves each run by its shift less `anchor`, in place, and the base
+    /// by `−anchor`.
+    fn shift_runs(&mut self, runs: &[(Range<usize>, isize)], anchor: isize) {
+        let base = self.base;
+        let to = |start: usize, s: isize| (base + start).wrapping_add_signed(s - anchor);
+        let from = |r: &Range<usize>| base + r.start..base + r.end;
+        // A run moving right can only overwrite the old place of runs
+        // that also move right and lie after it (the order of the points
+        // is kept), so those go first, from the end; symmetrically, runs
+        // moving left go from the start.
+        for (range, s) in runs.iter().rev().filter(|(_, s)| *s > anchor) {
+            self.buffer.copy_within(from(range), to(range.start, *s));
+        }
+        for (range, s) in runs.iter().filter(|(_, s)| *s < anchor) {
+            self.buffer.copy_within(from(range), to(range.start, *s));
+        }
+        self.base = base.wrapping_add_signed(-anchor);
+    }
+
+    /// Copies the runs, at their shifts, into a new buffer with room on
+    /// both sides for `len` points (the new faces' points are written by
+    /// the caller).
+    fn regrow(&mut self, runs: &[(Range<usize>, isize)], len: usize) {
+        let pad = headroom(len);
+        let mut buffer = vec![SurfacePoint::default(); len + 2 * pad];
+        for (range, s) in runs {
+            let to = (pad + range.start).wrapping_add_signed(*s);
+            buffer[to..to + range.len()]
+                .copy_from_slice(&self.buffer[self.base + range.start..self.base + range.end]);
+        }
+        self.buffer = buffer;
+        self.base = pad;
+    }
+
     /// All points, in face order.
     pub fn points(&self) -> &[SurfacePoint] {
-        &self.points
+        &self.buffer[self.base..self.base + self.len]
     }
 
     /// The points, consumed.
     pub fn into_points(self) -> Vec<SurfacePoint> {
-        self.points
+        let mut buffer = self.buffer;
+        buffer.truncate(self.base + self.len);
+        buffer.drain(..self.base);
+        buffer
     }
 
     /// Per-face offsets into [`points`](Self::points): `faces + 1`
@@ -560,7 +639,7 @@ impl<'a> Scatter<'a> {
 
     /// The points of face `face` (empty for no such face).
     pub fn face_points(&self, face: usize) -> &[SurfacePoint] {
-        &self.points[self.face_range(face)]
+        &self.points()[self.face_range(face)]
     }
 
     /// The mesh.
@@ -579,9 +658,10 @@ impl<'a> Scatter<'a> {
         self.max_density
     }
 
-    /// Heap memory of the scatter: points, offsets and per-face frames.
+    /// Heap memory of the scatter: points (with the room kept for
+    /// updates), offsets and per-face frames.
     pub fn memory_bytes(&self) -> usize {
-        self.points.capacity() * size_of::<SurfacePoint>()
+        self.buffer.capacity() * size_of::<SurfacePoint>()
             + self.offsets.capacity() * size_of::<u32>()
             + self.frames.capacity() * size_of::<Frame>()
     }
@@ -596,7 +676,7 @@ pub fn scatter(
     density: ScatterDensity<'_>,
     options: &ScatterOptions,
 ) -> Result<Vec<SurfacePoint>, Error> {
-    Scatter::new(mesh, density, options).map(Scatter::into_points)
+    Scatter::build(mesh, density, options, false).map(Scatter::into_points)
 }
 
 #[cfg(test)]

@@ -525,7 +525,11 @@ fn updates_with_counts_rising_and_falling_in_any_mix_give_a_rebuild() {
     let mut rng = SplitMix64(77);
     let opts = options(20.0, 1.0, 3);
     let mut weights = random_weights(&mut rng, indices.len());
-    let mut scatter = Scatter::new(mesh, Density::PerFace(&weights).into(), &opts).unwrap();
+    // Without room around the points: the first update that grows needs a
+    // new buffer, later ones move either side.
+    let mut scatter =
+        Scatter::build(mesh, Density::PerFace(&weights).into(), &opts, false).unwrap();
+    let (mut moved_front, mut regrown) = (false, false);
     for step in 0..200 {
         let faces: Vec<u32> = (0..1 + rng.below(12))
             .map(|_| rng.below(indices.len() as u64) as u32)
@@ -534,11 +538,16 @@ fn updates_with_counts_rising_and_falling_in_any_mix_give_a_rebuild() {
             // Zero, full, or anything between.
             weights[f as usize] = [0.0, 1.0, rng.f32()][rng.below(3) as usize];
         }
+        let (base, room) = (scatter.base, scatter.buffer.len());
         scatter
             .update_faces(&faces, Density::PerFace(&weights).into())
             .unwrap();
+        moved_front |= base != 0 && scatter.base != base && scatter.buffer.len() == room;
+        regrown |= scatter.buffer.len() != room;
         let rebuilt = Scatter::new(mesh, Density::PerFace(&weights).into(), &opts).unwrap();
         assert!(scatter.points() == rebuilt.points(), "step {step}");
         assert_eq!(scatter.offsets(), rebuilt.offsets(), "step {step}");
     }
+    assert!(moved_front, "no update moved the points before an edit");
+    assert!(regrown, "no update needed a new buffer");
 }
