@@ -32,6 +32,12 @@
 //! - **Blue noise** ([`blue_noise`], feature `blue-noise`): Poisson-disk
 //!   points that keep their distance, following any sampler's density, by
 //!   weighted sample elimination (Yuksel 2015).
+//! - **Scatter by rate** ([`Scatter`], [`scatter`]): `rate × density`
+//!   points per unit area (Blender's and Houdini's "density"), a Poisson
+//!   process of fixed candidates per face, each with its own threshold, so
+//!   that an edit keeps the points of other faces bit for bit, a raised
+//!   density only adds points, and [`Scatter::update_faces`] re-thins only
+//!   the edited faces.
 //! - **Weights**: [`Density::PerFace`] and [`Density::PerVertex`] (linear
 //!   over each triangle), both sampled exactly.
 //! - **Light sampling** ([`Emitter`], the paper's Sec. 5.3 application:
