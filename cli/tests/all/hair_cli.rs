@@ -207,3 +207,71 @@ fn bad_hair_arguments_are_errors_naming_them() {
     );
     assert!(!dir.path().join("x.usda").exists());
 }
+
+#[test]
+fn a_mesh_colours_channel_scales_each_strands_length_at_its_root() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, noise) = torus_and_noise(d, [32, 16], 16);
+    let (torus, noise) = (torus.to_str().unwrap(), noise.to_str().unwrap());
+    assert!(
+        run(
+            d,
+            &[
+                "colors",
+                "convert",
+                torus,
+                "--texture",
+                noise,
+                "-o",
+                "t.meshcolors"
+            ]
+        )
+        .status
+        .success()
+    );
+    for out in ["roots.ply", "h.hair"] {
+        let ok = run(
+            d,
+            &[
+                "sample",
+                torus,
+                "-n",
+                "300",
+                "--seed",
+                "9",
+                "--hair",
+                "0.5:2",
+                "--hair-length-meshcolors",
+                "t.meshcolors",
+                "--hair-length-channel",
+                "g",
+                "-o",
+                out,
+            ],
+        );
+        assert!(ok.status.success(), "{}", crate::common::stderr(&ok));
+    }
+    let (colors, _) = mesh_colors::file::load(d.join("t.meshcolors")).unwrap();
+    let roots = trilux_io::mesh::ply::read(d.join("roots.ply")).unwrap();
+    let faces = roots.face_ids.as_ref().unwrap();
+    let bary = |k: usize, i: usize| roots.scalars[k].1[i];
+    let curves = hair::read(d.join("h.hair")).unwrap();
+    let mut value = vec![0.0f32; colors.channels()];
+    let mut varied = (f32::INFINITY, 0.0f32);
+    for (i, strand) in curves.points.chunks(3).enumerate() {
+        let b = [bary(0, i), bary(1, i), bary(2, i)];
+        colors.linear(faces[i] as usize, b, &mut value).unwrap();
+        let length: f32 = strand.windows(2).map(|w| w[0].distance(w[1])).sum();
+        assert!(
+            (length - 0.5 * value[1]).abs() < 1e-4,
+            "strand {i}: {length} vs {}",
+            0.5 * value[1]
+        );
+        varied = (varied.0.min(length), varied.1.max(length));
+    }
+    assert!(
+        varied.1 > varied.0 + 0.05,
+        "the noise varies the lengths: {varied:?}"
+    );
+}
