@@ -631,7 +631,8 @@ impl<'a> Scatter<'a> {
 
     /// The indices of face `face`'s points (empty for no such face).
     pub fn face_range(&self, face: usize) -> Range<usize> {
-        match (self.offsets.get(face), self.offsets.get(face + 1)) {
+        let next = face.checked_add(1).and_then(|g| self.offsets.get(g));
+        match (self.offsets.get(face), next) {
             (Some(&a), Some(&b)) => a as usize..b as usize,
             _ => 0..0,
         }

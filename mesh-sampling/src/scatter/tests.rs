@@ -324,6 +324,8 @@ fn bad_arguments_are_errors() {
         .update_faces(&[0], ScatterDensity::Function(&|_, _| 1.5))
         .unwrap_err();
     assert!(matches!(e, Error::DensityOutOfRange { face: 0, .. }), "{e}");
+    // Faces that do not exist have no points.
+    assert!(s.face_points(usize::MAX).is_empty() && s.face_range(8).is_empty());
     // An empty mesh.
     let e = Scatter::new(
         MeshRef::new(&positions, &[]),
