@@ -341,6 +341,60 @@ fn no_public_function_panics_on_extreme_arguments() {
     }
 }
 
+/// Scatter by rate with extreme rates, ceilings, densities and faces:
+/// an `Err` or points, never a panic; an update with the same density
+/// (or one that fails) leaves the points as they were.
+#[test]
+fn scatter_never_panics_on_extreme_arguments() {
+    use mesh_sampling::{Scatter, ScatterDensity, ScatterOptions};
+    let texture = DensityTexture::new(2, 2, vec![0.0, 1.0, 0.5, 0.25]).unwrap();
+    for (positions, uvs, indices) in meshes() {
+        let mesh = MeshRef {
+            uvs: Some(&uvs),
+            ..MeshRef::new(&positions, &indices)
+        };
+        for &w in &EXTREME_F32 {
+            let face_w = vec![w; indices.len()];
+            let vertex_w = vec![w; positions.len()];
+            let function = move |_: usize, _: [f32; 3]| w;
+            let densities = [
+                ScatterDensity::Uniform,
+                Density::PerFace(&face_w).into(),
+                Density::PerVertex(&vertex_w).into(),
+                Density::PerVertex(&[]).into(),
+                Density::Texture(&texture).into(),
+                ScatterDensity::Function(&function),
+            ];
+            for density in densities {
+                for rate in [0.0, 1e-300, 1.0, 1e300, f64::INFINITY, f64::NAN, -1.0] {
+                    for max_density in [None, Some(0.0), Some(1.0), Some(1e300), Some(f64::NAN)] {
+                        for clamp in [false, true] {
+                            let options = ScatterOptions {
+                                max_density,
+                                clamp,
+                                seed: u64::MAX,
+                                ..ScatterOptions::new(rate)
+                            };
+                            let Ok(mut s) = Scatter::new(mesh, density, &options) else {
+                                continue;
+                            };
+                            let before = s.points().to_vec();
+                            for faces in [&[][..], &[0, 1], &[1, 1, 0], &[u32::MAX]] {
+                                // The same density: the same points, or an
+                                // error that changed nothing.
+                                let _ = s.update_faces(faces, density);
+                                assert_eq!(s.points(), &before[..]);
+                            }
+                            let _ = s.face_points(usize::MAX);
+                            assert_eq!(s.offsets().len(), indices.len() + 1);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Errors read as sentences that name the argument.
 #[test]
 fn errors_are_sentences() {
