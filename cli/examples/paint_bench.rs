@@ -47,7 +47,13 @@ impl Client {
 
     /// The status answering `seq` (texel frames on the way are counted).
     async fn status(&mut self, seq: u64) -> (Value, usize) {
-        let mut frames = 0;
+        let (status, kinds) = self.status_kinds(seq).await;
+        (status, kinds.len())
+    }
+
+    /// The status answering `seq` and the kinds of the frames on the way.
+    async fn status_kinds(&mut self, seq: u64) -> (Value, Vec<u8>) {
+        let mut frames = Vec::new();
         loop {
             let m = tokio::time::timeout(Duration::from_secs(600), self.socket.next())
                 .await
@@ -55,7 +61,7 @@ impl Client {
                 .expect("open")
                 .expect("no error");
             match m {
-                Message::Binary(_) => frames += 1,
+                Message::Binary(b) => frames.push(b.get(5).copied().unwrap_or(0)),
                 Message::Text(t) => {
                     let v: Value = serde_json::from_str(&t).unwrap_or_default();
                     assert_ne!(v["type"], "error", "{v}");
@@ -122,6 +128,103 @@ fn rebuild_ms(colors: &MeshColors) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
+/// Connects a client the way the page does.
+async fn connect(running: &trilux::paint::Running) -> Client {
+    let mut request = format!("ws://{}/{}/ws", running.addr, running.token)
+        .into_client_request()
+        .unwrap();
+    request.headers_mut().insert(
+        "Origin",
+        format!("http://{}", running.addr).parse().unwrap(),
+    );
+    // The whole samples texture comes first: tens of MB, as a page
+    // takes it.
+    let config = tokio_tungstenite::tungstenite::protocol::WebSocketConfig::default()
+        .max_message_size(Some(1 << 30))
+        .max_frame_size(Some(1 << 30));
+    let socket = tokio_tungstenite::connect_async_with_config(request, Some(config), false)
+        .await
+        .unwrap()
+        .0;
+    Client { socket, seq: 0 }
+}
+
+/// The scatter panel on `doc` with a `density` channel: the whole surface
+/// painted 1 with a rate that gives about 10⁶ points, then strokes of one
+/// dab (1 % of the diagonal) that lower the density under them, each
+/// timed from the dab sent to its points frame received (medians), beside
+/// a scatter of the whole surface again in the same run (what a node
+/// graph re-evaluates). Returns (stroke → points ms, points, rebuild ms).
+async fn scatter_rows(doc: &Document, diagonal: f32) -> (f64, usize, f64) {
+    let mut colors = MeshColors::uniform(
+        doc.surface.topology().unwrap(),
+        doc.colors.face_resolution(0).unwrap_or(8),
+        4,
+    )
+    .unwrap();
+    for s in colors.samples_mut().chunks_mut(4) {
+        s.copy_from_slice(&[0.8, 0.8, 0.8, 1.0]);
+    }
+    let area: f64 = doc
+        .surface
+        .faces
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|v| doc.surface.positions[v as usize].as_dvec3());
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum();
+    let dense = Document {
+        surface: doc.surface.clone(),
+        colors,
+        base: vec![0.8, 0.8, 0.8, 0.0],
+        scalars: vec!["density".into()],
+        source: json!({"mesh": null}),
+    };
+    let positions = dense.surface.positions.clone();
+    let dir = tempfile::tempdir().unwrap();
+    let options = Options {
+        export_dir: dir.path().to_path_buf(),
+        autosave: None,
+        ..Options::default()
+    };
+    let running = trilux::paint::start(dense, None, options).await.unwrap();
+    let mut c = connect(&running).await;
+    let rate = 1e6 / area;
+    let mut rebuild_ms = Vec::new();
+    let mut points = 0;
+    for seed in 0..5 {
+        let t = Instant::now();
+        let seq = c
+            .send(
+                "scatter",
+                json!({"mode": "rate", "channel": "density", "rate": rate, "seed": seed}),
+            )
+            .await;
+        let (status, kinds) = c.status_kinds(seq).await;
+        assert!(kinds.contains(&5));
+        rebuild_ms.push(t.elapsed().as_secs_f64() * 1e3);
+        points = status["points"].as_u64().unwrap() as usize;
+    }
+    let brush = json!({"mode": "mix", "channel": "density", "color": [0.3],
+                       "strength": 1.0, "hardness": 0.5, "mirror": false, "eye": null});
+    let radius = 0.01 * diagonal;
+    let mut stroke_ms = Vec::new();
+    for k in 0..21 {
+        let p = positions[(k * 7919) % positions.len()];
+        let t = Instant::now();
+        c.send("begin", json!({"brush": brush})).await;
+        c.send("dabs", json!({"dabs": [[p.x, p.y, p.z, radius, 1.0]]}))
+            .await;
+        let seq = c.send("end", json!({})).await;
+        let (_, kinds) = c.status_kinds(seq).await;
+        assert!(kinds.contains(&5), "{kinds:?}");
+        stroke_ms.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    running.stop().await.unwrap();
+    (median(stroke_ms), points, median(rebuild_ms))
+}
+
 fn main() {
     let (name, doc) = document();
     let samples = doc.colors.sample_count();
@@ -140,23 +243,9 @@ fn main() {
             autosave: None,
             ..Options::default()
         };
+        let scatter = scatter_rows(&doc, diagonal).await;
         let running = trilux::paint::start(doc, None, options).await.unwrap();
-        let mut request = format!("ws://{}/{}/ws", running.addr, running.token)
-            .into_client_request()
-            .unwrap();
-        request
-            .headers_mut()
-            .insert("Origin", format!("http://{}", running.addr).parse().unwrap());
-        // The whole samples texture comes first: tens of MB, as a page
-        // takes it.
-        let config = tokio_tungstenite::tungstenite::protocol::WebSocketConfig::default()
-            .max_message_size(Some(1 << 30))
-            .max_frame_size(Some(1 << 30));
-        let socket = tokio_tungstenite::connect_async_with_config(request, Some(config), false)
-            .await
-            .unwrap()
-            .0;
-        let mut c = Client { socket, seq: 0 };
+        let mut c = connect(&running).await;
         let brush = json!({"mode": "mix", "channel": "color", "color": [0.9, 0.1, 0.1],
                            "strength": 1.0, "hardness": 0.5, "mirror": false, "eye": null});
         // A brush of 1 % of the diagonal.
@@ -242,6 +331,8 @@ fn main() {
         println!("| dabs applied per second in a stroke | {dabs_per_s:.0} /s | {:.0} /s | ≥ 60 /s |", 1000.0 / rebuild);
         println!("| detail brush, ~1,000 faces up one level | {detail:.1} ms | {rebuild:.1} ms | ≤ 50 ms |");
         println!("| undo memory of 50 strokes / colours | {:.1} % | — | ≤ 10 % |", 100.0 * undo_share);
+        let (stroke, points, scatter_all) = scatter;
+        println!("| density stroke → its points frame received, {points} points | {stroke:.1} ms | {scatter_all:.1} ms (a new scatter of every face, {:.0}×) | ≤ 100 ms with the page's upload and draw |", scatter_all / stroke);
     });
 }
 

@@ -336,6 +336,29 @@ impl ScatterState {
         }
     }
 
+    /// The request it follows, as the page sends it (a page that
+    /// connects later shows it in its panel).
+    pub(crate) fn request(&self) -> Value {
+        let spec = &self.spec;
+        let mut v = serde_json::json!({"channel": spec.channel, "seed": spec.seed});
+        let (mode, key, amount) = match spec.mode {
+            ScatterMode::Off => ("off", None, Value::Null),
+            ScatterMode::Rate(r) => ("rate", Some("rate"), r.into()),
+            ScatterMode::Count(n) => ("count", Some("count"), n.into()),
+            ScatterMode::BlueNoise(n) => ("blue_noise", Some("count"), n.into()),
+        };
+        v["mode"] = mode.into();
+        if let Some(key) = key {
+            v[key] = amount;
+        }
+        v["hair"] = match &spec.hair {
+            None => Value::Null,
+            Some(h) => serde_json::json!({"length": h.length, "segments": h.segments,
+                "length_channel": h.length_channel}),
+        };
+        v
+    }
+
     /// The preview strands.
     pub(crate) fn strands(&self) -> Option<&Strands> {
         self.strands.as_ref()

@@ -196,6 +196,7 @@ impl Worker {
                 "points": self.scatter.as_ref().map_or(0, |s| s.points().len()),
                 "strands": self.scatter.as_ref().and_then(|s| s.strands()).map_or(0, |s| s.len()),
                 "scatter_ms": self.scatter.as_ref().map_or(0.0, |s| s.last_ms),
+                "scatter": self.scatter.as_ref().map(ScatterState::request),
             })
             .to_string(),
         )

@@ -401,6 +401,12 @@ async fn the_scatter_follows_the_painted_density() {
     send(&mut s, scatter).await;
     let st = status_of(&mut s, 1, &mut seen).await;
     assert_eq!(st["points"], 0);
+    // The status names the request, for a page that connects later.
+    assert_eq!(
+        st["scatter"],
+        json!({"mode": "rate", "channel": "density", "rate": rate, "seed": 3,
+            "hair": {"length": 0.05f32, "segments": 4, "length_channel": null}})
+    );
     assert_eq!(seen.points.as_deref().map(<[_]>::len), Some(0));
 
     // A stroke of density 1 around vertex 0: points there.

@@ -57,21 +57,32 @@ try {
     await page.mouse.click(400, 300);
     await framesAfter(frames);
     out.steps.filled = await t();
+    // One frame split: the mesh colours alone, the points alone, both
+    // (medians of 5, each waited for).
+    out.draw_ms = await page.evaluate(() => {
+      const med = (parts) => {
+        const v = [0, 1, 2, 3, 4].map(() => window.trilux.timeDraw(parts)).sort((a, b) => a - b);
+        return v[2];
+      };
+      return { mesh: med({ mesh: true }), points: med({ points: true }), both: med({ mesh: true, points: true }) };
+    });
     await page.keyboard.press('e');
     const times = [];
     for (let k = 0; k < 7; k++) {
       frames = (await t()).frames;
-      const x = 300 + 30 * k;
-      await page.mouse.move(x, 280);
+      // Across the middle of the model (the camera frames it centred).
+      const x = 340 + 15 * k;
+      await page.mouse.move(x, 380);
       const sent = await page.evaluate(() => performance.now());
       await page.mouse.down();
-      await page.mouse.move(x + 10, 285);
+      await page.mouse.move(x + 10, 385);
       await page.mouse.up();
       await framesAfter(frames);
       await page.waitForFunction((n) => window.trilux.pointsDrawnAt > 0 && window.trilux.scatterFrames > n, frames);
       await page.waitForTimeout(50);
-      const drawn = await page.evaluate(() => window.trilux.pointsDrawnAt);
+      const [arrived, drawn] = await page.evaluate(() => [window.trilux.pointsArrivedAt, window.trilux.pointsDrawnAt]);
       times.push(drawn - sent);
+      (out.arrived_ms = out.arrived_ms || []).push(arrived - sent);
     }
     times.sort((a, b) => a - b);
     out.stroke_to_points_ms = times;
