@@ -394,7 +394,7 @@ fn to_curves(strands: Strands) -> curves::Curves {
 
 /// The roots as a PLY point cloud: normals, UVs and `face_id` as
 /// `trilux::point_cloud` writes them, plus the barycentrics `bary0..2`
-/// and the strand's index `id` (`float`: exact below 2^24 strands).
+/// and the strand's index as the integer property `id`.
 fn roots_cloud(mesh: &TriMesh, points: &[SurfacePoint]) -> ply::PlyData {
     let mut cloud = trilux::point_cloud(mesh, points);
     for k in 0..3 {
@@ -403,8 +403,7 @@ fn roots_cloud(mesh: &TriMesh, points: &[SurfacePoint]) -> ply::PlyData {
             points.iter().map(|p| p.barycentric[k]).collect(),
         ));
     }
-    cloud
-        .scalars
-        .push(("id".into(), (0..points.len()).map(|i| i as f32).collect()));
+    // Strand indices as `uint id` (u32: `sample` draws fewer than 2^32).
+    cloud.ids = Some((0..points.len()).map(|i| i as u32).collect());
     cloud
 }

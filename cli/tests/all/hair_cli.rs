@@ -97,9 +97,8 @@ fn usda_glb_and_ply_outputs_carry_the_strands_and_roots() {
     assert_eq!(ply.positions.len(), 200);
     assert!(ply.face_ids.is_some() && ply.normals.is_some());
     let names: Vec<&str> = ply.scalars.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(names, ["bary0", "bary1", "bary2", "id"]);
-    let id = &ply.scalars[3].1;
-    assert!(id.iter().enumerate().all(|(i, &v)| v == i as f32));
+    assert_eq!(names, ["bary0", "bary1", "bary2"]);
+    assert_eq!(ply.ids, Some((0..200).collect()));
     for (k, (b0, (b1, b2))) in ply.scalars[0]
         .1
         .iter()

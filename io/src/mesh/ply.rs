@@ -63,6 +63,10 @@ pub struct PlyData {
     /// Per-vertex triangle indices (the face a sampled point lies on),
     /// stored as the integer property `face_id`.
     pub face_ids: Option<Vec<u32>>,
+    /// Per-vertex integer ids (a hair strand's or a sample's index),
+    /// stored as the integer property `id` (a float `id` is read as an
+    /// ordinary scalar).
+    pub ids: Option<Vec<u32>>,
     /// Other per-vertex scalar properties, by name, written as `float`.
     pub scalars: Vec<(String, Vec<f32>)>,
     /// The texture a `comment TextureFile NAME` header line names
@@ -455,7 +459,8 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
     // An integer `face_id` is a sampled point's triangle; a float one is
     // kept as an ordinary scalar.
     let face_id = find(&["face_id"]).filter(|&i| !element.properties[i].kind.is_float());
-    let known: Vec<usize> = [Some(x), Some(y), Some(z), alpha, face_id]
+    let id = find(&["id"]).filter(|&i| !element.properties[i].kind.is_float());
+    let known: Vec<usize> = [Some(x), Some(y), Some(z), alpha, face_id, id]
         .into_iter()
         .chain(normal)
         .chain(color)
@@ -484,6 +489,7 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
     let mut colors = Vec::with_capacity(if has_color { n } else { 0 });
     let mut uvs = Vec::with_capacity(if has_uv { n } else { 0 });
     let mut face_ids = Vec::with_capacity(if face_id.is_some() { n } else { 0 });
+    let mut ids = Vec::with_capacity(if id.is_some() { n } else { 0 });
     let mut scalars: Vec<(String, Vec<f32>)> = extra
         .iter()
         .map(|&i| (element.properties[i].name.clone(), Vec::with_capacity(n)))
@@ -538,6 +544,19 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
             }
             face_ids.push(v as u32);
         }
+        if let Some(i) = id {
+            let v = values[i];
+            if !(0.0..=f64::from(u32::MAX)).contains(&v) {
+                return Err(r.located(
+                    at,
+                    ErrorKind::Syntax {
+                        expected: format!("an id from 0 to {} at vertex {index}", u32::MAX),
+                        found: v.to_string(),
+                    },
+                ));
+            }
+            ids.push(v as u32);
+        }
         for ((_, column), &i) in scalars.iter_mut().zip(&extra) {
             column.push(values[i] as f32);
         }
@@ -558,6 +577,7 @@ fn read_vertices(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -
     out.colors = has_color.then_some(colors);
     out.uvs = has_uv.then_some(uvs);
     out.face_ids = face_id.map(|_| face_ids);
+    out.ids = id.map(|_| ids);
     out.scalars = scalars;
     Ok(())
 }
@@ -621,6 +641,9 @@ fn copy_vertex(out: &mut PlyData, v: usize) {
         colors.push(colors[v]);
     }
     if let Some(ids) = out.face_ids.as_mut() {
+        ids.push(ids[v]);
+    }
+    if let Some(ids) = out.ids.as_mut() {
         ids.push(ids[v]);
     }
     for (_, column) in &mut out.scalars {
@@ -843,7 +866,7 @@ fn read_strips(r: &mut DataReader<'_>, element: &Element, out: &mut PlyData) -> 
 /// Writes `data` as a `.ply` file: `float` coordinates (`double` when
 /// [`PlyData::origin`] is not zero, with the origin added back), then
 /// normals `nx ny nz`, colours `red green blue alpha` (uchar), texture
-/// coordinates `s t` (v up, as PLY tools expect), `uint face_id`, and the
+/// coordinates `s t` (v up, as PLY tools expect), `uint face_id`, `uint id`, and the
 /// extra scalars as `float`; faces as `list uchar int vertex_indices`.
 ///
 /// # Errors
@@ -930,6 +953,7 @@ pub fn to_bytes(path: impl AsRef<Path>, data: &PlyData, format: Format) -> Resul
         ("colors", data.colors.as_ref().map(Vec::len)),
         ("uvs", data.uvs.as_ref().map(Vec::len)),
         ("face ids", data.face_ids.as_ref().map(Vec::len)),
+        ("ids", data.ids.as_ref().map(Vec::len)),
     ];
     for (name, len) in lengths {
         if let Some(len) = len.filter(|&l| l != n) {
@@ -937,7 +961,7 @@ pub fn to_bytes(path: impl AsRef<Path>, data: &PlyData, format: Format) -> Resul
         }
     }
     let reserved = [
-        "x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha", "s", "t", "face_id",
+        "x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha", "s", "t", "face_id", "id",
     ];
     for (name, column) in &data.scalars {
         if column.len() != n {
@@ -1006,6 +1030,9 @@ pub fn to_bytes(path: impl AsRef<Path>, data: &PlyData, format: Format) -> Resul
     if data.face_ids.is_some() {
         header.push_str("property uint face_id\n");
     }
+    if data.ids.is_some() {
+        header.push_str("property uint id\n");
+    }
     for (name, _) in &data.scalars {
         let _ = writeln!(header, "property float {name}");
     }
@@ -1040,6 +1067,9 @@ pub fn to_bytes(path: impl AsRef<Path>, data: &PlyData, format: Format) -> Resul
             sink.put(1.0 - uvs[i].y);
         }
         if let Some(ids) = &data.face_ids {
+            sink.put(ids[i]);
+        }
+        if let Some(ids) = &data.ids {
             sink.put(ids[i]);
         }
         for (_, column) in &data.scalars {

@@ -251,6 +251,7 @@ fn written_files_read_back_in_every_format() {
                     .collect()
             }),
             face_ids: pick(&mut rng).then(|| (0..n).map(|_| rng.next_u64() as u32).collect()),
+            ids: pick(&mut rng).then(|| (0..n).map(|_| rng.next_u64() as u32).collect()),
             triangles: if pick(&mut rng) {
                 (0..rng.below(30))
                     .map(|_| [0, 1, 2].map(|_| rng.below(n as u64) as u32))
