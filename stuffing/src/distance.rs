@@ -79,10 +79,10 @@ fn fraction(x: f64, diagonal: f64) -> f64 {
 }
 
 /// A triangle surface with the tree its nearest-point queries walk.
-struct Surface<'a> {
-    positions: &'a [DVec3],
-    triangles: &'a [[u32; 3]],
-    bvh: &'a Bvh,
+pub(crate) struct Surface<'a> {
+    pub(crate) positions: &'a [DVec3],
+    pub(crate) triangles: &'a [[u32; 3]],
+    pub(crate) bvh: &'a Bvh,
 }
 
 impl Surface<'_> {
@@ -92,7 +92,16 @@ impl Surface<'_> {
 
     /// The distance from `q` to the nearest point of the surface.
     fn distance(&self, q: DVec3) -> f64 {
+        self.nearest(q).1.sqrt()
+    }
+
+    /// The nearest point of the surface to `q`, its squared distance and
+    /// its triangle (`q`, infinity and `u32::MAX` for a surface without
+    /// triangles).
+    pub(crate) fn nearest(&self, q: DVec3) -> (DVec3, f64, u32) {
         let mut best = f64::INFINITY;
+        let mut point = q;
+        let mut triangle = u32::MAX;
         // Depth-first, nearer child first; the tree's depth is below 40.
         let mut stack = [(0u32, 0.0f64); 64];
         let mut len = 1;
@@ -107,7 +116,13 @@ impl Surface<'_> {
                 let s = node.start as usize;
                 for &t in &self.bvh.order[s..s + node.count as usize] {
                     let [a, b, c] = self.corners(t as usize);
-                    best = best.min(closest_point_on_triangle(q, a, b, c).distance_squared(q));
+                    let p = closest_point_on_triangle(q, a, b, c);
+                    let d2 = p.distance_squared(q);
+                    if d2 < best {
+                        best = d2;
+                        point = p;
+                        triangle = t;
+                    }
                 }
                 continue;
             }
@@ -123,13 +138,13 @@ impl Surface<'_> {
             stack[len + 1] = near;
             len += 2;
         }
-        best.sqrt()
+        (point, best, triangle)
     }
 
     /// `n` points spread over the triangles `chosen` by area (see the
     /// module docs), plus the vertices those triangles use when there are
     /// at most `n` of them.
-    fn sample(&self, chosen: &[u32], n: usize) -> Vec<DVec3> {
+    pub(crate) fn sample(&self, chosen: &[u32], n: usize) -> Vec<DVec3> {
         let mut cumulative = Vec::with_capacity(chosen.len());
         let mut total = 0.0;
         for &t in chosen {
@@ -254,7 +269,7 @@ fn closest_on_segment(q: DVec3, a: DVec3, b: DVec3) -> DVec3 {
 /// a far-field cluster of it.) The test's margin, ½ on a closed surface,
 /// allows the coarsest series (β = 1), which keeps the exact near field,
 /// the costly part of a query on the surface, small.
-fn encloses_volume(wn: &WindingNumber, [a, b, c]: [DVec3; 3]) -> bool {
+pub(crate) fn encloses_volume(wn: &WindingNumber, [a, b, c]: [DVec3; 3]) -> bool {
     let doubled_area = (b - a).cross(c - a).length();
     // Zero, or NaN from overflow: no sides to tell apart.
     if !(doubled_area.is_finite() && doubled_area > 0.0) {

@@ -64,15 +64,36 @@ pub enum Error {
         /// The limit ([`super::Options::max_tets`]).
         limit: usize,
     },
-    /// No lattice vertex lies inside the surface at this spacing: the input
-    /// is an open sheet, a single triangle, or thinner than the lattice.
+    /// No lattice vertex lies inside the surface at this spacing, though
+    /// some of its triangles bound a volume: the volume is thinner than
+    /// the lattice (a smaller `h` holds it).
     #[error(
         "the surface encloses no volume at h = {h} (winding number above 1/2 at no lattice \
-         vertex): it is open, flat, or thinner than h"
+         vertex): it is thinner than h"
     )]
     EmptyVolume {
         /// The spacing used.
         h: f64,
+    },
+    /// No triangle of the surface bounds a volume: the winding number is on
+    /// the same side of 1/2 in front of and behind every one (an open
+    /// sheet, a single triangle, a doubled wall), so no spacing gives
+    /// tetrahedra.
+    #[error(
+        "the surface encloses no volume: none of its {triangles} triangles bounds one (the \
+         winding number is on the same side of 1/2 in front of and behind each: an open sheet \
+         or a doubled wall); no spacing changes that, close the surface or give it thickness"
+    )]
+    OpenSurface {
+        /// Number of triangles given.
+        triangles: usize,
+    },
+    /// The envelope ([`super::Options::envelope`]) is not a fraction of
+    /// the diagonal strictly between 0 and 1.
+    #[error("the envelope {eps} must be a fraction of the bounding-box diagonal between 0 and 1")]
+    InvalidEnvelope {
+        /// The value given.
+        eps: f64,
     },
     /// A grading option is out of range.
     #[error("the graded lattice's {what} is out of range: {value}")]

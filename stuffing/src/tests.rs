@@ -6,6 +6,8 @@ use glam::DVec3;
 
 use super::*;
 
+mod envelope;
+
 /// A triangle soup: positions and counter-clockwise triangles.
 type Soup = (Vec<DVec3>, Vec<[u32; 3]>);
 /// Every face of `tets` (4 each) as sorted vertex triples, sorted: a face
@@ -405,8 +407,14 @@ fn the_same_input_gives_the_same_mesh_on_one_and_two_threads() {
             .unwrap()
             .install(|| tetrahedralize(&p, &t, options).unwrap())
     };
-    for graded in [false, true] {
+    for (graded, envelope) in [
+        (false, None),
+        (true, None),
+        (false, Some(1e-3)),
+        (true, Some(1e-3)),
+    ] {
         options.graded = graded;
+        options.envelope = envelope;
         let a = run_on(1, &options);
         let b = run_on(2, &options);
         assert_eq!(a.tets, b.tets);
@@ -477,10 +485,16 @@ fn bad_input_is_refused_with_the_reason() {
         tetrahedralize::<DVec3>(&p, &[], &Options::new(0.3)).unwrap_err(),
         Error::NoTriangles
     );
-    // A single triangle and an open flat sheet enclose nothing.
+    // A single triangle encloses nothing at any spacing, and says so
+    // without asking for a smaller one; a slab thinner than the lattice
+    // does ask.
     let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
+    let e = tetrahedralize(&tri, &[[0, 1, 2]], &Options::new(0.1)).unwrap_err();
+    assert_eq!(e, Error::OpenSurface { triangles: 1 });
+    assert!(e.to_string().contains("no spacing changes that"), "{e}");
+    let (slab, slab_t) = cuboid(DVec3::ZERO, DVec3::new(1.0, 1.0, 0.01));
     assert!(matches!(
-        tetrahedralize(&tri, &[[0, 1, 2]], &Options::new(0.1)),
+        tetrahedralize(&slab, &slab_t, &Options::new(0.3)),
         Err(Error::EmptyVolume { .. })
     ));
     // A lattice beyond the memory bound is refused before allocation, and

@@ -1,0 +1,526 @@
+//! Fitting the stuffed boundary to the input ([`super::Options::envelope`]):
+//! boundary vertices moved onto the parts of the input the lattice cut
+//! across, each move kept only if the tetrahedra around the vertex keep
+//! their dihedral angles.
+//!
+//! Stuffing puts its boundary vertices on the ½ level set already (cut
+//! points on the input triangles, warped vertices on cut points), so what
+//! lies far from the boundary is what the lattice's triangles span across:
+//! tips (ears, fingers, a spout's end), sharp creases (fandisk) and thin
+//! parts narrower than the spacing. So the fit works from the input's side,
+//! as a one-sided Hausdorff pass (the way envelope meshers such as
+//! fTetWild hold their envelope, here with the lattice's connectivity
+//! fixed):
+//!
+//! 1. points to hold: the vertices of the input triangles that enclose
+//!    volume (the winding number decides, as for the measurement), points
+//!    every `h / 4` along its sharp edges (two faces meeting at an interior
+//!    angle below [`SHARP_DEG`]), and points spread over its area;
+//! 2. each point farther than the envelope from the boundary, farthest
+//!    first, pulls the boundary vertex nearest to it onto itself (or a half
+//!    or a quarter of the way), once per vertex; a few rounds, each against
+//!    the boundary as the last one left it;
+//! 3. the other boundary vertices are projected onto their nearest point of
+//!    the input (the same partial steps), which brings back the ones a
+//!    chord between two pulled vertices left off the surface.
+//!
+//! A move is kept when every tetrahedron around the vertex keeps its
+//! orientation and its dihedral angles within [`MIN_DIHEDRAL_DEG`]–
+//! [`MAX_DIHEDRAL_DEG`] (or, for one already outside that range, gets no
+//! worse). Moves are made one after another in a fixed order, so the
+//! result does not depend on the number of threads. What the fit cannot
+//! reach — a part thinner than the lattice with no tetrahedron near it —
+//! stays missing, and [`super::Report::distance`] says by how much.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::bvh::Bvh;
+use crate::distance::{Surface, closest_point_on_triangle, encloses_volume};
+use crate::quality::{dihedral_angles, signed_volume};
+use crate::winding::WindingNumber;
+
+/// The smallest dihedral angle, degrees, a fitted tetrahedron may have.
+pub(crate) const MIN_DIHEDRAL_DEG: f64 = 10.0;
+/// The largest dihedral angle, degrees, a fitted tetrahedron may have.
+pub(crate) const MAX_DIHEDRAL_DEG: f64 = 165.0;
+/// Interior angle, degrees, between two input faces below which their
+/// common edge is a crease the boundary should follow.
+pub(crate) const SHARP_DEG: f64 = 140.0;
+/// Fractions of a move tried, in order.
+const STEPS: [f64; 4] = [1.0, 0.5, 0.25, 0.125];
+/// Rounds of pulling vertices towards far input points.
+const ROUNDS: usize = 8;
+/// Farthest a vertex is moved, in lattice spacings: beyond it the point
+/// belongs to a part the lattice did not reach (or lies across a hole).
+const REACH: f64 = 1.0;
+
+/// What the fit did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Fitted {
+    /// Boundary vertices moved.
+    pub(crate) moved: usize,
+    /// Sharp input edges found.
+    pub(crate) sharp_edges: usize,
+}
+
+/// Moves boundary vertices of the tetrahedral mesh `(positions, tets)`
+/// with boundary `boundary` towards the input `wn` was built on, until
+/// the input's sampled points lie within `eps` of the boundary or no move
+/// is left that keeps the angles; `h` is the lattice spacing.
+pub(crate) fn fit(
+    wn: &WindingNumber,
+    positions: &mut [DVec3],
+    tets: &[[u32; 4]],
+    boundary: &[[u32; 3]],
+    h: f64,
+    eps: f64,
+) -> Fitted {
+    let input_positions = wn.positions();
+    let kept: Vec<[u32; 3]> = wn
+        .triangles()
+        .par_iter()
+        .filter(|t| encloses_volume(wn, t.map(|v| input_positions[v as usize])))
+        .copied()
+        .collect();
+    if kept.is_empty() || boundary.is_empty() {
+        return Fitted::default();
+    }
+    let sharp = sharp_edges(input_positions, &kept);
+    let targets = points_to_hold(input_positions, &kept, &sharp, h, boundary.len());
+    let incident = Incidence::new(positions.len(), tets);
+    let faces = Incidence::new(positions.len(), boundary);
+    let input_bvh = Bvh::build(input_positions, &kept);
+    let input = Surface {
+        positions: input_positions,
+        triangles: &kept,
+        bvh: &input_bvh,
+    };
+    let mut mover = Mover {
+        tets,
+        incident: &incident,
+        boundary,
+        faces: &faces,
+        input: &input,
+        eps,
+        moved: vec![false; positions.len()],
+        touched: vec![false; positions.len()],
+    };
+    // Later rounds look again only at the points that were far and still
+    // had a vertex to move: a pull uncovers at most half the distance it
+    // closes (or `eps`), see `Mover::pull`.
+    let mut far: Vec<u32> = (0..targets.len() as u32).collect();
+    for _ in 0..ROUNDS {
+        let moved;
+        (far, moved) = mover.pull(positions, boundary, &targets, &far, h, eps);
+        if moved == 0 {
+            break;
+        }
+    }
+    mover.project(positions, boundary, h);
+    Fitted {
+        moved: mover.touched.iter().filter(|&&m| m).count(),
+        sharp_edges: sharp.len(),
+    }
+}
+
+/// Edges shared by exactly two of `triangles` whose faces meet at an
+/// interior angle below [`SHARP_DEG`], as vertex pairs.
+pub(crate) fn sharp_edges(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<([u32; 2], u32)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(t, tri)| {
+            (0..3).map(move |k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                ([a.min(b), a.max(b)], t as u32)
+            })
+        })
+        .collect();
+    edges.par_sort_unstable();
+    let normal = |t: u32| {
+        let [a, b, c] = triangles[t as usize].map(|v| positions[v as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    };
+    // Interior angle θ between the faces: their normals are π − θ apart.
+    let cos_limit = (std::f64::consts::PI - SHARP_DEG.to_radians()).cos();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j].0 == edges[i].0 {
+            j += 1;
+        }
+        if j - i == 2 {
+            let (n0, n1) = (normal(edges[i].1), normal(edges[i + 1].1));
+            if n0 != DVec3::ZERO && n1 != DVec3::ZERO && n0.dot(n1) < cos_limit {
+                out.push(edges[i].0);
+            }
+        }
+        i = j;
+    }
+    out
+}
+
+/// The input's points the boundary should come near (see the module
+/// docs): vertices, points along sharp edges every `h / 4`, and
+/// `4 × boundary triangles` points spread by area (at most 2^18).
+fn points_to_hold(
+    positions: &[DVec3],
+    kept: &[[u32; 3]],
+    sharp: &[[u32; 2]],
+    h: f64,
+    boundary_triangles: usize,
+) -> Vec<DVec3> {
+    let mut used: Vec<u32> = kept.iter().flatten().copied().collect();
+    used.par_sort_unstable();
+    used.dedup();
+    let mut points: Vec<DVec3> = used.iter().map(|&v| positions[v as usize]).collect();
+    for &[a, b] in sharp {
+        let (pa, pb) = (positions[a as usize], positions[b as usize]);
+        let steps = (pa.distance(pb) / (0.25 * h)).ceil().min(1e4) as usize;
+        points.extend((1..steps).map(|k| pa.lerp(pb, k as f64 / steps as f64)));
+    }
+    let bvh = Bvh::build(positions, kept);
+    let surface = Surface {
+        positions,
+        triangles: kept,
+        bvh: &bvh,
+    };
+    let all: Vec<u32> = (0..kept.len() as u32).collect();
+    let n = (4 * boundary_triangles).min(1 << 18);
+    // `sample` adds the vertices again when there are few; they are
+    // already in.
+    points.extend(surface.sample(&all, n).into_iter().take(n));
+    points
+}
+
+/// The elements (tetrahedra or triangles) around each vertex, as
+/// compressed rows.
+struct Incidence {
+    start: Vec<u32>,
+    elements: Vec<u32>,
+}
+
+impl Incidence {
+    fn new<const N: usize>(vertices: usize, elements: &[[u32; N]]) -> Incidence {
+        let mut start = vec![0u32; vertices + 1];
+        for e in elements {
+            for &v in e {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for k in 0..vertices {
+            start[k + 1] += start[k];
+        }
+        let mut fill = start.clone();
+        let mut list = vec![0u32; start[vertices] as usize];
+        for (i, e) in elements.iter().enumerate() {
+            for &v in e {
+                list[fill[v as usize] as usize] = i as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        Incidence {
+            start,
+            elements: list,
+        }
+    }
+
+    fn of(&self, v: u32) -> &[u32] {
+        &self.elements[self.start[v as usize] as usize..self.start[v as usize + 1] as usize]
+    }
+}
+
+/// Moves vertices under the angle check.
+struct Mover<'a> {
+    tets: &'a [[u32; 4]],
+    incident: &'a Incidence,
+    boundary: &'a [[u32; 3]],
+    /// The boundary triangles around each vertex.
+    faces: &'a Incidence,
+    /// The input where it encloses volume.
+    input: &'a Surface<'a>,
+    /// The envelope, in the input's unit.
+    eps: f64,
+    /// Vertices pulled all the way onto an input point: not moved again.
+    moved: Vec<bool>,
+    /// Vertices moved at all.
+    touched: Vec<bool>,
+}
+
+impl Mover<'_> {
+    /// One round of step 2: every point of `targets` (those indexed by
+    /// `candidates`) farther than `eps` from the boundary, farthest first,
+    /// pulls the nearest corner of its nearest boundary triangle that is
+    /// free. Returns the indices of the points to look at next round and
+    /// the number of vertices moved.
+    fn pull(
+        &mut self,
+        positions: &mut [DVec3],
+        boundary: &[[u32; 3]],
+        targets: &[DVec3],
+        candidates: &[u32],
+        h: f64,
+        eps: f64,
+    ) -> (Vec<u32>, usize) {
+        let bvh = Bvh::build(positions, boundary);
+        let surface = Surface {
+            positions,
+            triangles: boundary,
+            bvh: &bvh,
+        };
+        let mut far: Vec<(f64, [u32; 3], usize)> = candidates
+            .par_iter()
+            .filter_map(|&i| {
+                let i = i as usize;
+                let s = targets[i];
+                let (_, d2, t) = surface.nearest(s);
+                if d2 <= eps * eps || t == u32::MAX {
+                    return None;
+                }
+                // The corners of the nearest triangle, nearest first.
+                let mut corners = boundary[t as usize];
+                corners.sort_by(|&a, &b| {
+                    positions[a as usize]
+                        .distance_squared(s)
+                        .total_cmp(&positions[b as usize].distance_squared(s))
+                        .then(a.cmp(&b))
+                });
+                Some((d2, corners, i))
+            })
+            .collect();
+        far.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.2.cmp(&b.2)));
+        let mut count = 0;
+        // Vertices moved this round, against the boundary as it was.
+        let mut busy = vec![false; positions.len()];
+        // Points to look at again: those that moved a vertex, or found
+        // their corners busy. A point none of whose corners could move
+        // (angles, reach) is given up.
+        let mut again = Vec::new();
+        for (d2, corners, i) in far {
+            // The nearest corner that is free and can move, if any.
+            let mut waiting = false;
+            for v in corners {
+                if self.moved[v as usize] || positions[v as usize].distance(targets[i]) > REACH * h
+                {
+                    continue;
+                }
+                if busy[v as usize] {
+                    waiting = true;
+                    continue;
+                }
+                // The pull must not uncover more of the input around the
+                // vertex's old place than it covers at the point.
+                let exposure = eps.max(0.5 * d2.sqrt());
+                if let Some(step) = self.try_move(positions, v, targets[i], exposure) {
+                    self.touched[v as usize] = true;
+                    busy[v as usize] = true;
+                    // A vertex that got all the way is done; one that got
+                    // part of the way may go on next round.
+                    self.moved[v as usize] = step == 1.0;
+                    count += 1;
+                    waiting = true;
+                    break;
+                }
+            }
+            if waiting {
+                again.push(i as u32);
+            }
+        }
+        again.sort_unstable();
+        (again, count)
+    }
+
+    /// Step 3: boundary vertices not pulled onto their nearest input point.
+    fn project(&mut self, positions: &mut [DVec3], boundary: &[[u32; 3]], h: f64) {
+        let mut vertices: Vec<u32> = boundary.iter().flatten().copied().collect();
+        vertices.sort_unstable();
+        vertices.dedup();
+        for v in vertices {
+            if self.moved[v as usize] {
+                continue;
+            }
+            let p = positions[v as usize];
+            let (q, d2, _) = self.input.nearest(p);
+            // Already on the surface (cut points are), or too far to be
+            // this part of it (across a hole).
+            if d2 <= (1e-9 * h).powi(2) || d2 > (0.5 * REACH * h).powi(2) {
+                continue;
+            }
+            if self.try_move(positions, v, q, f64::INFINITY).is_some() {
+                self.touched[v as usize] = true;
+            }
+        }
+    }
+
+    /// Moves `v` to `target`, or the largest of [`STEPS`] of the way there
+    /// that keeps the angle check, leaves `v`'s old place within
+    /// `exposure` of its new boundary triangles, and keeps those triangles
+    /// as near the input as they were (or within the envelope); the step
+    /// taken, if any.
+    fn try_move(
+        &self,
+        positions: &mut [DVec3],
+        v: u32,
+        target: DVec3,
+        exposure: f64,
+    ) -> Option<f64> {
+        let from = positions[v as usize];
+        let around = self.incident.of(v);
+        // Computed when a step first gets this far (it costs queries).
+        let mut off_before = None;
+        'steps: for s in STEPS {
+            let to = from.lerp(target, s);
+            for &t in around {
+                let ids = self.tets[t as usize];
+                let before = ids.map(|u| positions[u as usize]);
+                let after = ids.map(|u| if u == v { to } else { positions[u as usize] });
+                if !keeps_angles(before, after) {
+                    continue 'steps;
+                }
+            }
+            if exposure.is_finite() {
+                let uncovered = self
+                    .faces
+                    .of(v)
+                    .iter()
+                    .map(|&f| {
+                        let [a, b, c] = self.boundary[f as usize]
+                            .map(|u| if u == v { to } else { positions[u as usize] });
+                        closest_point_on_triangle(from, a, b, c).distance(from)
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                if uncovered > exposure {
+                    continue 'steps;
+                }
+            }
+            let before = *off_before.get_or_insert_with(|| self.ring_off_input(positions, v, from));
+            if self.ring_off_input(positions, v, to) > before.max(self.eps) {
+                continue;
+            }
+            positions[v as usize] = to;
+            return Some(s);
+        }
+        None
+    }
+}
+
+impl Mover<'_> {
+    /// How far the boundary triangles around `v`, with `v` at `at`, lie
+    /// from the input: the largest distance of their centroids and of the
+    /// midpoints of their edges at `v`.
+    fn ring_off_input(&self, positions: &[DVec3], v: u32, at: DVec3) -> f64 {
+        let mut off: f64 = 0.0;
+        for &f in self.faces.of(v) {
+            let corners =
+                self.boundary[f as usize].map(|u| if u == v { at } else { positions[u as usize] });
+            let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+            off = off.max(self.input.nearest(centroid).1);
+            for (k, &u) in self.boundary[f as usize].iter().enumerate() {
+                if u != v {
+                    off = off.max(self.input.nearest(0.5 * (at + corners[k])).1);
+                }
+            }
+        }
+        off.sqrt()
+    }
+}
+
+/// Whether a positively oriented tetrahedron moved from `before` to
+/// `after` stays positive with its angles within the fit's range, or no
+/// worse than before where it already was outside it.
+fn keeps_angles(before: [DVec3; 4], after: [DVec3; 4]) -> bool {
+    if signed_volume(after) <= 0.0 {
+        return false;
+    }
+    // None for a degenerate tetrahedron (NaN angles).
+    let range = |p: [DVec3; 4]| {
+        let a = dihedral_angles(p).map(f64::to_degrees);
+        if a.iter().any(|d| d.is_nan()) {
+            return None;
+        }
+        Some(a.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &d| {
+            (lo.min(d), hi.max(d))
+        }))
+    };
+    let Some((lo, hi)) = range(after) else {
+        return false;
+    };
+    let (lo0, hi0) = range(before).unwrap_or((0.0, 180.0));
+    lo >= MIN_DIHEDRAL_DEG.min(lo0) && hi <= MAX_DIHEDRAL_DEG.max(hi0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tests::{cuboid, sphere};
+
+    #[test]
+    fn a_box_has_its_twelve_edges_sharp_and_its_face_diagonals_not() {
+        let (p, t) = cuboid(DVec3::ZERO, DVec3::new(1.0, 2.0, 0.5));
+        let sharp = sharp_edges(&p, &t);
+        assert_eq!(sharp.len(), 12);
+        for [a, b] in sharp {
+            // A box edge changes exactly one coordinate.
+            let d = p[a as usize] - p[b as usize];
+            let changed = d.to_array().iter().filter(|c| c.abs() > 0.0).count();
+            assert_eq!(changed, 1, "{a}-{b}");
+        }
+        let (p, t) = sphere(24, 1.0, DVec3::ZERO);
+        assert!(sharp_edges(&p, &t).is_empty());
+    }
+
+    #[test]
+    fn a_move_that_flattens_or_inverts_a_tetrahedron_is_refused() {
+        let regular = [
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ];
+        assert!(signed_volume(regular) > 0.0);
+        let moved = |to: DVec3| {
+            let mut p = regular;
+            p[0] = to;
+            p
+        };
+        // A small move keeps the angles.
+        assert!(keeps_angles(regular, moved(DVec3::new(1.1, 0.9, 1.0))));
+        // Onto the opposite face's plane: flat; through it: inverted.
+        let centroid = (regular[1] + regular[2] + regular[3]) / 3.0;
+        assert!(!keeps_angles(regular, moved(centroid)));
+        assert!(!keeps_angles(regular, moved(centroid * 2.0)));
+        // Close to the plane: positive, but angles below 10°.
+        assert!(!keeps_angles(
+            regular,
+            moved(centroid + 0.02 * (regular[0] - centroid))
+        ));
+    }
+
+    #[test]
+    fn the_fit_pulls_a_box_corner_onto_the_input() {
+        // A box whose corners fall between lattice points: the plain
+        // stuffing cuts them off; the fit puts boundary vertices on them.
+        let (p, t) = cuboid(DVec3::splat(0.03), DVec3::new(1.07, 0.96, 0.52));
+        let mut options = crate::Options::new(0.1);
+        let plain = crate::tetrahedralize(&p, &t, &options).unwrap();
+        options.envelope = Some(1e-3);
+        let fitted = crate::tetrahedralize(&p, &t, &options).unwrap();
+        let corner_gap = |m: &crate::TetMesh| {
+            p.iter()
+                .map(|c| {
+                    m.positions
+                        .iter()
+                        .map(|q| q.distance(*c))
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .fold(0.0, f64::max)
+        };
+        let (before, after) = (corner_gap(&plain), corner_gap(&fitted));
+        assert!(before > 0.01, "{before}");
+        assert!(after < 1e-9, "{after}");
+        assert_eq!(fitted.report.sharp_edges, 12);
+        assert!(fitted.report.min_dihedral_deg >= MIN_DIHEDRAL_DEG);
+    }
+}
