@@ -123,6 +123,7 @@ impl Worker {
                 "mirror_x": self.doc.mirror_x(),
                 "faces": self.doc.surface.faces.len(),
                 "area": self.doc.area(),
+                "autosave": self.autosave.as_ref().map(|p| p.display().to_string()),
                 "max_level": mesh_colors::MAX_LEVEL,
             })
             .to_string(),

@@ -165,6 +165,10 @@ async fn the_scatter_panel_follows_a_stroke_of_density_in_chromium() {
     test_support::gltf::validate(&glb);
     let text = std::fs::read_to_string(&usda).unwrap();
     assert!(text.contains("BasisCurves"), "{text}");
+    let shot = step("screenshot");
+    assert_eq!(shot["name"], "trilux-paint.png", "{shot}");
+    assert_eq!(shot["png"], true, "{shot}");
+    assert!(shot["bytes"].as_u64().unwrap() > 2000, "{shot}");
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

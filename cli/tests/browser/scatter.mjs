@@ -127,6 +127,15 @@ try {
   await page.click('#exportStrands');
   await page.waitForFunction(() => window.trilux.exported.length >= 2, null, { timeout: 60000 });
   out.steps.export = { paths: await page.evaluate(() => window.trilux.exported) };
+
+  // The screenshot button: a PNG download of the view.
+  const [download] = await Promise.all([page.waitForEvent('download', { timeout: 60000 }), page.click('#screenshot')]);
+  const shot = dir + '/scatter-screenshot.png';
+  await download.saveAs(shot);
+  const fs = await import('node:fs');
+  const bytes = fs.readFileSync(shot);
+  out.steps.screenshot = { name: download.suggestedFilename(), bytes: bytes.length, png: bytes.subarray(1, 4).toString() === 'PNG' };
+  out.steps.autosave_note = await page.evaluate(() => document.getElementById('autosaveNote').textContent);
 } catch (e) {
   if (e !== null) out.failure = String(e && e.stack || e);
 } finally {

@@ -44,6 +44,10 @@ function onText(m) {
     fillChannels(m.channels);
     fillLevels(m.max_level);
     fillScatter(m);
+    if (m.autosave) {
+      $('autosaveNote').textContent = 'Autosaved to ' + m.autosave;
+      $('autosaveHelp').textContent = ', to ' + m.autosave;
+    }
   } else if (m.type === 'status') {
     state.status = m;
     // A page that connects to a server already scattering shows how.
@@ -367,6 +371,17 @@ for (const id of ['scatterMode', 'scatterChannel', 'hair', 'hairChannel', 'hairL
 for (const id of ['rate', 'count', 'seed', 'hairSegments']) $(id).addEventListener('input', sendScatter);
 $('pointSize').addEventListener('input', () => { dirty = true; });
 
+// Every slider shows its value beside it (the radius its own way).
+document.querySelectorAll('#panel input[type=range]').forEach((r) => {
+  if (r.id === 'radius') return;
+  const v = document.createElement('span');
+  v.className = 'value';
+  const show = () => { v.textContent = Number(r.value).toFixed(r.step && Number(r.step) < 0.01 ? 3 : 2).replace(/\.?0+$/, ''); };
+  r.after(v);
+  r.addEventListener('input', show);
+  show();
+});
+
 // ---- keys and buttons -------------------------------------------------
 
 let pendingExport = null;
@@ -406,6 +421,17 @@ $('exportPoints').onclick = () => {
 $('exportStrands').onclick = () => {
   const name = prompt('Export the strands (.usda, .glb or .hair)', 'strands.usda');
   if (name) exportFile('export', { kind: 'strands', name });
+};
+// The view as the canvas shows it, downloaded as a PNG.
+$('screenshot').onclick = () => {
+  dirty = true;
+  canvas.toBlob((blob) => {
+    const a = document.createElement('a');
+    a.href = URL.createObjectURL(blob);
+    a.download = 'trilux-paint.png';
+    a.click();
+    setTimeout(() => URL.revokeObjectURL(a.href), 1000);
+  }, 'image/png');
 };
 $('applyLevel').onclick = () => net.send('resolution', { level: Number($('level').value) });
 $('help').onclick = () => { $('helpbox').hidden = !$('helpbox').hidden; };
