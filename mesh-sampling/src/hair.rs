@@ -9,7 +9,7 @@ use rand::Rng;
 use rand_pcg::Pcg64Mcg;
 
 use crate::parallel::{CHUNK, check_points, chunk_rng, unit};
-use crate::{Error, SurfacePoint};
+use crate::{Error, SurfacePoint, SurfaceSampler};
 
 /// The most segments a strand may have (4,096): far beyond what a renderer
 /// needs, and a bound that catches a count given by mistake before the
@@ -250,6 +250,65 @@ pub fn grow_strands_with(
     options: &HairOptions,
     params: impl Fn(usize, &SurfacePoint) -> StrandParams + Sync,
 ) -> Result<Strands, Error> {
+    grow(roots.len(), &Given(roots), options, params)
+}
+
+/// Hair from `n` roots drawn from `sampler` with `seed`: the strands of
+/// [`grow_strands_with`] on `sampler.sample_n(seed, n)`, bit for bit, but
+/// each chunk of roots is drawn and grown at once instead of all roots
+/// being stored first (56 bytes a root less to write and read back: the
+/// Fig. 1a pipeline of the `hair` example).
+///
+/// # Errors
+/// As for [`grow_strands`].
+pub fn grow_strands_sampled<S: SurfaceSampler>(
+    sampler: &S,
+    seed: u64,
+    n: usize,
+    options: &HairOptions,
+    params: impl Fn(usize, &SurfacePoint) -> StrandParams + Sync,
+) -> Result<Strands, Error> {
+    grow(n, &Sampled { sampler, seed }, options, params)
+}
+
+/// Where a chunk's roots come from.
+trait RootSource: Sync {
+    /// `f` of the roots of chunk `c` (`len` of them).
+    fn with_chunk<R>(&self, c: usize, len: usize, f: impl FnOnce(&[SurfacePoint]) -> R) -> R;
+}
+
+/// Roots given by the caller.
+struct Given<'a>(&'a [SurfacePoint]);
+
+impl RootSource for Given<'_> {
+    fn with_chunk<R>(&self, c: usize, len: usize, f: impl FnOnce(&[SurfacePoint]) -> R) -> R {
+        f(&self.0[c * CHUNK..c * CHUNK + len])
+    }
+}
+
+/// Roots drawn chunk by chunk as [`SurfaceSampler::sample_n`] draws them
+/// (chunk `c` from `chunk_rng(seed, c)`, the same [`CHUNK`]).
+struct Sampled<'a, S> {
+    sampler: &'a S,
+    seed: u64,
+}
+
+impl<S: SurfaceSampler> RootSource for Sampled<'_, S> {
+    fn with_chunk<R>(&self, c: usize, len: usize, f: impl FnOnce(&[SurfacePoint]) -> R) -> R {
+        let mut roots = vec![SurfacePoint::default(); len];
+        self.sampler
+            .sample_into(&mut chunk_rng(self.seed, c), &mut roots);
+        f(&roots)
+    }
+}
+
+/// The strands of `n` roots from `source`.
+fn grow(
+    n: usize,
+    source: &impl RootSource,
+    options: &HairOptions,
+    params: impl Fn(usize, &SurfacePoint) -> StrandParams + Sync,
+) -> Result<Strands, Error> {
     let k = options.segments;
     if k == 0 || k > MAX_SEGMENTS {
         return Err(Error::InvalidOption(format!(
@@ -257,44 +316,17 @@ pub fn grow_strands_with(
         )));
     }
     let per = k as usize + 1;
-    check_points(roots.len() as f64 * per as f64)?;
-    let mut points = filled(roots.len() * per, Vec3::ZERO);
-    let mut widths = options.widths.then(|| vec![0.0f32; roots.len() * per]);
-    let mut out_roots = filled(roots.len(), Root::default());
-    let mut clump = vec![0.0f32; if options.clumps > 0 { roots.len() } else { 0 }];
+    check_points(n as f64 * per as f64)?;
+    let mut points = filled(n * per, Vec3::ZERO);
+    let mut widths = options.widths.then(|| vec![0.0f32; n * per]);
+    let mut out_roots = filled(n, Root::default());
+    let mut clump = vec![0.0f32; if options.clumps > 0 { n } else { 0 }];
 
-    let grow_chunk = |c: usize, mut chunk: ChunkOut<'_>| -> Result<(), Error> {
-        let mut rng = chunk_rng(options.seed, c);
-        let first = c * CHUNK;
-        for (j, (root, out_root)) in roots[first..first + chunk.roots.len()]
-            .iter()
-            .zip(chunk.roots.iter_mut())
-            .enumerate()
-        {
-            let index = first + j;
-            let p = params(index, root);
-            p.check(index)?;
-            let normal = root_normal(root, index)?;
-            *out_root = Root {
-                face: root.face,
-                barycentric: root.barycentric,
-                normal,
-                uv: root.uv,
-            };
-            let line = &mut chunk.points[j * per..(j + 1) * per];
-            grow_one(root.position, normal, &p, &mut rng, line);
-            if let Some(w) = chunk.widths.as_deref_mut() {
-                let w = &mut w[j * per..(j + 1) * per];
-                for (i, slot) in w.iter_mut().enumerate() {
-                    let s = i as f32 / k as f32;
-                    *slot = p.width + (p.tip_width - p.width) * s;
-                }
-            }
-            if let Some(slot) = chunk.clump.get_mut(j) {
-                *slot = p.clump;
-            }
-        }
-        Ok(())
+    let grow_one_chunk = |c: usize, chunk: ChunkOut<'_>| -> Result<(), Error> {
+        let len = chunk.roots.len();
+        source.with_chunk(c, len, |roots| {
+            grow_chunk(c, roots, chunk, options, &params)
+        })
     };
     let results = for_each_root_chunk(
         per,
@@ -302,13 +334,13 @@ pub fn grow_strands_with(
         widths.as_deref_mut(),
         &mut out_roots,
         &mut clump,
-        grow_chunk,
+        grow_one_chunk,
     );
     if let Some(error) = results.into_iter().find_map(Result::err) {
         return Err(error);
     }
-    if options.clumps > 0 && !roots.is_empty() {
-        apply_clumps(roots, options, per, &clump, &mut points);
+    if options.clumps > 0 && n > 0 {
+        apply_clumps(options, per, &clump, &mut points);
     }
     Ok(Strands {
         segments: k,
@@ -316,6 +348,45 @@ pub fn grow_strands_with(
         widths,
         roots: out_roots,
     })
+}
+
+/// Grows chunk `c`'s strands from its `roots` into its share of the outputs.
+fn grow_chunk(
+    c: usize,
+    roots: &[SurfacePoint],
+    mut chunk: ChunkOut<'_>,
+    options: &HairOptions,
+    params: &(impl Fn(usize, &SurfacePoint) -> StrandParams + Sync),
+) -> Result<(), Error> {
+    let k = options.segments;
+    let per = k as usize + 1;
+    let mut rng = chunk_rng(options.seed, c);
+    let first = c * CHUNK;
+    for (j, (root, out_root)) in roots.iter().zip(chunk.roots.iter_mut()).enumerate() {
+        let index = first + j;
+        let p = params(index, root);
+        p.check(index)?;
+        let normal = root_normal(root, index)?;
+        *out_root = Root {
+            face: root.face,
+            barycentric: root.barycentric,
+            normal,
+            uv: root.uv,
+        };
+        let line = &mut chunk.points[j * per..(j + 1) * per];
+        grow_one(root.position, normal, &p, &mut rng, line);
+        if let Some(w) = chunk.widths.as_deref_mut() {
+            let w = &mut w[j * per..(j + 1) * per];
+            for (i, slot) in w.iter_mut().enumerate() {
+                let s = i as f32 / k as f32;
+                *slot = p.width + (p.tip_width - p.width) * s;
+            }
+        }
+        if let Some(slot) = chunk.clump.get_mut(j) {
+            *slot = p.clump;
+        }
+    }
+    Ok(())
 }
 
 /// `n` copies of `value`, written on all threads: `vec![value; n]` fills
@@ -468,15 +539,10 @@ fn clump_centres(n: usize, options: &HairOptions) -> Vec<usize> {
 /// Pulls every strand toward its nearest clump centre's strand (second
 /// pass: the centres' strands are copied first, so the result does not
 /// depend on the order strands are visited in).
-fn apply_clumps(
-    roots: &[SurfacePoint],
-    options: &HairOptions,
-    per: usize,
-    clump: &[f32],
-    points: &mut [Vec3],
-) {
-    let centres = clump_centres(roots.len(), options);
-    let sites: Vec<Vec3> = centres.iter().map(|&c| roots[c].position).collect();
+fn apply_clumps(options: &HairOptions, per: usize, clump: &[f32], points: &mut [Vec3]) {
+    // A strand's first point is its root, exactly, and never moves.
+    let centres = clump_centres(points.len() / per, options);
+    let sites: Vec<Vec3> = centres.iter().map(|&c| points[c * per]).collect();
     let grid = Grid::new(&sites);
     let centre_lines: Vec<Vec3> = centres
         .iter()
@@ -488,7 +554,7 @@ fn apply_clumps(
         if amount == 0.0 {
             return;
         }
-        let nearest = grid.nearest(&sites, roots[s].position);
+        let nearest = grid.nearest(&sites, line[0]);
         let centre = &centre_lines[nearest * per..(nearest + 1) * per];
         for (i, (at, c)) in line.iter_mut().zip(centre).enumerate() {
             *at += (*c - *at) * (amount * i as f32 / k);
@@ -781,6 +847,36 @@ mod tests {
         let four = pool(4).install(grow);
         assert_eq!(one, four);
         assert_eq!(one.widths.as_ref().map(Vec::len), Some(one.points.len()));
+    }
+
+    #[test]
+    fn strands_grown_while_sampling_equal_those_of_the_stored_roots() {
+        let (p, i, uv) = square();
+        let mesh = MeshRef {
+            uvs: Some(&uv),
+            ..MeshRef::new(&p, &i)
+        };
+        let sampler = UniformSampler::new(mesh).unwrap();
+        let n = 2 * CHUNK + 99;
+        let options = HairOptions {
+            segments: 5,
+            seed: 3,
+            clumps: 25,
+            widths: true,
+        };
+        let params = |i: usize, r: &SurfacePoint| StrandParams {
+            curl_radius: 0.01,
+            curl_turns: 2.0,
+            noise: 0.003,
+            clump: r.position.x,
+            ..StrandParams::straight(0.1 + (i % 7) as f32 * 0.01)
+        };
+        let stored =
+            grow_strands_with(&sampler.sample_n(11, n).unwrap(), &options, params).unwrap();
+        let streamed = grow_strands_sampled(&sampler, 11, n, &options, params).unwrap();
+        assert_eq!(stored, streamed);
+        let other_seed = grow_strands_sampled(&sampler, 12, n, &options, params).unwrap();
+        assert_ne!(stored.points, other_seed.points);
     }
 
     #[test]

@@ -139,7 +139,8 @@ pub use emitter::{
 };
 pub use error::Error;
 pub use hair::{
-    HairOptions, MAX_SEGMENTS, Root, StrandParams, Strands, grow_strands, grow_strands_with,
+    HairOptions, MAX_SEGMENTS, Root, StrandParams, Strands, grow_strands, grow_strands_sampled,
+    grow_strands_with,
 };
 pub use layout::{Layout, MAX_VALUE_SHIFT, MIN_THRESHOLD_BITS};
 pub use mesh::MeshRef;
