@@ -401,6 +401,7 @@ impl Worker {
         let (lo, hi) = self.bounds();
         json!({
             "type": "hello",
+            "app": "view",
             "protocol": protocol::VERSION,
             "eta": self.session.pieces()[0].eta(),
             "unit_mm": self.session.pieces()[0].length_unit_mm(),

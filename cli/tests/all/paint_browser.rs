@@ -165,6 +165,16 @@ async fn the_scatter_panel_follows_a_stroke_of_density_in_chromium() {
     test_support::gltf::validate(&glb);
     let text = std::fs::read_to_string(&usda).unwrap();
     assert!(text.contains("BasisCurves"), "{text}");
+    let mismatch = step("mismatch");
+    assert!(
+        mismatch["states"].to_string().contains("reload the page"),
+        "{mismatch}"
+    );
+    assert_eq!(
+        mismatch["texts"],
+        json!([]),
+        "nothing read after a hello of another protocol"
+    );
     let shot = step("screenshot");
     assert_eq!(shot["name"], "trilux-paint.png", "{shot}");
     assert_eq!(shot["png"], true, "{shot}");

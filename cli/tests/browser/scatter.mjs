@@ -135,6 +135,16 @@ try {
   const fs = await import('node:fs');
   const bytes = fs.readFileSync(shot);
   out.steps.screenshot = { name: download.suggestedFilename(), bytes: bytes.length, png: bytes.subarray(1, 4).toString() === 'PNG' };
+  // A page of another protocol version asks for a reload instead of
+  // reading frames it would misread.
+  out.steps.mismatch = await page.evaluate(async () => {
+    const { Connection } = await import('./net.js');
+    const states = [], texts = [];
+    const c = new Connection('paint', (b) => b, (m) => texts.push(m.type), () => {}, (s) => states.push(s), 99);
+    for (let i = 0; i < 100 && !states.some((s) => s.includes('reload')); i++) await new Promise((r) => setTimeout(r, 50));
+    c.ws.onclose = null; c.ws.close();
+    return { states, texts };
+  });
   out.steps.autosave_note = await page.evaluate(() => document.getElementById('autosaveNote').textContent);
 } catch (e) {
   if (e !== null) out.failure = String(e && e.stack || e);

@@ -94,7 +94,7 @@ export class PointsLayer {
     gl.uniformMatrix4fv(this.loc.viewProj, false, viewProj);
     gl.uniform1f(this.loc.size, opts.size || 2);
     if (this.lineVertices) {
-      gl.uniform4fv(this.loc.color, [0.95, 0.85, 0.55, 1]);
+      gl.uniform4fv(this.loc.color, [0.55, 0.9, 1.0, 1]);
       gl.bindVertexArray(this.strands.vao);
       gl.drawArrays(gl.LINES, 0, this.lineVertices);
     }

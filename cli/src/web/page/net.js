@@ -7,8 +7,11 @@ import { uploadHeader } from './frame.js';
 export class Connection {
   // `app` names the app in what the page shows ("trilux view is not
   // answering"); `decode(buffer)` turns a binary frame into what
-  // `onFrame` takes.
-  constructor(app, decode, onText, onFrame, onState) {
+  // `onFrame` takes; `protocol` is the frames' version this page reads,
+  // which the server's hello must name (else the page asks for a reload
+  // and reads nothing more).
+  constructor(app, decode, onText, onFrame, onState, protocol = 1) {
+    this.protocol = protocol;
     // Each page starts its numbers at random: the server's status lists
     // the seqs it answered to every page, and two tabs that both counted
     // from 1 would take each other's answers for their own.
@@ -32,8 +35,15 @@ export class Connection {
       setTimeout(() => this.open(), 1000);
     };
     ws.onmessage = (e) => {
-      if (typeof e.data === 'string') this.onText(JSON.parse(e.data));
-      else this.onFrame(this.decode(e.data));
+      if (this.stale) return;
+      if (typeof e.data !== 'string') { this.onFrame(this.decode(e.data)); return; }
+      const m = JSON.parse(e.data);
+      if (m.type === 'hello' && m.protocol !== undefined && (m.app !== this.app || m.protocol !== this.protocol)) {
+        this.stale = true;
+        this.onState(`this page reads trilux ${this.app} protocol ${this.protocol}, the server speaks ${m.app} ${m.protocol}: reload the page`);
+        return;
+      }
+      this.onText(m);
     };
     this.ws = ws;
   }
