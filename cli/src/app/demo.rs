@@ -359,6 +359,7 @@ fn translucent(d: &Demo<'_>, i: &Inputs) -> Pipeline {
         },
         true,
         false,
+        None,
     )?;
     let tets = trilux::tet::from_stuffing(&stuffed, i.blob.origin);
     let files = trilux::output::write_atomic_files(&d.path("blob.node"), d.context.force, |tmp| {

@@ -27,6 +27,13 @@ pub(crate) struct Args {
     /// Coarser tetrahedra deep inside (octree grading).
     #[arg(long)]
     pub(crate) graded: bool,
+    /// Fit the boundary to the surface: move boundary vertices onto tips,
+    /// creases and thin parts farther than EPS (a fraction of the bounding
+    /// box's diagonal, e.g. 0.002) from it, keeping every dihedral angle
+    /// at 10° or more. Not a guarantee: the summary prints the distance
+    /// reached.
+    #[arg(long, value_name = "EPS")]
+    pub(crate) envelope: Option<f64>,
     /// The tetrahedral mesh: .node (with .ele), .mesh or .vtu.
     #[arg(short, long, value_name = "OUT.node")]
     pub(crate) output: PathBuf,
@@ -64,7 +71,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     };
     let mesh = super::read_mesh(context, &args.surface)?;
     let (tets, h) = context.step("stuffing", || {
-        stuff(&mesh, &args.surface, spacing, args.graded, true)
+        stuff(
+            &mesh,
+            &args.surface,
+            spacing,
+            args.graded,
+            true,
+            args.envelope,
+        )
     })?;
     let out = trilux::tet::from_stuffing(&tets, mesh.origin);
     let force = context.force;
@@ -98,13 +112,24 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
             100.0 * d.left_out_area
         );
     }
+    let diagonal = trilux::mesh::bounds(&mesh)
+        .map(|(lo, hi)| (hi.as_dvec3() - lo.as_dvec3()).length())
+        .unwrap_or(0.0);
     let text = format!(
-        "{} tetrahedra, {} vertices, {} boundary triangles at spacing {}{} in {:.2} s; dihedral angles {:.2}° .. {:.2}°{}; written to {}\n",
+        "{} tetrahedra, {} vertices, {} boundary triangles at spacing {}{}{} in {:.2} s; dihedral angles {:.2}° .. {:.2}°{}; written to {}\n",
         r.tets,
         r.vertices,
         r.boundary_triangles,
-        number(h),
+        spacing_text(h, diagonal),
         if args.graded { " (graded)" } else { "" },
+        args.envelope
+            .map(|eps| format!(
+                ", fitted to an envelope of {}% of the diagonal ({} boundary vertices moved, {} creases)",
+                significant(100.0 * eps),
+                r.fitted_vertices,
+                r.sharp_edges
+            ))
+            .unwrap_or_default(),
         r.elapsed.as_secs_f64(),
         r.min_dihedral_deg,
         r.max_dihedral_deg,
@@ -122,7 +147,11 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "vertices": r.vertices,
         "boundary_triangles": r.boundary_triangles,
         "spacing": h,
+        "diagonal": diagonal,
         "graded": args.graded,
+        "envelope": args.envelope,
+        "fitted_vertices": r.fitted_vertices,
+        "sharp_edges": r.sharp_edges,
         "dihedral_degrees": [r.min_dihedral_deg, r.max_dihedral_deg],
         "distance": r.distance.as_ref().map(distance_json),
         "stuffing_seconds": r.elapsed.as_secs_f64(),
@@ -131,6 +160,40 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     });
     context.report(&text, json);
     Ok(())
+}
+
+/// The spacing in the mesh's unit to 4 significant digits, and as a share
+/// of the bounding box's diagonal (which the default spacing is 1/40 of).
+fn spacing_text(h: f64, diagonal: f64) -> String {
+    if diagonal > 0.0 && diagonal.is_finite() {
+        format!(
+            "{} (1/{} of the diagonal, {})",
+            significant(h),
+            significant(diagonal / h),
+            significant(diagonal)
+        )
+    } else {
+        significant(h)
+    }
+}
+
+/// `x` to 4 significant digits, in plain notation between 10⁻⁴ and 10⁷.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return number(x);
+    }
+    if (1e-4..1e7).contains(&x.abs()) {
+        let decimals = (3 - x.abs().log10().floor() as i32).max(0) as usize;
+        let text = format!("{x:.decimals$}");
+        // 0.002500 -> 0.0025, 40.00 -> 40.
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        format!("{x:.3e}")
+    }
 }
 
 /// The summary's clause on how far the boundary lies from the surface.

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use crate::common;
-use common::{blob, data, fails, have_data, json, run, trilux};
+use common::{blob, data, fails, fails_with, have_data, json, run, trilux};
 use glam::Vec3;
 use trilux_io::mesh::TriMesh;
 
@@ -132,6 +132,55 @@ fn tetra_reports_how_far_the_boundary_lies_from_the_surface_and_what_it_left_out
 }
 
 #[test]
+fn tetra_fits_the_boundary_to_an_envelope_and_says_how_near_it_came() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    let plain = json(d, &["tetra", blob, "--spacing", "0.1", "-o", "p.node"]);
+    let args = [
+        "tetra",
+        blob,
+        "--spacing",
+        "0.1",
+        "--envelope",
+        "0.002",
+        "-o",
+        "e.node",
+    ];
+    let fitted = json(d, &args);
+    assert_eq!(fitted["envelope"], 0.002, "{fitted}");
+    assert!(fitted["fitted_vertices"].as_u64().unwrap() > 0, "{fitted}");
+    assert_eq!(fitted["tetrahedra"], plain["tetrahedra"]);
+    assert!(
+        fitted["dihedral_degrees"][0].as_f64().unwrap() >= 10.0,
+        "{fitted}"
+    );
+    let hausdorff = |r: &serde_json::Value| r["distance"]["hausdorff"].as_f64().unwrap();
+    assert!(
+        hausdorff(&fitted) <= hausdorff(&plain),
+        "{fitted} vs {plain}"
+    );
+    assert!(plain["envelope"].is_null() && plain["fitted_vertices"] == 0);
+    // The summary gives the spacing to 4 digits with its share of the
+    // diagonal, and the envelope.
+    let out = run(d, &[&args[..7], &["e2.node"]].concat());
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("at spacing 0.1 (1/"), "{stdout}");
+    assert!(
+        stdout.contains("fitted to an envelope of 0.2% of the diagonal"),
+        "{stdout}"
+    );
+    // A wrong argument: exit code 2.
+    fails_with(
+        d,
+        2,
+        &["tetra", blob, "--envelope", "1.5", "-o", "bad.node"],
+        &["--envelope 1.5", "between 0 and 1"],
+    );
+}
+
+#[test]
 fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
@@ -164,11 +213,19 @@ fn tetra_refuses_a_surface_that_encloses_nothing_and_keeps_outputs() {
         ..TriMesh::default()
     };
     sheet.write(d.join("sheet.obj")).unwrap();
-    fails(
+    // No spacing gives a sheet a volume: the message says what is wrong
+    // instead of asking for a smaller spacing.
+    let err = fails_with(
         d,
+        1,
         &["tetra", "sheet.obj", "--spacing", "0.1", "-o", "s.node"],
-        &["sheet.obj", "encloses nothing"],
+        &[
+            "sheet.obj",
+            "encloses nothing",
+            "none of its 128 triangles bounds a volume",
+        ],
     );
+    assert!(!err.contains("smaller"), "{err}");
     fails(
         d,
         &["tetra", "missing.obj", "-o", "m.node"],

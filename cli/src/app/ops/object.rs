@@ -81,7 +81,7 @@ pub(crate) fn read_volume(context: &mut Context, input: &Path, with_vtu: bool) -
         eprintln!("warning: {}", open_surface(input, &shape));
     }
     let (stuffed, _) = context.step("tetrahedralizing", || {
-        stuff(&surface, input, Spacing::Default, false, false)
+        stuff(&surface, input, Spacing::Default, false, false, None)
     })?;
     let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
     Ok((out.positions, out.tets, None))

@@ -53,13 +53,15 @@ impl Spacing {
 /// default 1/40 of the bounding box's diagonal; returns the mesh and the
 /// spacing used. With `distance`, the report says how far the boundary
 /// lies from the surface (`tetra` prints it; a command that goes on to
-/// solve skips the cost).
+/// solve skips the cost). `envelope` is `tet_stuffing::Options::envelope`
+/// (`trilux tetra --envelope`).
 pub(crate) fn stuff(
     mesh: &TriMesh,
     path: &Path,
     spacing: Spacing,
     graded: bool,
     distance: bool,
+    envelope: Option<f64>,
 ) -> Result<(stuffing::TetMesh, f64)> {
     let (h, given) = match spacing {
         Spacing::Given { h: Some(h), .. } => (h, true),
@@ -94,6 +96,7 @@ pub(crate) fn stuff(
         } else {
             0
         },
+        envelope,
         ..defaults
     };
     let stuffed = stuffing::tetrahedralize(&mesh.positions, &mesh.indices, &options)
@@ -117,9 +120,23 @@ fn failure(e: stuffing::Error, path: &Path, spacing: Spacing, h: f64, given: boo
         stuffing::Error::EmptyVolume { h } => file_error(
             path,
             format!(
-                "the surface encloses nothing at spacing {h} (an open sheet, or thinner than \
-                 the lattice: {smaller})"
+                "the surface encloses nothing at spacing {}: it is thinner than the lattice; \
+                 {smaller}",
+                number(h)
             ),
+        ),
+        stuffing::Error::OpenSurface { triangles } => file_error(
+            path,
+            format!(
+                "the surface encloses nothing: none of its {triangles} triangles bounds a volume \
+                 (an open sheet or a doubled wall, by the winding number), so no spacing gives \
+                 tetrahedra; close the surface or give it thickness"
+            ),
+        ),
+        stuffing::Error::InvalidEnvelope { eps } => arg_error(
+            format!("--envelope {}", number(eps)),
+            "the envelope is a fraction of the bounding box's diagonal, between 0 and 1 \
+             (e.g. 0.002)",
         ),
         stuffing::Error::LatticeTooLarge {
             vertices, limit, ..
