@@ -38,6 +38,11 @@
 //!   that an edit keeps the points of other faces bit for bit, a raised
 //!   density only adds points, and [`Scatter::update_faces`] re-thins only
 //!   the edited faces.
+//! - **Hair** ([`grow_strands`], the paper's Sec. 6 application, Fig. 1a):
+//!   a `k`-segment strand from every root along its shading normal, with
+//!   per-root length, comb, curl, noise, clumping and widths from a
+//!   closure; [`grow_strands_sampled`] grows the roots as a sampler draws
+//!   them, the same strands without storing the roots.
 //! - **Weights**: [`Density::PerFace`] and [`Density::PerVertex`] (linear
 //!   over each triangle), both sampled exactly.
 //! - **Light sampling** ([`Emitter`], the paper's Sec. 5.3 application:
