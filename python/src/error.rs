@@ -297,7 +297,16 @@ impl From<tet_stuffing::Error> for Failure {
             ),
             E::EmptyVolume { h } => format!(
                 "the surface encloses no volume at spacing={h} (winding number above 1/2 at no \
-                 lattice vertex): it is open, flat, or thinner than the spacing"
+                 lattice vertex): it is thinner than the spacing; try a smaller spacing"
+            ),
+            E::OpenSurface { triangles } => format!(
+                "the surface encloses no volume: none of its {triangles} triangles bounds one (an \
+                 open sheet or a doubled wall, by the winding number), so no spacing gives \
+                 tetrahedra; close the surface or give it thickness"
+            ),
+            E::InvalidEnvelope { eps } => format!(
+                "envelope={eps}: the envelope is a fraction of the bounding box's diagonal, \
+                 between 0 and 1 (e.g. 0.002)"
             ),
             _ => chain(&e),
         };

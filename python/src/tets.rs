@@ -53,19 +53,27 @@ pub(crate) fn tets_in(
 /// `mean_distance_fraction` of the bounding box's `diagonal`, measured at
 /// `distance_points` (input, boundary) points — `left_out_triangles` and
 /// `left_out_area_fraction` (input triangles that enclose no volume, also
-/// a `UserWarning`), and `seconds`. Measuring the distances costs up to
+/// a `UserWarning`), `envelope`, `fitted_vertices` and `sharp_edges` (the
+/// fit, see below), and `seconds`. Measuring the distances costs up to
 /// as much again as the stuffing on inputs of 10⁵ triangles.
 ///
 /// `spacing`: the lattice spacing in mesh units (default: 1/40 of the
 /// bounding box's diagonal, as `trilux tetra`); `graded=True` makes the
-/// tetrahedra coarser deep inside (an octree). The GIL is released.
+/// tetrahedra coarser deep inside (an octree). `envelope` (a fraction of
+/// the diagonal between 0 and 1, e.g. 0.002; default None, off) fits the
+/// boundary to the surface: boundary vertices move onto tips, creases and
+/// thin parts farther than it from the boundary, keeping every dihedral
+/// angle at 10° or more; not a guarantee, the report's `hausdorff` says
+/// how near it came, `fitted_vertices` and `sharp_edges` what it did. The
+/// GIL is released.
 #[pyfunction]
-#[pyo3(signature = (mesh, *, spacing = None, graded = false, return_report = false))]
+#[pyo3(signature = (mesh, *, spacing = None, graded = false, envelope = None, return_report = false))]
 pub(crate) fn tetrahedralize<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, PyAny>,
     spacing: Option<f64>,
     graded: bool,
+    envelope: Option<f64>,
     return_report: bool,
 ) -> PyResult<Bound<'py, PyTuple>> {
     let mesh = mesh_arg(mesh, None)?;
@@ -74,6 +82,7 @@ pub(crate) fn tetrahedralize<'py>(
     // open sheets the stuffing leaves out, which are warned of.
     let options = stuffing::Options {
         graded,
+        envelope,
         ..stuffing::Options::new(h)
     };
     let stuffed = detached(py, || {
@@ -94,6 +103,9 @@ pub(crate) fn tetrahedralize<'py>(
         d.set_item("spacing", h)?;
         d.set_item("min_dihedral_deg", r.min_dihedral_deg)?;
         d.set_item("max_dihedral_deg", r.max_dihedral_deg)?;
+        d.set_item("envelope", envelope)?;
+        d.set_item("fitted_vertices", r.fitted_vertices)?;
+        d.set_item("sharp_edges", r.sharp_edges)?;
         if let Some(m) = &r.distance {
             d.set_item("hausdorff", m.hausdorff)?;
             d.set_item("hausdorff_fraction", m.hausdorff_fraction())?;

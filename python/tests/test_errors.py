@@ -76,7 +76,11 @@ def test_rust_errors_keep_their_message():
            trilux.MeshColors.from_texture, (V, F), np.ones((2, 2, 3)))
     one = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
     e = raises(trilux.InputError, None, trilux.tetrahedralize, (one, [[0, 1, 2]]), spacing=0.1)
-    assert str(e).startswith("the surface encloses no volume at spacing=0.1 ")
+    # A single triangle bounds no volume at any spacing: the message says so.
+    assert str(e).startswith("the surface encloses no volume: none of its 1 triangles bounds one"), e
+    assert "smaller spacing" not in str(e)
+    raises(trilux.InputError, "envelope=1.5: the envelope is a fraction of the bounding box's diagonal, between 0 and 1 (e.g. 0.002)",
+           trilux.tetrahedralize, (V, F), envelope=1.5)
 
 
 def test_file_errors(tmp_path):

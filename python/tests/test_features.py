@@ -75,6 +75,24 @@ def test_tetrahedralize_and_tet_files(tmp_path):
     assert np.array_equal(t2, tets) and np.abs(n2 - nodes).max() < 1e-9
 
 
+def test_tetrahedralize_fits_a_box_to_an_envelope():
+    import trimesh
+
+    # A box whose corners fall between lattice points: the plain stuffing
+    # cuts them off, the fit moves boundary vertices onto them.
+    box = trimesh.creation.box(extents=[1.04, 0.93, 0.49])
+    box.apply_translation([0.03, 0.017, 0.011])
+    _, plain_tets, plain = trilux.tetrahedralize(box, spacing=0.1, return_report=True)
+    nodes, tets, fitted = trilux.tetrahedralize(box, spacing=0.1, envelope=0.001, return_report=True)
+    assert plain["envelope"] is None and plain["fitted_vertices"] == 0
+    assert fitted["envelope"] == 0.001 and fitted["fitted_vertices"] > 0 and fitted["sharp_edges"] == 12
+    assert len(tets) == len(plain_tets) and fitted["min_dihedral_deg"] >= 10
+    assert fitted["input_to_tets"] < 0.5 * plain["input_to_tets"]
+    corners = np.asarray(box.vertices)
+    gap = max(np.linalg.norm(nodes - c, axis=1).min() for c in corners)
+    assert gap < 1e-6  # the corners as float32 (the mesh is read in single precision)
+
+
 def test_tetrahedralize_warns_of_a_sheet_it_leaves_out():
     import trimesh
 

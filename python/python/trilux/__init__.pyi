@@ -681,6 +681,7 @@ def tetrahedralize(
     *,
     spacing: Optional[float] = None,
     graded: bool = False,
+    envelope: Optional[float] = None,
     return_report: Literal[False] = False,
 ) -> Tuple[F64, I64]: ...
 @overload
@@ -689,6 +690,7 @@ def tetrahedralize(
     *,
     spacing: Optional[float] = None,
     graded: bool = False,
+    envelope: Optional[float] = None,
     return_report: Literal[True],
 ) -> Tuple[F64, I64, dict[str, Any]]: ...
 @overload
@@ -697,6 +699,7 @@ def tetrahedralize(
     *,
     spacing: Optional[float] = None,
     graded: bool = False,
+    envelope: Optional[float] = None,
     return_report: bool = False,
 ) -> Union[Tuple[F64, I64], Tuple[F64, I64, dict[str, Any]]]: ...
 # load_tets: the tets as the file stores them, in its node order, not
