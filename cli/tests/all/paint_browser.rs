@@ -105,6 +105,14 @@ async fn run(
     v
 }
 
+/// Where screenshots go: `TRILUX_SCREENSHOTS` (to look at them), else
+/// the test's own folder.
+fn shots(tmp: &Path) -> PathBuf {
+    std::env::var("TRILUX_SCREENSHOTS")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| tmp.to_path_buf())
+}
+
 /// The browser, the script's path and a screenshot folder, or `None`
 /// (with the notice) when something is missing.
 fn setup(script: &str) -> Option<(String, PathBuf)> {
@@ -137,10 +145,7 @@ async fn the_scatter_panel_follows_a_stroke_of_density_in_chromium() {
         return;
     };
     let tmp = tempfile::tempdir().unwrap();
-    let shots = std::env::var("TRILUX_SCREENSHOTS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| tmp.path().to_path_buf());
-    let exports = tmp.path();
+    let (shots, exports) = (shots(tmp.path()), tmp.path());
     let doc = document_with(None, true);
     let v = run(&script, &browser, &shots, exports, doc, "test").await;
     assert_eq!(v["console_errors"], json!([]), "{v:#}");
@@ -187,10 +192,7 @@ async fn the_page_paints_picks_adds_detail_undoes_saves_and_exports_in_chromium(
         return;
     };
     let tmp = tempfile::tempdir().unwrap();
-    let shots = std::env::var("TRILUX_SCREENSHOTS")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| tmp.path().to_path_buf());
-    let exports = tmp.path();
+    let (shots, exports) = (shots(tmp.path()), tmp.path());
     let v = run(&script, &browser, &shots, exports, document(None), "all").await;
     let step = |s: &str| &v["steps"][s];
     eprintln!(

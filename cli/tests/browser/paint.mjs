@@ -3,17 +3,14 @@
 // a GLB export through the page's buttons. Prints one JSON object with
 // what it saw; the Rust test (cli/tests/all/paint_browser.rs) asserts on
 // it. Usage: node paint.mjs URL SCREENSHOT_DIR [load-only]
-import { launch } from './lib.mjs';
+import { launch, openPage } from './lib.mjs';
 
 const [url, dir, only] = process.argv.slice(2);
 const browser = await launch();
 const out = { steps: {} };
 const consoleErrors = [];
 try {
-  // The page's CSP forbids eval, which Playwright's argument passing needs.
-  const page = await browser.newPage({ viewport: { width: 800, height: 600 }, bypassCSP: true });
-  page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
-  page.on('pageerror', (e) => consoleErrors.push('pageerror: ' + e.message));
+  const page = await openPage(browser, consoleErrors);
   const t0 = Date.now();
   await page.goto(url);
   await page.waitForFunction(() => window.trilux && window.trilux.ready, null, { timeout: 60000 });

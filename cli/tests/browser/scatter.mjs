@@ -7,16 +7,14 @@
 // Usage: node scatter.mjs URL SCREENSHOT_DIR [bench POINTS]
 //   bench: fills the density, scatters about POINTS points by rate, then
 //   times strokes from the dab sent to the points frame drawn (medians).
-import { launch } from './lib.mjs';
+import { launch, openPage } from './lib.mjs';
 
 const [url, dir, mode, benchPoints] = process.argv.slice(2);
 const browser = await launch();
 const out = { steps: {} };
 const consoleErrors = [];
 try {
-  const page = await browser.newPage({ viewport: { width: 800, height: 600 }, bypassCSP: true });
-  page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
-  page.on('pageerror', (e) => consoleErrors.push('pageerror: ' + e.message));
+  const page = await openPage(browser, consoleErrors);
   const names = [];
   page.on('dialog', (d) => d.accept(names.shift()));
   await page.goto(url);
