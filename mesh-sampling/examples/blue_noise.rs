@@ -5,7 +5,7 @@
 //! the same run, and optionally Yuksel's own C++ elimination.
 //!
 //! ```sh
-//! TRILUX_DATA=../shared/data cargo run --release -p mesh-sampling --example blue_noise -- [--json] [--no-peers] [--n 10000,100000] [--mesh spot] [--packing elimination,dense] [--peer-cy auto|BIN]
+//! TRILUX_DATA=../shared/data cargo run --release -p mesh-sampling --example blue_noise -- [--json] [--no-peers] [--n 10000,100000] [--mesh spot] [--packing elimination,dense] [--threads 1,2] [--peer-cy auto|BIN]
 //! ```
 //!
 //! For each of the Stanford bunny, spot and fandisk, at N = 10⁴, 10⁵ and
@@ -55,8 +55,10 @@
 //! `mesh`, `density`, `n`, `points` (the output count: N except MeshLab's),
 //! `tool`, `threads`, `ms`, `rho`, `candidates`.
 
+use std::alloc::{GlobalAlloc, Layout, System};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use glam::Vec3;
@@ -67,6 +69,75 @@ use mesh_sampling::{
 
 const MESHES: [&str; 3] = ["stanford-bunny", "spot", "fandisk"];
 
+/// The system allocator, counting the bytes live and their peak: the
+/// memory column is the peak during a `blue_noise` call over what was live
+/// before it (the mesh and sampler are not counted, the output is).
+struct Counting;
+
+static LIVE: AtomicUsize = AtomicUsize::new(0);
+static PEAK: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator; only counts.
+#[expect(
+    unsafe_code,
+    reason = "a counting global allocator is the honest way to measure peak memory"
+)]
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: the caller's contract is passed on unchanged.
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            let live = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+            PEAK.fetch_max(live, Ordering::Relaxed);
+        }
+        p
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: as above.
+        let p = unsafe { System.alloc_zeroed(layout) };
+        if !p.is_null() {
+            let live = LIVE.fetch_add(layout.size(), Ordering::Relaxed) + layout.size();
+            PEAK.fetch_max(live, Ordering::Relaxed);
+        }
+        p
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: as above.
+        unsafe { System.dealloc(ptr, layout) };
+        LIVE.fetch_sub(layout.size(), Ordering::Relaxed);
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        // SAFETY: as above.
+        let p = unsafe { System.realloc(ptr, layout, new_size) };
+        if !p.is_null() {
+            let live = if new_size >= layout.size() {
+                LIVE.fetch_add(new_size - layout.size(), Ordering::Relaxed) + new_size
+                    - layout.size()
+            } else {
+                LIVE.fetch_sub(layout.size() - new_size, Ordering::Relaxed)
+                    - (layout.size() - new_size)
+            };
+            PEAK.fetch_max(live, Ordering::Relaxed);
+        }
+        p
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Runs `f` and returns its result with the peak bytes allocated during
+/// it above what was live before.
+fn peak_during<T>(f: impl FnOnce() -> T) -> (T, usize) {
+    let base = LIVE.load(Ordering::Relaxed);
+    PEAK.store(base, Ordering::Relaxed);
+    let out = f();
+    (out, PEAK.load(Ordering::Relaxed).saturating_sub(base))
+}
+
 struct Args {
     json: bool,
     peers: bool,
@@ -74,6 +145,7 @@ struct Args {
     meshes: Vec<String>,
     packings: Vec<Packing>,
     peer_cy: Option<PeerCy>,
+    threads: Vec<usize>,
 }
 
 /// Where the cySampleElim driver comes from.
@@ -92,6 +164,7 @@ fn parse_args() -> Result<Args, String> {
         meshes: MESHES.iter().map(ToString::to_string).collect(),
         packings: vec![Packing::Elimination, Packing::Dense],
         peer_cy: None,
+        threads: vec![1, 2],
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -108,6 +181,19 @@ fn parse_args() -> Result<Args, String> {
                         s.trim()
                             .parse()
                             .map_err(|_| format!("--n: '{s}' is not a count"))
+                    })
+                    .collect::<Result<_, _>>()?;
+            }
+            "--threads" => {
+                let list = it
+                    .next()
+                    .ok_or("--threads needs a comma-separated list of thread counts")?;
+                args.threads = list
+                    .split(',')
+                    .map(|s| {
+                        s.trim()
+                            .parse()
+                            .map_err(|_| format!("--threads: '{s}' is not a count"))
                     })
                     .collect::<Result<_, _>>()?;
             }
@@ -144,7 +230,7 @@ fn parse_args() -> Result<Args, String> {
             }
             other => {
                 return Err(format!(
-                    "unknown argument '{other}' (try --json, --no-peers, --n, --mesh, --packing, --peer-cy)"
+                    "unknown argument '{other}' (try --json, --no-peers, --n, --mesh, --packing, --threads, --peer-cy)"
                 ));
             }
         }
@@ -164,12 +250,14 @@ struct Row {
     ms: f64,
     rho: f64,
     candidates: usize,
+    /// Peak bytes per output point during the call (0: not measured).
+    bytes_per_point: f64,
 }
 
 impl Row {
     fn json(&self) -> String {
         format!(
-            "{{\"mesh\": \"{}\", \"density\": \"{}\", \"n\": {}, \"points\": {}, \"tool\": \"{}\", \"threads\": {}, \"ms\": {:.2}, \"rho\": {:.4}, \"candidates\": {}}}",
+            "{{\"mesh\": \"{}\", \"density\": \"{}\", \"n\": {}, \"points\": {}, \"tool\": \"{}\", \"threads\": {}, \"ms\": {:.2}, \"rho\": {:.4}, \"candidates\": {}, \"bytes_per_point\": {:.1}}}",
             self.mesh,
             self.density,
             self.n,
@@ -178,7 +266,8 @@ impl Row {
             self.threads,
             self.ms,
             self.rho,
-            self.candidates
+            self.candidates,
+            self.bytes_per_point
         )
     }
 }
@@ -246,26 +335,36 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {
         .map_err(|e| e.to_string())
 }
 
-/// Times `blue_noise` on `sampler` and measures the spacing of its output.
+/// Times `blue_noise` on `sampler` and measures the spacing of its output
+/// and the peak memory of the call: (ms, ρ, bytes per output point).
 fn ours<S: SurfaceSampler + SurfaceArea>(
     sampler: &S,
     n: usize,
     threads: usize,
     options: &BlueNoiseOptions,
-) -> Result<(f64, f64), String> {
+) -> Result<(f64, f64, f64), String> {
     let runs = if n >= 1_000_000 { 1 } else { 3 };
     let mut times = Vec::new();
     let mut points = Vec::new();
+    let mut peak = 0;
+    let pool = pool(threads)?;
     for seed in 0..runs {
+        drop(std::mem::take(&mut points));
         let start = Instant::now();
-        points = pool(threads)?
-            .install(|| blue_noise(sampler, BlueNoiseTarget::Count(n), seed as u64, options))
-            .map_err(|e| e.to_string())?;
+        let (result, bytes) = peak_during(|| {
+            pool.install(|| blue_noise(sampler, BlueNoiseTarget::Count(n), seed as u64, options))
+        });
         times.push(start.elapsed().as_secs_f64() * 1e3);
+        points = result.map_err(|e| e.to_string())?;
+        peak = peak.max(bytes);
     }
     let xyz: Vec<Vec3> = points.iter().map(|p| p.position).collect();
     let pdf: Vec<f32> = points.iter().map(|p| p.pdf).collect();
-    Ok((median(times), relative_radius_with_density(&xyz, &pdf)))
+    Ok((
+        median(times),
+        relative_radius_with_density(&xyz, &pdf),
+        peak as f64 / n as f64,
+    ))
 }
 
 /// Points stored as little-endian `f32` triples (what the peers write).
@@ -528,7 +627,7 @@ fn run() -> Result<(), String> {
                     Packing::Dense => ("trilux-dense", BlueNoiseOptions::dense()),
                 };
                 let candidates = (options.candidate_factor * n as f64).ceil() as usize;
-                for threads in [1, 2] {
+                for &threads in &args.threads {
                     eprintln!("{name}, N = {n}, {tool}, {threads} thread(s)…");
                     for (density, row) in [
                         ("uniform", ours(&uniform, n, threads, &options)?),
@@ -544,6 +643,7 @@ fn run() -> Result<(), String> {
                             ms: row.0,
                             rho: row.1,
                             candidates,
+                            bytes_per_point: row.2,
                         });
                     }
                 }
@@ -563,6 +663,7 @@ fn run() -> Result<(), String> {
                         ms,
                         rho,
                         candidates: 5 * n,
+                        bytes_per_point: 0.0,
                     }),
                     Err(e) => eprintln!("cySampleElim did not run: {e}"),
                 }
@@ -588,6 +689,7 @@ fn run() -> Result<(), String> {
                             ms: r.ms,
                             rho: r.rho,
                             candidates,
+                            bytes_per_point: 0.0,
                         });
                     }
                 }
@@ -601,11 +703,18 @@ fn run() -> Result<(), String> {
         }
         return Ok(());
     }
-    println!("| mesh | density | N | points | tool | threads | ms | M points/s | ρ | candidates |");
-    println!("|---|---|---:|---:|---|---:|---:|---:|---:|---:|");
+    println!(
+        "| mesh | density | N | points | tool | threads | ms | M points/s | ρ | candidates | peak B/point |"
+    );
+    println!("|---|---|---:|---:|---|---:|---:|---:|---:|---:|---:|");
     for r in &rows {
+        let bytes = if r.bytes_per_point > 0.0 {
+            format!("{:.0}", r.bytes_per_point)
+        } else {
+            "—".to_string()
+        };
         println!(
-            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.3} | {:.3} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {:.3} | {:.3} | {} | {bytes} |",
             r.mesh,
             r.density,
             r.n,

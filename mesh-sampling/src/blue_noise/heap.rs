@@ -71,6 +71,7 @@ impl BucketQueue {
     }
 
     /// The number of items left.
+    #[cfg(test)]
     pub(crate) fn len(&self) -> usize {
         self.len
     }
@@ -82,7 +83,7 @@ impl BucketQueue {
     }
 
     /// The current key of `item` (−∞ once removed).
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn key(&self, item: u32) -> f64 {
         self.keys[item as usize]
     }

@@ -4,9 +4,11 @@
 
 use glam::Vec3;
 use kiddo::SquaredEuclidean;
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use std::num::NonZero;
 
-use super::elimination::Tree;
+/// A k-d tree over positions (32 points per leaf).
+type Tree = ImmutableKdTree<f32, u32, 3, 32>;
 
 /// The radius of the densest packing of `n` disks on area `area`:
 /// `r_max = √(A / (2√3 N))` (hexagonal packing; Yuksel 2015 Eq. 4 and
