@@ -357,7 +357,7 @@ fn write(
         })?;
         return Ok(vec![output.to_path_buf()]);
     }
-    let curves = context.step("building the curves", || to_curves(strands));
+    let curves = context.step("building the curves", || to_curves(strands, mesh.origin));
     if ext == "glb" || ext == "gltf" {
         return context.step("writing the glTF file", || {
             trilux::output::write_gltf(output, force, |tmp| curves::write_gltf(tmp, &curves))
@@ -375,9 +375,14 @@ fn write(
     Ok(vec![output.to_path_buf()])
 }
 
-/// The strands as the writers' curves, the points moved (not copied),
+/// The strands as the writers' curves, the points moved (not copied) and
+/// put back in the file's frame (a far mesh's `origin` added, in `f32`),
 /// with the roots' face, barycentrics, normal and UV (when all have one).
-fn to_curves(strands: Strands) -> curves::Curves {
+fn to_curves(mut strands: Strands, origin: glam::DVec3) -> curves::Curves {
+    if origin != glam::DVec3::ZERO {
+        let o = origin.as_vec3();
+        strands.points.iter_mut().for_each(|p| *p += o);
+    }
     let per = strands.points_per_strand() as u32;
     let roots = &strands.roots;
     let uvs: Option<Vec<_>> = roots.iter().map(|r| r.uv).collect();

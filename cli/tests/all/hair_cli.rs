@@ -274,3 +274,31 @@ fn a_mesh_colours_channel_scales_each_strands_length_at_its_root() {
         "the noise varies the lengths: {varied:?}"
     );
 }
+
+#[test]
+fn strands_of_a_far_mesh_are_written_in_the_files_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut far = trilux::shapes::torus(32, 16);
+    far.origin = trilux_io::glam::DVec3::new(4.0e5, -2.5e5, 1.0e5);
+    far.write(d.join("far.obj")).unwrap();
+    for out in ["roots.ply", "h.hair"] {
+        let ok = run(
+            d,
+            &[
+                "sample", "far.obj", "-n", "50", "--hair", "0.3:3", "-o", out,
+            ],
+        );
+        assert!(ok.status.success(), "{}", crate::common::stderr(&ok));
+    }
+    let roots = trilux_io::mesh::ply::read(d.join("roots.ply")).unwrap();
+    let curves = hair::read(d.join("h.hair")).unwrap();
+    for (i, strand) in curves.points.chunks(4).enumerate() {
+        let want = roots.origin + roots.positions[i].as_dvec3();
+        // f32 holds coordinates near 4·10^5 to 1/32.
+        assert!(
+            (strand[0].as_dvec3() - want).abs().max_element() < 0.04,
+            "root {i}"
+        );
+    }
+}
