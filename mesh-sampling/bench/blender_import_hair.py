@@ -55,6 +55,10 @@ def main():
     bpy.ops.wm.usd_import(filepath=args.usda)
     usd = counts()
     print(f"USD  {args.usda}: {usd}")
+    for obj in bpy.context.scene.objects:
+        if obj.type in ("CURVES", "POINTCLOUD"):
+            names = sorted(a.name for a in obj.data.attributes if not a.name.startswith("."))
+            print(f"  {obj.type} {obj.name} attributes: {', '.join(names)}")
 
     empty_scene()
     bpy.ops.import_scene.gltf(filepath=args.glb)
