@@ -12,7 +12,11 @@ For each N, times once, around the call only (loading is not timed):
 - meshlab: pymeshlab's generate_sampling_poisson_disk(samplenum=N) with its
   defaults (Corsini et al. 2012: Poisson-disk dart throwing on a Monte Carlo
   pool of 20 N points, radius found by search, best-sample heuristic on).
-  MeshLab returns a count near N, not N: the row carries its own count.
+  MeshLab returns a count near N, not N: the row carries its own count;
+- pcu: point-cloud-utils' sample_mesh_poisson_disk(v, f, num_samples=N)
+  with its defaults (VCG's Poisson-disk sampling, Corsini et al. 2012, as
+  MeshLab's), positions from the returned faces and barycentrics (timed
+  with the call: a user needs them; a few ms).
 
 and writes the points as little-endian float32 x, y, z triples to
 OUT_DIR/<peer>_<N>.f32 so that the Rust side measures their spacing exactly
@@ -87,14 +91,39 @@ def meshlab_rows(mesh_path, out_dir, counts):
             print(json.dumps({"peer": "meshlab", "n": n, "error": str(e)}), flush=True)
 
 
+def pcu_rows(mesh_path, out_dir, counts):
+    try:
+        import point_cloud_utils as pcu
+    except Exception as e:
+        for n in counts:
+            print(json.dumps({"peer": "pcu", "n": n, "error": f"import: {e}"}), flush=True)
+        return
+    from importlib.metadata import version as package_version
+
+    version = package_version("point-cloud-utils")
+    v, f = pcu.load_mesh_vf(mesh_path)
+    for n in counts:
+        try:
+            def call():
+                fid, bc = pcu.sample_mesh_poisson_disk(v, f, num_samples=n)
+                return pcu.interpolate_barycentric_coords(f, fid, bc, v)
+
+            points, ms, cpu_ms = timed(call)
+            report("pcu", version, n, out_dir, points, ms, cpu_ms)
+        except Exception as e:
+            print(json.dumps({"peer": "pcu", "n": n, "error": str(e)}), flush=True)
+
+
 def main():
     mesh_path, out_dir = sys.argv[1], sys.argv[2]
     counts = [int(a) for a in sys.argv[3:]]
-    peers = os.environ.get("BLUE_NOISE_PEERS", "open3d,meshlab").split(",")
+    peers = os.environ.get("BLUE_NOISE_PEERS", "open3d,meshlab,pcu").split(",")
     if "open3d" in peers:
         open3d_rows(mesh_path, out_dir, counts)
     if "meshlab" in peers:
         meshlab_rows(mesh_path, out_dir, counts)
+    if "pcu" in peers:
+        pcu_rows(mesh_path, out_dir, counts)
 
 
 if __name__ == "__main__":

@@ -54,5 +54,8 @@ fi
 if [ "$script" = blue_noise_peer.py ] && ! "$py" -c 'import pymeshlab' 2>/dev/null; then
     pip_install pymeshlab || say "could not install pymeshlab"
 fi
+if [ "$script" = blue_noise_peer.py ] && ! "$py" -c 'import point_cloud_utils' 2>/dev/null; then
+    pip_install point-cloud-utils || say "could not install point-cloud-utils"
+fi
 
 exec "$py" "$here/$script" "$@" 1>&3 3>&-

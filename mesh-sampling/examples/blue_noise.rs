@@ -5,7 +5,7 @@
 //! the same run, and optionally Yuksel's own C++ elimination.
 //!
 //! ```sh
-//! TRILUX_DATA=../shared/data cargo run --release -p mesh-sampling --example blue_noise -- [--json] [--no-peers] [--n 10000,100000] [--mesh spot] [--packing elimination,dense] [--threads 1,2] [--peer-cy auto|BIN]
+//! TRILUX_DATA=../shared/data cargo run --release -p mesh-sampling --example blue_noise -- [--json] [--no-peers] [--n 10000,100000] [--mesh spot] [--packing elimination,dense] [--threads 1,2] [--peer-cy auto|BIN] [--blender auto|PYTHON]
 //! ```
 //!
 //! For each of the Stanford bunny, spot and fandisk, at N = 10⁴, 10⁵ and
@@ -146,6 +146,8 @@ struct Args {
     packings: Vec<Packing>,
     peer_cy: Option<PeerCy>,
     threads: Vec<usize>,
+    /// Blender's Python (`bench/blender_scatter.py`), for the scatter rows.
+    blender: Option<PathBuf>,
 }
 
 /// Where the cySampleElim driver comes from.
@@ -165,6 +167,7 @@ fn parse_args() -> Result<Args, String> {
         packings: vec![Packing::Elimination, Packing::Dense],
         peer_cy: None,
         threads: vec![1, 2],
+        blender: None,
     };
     let mut it = std::env::args().skip(1);
     while let Some(a) = it.next() {
@@ -183,6 +186,16 @@ fn parse_args() -> Result<Args, String> {
                             .map_err(|_| format!("--n: '{s}' is not a count"))
                     })
                     .collect::<Result<_, _>>()?;
+            }
+            "--blender" => {
+                let py = it
+                    .next()
+                    .ok_or("--blender needs Blender's Python (auto: target/bpy-venv/bin/python)")?;
+                args.blender = Some(if py == "auto" {
+                    Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bpy-venv/bin/python")
+                } else {
+                    PathBuf::from(py)
+                });
             }
             "--threads" => {
                 let list = it
@@ -230,7 +243,7 @@ fn parse_args() -> Result<Args, String> {
             }
             other => {
                 return Err(format!(
-                    "unknown argument '{other}' (try --json, --no-peers, --n, --mesh, --packing, --threads, --peer-cy)"
+                    "unknown argument '{other}' (try --json, --no-peers, --n, --mesh, --packing, --threads, --peer-cy, --blender)"
                 ));
             }
         }
@@ -597,6 +610,108 @@ fn python_peers(file: &Path, counts: &[usize], area: f64) -> Result<Vec<PeerRow>
     Ok(rows)
 }
 
+/// (tool, case, points, ms, ρ or NaN) of a scatter row.
+type ScatterRow = (String, String, usize, f64, f64);
+
+/// Blender's Distribute Points on Faces (`bench/blender_scatter.py`, run
+/// by `python`, Blender as a module) on `file`, beside trilux's uniform and
+/// per-vertex sampling of as many points (median of three, on the given
+/// threads) and its blue noise at Blender's Poisson counts: rows of
+/// (tool, case, points, ms, ρ or NaN).
+fn blender_rows(
+    python: &Path,
+    file: &Path,
+    mesh: &trilux_io::mesh::TriMesh,
+    threads: usize,
+) -> Result<Vec<ScatterRow>, String> {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out_dir = std::env::temp_dir().join(format!("trilux-blender-{}", std::process::id()));
+    std::fs::create_dir_all(&out_dir).map_err(|e| format!("{}: {e}", out_dir.display()))?;
+    let output = Command::new(python)
+        .arg(here.join("bench/blender_scatter.py"))
+        .arg(file)
+        .arg(&out_dir)
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| format!("{}: {e}", python.display()))?;
+    let text = String::from_utf8_lossy(&output.stdout);
+    let mesh_ref = MeshRef::new(&mesh.positions, &mesh.indices);
+    let uniform = UniformSampler::new(mesh_ref).map_err(|e| e.to_string())?;
+    let area = uniform.surface_area();
+    let pool = pool(threads)?;
+    let time = |f: &(dyn Fn(u64) -> usize + Sync)| -> (f64, usize) {
+        let mut ms = Vec::new();
+        let mut count = 0;
+        for seed in 0..3 {
+            let start = Instant::now();
+            count = pool.install(|| f(seed));
+            ms.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        (median(ms), count)
+    };
+    let mut rows = Vec::new();
+    for line in text.lines().filter(|l| l.starts_with('{')) {
+        let case = field(line, "case").ok_or("a Blender line without \"case\"")?;
+        let number = |key: &str| -> Result<f64, String> {
+            field(line, key)
+                .and_then(|v| v.parse().ok())
+                .ok_or_else(|| format!("blender {case}: no {key} in {line}"))
+        };
+        let (n, ms) = (number("n")? as usize, number("ms")?);
+        let xyz = read_points(&PathBuf::from(
+            field(line, "file").ok_or("a Blender line without \"file\"")?,
+        ))?;
+        let version = field(line, "version").unwrap_or_default();
+        let tool = format!("Blender {version}");
+        if case.starts_with("poisson") {
+            rows.push((
+                tool,
+                case.clone(),
+                xyz.len(),
+                ms,
+                relative_radius(&xyz, area),
+            ));
+            continue;
+        }
+        rows.push((tool, case.clone(), xyz.len(), ms, f64::NAN));
+        if case == "random" {
+            let (ms, count) =
+                time(&|seed| uniform.sample_positions(seed, n).map_or(0, |p| p.len()));
+            rows.push(("trilux".into(), case, count, ms, f64::NAN));
+        } else if case == "random-vertex" {
+            // Blender's per-vertex density, the same weights.
+            let bytes = std::fs::read(out_dir.join("blender_vertex_weights.f32"))
+                .map_err(|e| format!("Blender's vertex weights: {e}"))?;
+            let w: Vec<f32> = bytes
+                .chunks_exact(4)
+                .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                .collect();
+            let sampler =
+                DensitySampler::new(mesh_ref, Density::PerVertex(&w)).map_err(|e| e.to_string())?;
+            let (ms, count) =
+                time(&|seed| sampler.sample_positions(seed, n).map_or(0, |p| p.len()));
+            rows.push(("trilux".into(), case, count, ms, f64::NAN));
+        }
+    }
+    // trilux's elimination at the count of Blender's Poisson rows.
+    let counts: Vec<usize> = rows
+        .iter()
+        .filter(|r| r.1.starts_with("poisson"))
+        .map(|r| r.2)
+        .collect();
+    if let Some(&n) = counts.first() {
+        for (tool, options) in [
+            ("trilux", BlueNoiseOptions::default()),
+            ("trilux-dense", BlueNoiseOptions::dense()),
+        ] {
+            let (ms, rho, _) = ours(&uniform, n, threads, &options)?;
+            rows.push((tool.into(), "blue noise".into(), n, ms, rho));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&out_dir);
+    Ok(rows)
+}
+
 fn run() -> Result<(), String> {
     let args = parse_args()?;
     let dir = PathBuf::from(std::env::var_os("TRILUX_DATA").ok_or(
@@ -678,7 +793,12 @@ fn run() -> Result<(), String> {
                     for r in peer {
                         // Open3D eliminates 5 N candidates; MeshLab throws
                         // darts at a Monte Carlo pool of 20 N points.
-                        let candidates = if r.tool == "meshlab" { 20 } else { 5 } * r.n;
+                        // (pcu's pool is VCG's own: not counted.)
+                        let candidates = match r.tool.as_str() {
+                            "meshlab" => 20 * r.n,
+                            "pcu" => 0,
+                            _ => 5 * r.n,
+                        };
                         rows.push(Row {
                             mesh: name,
                             density: "uniform",
@@ -697,7 +817,23 @@ fn run() -> Result<(), String> {
             }
         }
     }
+    let mut scatter = Vec::new();
+    if let (Some(python), Some(name)) = (&args.blender, args.meshes.first()) {
+        let file = dir.join(format!("meshes/{name}.obj"));
+        let mesh = trilux_io::mesh::TriMesh::read(&file).map_err(|e| e.to_string())?;
+        let threads = args.threads.iter().copied().max().unwrap_or(2);
+        eprintln!("{name}: Blender's Distribute Points on Faces and trilux ({threads} threads)…");
+        match blender_rows(python, &file, &mesh, threads) {
+            Ok(r) => scatter = r.into_iter().map(|r| (name.clone(), threads, r)).collect(),
+            Err(e) => eprintln!("Blender did not run: {e}"),
+        }
+    }
     if args.json {
+        for (mesh, threads, (tool, case, points, ms, rho)) in &scatter {
+            println!(
+                "{{\"mesh\": \"{mesh}\", \"scatter\": \"{case}\", \"tool\": \"{tool}\", \"threads\": {threads}, \"points\": {points}, \"ms\": {ms:.2}, \"rho\": {rho:.4}}}"
+            );
+        }
         for r in &rows {
             println!("{}", r.json());
         }
@@ -727,7 +863,26 @@ fn run() -> Result<(), String> {
             r.candidates
         );
     }
-    for peer in ["cySampleElim", "open3d", "meshlab"] {
+    if !scatter.is_empty() {
+        println!(
+            "\nScatter beside Blender's Distribute Points on Faces (evaluation of the node only; \
+             ρ for Poisson rows, measured as ours):\n"
+        );
+        println!("| mesh | case | tool | threads | points | ms | M points/s | ρ |");
+        println!("|---|---|---|---:|---:|---:|---:|---:|");
+        for (mesh, threads, (tool, case, points, ms, rho)) in &scatter {
+            let rho = if rho.is_nan() {
+                "—".to_string()
+            } else {
+                format!("{rho:.3}")
+            };
+            println!(
+                "| {mesh} | {case} | {tool} | {threads} | {points} | {ms:.1} | {:.2} | {rho} |",
+                *points as f64 / ms / 1e3
+            );
+        }
+    }
+    for peer in ["cySampleElim", "open3d", "meshlab", "pcu"] {
         if !rows.iter().any(|r| r.tool == peer) {
             continue;
         }
