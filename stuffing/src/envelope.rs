@@ -408,8 +408,7 @@ impl Mover<'_> {
 
 impl Mover<'_> {
     /// How far the boundary triangles around `v`, with `v` at `at`, lie
-    /// from the input: the largest distance of their centroids and of the
-    /// midpoints of their edges at `v`.
+    /// from the input: the largest distance of their centroids.
     fn ring_off_input(&self, positions: &[DVec3], v: u32, at: DVec3) -> f64 {
         let mut off: f64 = 0.0;
         for &f in self.faces.of(v) {
@@ -417,11 +416,6 @@ impl Mover<'_> {
                 self.boundary[f as usize].map(|u| if u == v { at } else { positions[u as usize] });
             let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
             off = off.max(self.input.nearest(centroid).1);
-            for (k, &u) in self.boundary[f as usize].iter().enumerate() {
-                if u != v {
-                    off = off.max(self.input.nearest(0.5 * (at + corners[k])).1);
-                }
-            }
         }
         off.sqrt()
     }
@@ -447,6 +441,9 @@ fn keeps_angles(before: [DVec3; 4], after: [DVec3; 4]) -> bool {
     let Some((lo, hi)) = range(after) else {
         return false;
     };
+    if lo >= MIN_DIHEDRAL_DEG && hi <= MAX_DIHEDRAL_DEG {
+        return true;
+    }
     let (lo0, hi0) = range(before).unwrap_or((0.0, 180.0));
     lo >= MIN_DIHEDRAL_DEG.min(lo0) && hi <= MAX_DIHEDRAL_DEG.max(hi0)
 }

@@ -19,7 +19,10 @@
 //! 4. stencils that fill each lattice tetrahedron with its inside part,
 //!    splitting shared quadrilaterals by the paper's parity rule;
 //! 5. optionally ([`Options::graded`]) coarser, octree-graded tetrahedra
-//!    deep inside, with the fine BCC lattice kept near the surface.
+//!    deep inside, with the fine BCC lattice kept near the surface;
+//! 6. optionally ([`Options::envelope`]) boundary vertices moved onto the
+//!    tips, creases and thin parts of the input the lattice cut across,
+//!    each move kept only if the tetrahedra around it keep 10°–165°.
 //!
 //! The crate depends on `glam`, `rayon`, `thiserror` and `std` only: a
 //! user who wants tetrahedra from a surface gets no solver, sparse-matrix

@@ -436,7 +436,7 @@ fn farthest_from_boundary(lines: &[(DVec3, DVec3)], step: f64, cap: f64, m: &Tet
 /// plain and fitted with an envelope of 10⁻³ of the diagonal: the fit
 /// brings them to under 40 % of the plain distance, within 0.5 % of
 /// the diagonal at 1/40 of it as spacing and 0.3 % at 1/80 (measured:
-/// 1.37 % → 0.43 % and 0.66 % → 0.23 %). The envelope itself (0.1 %) is
+/// 1.37 % → 0.44 % and 0.66 % → 0.26 %). The envelope itself (0.1 %) is
 /// not reached: a crease a lattice cell across gets the boundary vertices
 /// the angle bound lets move onto it, and the chords between them.
 #[test]
