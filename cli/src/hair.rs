@@ -19,15 +19,27 @@ use trilux_io::curves::Curves;
 /// # Ok::<(), mesh_sampling::Error>(())
 /// ```
 pub fn curves(strands: &Strands) -> Curves {
+    into_curves(strands.clone(), glam::DVec3::ZERO)
+}
+
+/// [`curves`] without copying the points (they are moved), put back in
+/// a file's frame: `origin` (a far mesh's `TriMesh::origin`, which the
+/// strands' points are relative to) added in `f32`.
+pub fn into_curves(mut strands: Strands, origin: glam::DVec3) -> Curves {
+    if origin != glam::DVec3::ZERO {
+        let o = origin.as_vec3();
+        strands.points.iter_mut().for_each(|p| *p += o);
+    }
+    let per = strands.points_per_strand() as u32;
     let roots = &strands.roots;
     let uvs: Option<Vec<_>> = roots.iter().map(|r| r.uv).collect();
     Curves {
-        points: strands.points.clone(),
-        counts: vec![strands.points_per_strand() as u32; strands.len()],
-        widths: strands.widths.clone(),
+        counts: vec![per; roots.len()],
         faces: Some(roots.iter().map(|r| r.face).collect()),
         barycentrics: Some(roots.iter().map(|r| r.barycentric).collect()),
         normals: Some(roots.iter().map(|r| r.normal).collect()),
         uvs: uvs.filter(|_| !roots.is_empty()),
+        points: strands.points,
+        widths: strands.widths,
     }
 }

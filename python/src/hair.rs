@@ -6,7 +6,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use mesh_sampling::{HairOptions, StrandParams, SurfacePoint, grow_strands_with};
-use trilux_io::curves::Curves;
 
 use crate::arrays::{self, Int};
 use crate::error::{Failure, Result, detached};
@@ -196,11 +195,7 @@ pub(crate) fn grow_hair<'py>(
             e => Failure::from(e),
         })?;
         if let Some(p) = &path {
-            let mut curves = to_curves(&strands);
-            if mesh.origin != glam::DVec3::ZERO {
-                let o = mesh.origin.as_vec3();
-                curves.points.iter_mut().for_each(|q| *q += o);
-            }
+            let curves = trilux::hair::into_curves(strands.clone(), mesh.origin);
             trilux_io::curves::write(p, &curves)?;
         }
         Ok(strands)
@@ -241,19 +236,4 @@ pub(crate) fn grow_hair<'py>(
         None => out.set_item("uv", py.None())?,
     }
     Ok(out)
-}
-
-/// The strands as trilux-io's curves, with the roots' data.
-fn to_curves(strands: &mesh_sampling::Strands) -> Curves {
-    let roots = &strands.roots;
-    let uvs: Option<Vec<_>> = roots.iter().map(|r| r.uv).collect();
-    Curves {
-        points: strands.points.clone(),
-        counts: vec![strands.points_per_strand() as u32; roots.len()],
-        widths: strands.widths.clone(),
-        faces: Some(roots.iter().map(|r| r.face).collect()),
-        barycentrics: Some(roots.iter().map(|r| r.barycentric).collect()),
-        normals: Some(roots.iter().map(|r| r.normal).collect()),
-        uvs: uvs.filter(|_| !roots.is_empty()),
-    }
 }

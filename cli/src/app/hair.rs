@@ -357,7 +357,9 @@ fn write(
         })?;
         return Ok(vec![output.to_path_buf()]);
     }
-    let curves = context.step("building the curves", || to_curves(strands, mesh.origin));
+    let curves = context.step("building the curves", || {
+        trilux::hair::into_curves(strands, mesh.origin)
+    });
     if ext == "glb" || ext == "gltf" {
         return context.step("writing the glTF file", || {
             trilux::output::write_gltf(output, force, |tmp| curves::write_gltf(tmp, &curves))
@@ -373,28 +375,6 @@ fn write(
         })
     })?;
     Ok(vec![output.to_path_buf()])
-}
-
-/// The strands as the writers' curves, the points moved (not copied) and
-/// put back in the file's frame (a far mesh's `origin` added, in `f32`),
-/// with the roots' face, barycentrics, normal and UV (when all have one).
-fn to_curves(mut strands: Strands, origin: glam::DVec3) -> curves::Curves {
-    if origin != glam::DVec3::ZERO {
-        let o = origin.as_vec3();
-        strands.points.iter_mut().for_each(|p| *p += o);
-    }
-    let per = strands.points_per_strand() as u32;
-    let roots = &strands.roots;
-    let uvs: Option<Vec<_>> = roots.iter().map(|r| r.uv).collect();
-    curves::Curves {
-        counts: vec![per; roots.len()],
-        faces: Some(roots.iter().map(|r| r.face).collect()),
-        barycentrics: Some(roots.iter().map(|r| r.barycentric).collect()),
-        normals: Some(roots.iter().map(|r| r.normal).collect()),
-        uvs: uvs.filter(|_| !roots.is_empty()),
-        points: strands.points,
-        widths: strands.widths,
-    }
 }
 
 /// The roots as a PLY point cloud: normals, UVs and `face_id` as
