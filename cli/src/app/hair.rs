@@ -57,11 +57,20 @@ pub(crate) struct HairArgs {
     pub(crate) hair_clumps: Option<String>,
     /// With --hair: each strand's length is LEN times this mesh-colours
     /// channel at its root (a painted length map of this mesh).
-    #[arg(long, value_name = "FILE.meshcolors", requires = "hair")]
+    #[arg(
+        long,
+        value_name = "FILE.meshcolors",
+        requires = "hair",
+        group = "hair_length"
+    )]
     pub(crate) hair_length_meshcolors: Option<PathBuf>,
-    /// Which value of --hair-length-meshcolors scales the length
-    /// (default: luminance).
-    #[arg(long, value_enum, requires = "hair_length_meshcolors")]
+    /// With --hair: each strand's length is LEN times this texture (PNG,
+    /// JPEG, HDR, EXR; values as stored) at its root's UV.
+    #[arg(long, value_name = "IMAGE", requires = "hair", group = "hair_length")]
+    pub(crate) hair_length_texture: Option<PathBuf>,
+    /// Which value of --hair-length-meshcolors or --hair-length-texture
+    /// scales the length (default: luminance).
+    #[arg(long, value_enum, requires = "hair_length")]
     pub(crate) hair_length_channel: Option<ChannelArg>,
 }
 
@@ -291,10 +300,13 @@ fn length_scale(
     mesh_path: &Path,
     points: &[SurfacePoint],
 ) -> Result<Option<Vec<f32>>> {
+    let channel = args.hair_length_channel.unwrap_or(ChannelArg::Luminance);
+    if let Some(path) = &args.hair_length_texture {
+        return texture_scale(context, (path, channel), mesh, mesh_path, points).map(Some);
+    }
     let Some(path) = &args.hair_length_meshcolors else {
         return Ok(None);
     };
-    let channel = args.hair_length_channel.unwrap_or(ChannelArg::Luminance);
     let (_, colors) = super::ops::colors::load_for(mesh, mesh_path, path)?;
     let c = colors.channels();
     let lookups: Vec<(u32, [f32; 3])> = points.iter().map(|p| (p.face, p.barycentric)).collect();
@@ -333,6 +345,43 @@ fn length_scale(
         })
         .collect::<Result<Vec<f32>>>()
         .map(Some)
+}
+
+/// Per-root length factors from `--hair-length-texture`: the texture's
+/// `channel` (bilinear, wrapped as the mesh's first material says) at
+/// each root's UV, clamped to be >= 0.
+fn texture_scale(
+    context: &mut Context,
+    (path, channel): (&Path, ChannelArg),
+    mesh: &TriMesh,
+    mesh_path: &Path,
+    points: &[SurfacePoint],
+) -> Result<Vec<f32>> {
+    let image = super::read_image(context, path, true)?;
+    if mesh.uvs.is_none() {
+        return Err(super::file_error(
+            mesh_path,
+            "--hair-length-texture is looked up at texture coordinates, and the mesh has none \
+             (use --hair-length-meshcolors)",
+        ));
+    }
+    let wrap = mesh
+        .materials
+        .first()
+        .map_or(mesh_sampling::Wrap::Repeat, |m| {
+            trilux::sampling_wrap(m.wrap[0])
+        });
+    let texture = trilux::density_texture(&image, channel.channel())
+        .map_err(|e| file_cause(path, e))?
+        .with_wrap(wrap);
+    Ok(points
+        .iter()
+        .map(|p| {
+            let uv = p.uv.unwrap_or_default().as_dvec2();
+            let v = texture.eval(uv) as f32;
+            if v.is_finite() { v.max(0.0) } else { 0.0 }
+        })
+        .collect())
 }
 
 /// The strands as the file `output` names.

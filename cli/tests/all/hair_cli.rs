@@ -302,3 +302,66 @@ fn strands_of_a_far_mesh_are_written_in_the_files_frame() {
         );
     }
 }
+
+#[test]
+fn a_texture_channel_scales_each_strands_length_at_its_roots_uv() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, noise) = torus_and_noise(d, [32, 16], 16);
+    let (torus, noise) = (torus.to_str().unwrap(), noise.to_str().unwrap());
+    for out in ["roots.ply", "h.hair"] {
+        let ok = run(
+            d,
+            &[
+                "sample",
+                torus,
+                "-n",
+                "300",
+                "--seed",
+                "4",
+                "--hair",
+                "0.5:2",
+                "--hair-length-texture",
+                noise,
+                "--hair-length-channel",
+                "r",
+                "-o",
+                out,
+            ],
+        );
+        assert!(ok.status.success(), "{}", crate::common::stderr(&ok));
+    }
+    let options = trilux_io::image::ReadOptions {
+        raw: true,
+        ..Default::default()
+    };
+    let image = trilux_io::image::read_with(noise, options).unwrap();
+    let texture = trilux::density_texture(&image, mesh_sampling::Channel::Index(0)).unwrap();
+    let roots = trilux_io::mesh::ply::read(d.join("roots.ply")).unwrap();
+    let uvs = roots.uvs.as_ref().unwrap();
+    let curves = hair::read(d.join("h.hair")).unwrap();
+    for (i, strand) in curves.points.chunks(3).enumerate() {
+        let length: f32 = strand.windows(2).map(|w| w[0].distance(w[1])).sum();
+        let want = 0.5 * texture.eval(uvs[i].as_dvec2()) as f32;
+        assert!(
+            (length - want).abs() < 1e-3,
+            "strand {i}: {length} vs {want}"
+        );
+    }
+    fails(
+        d,
+        &[
+            "sample",
+            torus,
+            "-n",
+            "10",
+            "--hair",
+            "0.1",
+            "--hair-length-channel",
+            "r",
+            "-o",
+            "x.usda",
+        ],
+        &["--hair-length"],
+    );
+}
