@@ -47,6 +47,8 @@ pub(crate) const MAX_DIHEDRAL_DEG: f64 = 165.0;
 /// Interior angle, degrees, between two input faces below which their
 /// common edge is a crease the boundary should follow.
 pub(crate) const SHARP_DEG: f64 = 140.0;
+/// Most points put along the creases (about 24 MB), whatever their length.
+const MAX_CREASE_POINTS: usize = 1 << 20;
 /// Fractions of a move tried, in order.
 const STEPS: [f64; 4] = [1.0, 0.5, 0.25, 0.125];
 /// Rounds of pulling vertices towards far input points.
@@ -163,7 +165,8 @@ pub(crate) fn sharp_edges(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u
 }
 
 /// The input's points the boundary should come near (see the module
-/// docs): vertices, points along sharp edges every `h / 4`, and
+/// docs): vertices, points along sharp edges every `h / 4` (at most
+/// [`MAX_CREASE_POINTS`] of them), and
 /// `4 × boundary triangles` points spread by area (at most 2^18).
 fn points_to_hold(
     positions: &[DVec3],
@@ -176,9 +179,18 @@ fn points_to_hold(
     used.par_sort_unstable();
     used.dedup();
     let mut points: Vec<DVec3> = used.iter().map(|&v| positions[v as usize]).collect();
+    // Every h/4, or farther apart when the creases are so long that this
+    // would be more than MAX_CREASE_POINTS.
+    let length: f64 = sharp
+        .iter()
+        .map(|&[a, b]| positions[a as usize].distance(positions[b as usize]))
+        .sum();
+    let step = (0.25 * h).max(length / MAX_CREASE_POINTS as f64);
     for &[a, b] in sharp {
         let (pa, pb) = (positions[a as usize], positions[b as usize]);
-        let steps = (pa.distance(pb) / (0.25 * h)).ceil().min(1e4) as usize;
+        let steps = (pa.distance(pb) / step)
+            .ceil()
+            .min(MAX_CREASE_POINTS as f64) as usize;
         points.extend((1..steps).map(|k| pa.lerp(pb, k as f64 / steps as f64)));
     }
     let bvh = Bvh::build(positions, kept);
