@@ -294,6 +294,41 @@ impl Renderer {
         }
     }
 
+    /// Draws line segments `(a, b)` one sample wide, coloured by
+    /// `color(index)`, depth-tested against what is drawn with the bias
+    /// [`draw_points`](Self::draw_points) uses; a segment with an end
+    /// behind the camera is skipped.
+    pub fn draw_lines(&mut self, segments: &[(Vec3, Vec3)], color: impl Fn(usize) -> [f32; 3]) {
+        let (w, h) = (self.width * self.ss, self.height * self.ss);
+        let (wf, hf) = (w as f32, h as f32);
+        for (k, &(a, b)) in segments.iter().enumerate() {
+            let clip = [a, b].map(|p| self.view_projection * p.extend(1.0));
+            if clip.iter().any(|c| !c.is_finite() || c.w <= 0.0) {
+                continue;
+            }
+            let [(sa, za, _), (sb, zb, _)] = clip.map(|c| to_screen(c, wf, hf));
+            // NDC depth is affine in screen space, so it is interpolated
+            // linearly along the segment; one step per sample, capped so
+            // that a segment far off screen costs little.
+            let steps = (sb - sa).length().ceil().clamp(1.0, 4.0 * (wf + hf)) as u32;
+            let rgb = color(k);
+            for i in 0..=steps {
+                let t = i as f32 / steps as f32;
+                let s = sa.lerp(sb, t);
+                let z = za + (zb - za) * t;
+                let z = z - (1.0 - z).abs() * 1e-3 - 1e-5;
+                if !(s.x >= 0.0 && s.y >= 0.0 && s.x < wf && s.y < hf) {
+                    continue;
+                }
+                let i = (s.y as u32 * w + s.x as u32) as usize;
+                if z < self.depth[i] {
+                    self.depth[i] = z;
+                    self.color[i] = [rgb[0], rgb[1], rgb[2], 1.0];
+                }
+            }
+        }
+    }
+
     /// Per output pixel, the fraction of its samples a triangle or point
     /// covers (0 = background only, 1 = fully covered), row-major like
     /// [`image`](Self::image).

@@ -14,7 +14,7 @@ use super::ops::sample::ChannelArg;
 use super::{Context, Result, arg_error, file_cause};
 
 /// The outputs `-o` takes with `--hair`.
-pub(crate) const OUTPUTS: &[&str] = &["usda", "glb", "gltf", "hair", "ply"];
+pub(crate) const OUTPUTS: &[&str] = &["usda", "usd", "glb", "gltf", "hair", "ply"];
 
 /// Segments per strand without `:SEGMENTS` (Šik & Křivánek's Fig. 1a).
 const DEFAULT_SEGMENTS: u32 = 8;
@@ -23,9 +23,9 @@ const DEFAULT_SEGMENTS: u32 = 8;
 pub(crate) struct HairArgs {
     /// Grow a hair strand from every point: its length LEN in the mesh's
     /// unit along the surface normal, in SEGMENTS segments (default 8);
-    /// -o then takes .usda (BasisCurves + the roots as Points), .glb/.gltf
-    /// (LINES + root POINTS), .hair (Cem Yuksel's format) or .ply (the
-    /// roots, with face, barycentrics, normal and id).
+    /// -o then takes .usda or .usd (USD text: BasisCurves + the roots as
+    /// Points), .glb/.gltf (LINES + root POINTS), .hair (Cem Yuksel's
+    /// format) or .ply (the roots, with face, barycentrics, normal and id).
     #[arg(long, value_name = "LEN[:SEGMENTS]", allow_hyphen_values = true)]
     pub(crate) hair: Option<String>,
     /// With --hair: comb the strands toward the world direction X,Y,Z,
@@ -176,6 +176,13 @@ impl HairArgs {
     }
 }
 
+/// `--hair LEN[:SEGMENTS]`'s LEN as typed, in `f64` (checked by
+/// [`HairArgs::spec`] already).
+fn typed_length(args: &HairArgs) -> Option<f64> {
+    let hair = args.hair.as_deref()?;
+    hair.split(':').next()?.trim().parse().ok()
+}
+
 /// `A:B` as two finite numbers.
 fn pair(text: &str, typed: &str, expected: &str) -> Result<[f32; 2]> {
     let bad = || arg_error(typed, format!("expected {expected}"));
@@ -215,6 +222,7 @@ pub(crate) fn run(
     sample: &super::sample::Args,
     mesh: &TriMesh,
     points: &[SurfacePoint],
+    sampling: serde_json::Value,
 ) -> Result<()> {
     let args = &sample.hair;
     let spec = args.spec()?;
@@ -225,20 +233,33 @@ pub(crate) fn run(
         (mesh, &sample.mesh),
         points,
         (sample.seed, &sample.output, sample.ascii),
+        sample.preview.as_deref(),
     )?;
+    let written = files
+        .iter()
+        .map(|f| f.display().to_string())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let s = if strands == 1 { "" } else { "s" };
+    // A PLY holds the roots only: say so rather than count curve points
+    // the file does not have.
+    let written = if super::extension(&sample.output) == "ply" {
+        format!("; the {strands} root{s} written to {written} (PLY holds no curves)")
+    } else {
+        format!(" written to {written}")
+    };
     let text = format!(
-        "{strands} strand{} of {} segments ({total} points) grown on {} ({} triangles) written to {}\n",
-        if strands == 1 { "" } else { "s" },
+        "{strands} strand{s} of {} segments ({total} points) grown on {} ({} triangles){written}{}\n",
         spec.segments,
         sample.mesh.display(),
         mesh.indices.len(),
-        files
-            .iter()
-            .map(|f| f.display().to_string())
-            .collect::<Vec<_>>()
-            .join(", "),
+        sample
+            .preview
+            .as_ref()
+            .map(|p| format!(", preview {}", p.display()))
+            .unwrap_or_default()
     );
-    let json = serde_json::json!({
+    let mut json = serde_json::json!({
         "command": "sample",
         "mesh": super::shown(&sample.mesh),
         "triangles": mesh.indices.len(),
@@ -246,12 +267,17 @@ pub(crate) fn run(
         "strands": strands,
         "segments": spec.segments,
         "strand_points": total,
-        "length": spec.length,
-        "seed": sample.seed,
+        // The length as typed (f64), not its f32 with its rounding noise.
+        "length": typed_length(args),
         "output": super::shown(&sample.output),
         "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
         "seconds": context.timings_json(),
     });
+    // The sampling's own fields (method, rate, seed, …), as plain
+    // `sample --json` prints them.
+    if let (Some(json), serde_json::Value::Object(fields)) = (json.as_object_mut(), sampling) {
+        json.extend(fields);
+    }
     context.report(&text, json);
     Ok(())
 }
@@ -265,6 +291,7 @@ fn grow_and_write(
     (mesh, mesh_path): (&TriMesh, &Path),
     points: &[SurfacePoint],
     (seed, output, ascii): (u64, &Path, bool),
+    preview: Option<&Path>,
 ) -> Result<(Vec<PathBuf>, usize, usize)> {
     let scale = length_scale(context, args, mesh, mesh_path, points)?;
     let options = HairOptions {
@@ -287,7 +314,17 @@ fn grow_and_write(
         })
     })?;
     let (count, total) = (strands.len(), strands.points.len());
+    // Drawn before `write` takes the strands, written after the strands
+    // (as `sample` writes its preview after the points).
+    let image = preview.map(|_| {
+        context.step("rendering the preview", || {
+            super::ops::sample::strands_preview(mesh, points, &strands, 768, 768)
+        })
+    });
     let files = write(context, strands, mesh, points, (output, ascii))?;
+    if let (Some(path), Some(image)) = (preview, image) {
+        super::write_image(context, path, &image)?;
+    }
     Ok((files, count, total))
 }
 
@@ -417,7 +454,11 @@ fn write(
     context.step(&format!("writing the .{ext} file"), || {
         trilux::output::write_atomic(output, force, |tmp| {
             match ext.as_str() {
-                "usda" => curves::usda::write(tmp, &curves, &curves::usda::Stage::default())?,
+                // `.usd` may hold text or binary (crate) USD; Blender and
+                // Houdini read either, so text is written for both.
+                "usda" | "usd" => {
+                    curves::usda::write(tmp, &curves, &curves::usda::Stage::default())?
+                }
                 _ => curves::hair::write(tmp, &curves)?,
             }
             Ok(())

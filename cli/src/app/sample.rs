@@ -176,7 +176,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         }
     })?;
     if args.hair.on() {
-        return super::hair::run(context, &args, &mesh, &points);
+        let sampling = sampling_json(&args, method);
+        return super::hair::run(context, &args, &mesh, &points, sampling);
     }
     let files = write(context, &args, &mesh, &points)?;
     report(context, &args, (&mesh, &points), method, &files);
@@ -419,18 +420,33 @@ fn report(
         "mesh": super::shown(&args.mesh),
         "triangles": mesh.indices.len(),
         "points": points.len(),
+        "output": super::shown(&args.output),
+        "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
+        "seconds": context.timings_json(),
+    });
+    let mut json = json;
+    if let (Some(json), serde_json::Value::Object(fields)) =
+        (json.as_object_mut(), sampling_json(args, method))
+    {
+        json.extend(fields);
+    }
+    context.report(&text, json);
+}
+
+/// How the points were drawn, as `--json` reports it with and without
+/// `--hair`: method, rate, max_density, blue_noise, packing, seed and
+/// preview.
+pub(crate) fn sampling_json(args: &Args, method: Method) -> serde_json::Value {
+    let packing = args.packing.unwrap_or(PackingArg::Elimination);
+    serde_json::json!({
         "method": if args.rate.is_some() { "rate" } else { method.name() },
         "rate": args.rate,
         "max_density": args.max_density,
         "blue_noise": args.blue_noise,
         "packing": args.blue_noise.then_some(packing.name()),
         "seed": args.seed,
-        "output": super::shown(&args.output),
-        "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
         "preview": args.preview.as_deref().map(super::shown),
-        "seconds": context.timings_json(),
-    });
-    context.report(&text, json);
+    })
 }
 
 #[cfg(test)]

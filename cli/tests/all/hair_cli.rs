@@ -365,3 +365,91 @@ fn a_texture_channel_scales_each_strands_length_at_its_roots_uv() {
         &["--hair-length"],
     );
 }
+
+/// `--preview` with `--hair` draws the strands (it wrote nothing before):
+/// a picture unlike the points' preview of the same seed, which has no
+/// strands; `.usd` is written as USD text, the same bytes as `.usda`; a
+/// PLY's summary counts the roots it holds, not curve points; `--json`
+/// gives the length as typed and the sampling's fields.
+#[test]
+fn hair_preview_usd_ply_summary_and_json_say_what_was_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mesh = torus(d);
+    let hair = |extra: &[&str]| {
+        let mut args = vec!["sample", mesh.as_str(), "-n", "300", "--seed", "4"];
+        args.extend_from_slice(extra);
+        json(d, &args)
+    };
+    let report = hair(&["--hair", "0.3", "-o", "h.usda", "--preview", "h.png"]);
+    assert_eq!(report["preview"], "h.png");
+    let strands = trilux_io::image::read(d.join("h.png")).unwrap();
+    json(
+        d,
+        &[
+            "sample",
+            &mesh,
+            "-n",
+            "300",
+            "--seed",
+            "4",
+            "-o",
+            "p.ply",
+            "--preview",
+            "p.png",
+        ],
+    );
+    let points = trilux_io::image::read(d.join("p.png")).unwrap();
+    assert_eq!(
+        (strands.width, strands.height),
+        (points.width, points.height)
+    );
+    assert_ne!(strands.pixels, points.pixels, "the strands are drawn");
+
+    hair(&["--hair", "0.3", "-o", "h.usd"]);
+    assert_eq!(
+        std::fs::read(d.join("h.usd")).unwrap(),
+        std::fs::read(d.join("h.usda")).unwrap()
+    );
+
+    let out = run(
+        d,
+        &[
+            "sample", &mesh, "-n", "300", "--hair", "0.05", "-o", "h.ply",
+        ],
+    );
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("the 300 roots written to h.ply (PLY holds no curves)"),
+        "{text}"
+    );
+
+    let report = hair(&["--hair", "0.05", "-o", "j.hair"]);
+    assert_eq!(report["length"].to_string(), "0.05");
+    assert_eq!(report["method"], "uniform");
+    assert_eq!(report["seed"], 4);
+    for key in ["rate", "max_density", "blue_noise", "packing", "preview"] {
+        assert!(report.get(key).is_some(), "{key}: {report}");
+    }
+    let report = json(
+        d,
+        &[
+            "sample",
+            &mesh,
+            "--rate",
+            "50",
+            "--max-density",
+            "1",
+            "--hair",
+            "0.05",
+            "-o",
+            "r.hair",
+        ],
+    );
+    assert_eq!(
+        (report["method"].as_str(), report["rate"].as_f64()),
+        (Some("rate"), Some(50.0))
+    );
+    assert_eq!(report["max_density"], 1.0);
+}

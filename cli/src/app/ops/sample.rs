@@ -318,3 +318,37 @@ pub(crate) fn preview(
     r.draw_points(&shown, radius, |_| [1.0, 0.35, 0.05]);
     r.image()
 }
+
+/// A preview of hair: the mesh in grey, the strands as light blue lines
+/// (at most about 100,000 of them, evenly strided) and their roots as
+/// orange points, as [`preview`] draws points.
+pub(crate) fn strands_preview(
+    mesh: &TriMesh,
+    points: &[SurfacePoint],
+    strands: &mesh_sampling::Strands,
+    width: u32,
+    height: u32,
+) -> trilux_io::image::Image {
+    use trilux::preview::{Camera, Renderer, lambert};
+    let Some((lo, hi)) = trilux::mesh::bounds(mesh) else {
+        return trilux::preview::render_mesh(&[], &[], width, height);
+    };
+    // The box grown by the strands, so that long hair stays in the picture.
+    let (lo, hi) =
+        trilux::preview::bounds(&strands.points).map_or((lo, hi), |(a, b)| (lo.min(a), hi.max(b)));
+    let mut r = Renderer::new(width, height, Camera::fit(lo, hi));
+    r.draw_mesh(&mesh.positions, &mesh.indices, |f| lambert([0.55; 3], f));
+    let per = strands.points_per_strand();
+    let step = strands.len().div_ceil(100_000).max(1);
+    let segments: Vec<(Vec3, Vec3)> = strands
+        .points
+        .chunks_exact(per)
+        .step_by(step)
+        .flat_map(|s| s.windows(2).map(|w| (w[0], w[1])))
+        .collect();
+    r.draw_lines(&segments, |_| [0.45, 0.75, 1.0]);
+    let shown: Vec<Vec3> = points.iter().step_by(step).map(|p| p.position).collect();
+    let radius = (150.0 / (shown.len() as f32).sqrt()).clamp(0.5, 2.0);
+    r.draw_points(&shown, radius, |_| [1.0, 0.35, 0.05]);
+    r.image()
+}
