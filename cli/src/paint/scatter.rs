@@ -136,7 +136,15 @@ fn count(o: &Map<String, Value>) -> Parsed<usize> {
         .as_u64()
         .filter(|&n| n >= 1 && n <= MAX_SHOWN_POINTS as u64)
         .map(|n| n as usize)
-        .ok_or_else(|| BadField::new("count", format!("expected 1 to {MAX_SHOWN_POINTS} points")))
+        .ok_or_else(|| {
+            BadField::new(
+                "count",
+                format!(
+                    "expected a whole number of points, 1 to {}",
+                    thousands(MAX_SHOWN_POINTS as f64)
+                ),
+            )
+        })
 }
 
 fn hair(v: &Value) -> Parsed<HairSpec> {
@@ -462,17 +470,19 @@ impl ScatterState {
 
     /// Grows the preview strands from evenly spaced points.
     fn grow(&mut self, colors: &MeshColors) -> Parsed<()> {
-        self.strands = self.strands_from(colors, MAX_PREVIEW_STRANDS)?;
+        self.strands = self.strands_from(colors, MAX_PREVIEW_STRANDS, false)?;
         Ok(())
     }
 
     /// Strands from at most `roots` evenly spaced points (all of them
-    /// when there are fewer), as the request's hair asks; `None` without
-    /// hair.
+    /// when there are fewer), as the request's hair asks, with per-point
+    /// widths when `widths` (a renderer needs them; the preview's lines
+    /// do not); `None` without hair.
     pub(crate) fn strands_from(
         &self,
         colors: &MeshColors,
         roots: usize,
+        widths: bool,
     ) -> Parsed<Option<Strands>> {
         let Some(hair) = &self.spec.hair else {
             return Ok(None);
@@ -484,6 +494,7 @@ impl ScatterState {
         let options = HairOptions {
             segments: hair.segments,
             seed: self.spec.seed,
+            widths,
             ..HairOptions::default()
         };
         mesh_sampling::grow_strands(&chosen, &options, |p| {
@@ -513,8 +524,9 @@ fn rate_scatter(
         return Err(BadField::new(
             "rate",
             format!(
-                "{rate} points per unit area on an area of {area:.4} could give {:.0} points, more than the {MAX_SHOWN_POINTS} the page shows",
-                rate * area
+                "{rate} points per unit area on an area of {area:.4} could give {} points, more than the {} the page shows",
+                thousands(rate * area),
+                thousands(MAX_SHOWN_POINTS as f64)
             ),
         ));
     }
@@ -531,6 +543,32 @@ fn rate_scatter(
     .map_err(|e| BadField::new("rate", e.to_string()))
 }
 
+/// `x` rounded, its digits grouped by three: 5,709,518,805.
+fn thousands(x: f64) -> String {
+    let digits = format!("{:.0}", x.max(0.0));
+    let mut out = String::new();
+    for (k, c) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
 fn scatter_error(e: mesh_sampling::Error) -> (String, String) {
     ("scatter".to_string(), e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_are_grouped_by_thousands() {
+        assert_eq!(thousands(5_709_518_805.4), "5,709,518,805");
+        assert_eq!(thousands(4e6), "4,000,000");
+        assert_eq!(thousands(999.0), "999");
+        assert_eq!(thousands(0.0), "0");
+    }
 }

@@ -441,22 +441,30 @@ impl Worker {
 
     /// Strands from every point of the scatter, as the panel's hair asks.
     fn curves(&self) -> crate::Result<trilux_io::curves::Curves> {
+        self.scatter_points()?;
         let scatter = self.scatter.as_ref().ok_or_else(nothing_scattered)?;
         let strands = scatter
-            .strands_from(self.session.colors(), usize::MAX)
+            .strands_from(self.session.colors(), usize::MAX, true)
             .map_err(|b| crate::Error::Invalid(format!("{}: {}", b.field, b.problem)))?
             .ok_or_else(|| {
                 crate::Error::Invalid("no strands: turn on hair in the scatter panel first".into())
             })?;
-        Ok(crate::hair::curves(&strands))
+        Ok(crate::hair::into_curves(strands, self.doc.surface.origin))
     }
 
     /// The scatter's points, or an error when the panel has none.
     fn scatter_points(&self) -> crate::Result<&[mesh_sampling::SurfacePoint]> {
-        self.scatter
+        let points = self
+            .scatter
             .as_ref()
             .map(|s| s.points())
-            .ok_or_else(nothing_scattered)
+            .ok_or_else(nothing_scattered)?;
+        if points.is_empty() {
+            return Err(crate::Error::Invalid(
+                "no points to export yet: paint the scatter's channel first".into(),
+            ));
+        }
+        Ok(points)
     }
 
     /// Writes the autosave when there is one and something to save.

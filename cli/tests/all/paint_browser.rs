@@ -152,6 +152,12 @@ async fn the_scatter_panel_follows_a_stroke_of_density_in_chromium() {
     let step = |s: &str| &v["steps"][s];
     assert_eq!(step("rate")["points"], 0, "{v:#}");
     assert_eq!(step("rate")["orange"], 0, "{v:#}");
+    let empty = step("empty_export");
+    assert!(
+        empty["message"].as_str().unwrap().contains("no points"),
+        "{empty}"
+    );
+    assert_eq!(step("refused")["mode"], "rate", "{v:#}");
     let stroke = step("stroke");
     assert!(stroke["points"].as_u64().unwrap() > 50, "{stroke}");
     assert_eq!(stroke["points"], stroke["status"]["points"]);
@@ -170,6 +176,10 @@ async fn the_scatter_panel_follows_a_stroke_of_density_in_chromium() {
     test_support::gltf::validate(&glb);
     let text = std::fs::read_to_string(&usda).unwrap();
     assert!(text.contains("BasisCurves"), "{text}");
+    assert!(
+        text.contains("widths"),
+        "strands a renderer can draw: {text}"
+    );
     let mismatch = step("mismatch");
     assert!(
         mismatch["states"].to_string().contains("reload the page"),

@@ -96,6 +96,22 @@ try {
   out.steps.rate = await t();
   out.steps.rate.orange = await orange();
 
+  // Nothing painted: exporting the points is refused, not an empty file.
+  names.push('empty.glb');
+  const errorsBefore = (await t()).errors.length;
+  await page.click('#exportPoints');
+  await page.waitForFunction((n) => window.trilux.errors.length > n, errorsBefore, { timeout: 60000 });
+  out.steps.empty_export = (await t()).errors.slice(-1)[0];
+
+  // A count of 0 in blue-noise mode is refused by the server, and the
+  // panel goes back to what is in effect (rate).
+  await page.selectOption('#scatterMode', 'blue_noise');
+  await page.fill('#count', '0');
+  await page.waitForFunction(() => window.trilux.errors.some((e) => e.field === 'count'), null, { timeout: 60000 });
+  await page.waitForFunction(() => document.getElementById('scatterMode').value === 'rate', null, { timeout: 60000 });
+  out.steps.refused = { mode: await page.evaluate(() => document.getElementById('scatterMode').value) };
+  frames = (await t()).frames;
+
   // A stroke of density 1 across the middle: points under it.
   frames = (await t()).frames;
   await page.mouse.move(330, 300);

@@ -51,7 +51,7 @@ function onText(m) {
   } else if (m.type === 'status') {
     state.status = m;
     // A page that connects to a server already scattering shows how.
-    if (!state.scatterShown) { state.scatterShown = true; if (m.scatter) showScatter(m.scatter); }
+    if (!state.scatterShown) { state.scatterShown = true; showScatter(scatterInEffect()); }
     showStatus(m);
     // The global resolution offers the finest level now in use.
     if (!state.levelSet) { $('level').value = m.finest_level; state.levelSet = true; }
@@ -64,6 +64,9 @@ function onText(m) {
     flash('written: ' + m.path);
   } else if (m.type === 'error') {
     state.errors.push(m);
+    // A refused scatter request changed nothing: the panel shows again
+    // what the server has (the last status says).
+    if (m.seq !== undefined && m.seq === state.scatterSeq) showScatter(scatterInEffect());
     if (m.exists && pendingExport && confirm(m.message + '. Replace it?')) pendingExport(true);
     else flash(m.field + ': ' + m.message);
   }
@@ -324,17 +327,26 @@ function diagonal() {
 }
 
 // The scatter request the panel describes.
+// The boxes' numbers go as typed: the server refuses what it cannot take
+// (a count of 0 or 1.5, a negative seed) with a message, and the panel
+// then shows again what is in effect.
 function scatterRequest() {
   const mode = $('scatterMode').value;
-  const req = { mode, channel: $('scatterChannel').value, seed: Math.max(0, Math.floor(Number($('seed').value) || 0)) };
+  const req = { mode, channel: $('scatterChannel').value, seed: Number($('seed').value) };
   if (mode === 'rate') req.rate = Number($('rate').value);
-  if (mode === 'count' || mode === 'blue_noise') req.count = Math.max(1, Math.floor(Number($('count').value) || 1));
+  if (mode === 'count' || mode === 'blue_noise') req.count = Number($('count').value);
   req.hair = $('hair').checked ? {
     length: Number($('hairLength').value) * diagonal(),
-    segments: Math.max(1, Math.floor(Number($('hairSegments').value) || 1)),
+    segments: Number($('hairSegments').value),
     length_channel: $('hairChannel').value || null,
   } : null;
   return req;
+}
+
+// The scatter request the server follows, by the last status.
+function scatterInEffect() {
+  const s = state.status && state.status.scatter;
+  return s || { mode: 'off', channel: $('scatterChannel').value, seed: 0, hair: null };
 }
 
 // Sets the panel to a scatter request (without sending it).
@@ -347,6 +359,7 @@ function showScatter(r) {
     $('hairSegments').value = r.hair.segments;
     $('hairLength').value = r.hair.length / diagonal();
     $('hairChannel').value = r.hair.length_channel || '';
+    $('hairLength').dispatchEvent(new Event('input'));
   }
   showScatterRows(); showRate();
 }
@@ -364,7 +377,7 @@ let scatterTimer = 0;
 function sendScatter() {
   showScatterRows(); showRate();
   clearTimeout(scatterTimer);
-  scatterTimer = setTimeout(() => { if (state.hello) net.send('scatter', scatterRequest()); }, 150);
+  scatterTimer = setTimeout(() => { if (state.hello) state.scatterSeq = net.send('scatter', scatterRequest()); }, 150);
 }
 state.scatter = (fields) => net.send('scatter', fields);
 for (const id of ['scatterMode', 'scatterChannel', 'hair', 'hairChannel', 'hairLength']) $(id).addEventListener('change', sendScatter);
