@@ -17,7 +17,7 @@ use super::{Context, Result, arg_error, file_cause, file_error};
 #[derive(Debug, clap::Args)]
 #[command(
     about = "Scatter random points on a mesh (uniform or with a density) and write a PLY or glTF point cloud",
-    after_help = "Examples:\n  trilux sample ../shared/data/meshes/spot.obj -n 1000000 \\\n      --density ../shared/data/textures/spot_texture.png -o spot.ply --preview spot.png\n  trilux sample ../shared/data/meshes/spot.obj --blue-noise --radius 0.01 -o spot_blue.ply\n  trilux sample ../shared/data/meshes/spot.obj -n 100000 -o spot_points.glb\n  trilux sample ../shared/data/meshes/spot.obj --rate 2000 --density ../shared/data/textures/spot_texture.png -o spot_rate.ply"
+    after_help = "Examples:\n  trilux sample ../shared/data/meshes/spot.obj -n 1000000 \\\n      --density ../shared/data/textures/spot_texture.png -o spot.ply --preview spot.png\n  trilux sample ../shared/data/meshes/spot.obj --blue-noise --radius 0.01 -o spot_blue.ply\n  trilux sample ../shared/data/meshes/spot.obj -n 100000 -o spot_points.glb\n  trilux sample ../shared/data/meshes/spot.obj --rate 2000 --density ../shared/data/textures/spot_texture.png -o spot_rate.ply\n  trilux sample ../shared/data/meshes/spot.obj -n 100000 --hair 0.05:8 --hair-comb 0,-1,0:40 \\\n      -o spot_hair.usda --preview spot_hair.png"
 )]
 pub(crate) struct Args {
     /// The mesh: .obj, .gltf, .glb or .ply.
@@ -30,7 +30,9 @@ pub(crate) struct Args {
         long = "count",
         value_name = "N",
         allow_negative_numbers = true,
-        required_unless_present_any = ["radius", "rate"]
+        // `--max-density` requires `--rate` (which conflicts with -n): so
+        // that clap asks for `--rate` alone, not for -n too.
+        required_unless_present_any = ["radius", "rate", "max_density"]
     )]
     pub(crate) count: Option<i64>,
     /// Instead of -n: points per unit area (in the mesh's unit) where the
@@ -49,7 +51,12 @@ pub(crate) struct Args {
     /// (rate × M per unit area). Default: the density's own maximum (1
     /// without a density); state it (1 for a [0, 1] channel) to keep the
     /// points when the density is edited and sampled again.
-    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        value_name = "M",
+        allow_negative_numbers = true,
+        requires = "rate"
+    )]
     pub(crate) max_density: Option<f64>,
     /// Blue noise: points that keep their distance (Poisson-disk), following
     /// the density, by weighted sample elimination (Yuksel 2015; --packing
@@ -143,13 +150,15 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let wanted = wanted(&args)?;
     let channel = args.channel.unwrap_or(ChannelArg::Luminance).channel();
     super::check_output(context, "-o", &args.output, args.hair.outputs())?;
-    let gltf = super::extension(&args.output) != "ply";
-    if gltf && args.ascii {
+    let ext = super::extension(&args.output);
+    let gltf = ext == "glb" || ext == "gltf";
+    if ext != "ply" && args.ascii {
         return Err(arg_error(
             "--ascii",
             format!(
-                "ASCII is a PLY encoding, and {} is glTF (write .ply, or leave out --ascii)",
-                args.output.display()
+                "ASCII is a PLY encoding, and {} is {} (write .ply, or leave out --ascii)",
+                args.output.display(),
+                format_name(&ext)
             ),
         ));
     }
@@ -184,10 +193,23 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     Ok(())
 }
 
+/// What an output's extension `ext` (lower case) holds, in words.
+fn format_name(ext: &str) -> &'static str {
+    match ext {
+        "ply" => "PLY",
+        "glb" | "gltf" => "glTF",
+        "usda" | "usd" => "USD text already",
+        "hair" => "Cem Yuksel's binary .hair format",
+        _ => "not PLY",
+    }
+}
+
 /// How many points `-n` or `--radius` asks for; a `--channel` needs a
 /// density with channels.
 fn wanted(args: &Args) -> Result<Points> {
     let packing = args.packing.unwrap_or(PackingArg::Elimination).packing();
+    // clap's `requires = "rate"` lets `-n N --max-density M` through (-n
+    // conflicts with --rate, and clap then waives the requirement).
     if let (Some(m), None) = (args.max_density, args.rate) {
         return Err(arg_error(
             format!("--max-density {m}"),
@@ -415,7 +437,7 @@ fn report(
             .map(|p| format!(", preview {}", p.display()))
             .unwrap_or_default()
     );
-    let json = serde_json::json!({
+    let mut json = serde_json::json!({
         "command": "sample",
         "mesh": super::shown(&args.mesh),
         "triangles": mesh.indices.len(),
@@ -424,7 +446,6 @@ fn report(
         "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
         "seconds": context.timings_json(),
     });
-    let mut json = json;
     if let (Some(json), serde_json::Value::Object(fields)) =
         (json.as_object_mut(), sampling_json(args, method))
     {

@@ -168,3 +168,49 @@ fn sample_by_rate_argument_errors_name_the_argument() {
     );
     assert!(!d.join("a.ply").exists());
 }
+
+/// What a fresh user met (issue #47): `--max-density` alone asks for
+/// `--rate` (not for -n, which --rate excludes); a rate too large says
+/// what rate fits, in the CLI's terms (not the library's `sample_stream`);
+/// `--ascii` with a non-PLY output names that output's real format.
+#[test]
+fn rate_and_ascii_errors_name_what_the_user_can_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (torus, _) = common::torus_and_noise(d, [16, 8], 4);
+    let torus = torus.to_str().unwrap();
+    let message = fails_with(
+        d,
+        2,
+        &["sample", torus, "--max-density", "1", "-o", "a.ply"],
+        &["--rate <R>"],
+    );
+    assert!(!message.contains("--count"), "{message}");
+    let message = fails_with(
+        d,
+        2,
+        &["sample", torus, "--rate", "1e12", "-o", "a.ply"],
+        &["--rate 1000000000000", "--rate of at most", "134217728"],
+    );
+    assert!(!message.contains("sample_stream"), "{message}");
+    for (out, format) in [
+        ("a.glb", "glTF"),
+        ("a.usda", "USD text"),
+        ("a.usd", "USD text"),
+        ("a.hair", ".hair"),
+    ] {
+        let message = fails_with(
+            d,
+            2,
+            &[
+                "sample", torus, "-n", "10", "--hair", "0.1", "--ascii", "-o", out,
+            ],
+            &["--ascii", out, format],
+        );
+        assert!(
+            format == "glTF" || !message.contains("glTF"),
+            "{out}: {message}"
+        );
+    }
+    assert!(!d.join("a.ply").exists());
+}

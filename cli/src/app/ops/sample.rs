@@ -125,11 +125,26 @@ fn scatter_points(
                  out for the density's own maximum)"
             ),
         ),
-        mesh_sampling::Error::TooManyPoints { .. } => {
-            arg_error(format!("--rate {rate}"), e.to_string())
-        }
+        // The library's message names its streaming API; a CLI user can
+        // only lower the rate, so say by how much.
+        mesh_sampling::Error::TooManyPoints { requested, budget } => arg_error(
+            format!("--rate {rate}"),
+            too_many_by_rate(rate, requested, budget),
+        ),
         e => e.into(),
     })
+}
+
+/// Why `--rate rate` is refused when it would draw about `requested`
+/// points (candidates: rate × the density's ceiling × area) and a run
+/// writes at most `budget`: the largest rate that fits.
+fn too_many_by_rate(rate: f64, requested: f64, budget: usize) -> String {
+    let fits = rate * budget as f64 / requested;
+    format!(
+        "this rate would draw about {requested:.3e} points (rate × the density's ceiling × the \
+         mesh's area), and one run writes at most {budget}: give a --rate of at most {fits:.3e}, \
+         or -n N for a fixed count"
+    )
 }
 
 /// The blue-noise options of `trilux sample --blue-noise [--packing P]`:
