@@ -12,7 +12,32 @@ use crate::error::{Failure, Result, detached};
 use crate::mesh::{check_extension, mesh_arg, path_arg};
 
 /// What `path=` may end in.
-const HAIR_EXTENSIONS: [&str; 4] = ["usda", "hair", "glb", "gltf"];
+const HAIR_EXTENSIONS: [&str; 5] = ["usda", "usd", "hair", "glb", "gltf"];
+
+/// How far a barycentric coordinate may fall below 0, and its row's sum
+/// from 1: `sample_surface` returns `f32` coordinates, rounded.
+const BARYCENTRIC_TOLERANCE: [f64; 2] = [1e-6, 1e-3];
+
+/// Each row of `barycentric` a point of its triangle: no coordinate
+/// below 0 and their sum 1 (within [`BARYCENTRIC_TOLERANCE`]); else the
+/// root would be off the surface.
+fn check_barycentric(bary: &[[f64; 3]]) -> PyResult<()> {
+    let [below, sum] = BARYCENTRIC_TOLERANCE;
+    let bad = |b: &[f64; 3]| {
+        !(b.iter().all(|&x| x >= -below) && (b.iter().sum::<f64>() - 1.0).abs() <= sum)
+    };
+    match bary.iter().position(bad) {
+        None => Ok(()),
+        Some(i) => {
+            let [a, b, c] = bary[i];
+            Err(Failure::input(format!(
+                "barycentric[{i}] = [{a}, {b}, {c}]: not barycentric coordinates (each must be \
+                 >= 0 and the three sum to 1 within {sum}); the root would be off the surface"
+            ))
+            .into())
+        }
+    }
+}
 
 /// A per-root parameter: one value for all roots, or one per root.
 struct PerRoot {
@@ -40,6 +65,25 @@ impl PerRoot {
         Ok(Self { values })
     }
 
+    /// Degrees (0 to 180, as `--hair-comb` and Blender's UI take them)
+    /// to the radians the library takes, each checked first so that an
+    /// error names the value as given.
+    fn degrees_to_radians(mut self, name: &str) -> PyResult<Self> {
+        if let Some((i, v)) = self
+            .values
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !(0.0..=180.0).contains(*v))
+        {
+            return Err(Failure::input(format!(
+                "{name}[{i}] = {v}: must be in [0, 180] degrees from the normal"
+            ))
+            .into());
+        }
+        self.values.iter_mut().for_each(|v| *v = v.to_radians());
+        Ok(self)
+    }
+
     fn at(&self, i: usize) -> f32 {
         let v = if self.values.len() == 1 {
             self.values[0]
@@ -58,7 +102,8 @@ impl PerRoot {
 /// polyline of `segments` segments (`segments + 1` points, the root
 /// first) along the mesh's interpolated normal (the face's normal when
 /// the mesh has none), `length` long (mesh units), tilted `comb_angle`
-/// radians from the normal toward the world direction `comb` (its part in
+/// degrees (0 to 180, as the CLI's `--hair-comb` and Blender's UI) from
+/// the normal toward the world direction `comb` (not zero; its part in
 /// the tangent plane), curled around its axis (`curl_radius` at the tip,
 /// `curl_turns` turns), jittered by `noise` at the tip, and pulled the
 /// fraction `clump` of the way (at the tip) toward the strand of the
@@ -73,10 +118,13 @@ impl PerRoot {
 /// `face_index` `(S,)` int64, `barycentric` `(S, 3)` float64, `normal`
 /// `(S, 3)` float64 (the direction grown along) and `uv` `(S, 2)`
 /// float64 (OpenGL convention) or `None` without UVs. With `path`, also
-/// writes the strands by extension: `.usda` (USD `BasisCurves` and the
-/// roots as `Points`, metres, Y up), `.hair` (Cem Yuksel's format) or
-/// `.glb`/`.gltf` (lines and root points). Same seed, same strands on any
-/// number of threads. Raises `trilux.InputError` naming the argument (and
+/// writes the strands by extension: `.usda` or `.usd` (USD text:
+/// `BasisCurves` and the roots as `Points`, metres, Y up), `.hair` (Cem
+/// Yuksel's format) or `.glb`/`.gltf` (lines and root points); an
+/// existing file is replaced, as `trilux.save` and `trilux.save_points`
+/// replace theirs. `barycentric` rows must be barycentric (each >= 0,
+/// summing to 1 within 1e-3). Same seed, same strands on any number of
+/// threads. Raises `trilux.InputError` naming the argument (and
 /// the root) for bad values, `trilux.FileError` for an unwritable path.
 /// The GIL is released.
 #[pyfunction]
@@ -114,6 +162,7 @@ pub(crate) fn grow_hair<'py>(
         ))
         .into());
     }
+    check_barycentric(&bary)?;
     let segments = u32::try_from(arrays::count(&segments, "segments")?).unwrap_or(u32::MAX);
     let clumps = arrays::count(&clumps, "clumps")?;
     let seed = arrays::seed(seed.as_ref())?;
@@ -128,13 +177,23 @@ pub(crate) fn grow_hair<'py>(
                 ))
                 .into());
             };
-            glam::DVec3::new(x, y, z).as_vec3()
+            let v = glam::DVec3::new(x, y, z);
+            // As `--hair-comb`: a direction, not zero (leave `comb` out
+            // for no comb).
+            if !(v.is_finite() && v != glam::DVec3::ZERO) {
+                return Err(Failure::input(format!(
+                    "comb = [{x}, {y}, {z}]: a direction must be finite and not zero (leave \
+                     comb out for strands along the normal)"
+                ))
+                .into());
+            }
+            v.as_vec3()
         }
     };
     let per_root = |obj, name, default| PerRoot::new(obj, name, default, n);
     let length = per_root(Some(length), "length", 0.0)?;
     let params = [
-        per_root(comb_angle, "comb_angle", 0.0)?,
+        per_root(comb_angle, "comb_angle", 0.0)?.degrees_to_radians("comb_angle")?,
         per_root(curl_radius, "curl_radius", 0.0)?,
         per_root(curl_turns, "curl_turns", 0.0)?,
         per_root(noise, "noise", 0.0)?,

@@ -728,6 +728,8 @@ pub(crate) fn sample_surface_even<'py>(
 /// "density" in Blender's Distribute Points on Faces and Houdini's
 /// Scatter): a Poisson process of `rate × density` points per unit area
 /// (mesh units), so the count is random, about `rate × ∫ density dA`.
+/// `rate` and `max_density` must be positive (0 is an `InputError`, as in
+/// `trilux sample --rate` and the paint page).
 ///
 /// Each face draws Poisson(`rate × max_density × area`) candidates from
 /// its own stream, seeded by `seed` and the face index, each with a fixed
@@ -795,6 +797,7 @@ pub(crate) fn scatter<'py>(
         pdf: return_pdf,
         normal: return_normal,
     };
+    check_rate(rate, max_density)?;
     let options = mesh_sampling::ScatterOptions {
         max_density,
         clamp,
@@ -813,6 +816,27 @@ pub(crate) fn scatter<'py>(
         mesh_sampling::scatter(mesh_ref, density, &options).map_err(|e| scatter_failure(e, rate))
     })?;
     Points::of(py, &points, origin, want)?.into_tuple(py)
+}
+
+/// `rate` and `max_density` positive, as `trilux sample --rate R
+/// --max-density M` and the paint page take them: a rate of 0 (or a
+/// ceiling of 0, which leaves no density to sample) is a mistake to tell,
+/// not an empty result (the library itself takes 0).
+fn check_rate(rate: f64, max_density: Option<f64>) -> PyResult<()> {
+    if !(rate.is_finite() && rate > 0.0) {
+        return Err(Failure::input(format!(
+            "rate: {rate} must be a positive number (points per unit area)"
+        ))
+        .into());
+    }
+    if let Some(m) = max_density.filter(|m| !(m.is_finite() && *m > 0.0)) {
+        return Err(Failure::input(format!(
+            "max_density: {m} must be a positive number (leave it out for the density's own \
+             maximum)"
+        ))
+        .into());
+    }
+    Ok(())
 }
 
 /// mesh-sampling's scatter errors in Python's words: the rate and the

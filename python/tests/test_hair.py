@@ -45,7 +45,8 @@ def test_straight_strands_stand_on_their_roots_with_their_lengths():
 
 def test_comb_tilts_by_its_angle_and_curl_keeps_its_radius():
     mesh, p, f, b = roots(200)
-    out = trilux.grow_hair(mesh, f, b, 1.0, comb=[0, 1, 0], comb_angle=0.5)
+    # Degrees, as `--hair-comb X,Y,Z:ANGLE` and Blender's UI.
+    out = trilux.grow_hair(mesh, f, b, 1.0, comb=[0, 1, 0], comb_angle=np.degrees(0.5))
     axis = out["points"][:, -1] - out["points"][:, 0]
     np.testing.assert_allclose(axis, np.tile([0, np.sin(0.5), np.cos(0.5)], (len(f), 1)), atol=1e-5)
     out = trilux.grow_hair(mesh, f, b, 1.0, segments=16, curl_radius=0.2, curl_turns=2.0)
@@ -76,6 +77,9 @@ def test_same_seed_same_strands_and_clumps_pull_tips_together():
         (dict(length=0.1, segments=0), "segments"),
         (dict(length=0.1, clump=2.0), "clump[0] = 2"),
         (dict(length=0.1, comb=[1, 0]), "comb"),
+        (dict(length=0.1, comb=[0, 0, 0]), "comb = [0, 0, 0]: a direction"),
+        (dict(length=0.1, comb=[0, 1, 0], comb_angle=200), "comb_angle[0] = 200: must be in [0, 180] degrees"),
+        (dict(length=0.1, comb=[0, 1, 0], comb_angle=-1), "comb_angle[0] = -1"),
         (dict(length=0.1, path="strands.obj"), ".usda"),
     ],
 )
@@ -84,6 +88,28 @@ def test_bad_arguments_name_themselves(kwargs, needle):
     with pytest.raises(trilux.Error) as e:
         trilux.grow_hair(mesh, f, b, **kwargs)
     assert needle in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("scale", [5.0, -1.0])
+def test_barycentrics_that_are_not_barycentric_are_named(scale):
+    # bary * 5 sums to 5, -bary has negative coordinates: both would put
+    # roots off the surface.
+    mesh, p, f, b = roots(5)
+    bad = b.astype(np.float64).copy()
+    bad[2] *= scale
+    with pytest.raises(trilux.InputError, match=r"barycentric\[2\] = .*not barycentric"):
+        trilux.grow_hair(mesh, f, bad, 0.1)
+    # The f32 rounding of sample_surface's own coordinates is accepted.
+    trilux.grow_hair(mesh, f, b.astype(np.float32), 0.1)
+
+
+def test_usd_is_written_as_usd_text_and_a_path_is_replaced(tmp_path):
+    mesh, p, f, b = roots(20)
+    trilux.grow_hair(mesh, f, b, 0.2, segments=3, path=tmp_path / "a.usda")
+    path = tmp_path / "a.usd"
+    path.write_text("old")
+    trilux.grow_hair(mesh, f, b, 0.2, segments=3, path=path)
+    assert path.read_bytes() == (tmp_path / "a.usda").read_bytes()
 
 
 def test_a_face_index_outside_the_mesh_is_named():

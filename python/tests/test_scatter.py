@@ -142,11 +142,13 @@ def test_pdf_is_the_intensity_and_the_arrays_are_consistent():
 
 def test_bad_arguments_name_what_is_wrong():
     v, f, uv = grid(3)
-    for rate in (-1.0, math.nan, math.inf):
-        with pytest.raises(trilux.InputError, match="rate"):
+    # 0 too, as `trilux sample --rate 0` and the paint page refuse it.
+    for rate in (-1.0, 0.0, math.nan, math.inf):
+        with pytest.raises(trilux.InputError, match="rate: .* must be a positive number"):
             trilux.scatter((v, f), rate)
-    with pytest.raises(trilux.InputError, match="max_density"):
-        trilux.scatter((v, f), 10.0, max_density=-1.0)
+    for m in (-1.0, 0.0):
+        with pytest.raises(trilux.InputError, match="max_density: .* positive"):
+            trilux.scatter((v, f), 10.0, max_density=m)
     with pytest.raises(trilux.InputError, match="rate"):
         trilux.scatter((v, f), 1e30)
     w = np.full(len(f), 0.5)

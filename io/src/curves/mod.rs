@@ -158,12 +158,13 @@ impl Curves {
 pub fn write(path: impl AsRef<Path>, curves: &Curves) -> Result<()> {
     let path = path.as_ref();
     match crate::error::extension(path).as_str() {
-        "usda" => usda::write(path, curves, &usda::Stage::default()),
+        // `.usd` may be text or binary USD; readers take either.
+        "usda" | "usd" => usda::write(path, curves, &usda::Stage::default()),
         "hair" => hair::write(path, curves),
         "glb" | "gltf" => write_gltf(path, curves),
         other => Err(Error::new(
             path,
-            ErrorKind::UnknownExtension(other.to_string(), ".usda, .hair, .glb, .gltf"),
+            ErrorKind::UnknownExtension(other.to_string(), ".usda, .usd, .hair, .glb, .gltf"),
         )),
     }
 }

@@ -663,7 +663,7 @@ def grow_hair(
     *,
     segments: int = 8,
     comb: Optional[ArrayLike] = None,
-    comb_angle: Optional[Scalars] = None,
+    comb_angle: Optional[Scalars] = None,  # degrees from the normal, 0 to 180 (as --hair-comb)
     curl_radius: Optional[Scalars] = None,
     curl_turns: Optional[Scalars] = None,
     noise: Optional[Scalars] = None,
