@@ -23,7 +23,9 @@
 //! the median of `--runs` (5) runs on a pool of `--threads` (2) threads;
 //! the table is Markdown on stdout.
 
-use std::path::{Path, PathBuf};
+#[path = "support/data.rs"]
+mod data;
+use std::path::PathBuf;
 use std::time::Instant;
 
 use glam::{Vec2, Vec3};
@@ -100,18 +102,9 @@ impl Scene {
     }
 }
 
-fn data_dir() -> Option<PathBuf> {
-    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    Some(if given.is_dir() {
-        given
-    } else {
-        root.join(given)
-    })
-}
 
 fn load(args: &Args) -> Result<Scene, String> {
-    let (mesh, texture_path) = match (&args.mesh, &args.texture, data_dir()) {
+    let (mesh, texture_path) = match (&args.mesh, &args.texture, data::data_dir()) {
         (Some(m), Some(t), _) => (m.clone(), t.clone()),
         (Some(_), None, _) | (None, Some(_), _) => {
             return Err("--mesh and --texture go together".into());

@@ -56,6 +56,8 @@
 //! 64 for the variance, one timed run, no equal time (a first look; the
 //! test runs the same module on generated data).
 
+#[path = "support/data.rs"]
+mod data;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -165,13 +167,6 @@ fn parse_args() -> Result<Args, String> {
     Ok(args)
 }
 
-fn data_dir() -> Option<PathBuf> {
-    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    [given.clone(), workspace.join(&given)]
-        .into_iter()
-        .find(|p| p.is_dir())
-}
 
 /// An image file as an emission texture (bilinear, clamped), shrunk by
 /// box averaging (which keeps its power) until it is at most `max_width`
@@ -242,7 +237,7 @@ struct Case {
 
 fn run() -> Result<(), String> {
     let args = parse_args()?;
-    let data = data_dir();
+    let data = data::data_dir();
     let max_width = args.quick.then_some(128);
     // Textures, the sun (largest peak over mean) first.
     let mut textures: Vec<(String, EmissionTexture)> = Vec::new();

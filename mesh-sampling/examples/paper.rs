@@ -31,6 +31,8 @@
 //! layout on every mesh and density), in a few minutes instead of the
 //! whole table's hour.
 
+#[path = "support/data.rs"]
+mod data;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode};
@@ -135,19 +137,10 @@ impl TestMesh {
     }
 }
 
-fn data_dir() -> Option<PathBuf> {
-    let given = PathBuf::from(std::env::var_os("TRILUX_DATA")?);
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    Some(if given.is_dir() {
-        given
-    } else {
-        root.join(given)
-    })
-}
 
 fn load_meshes(filter: Option<&str>) -> Result<Vec<TestMesh>, String> {
     let mut out = Vec::new();
-    let files: Vec<PathBuf> = match (filter, data_dir()) {
+    let files: Vec<PathBuf> = match (filter, data::data_dir()) {
         (Some(f), _) if Path::new(f).is_file() => vec![PathBuf::from(f)],
         (_, Some(dir)) => {
             let dir = dir.join("meshes");
@@ -317,7 +310,7 @@ fn densities(filter: Option<&str>) -> Result<Vec<(String, DensityTexture)>, Stri
     ]
     .map(String::from)
     .to_vec();
-    let hdr_files: Vec<PathBuf> = match data_dir() {
+    let hdr_files: Vec<PathBuf> = match data::data_dir() {
         Some(dir) => {
             let mut f: Vec<PathBuf> = std::fs::read_dir(dir.join("hdr"))
                 .map_err(|e| format!("{}: {e}", dir.display()))?
@@ -1105,7 +1098,7 @@ fn run() -> Result<(), String> {
     }
     if args.peers
         && let Some(bunny) = meshes.iter().find(|m| m.name.contains("bunny"))
-        && let Some(dir) = data_dir()
+        && let Some(dir) = data::data_dir()
     {
         peers(
             bunny,

@@ -721,38 +721,32 @@ impl<'a> Document<'a> {
     /// The index accessor of `triangles`: `u16` when every index is below
     /// 65 535 (which is the primitive-restart value), else `u32`.
     fn indices(&mut self, triangles: &[[u32; 3]], vertices: usize) -> Index<json::Accessor> {
-        let flat = triangles.iter().flatten();
-        let (bytes, kind): (Vec<u8>, _) = if vertices <= usize::from(u16::MAX) {
-            (
-                flat.flat_map(|&i| (i as u16).to_le_bytes()).collect(),
-                ComponentType::U16,
-            )
-        } else {
-            (
-                flat.flat_map(|i| i.to_le_bytes()).collect(),
-                ComponentType::U32,
-            )
-        };
-        let view = self.view(&bytes, Some(Target::ElementArrayBuffer));
-        self.accessor(view, 3 * triangles.len(), kind, Type::Scalar, None, None)
+        self.index_accessor(triangles.as_flattened(), vertices)
     }
 
     /// The index accessor of line segments (`u16` below 65 535 vertices).
     fn index_pairs(&mut self, pairs: &[[u32; 2]], vertices: usize) -> Index<json::Accessor> {
-        let flat = pairs.iter().flatten();
+        self.index_accessor(pairs.as_flattened(), vertices)
+    }
+
+    /// An accessor of indices into `vertices` vertices, `u16` when they
+    /// all fit below the primitive-restart value 65 535, else `u32`.
+    fn index_accessor(&mut self, flat: &[u32], vertices: usize) -> Index<json::Accessor> {
         let (bytes, kind): (Vec<u8>, _) = if vertices <= usize::from(u16::MAX) {
             (
-                flat.flat_map(|&i| (i as u16).to_le_bytes()).collect(),
+                flat.iter()
+                    .flat_map(|&i| (i as u16).to_le_bytes())
+                    .collect(),
                 ComponentType::U16,
             )
         } else {
             (
-                flat.flat_map(|i| i.to_le_bytes()).collect(),
+                flat.iter().flat_map(|i| i.to_le_bytes()).collect(),
                 ComponentType::U32,
             )
         };
         let view = self.view(&bytes, Some(Target::ElementArrayBuffer));
-        self.accessor(view, 2 * pairs.len(), kind, Type::Scalar, None, None)
+        self.accessor(view, flat.len(), kind, Type::Scalar, None, None)
     }
 
     fn accessor(
