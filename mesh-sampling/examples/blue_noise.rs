@@ -677,7 +677,21 @@ fn blender_rows(
         if case == "random" {
             let (ms, count) =
                 time(&|seed| uniform.sample_positions(seed, n).map_or(0, |p| p.len()));
-            rows.push(("trilux".into(), case, count, ms, f64::NAN));
+            rows.push(("trilux".into(), case.clone(), count, ms, f64::NAN));
+            // In face order, as Blender's node walks the faces: the same
+            // independent points as a set, each group of faces in cache.
+            let (ms, count) = time(&|seed| {
+                uniform
+                    .sample_positions_grouped(seed, n)
+                    .map_or(0, |p| p.len())
+            });
+            rows.push((
+                "trilux, grouped in face order".into(),
+                case,
+                count,
+                ms,
+                f64::NAN,
+            ));
         } else if case == "random-vertex" {
             // Blender's per-vertex density, the same weights.
             let bytes = std::fs::read(out_dir.join("blender_vertex_weights.f32"))

@@ -157,7 +157,7 @@ pub use projection::spherical_uvs;
 pub use rejection::RejectionSampler;
 pub use scatter::{Scatter, ScatterDensity, ScatterOptions, ScatterUpdate, scatter};
 pub use texture::{Channel, DensityTexture, Filter, MAX_INTEGRATION_CELLS, Wrap, luminance};
-pub use uniform::UniformSampler;
+pub use uniform::{GROUP, UniformSampler};
 
 /// The README's examples, compiled and run as doctests.
 #[cfg(doctest)]

@@ -11,6 +11,10 @@ use crate::point::{Frame, uniform_barycentric};
 use crate::prefetch::prefetch;
 use crate::{Error, MeshRef, SurfacePoint, SurfaceSampler};
 
+mod grouped;
+
+pub use grouped::GROUP;
+
 /// Draws points uniformly over a mesh's surface: density `1 / A` for a
 /// total area `A`. Zero-area triangles are never drawn.
 ///
