@@ -102,7 +102,6 @@ impl Scene {
     }
 }
 
-
 fn load(args: &Args) -> Result<Scene, String> {
     let (mesh, texture_path) = match (&args.mesh, &args.texture, data::data_dir()) {
         (Some(m), Some(t), _) => (m.clone(), t.clone()),

@@ -167,7 +167,6 @@ fn parse_args() -> Result<Args, String> {
     Ok(args)
 }
 
-
 /// An image file as an emission texture (bilinear, clamped), shrunk by
 /// box averaging (which keeps its power) until it is at most `max_width`
 /// wide.

@@ -137,7 +137,6 @@ impl TestMesh {
     }
 }
 
-
 fn load_meshes(filter: Option<&str>) -> Result<Vec<TestMesh>, String> {
     let mut out = Vec::new();
     let files: Vec<PathBuf> = match (filter, data::data_dir()) {
