@@ -165,15 +165,7 @@ async fn scatter_rows(doc: &Document, diagonal: f32) -> (f64, usize, f64) {
     for s in colors.samples_mut().chunks_mut(4) {
         s.copy_from_slice(&[0.8, 0.8, 0.8, 1.0]);
     }
-    let area: f64 = doc
-        .surface
-        .faces
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|v| doc.surface.positions[v as usize].as_dvec3());
-            0.5 * (b - a).cross(c - a).length()
-        })
-        .sum();
+    let area = doc.area();
     let dense = Document {
         surface: doc.surface.clone(),
         colors,

@@ -125,7 +125,6 @@ pub(crate) fn eliminate(local: &Local, stop: Stop, weights: Weights) -> Vec<bool
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::blue_noise::grid::Kind;
 
     #[test]
     fn weight_function_matches_the_paper() {
@@ -153,19 +152,7 @@ mod tests {
     }
 
     fn local(points: &[[f32; 3]], r: f32, frozen: &[usize]) -> Local {
-        let pts: Vec<_> = points
-            .iter()
-            .enumerate()
-            .map(|(i, &p)| {
-                let kind = if frozen.contains(&i) {
-                    Kind::Frozen
-                } else {
-                    Kind::Own
-                };
-                (p, r, i as u32, kind)
-            })
-            .collect();
-        Local::new(&pts, [-1.0; 3], [6.0, 1.0, 1.0], 0.5)
+        Local::of_points(points, r, frozen, [-1.0; 3], [6.0, 1.0, 1.0])
     }
 
     fn kept(l: &Local, flags: &[bool]) -> Vec<u32> {

@@ -72,6 +72,32 @@ impl Grid {
 }
 
 impl Local {
+    /// The tests' grid: `points` of radius `r` (pool indices their
+    /// positions in the slice, those in `frozen` kept from earlier tiles)
+    /// over the box `lo..hi`, cells of 0.5.
+    #[cfg(test)]
+    pub(crate) fn of_points(
+        points: &[[f32; 3]],
+        r: f32,
+        frozen: &[usize],
+        lo: [f32; 3],
+        hi: [f32; 3],
+    ) -> Self {
+        let pts: Vec<_> = points
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| {
+                let kind = if frozen.contains(&i) {
+                    Kind::Frozen
+                } else {
+                    Kind::Own
+                };
+                (p, r, i as u32, kind)
+            })
+            .collect();
+        Self::new(&pts, lo, hi, 0.5)
+    }
+
     /// Sorts `points` (position, radius, pool index, kind) into a grid of
     /// cubic cells of side `cell` over the box `lo..hi`; points outside the
     /// box go to its border cells (queries clamp the same way, so nothing

@@ -313,22 +313,9 @@ pub(crate) fn relocate(local: &Local, kept: Vec<bool>) -> Vec<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::blue_noise::grid::Kind;
 
     fn local(points: &[[f32; 3]], frozen: &[usize]) -> Local {
-        let pts: Vec<_> = points
-            .iter()
-            .enumerate()
-            .map(|(i, &p)| {
-                let kind = if frozen.contains(&i) {
-                    Kind::Frozen
-                } else {
-                    Kind::Own
-                };
-                (p, 0.5, i as u32, kind)
-            })
-            .collect();
-        Local::new(&pts, [-1.0; 3], [2.0, 2.0, 1.0], 0.5)
+        Local::of_points(points, 0.5, frozen, [-1.0; 3], [2.0, 2.0, 1.0])
     }
 
     fn kept_of(l: &Local, flags: &[bool]) -> Vec<u32> {

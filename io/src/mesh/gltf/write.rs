@@ -156,15 +156,7 @@ pub fn write_points(path: impl AsRef<Path>, points: &Points) -> Result<()> {
             data: &data,
         };
         let attributes = doc.vertices(&vertices)?;
-        let primitive = json::mesh::Primitive {
-            attributes,
-            extensions: None,
-            extras: Default::default(),
-            indices: None,
-            material: None,
-            mode: Valid(Mode::Points),
-            targets: None,
-        };
+        let primitive = bare_primitive(attributes, None, Mode::Points);
         doc.node("points", primitive, points.origin.as_vec3());
     }
     doc.save(container)
@@ -218,15 +210,7 @@ pub(crate) fn write_curves(path: &Path, curves: &crate::curves::Curves) -> Resul
             pairs.extend((first..first + count - 1).map(|i| [i, i + 1]));
         }
         let indices = doc.index_pairs(&pairs, curves.points.len());
-        let lines = json::mesh::Primitive {
-            attributes,
-            extensions: None,
-            extras: Default::default(),
-            indices: Some(indices),
-            material: None,
-            mode: Valid(Mode::Lines),
-            targets: None,
-        };
+        let lines = bare_primitive(attributes, Some(indices), Mode::Lines);
         doc.node("strands", lines, Vec3::ZERO);
 
         let first = curves.offsets();
@@ -257,15 +241,7 @@ pub(crate) fn write_curves(path: &Path, curves: &crate::curves::Curves) -> Resul
             data: &data,
         };
         let attributes = doc.vertices(&vertices)?;
-        let points = json::mesh::Primitive {
-            attributes,
-            extensions: None,
-            extras: Default::default(),
-            indices: None,
-            material: None,
-            mode: Valid(Mode::Points),
-            targets: None,
-        };
+        let points = bare_primitive(attributes, None, Mode::Points);
         doc.node("roots", points, Vec3::ZERO);
     }
     doc.save(container)
@@ -1001,4 +977,22 @@ fn percent_encode(name: &str) -> String {
         }
     }
     out
+}
+
+/// A primitive without a material (points, lines): its attributes, its
+/// indices if any, and how they are drawn.
+fn bare_primitive(
+    attributes: BTreeMap<Checked<Semantic>, Index<json::Accessor>>,
+    indices: Option<Index<json::Accessor>>,
+    mode: Mode,
+) -> json::mesh::Primitive {
+    json::mesh::Primitive {
+        attributes,
+        extensions: None,
+        extras: Default::default(),
+        indices,
+        material: None,
+        mode: Valid(mode),
+        targets: None,
+    }
 }
