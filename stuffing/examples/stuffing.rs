@@ -1,4 +1,5 @@
-//! Isosurface stuffing on real meshes, side by side with TetGen.
+//! Isosurface stuffing on real meshes, side by side with TetGen (and, in
+//! issue #48's table, Gmsh and fTetWild).
 //!
 //! ```text
 //! TRILUX_DATA=../shared/data cargo run --release -p tet-stuffing --example stuffing -- [--json]
@@ -12,7 +13,7 @@
 //! `tetgen`, run with `-pq1.2a<volume>` and a maximum volume tuned to give a
 //! similar tetrahedron count) runs on the same surfaces when a Python with
 //! `tetgen` is found (`$TETGEN_PYTHON`, else a venv the example sets up
-//! under `target/peers-venv`, `--no-tetgen` to skip it);
+//! under `target/peers-venv`, `--no-tetgen` or `--no-peers` to skip it);
 //! where it refuses an input the table says why. A second table measures
 //! the fast winding number against the exact sum.
 //!
@@ -20,22 +21,39 @@
 //! from each input at the default spacing (Hausdorff and mean distance as
 //! shares of the diagonal, and what the measurement costs).
 //!
-//! With `--envelope [--runs N]`, only issue #48's table: per mesh at the
-//! default spacing, the plain stuffing beside `Options::envelope` at 2·10⁻³
-//! and 10⁻³ of the diagonal (uniform, graded, and graded at half the
-//! spacing): Hausdorff distance both ways and mean, tetrahedra, median time
-//! of N runs (3) without the measurement, smallest dihedral angle, and the
-//! time and count as ratios to the plain stuffing of the same run.
+//! With `--envelope [--runs N] [--peer-cap S]`, only issue #48's table:
+//! per mesh at the default spacing, the plain stuffing beside
+//! `Options::envelope` at 2·10⁻³ and 10⁻³ of the diagonal (uniform, graded,
+//! and graded at half the spacing): Hausdorff distance both ways and mean,
+//! tetrahedra, median time of N runs (3) without the measurement, dihedral
+//! angle range, and the time and count as ratios to the plain stuffing of
+//! the same run. Then the peers on the same surface, aiming at the plain
+//! stuffing's count: TetGen (`-pq1.2a<volume>`), Gmsh (the surface as a
+//! classified discrete entity, one volume, `Mesh.MeshSizeMax`; both keep
+//! the input triangles and recalibrate their parameter up to twice) and
+//! fTetWild (`pytetwild`, default envelope 10⁻³, an edge length from the
+//! count, one calibration-free run), each run in a child process stopped
+//! after S seconds (120), its boundary measured by
+//! `tet_stuffing::surface_distance` with the same sample count; a peer
+//! that refuses the input, crashes or runs out of time gets its reason.
+//! The example installs them (`pip install numpy tetgen gmsh
+//! pytetwild[all]`) into the venv `target/peers-venv` when they do not
+//! import; `--no-peers` skips them all, `--no-tetgen` TetGen.
 //!
 //! With `--json`: one object per line with the keys `mesh`, `h`, `graded`,
 //! `tool`, `tets`, `ms`, `min_dihedral_deg`, `max_dihedral_deg`, `error`.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use tet_stuffing::glam::DVec3;
 use tet_stuffing::{self as stuffing, Options, winding::WindingNumber};
+
+// Beside the example, not in `examples/`, so that Cargo does not take it
+// for an example of its own.
+#[path = "stuffing/peers.rs"]
+mod peers;
 
 /// One row of the table.
 struct Row {
@@ -90,14 +108,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let work = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/stuffing-bench");
     std::fs::create_dir_all(&work)?;
-    let python = if args.iter().any(|a| a == "--no-tetgen") {
-        None
-    } else {
-        tetgen_python()
-    };
-    if python.is_none() && !json {
-        println!("(TetGen not found: set TETGEN_PYTHON to a Python with the `tetgen` package)\n");
-    }
+    let no_tetgen = args.iter().any(|a| a == "--no-tetgen" || a == "--no-peers");
     let mut inputs = inputs(&data)?;
     if let Some(only) = &only {
         inputs.retain(|(name, _, _)| name.contains(only.as_str()));
@@ -108,14 +119,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         return Ok(());
     }
     if args.iter().any(|a| a == "--envelope") {
-        let runs = args
-            .iter()
-            .position(|a| a == "--runs")
-            .and_then(|i| args.get(i + 1))
-            .and_then(|r| r.parse().ok())
-            .unwrap_or(3);
-        envelope_table(&inputs, runs);
+        let number = |flag: &str, default: usize| {
+            args.iter()
+                .position(|a| a == flag)
+                .and_then(|i| args.get(i + 1))
+                .and_then(|r| r.parse().ok())
+                .unwrap_or(default)
+        };
+        let runs = number("--runs", 3);
+        let peers = if args.iter().any(|a| a == "--no-peers") {
+            None
+        } else {
+            let wanted: Vec<peers::Peer> = peers::Peer::ALL
+                .into_iter()
+                .filter(|&p| !(no_tetgen && p == peers::Peer::TetGen))
+                .collect();
+            let cap = Duration::from_secs(number("--peer-cap", 120) as u64);
+            Some(peers::Runner::new(&wanted, work, runs, cap))
+        };
+        envelope_table(&inputs, runs, peers.as_ref());
         return Ok(());
+    }
+    let python = if no_tetgen { None } else { tetgen_python() };
+    if python.is_none() && !json {
+        println!("(TetGen not found: set TETGEN_PYTHON to a Python with the `tetgen` package)\n");
     }
     let mut rows: Vec<Row> = Vec::new();
     let mut winding_rows = Vec::new();
@@ -248,16 +275,19 @@ fn distance_table(inputs: &[Surface]) {
 /// 2^16 points a side plus the vertices), tetrahedra, median time of
 /// `runs` runs without the measurement, the smallest dihedral angle, and
 /// the time and count as ratios to the plain stuffing of the same run.
-fn envelope_table(inputs: &[Surface], runs: usize) {
+/// Then the peers (when `peers` is given, see [`peers`]) on the same
+/// surface at a count near the plain stuffing's, measured the same way.
+fn envelope_table(inputs: &[Surface], runs: usize, peers: Option<&peers::Runner>) {
     println!(
-        "| mesh | options | Hausdorff / diag | input → tets | tets → input | mean | tets | ms | min dihedral | time ratio | tet ratio | fitted vertices, sharp edges |"
+        "| mesh | options | Hausdorff / diag | input → tets | tets → input | mean | tets | ms | min dihedral | max dihedral | time ratio | tet ratio | fitted vertices, sharp edges |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let pct = |x: f64, diag: f64| format!("{:.3} %", 100.0 * x / diag);
     for (name, p, t) in inputs {
         let (lo, hi) = bounds(p, t);
         let base = Options::new(lo.distance(hi) / 40.0);
-        let mut baseline: Option<(f64, usize)> = None;
+        // The plain stuffing's time, count and volume.
+        let mut baseline: Option<(f64, usize, f64)> = None;
         for (label, envelope, graded, refine) in [
             ("default", None, false, 1.0),
             ("envelope 2e-3", Some(2e-3), false, 1.0),
@@ -279,7 +309,7 @@ fn envelope_table(inputs: &[Surface], runs: usize) {
                 }
             }
             if let Some(e) = failed {
-                println!("| {name} | {label} | {e} | | | | | | | | | |");
+                println!("| {name} | {label} | {e} | | | | | | | | | | |");
                 continue;
             }
             ms.sort_by(f64::total_cmp);
@@ -288,29 +318,83 @@ fn envelope_table(inputs: &[Surface], runs: usize) {
             let m = match stuffing::tetrahedralize(p, t, &options) {
                 Ok(m) => m,
                 Err(e) => {
-                    println!("| {name} | {label} | {e} | | | | | | | | | |");
+                    println!("| {name} | {label} | {e} | | | | | | | | | | |");
                     continue;
                 }
             };
             let Some(d) = &m.report.distance else {
                 continue;
             };
-            let (base_ms, base_tets) = *baseline.get_or_insert((median, m.tets.len()));
+            let (base_ms, base_tets, _) =
+                *baseline.get_or_insert_with(|| (median, m.tets.len(), volume(&m)));
             println!(
-                "| {name} | {label} | {} | {} | {} | {} | {} | {median:.0} | {:.2}° | {:.2} | {:.2} | {}, {} |",
+                "| {name} | {label} | {} | {} | {} | {} | {} | {median:.0} | {:.2}° | {:.2}° | {:.2} | {:.2} | {}, {} |",
                 pct(d.hausdorff, d.diagonal),
                 pct(d.input_to_tets, d.diagonal),
                 pct(d.tets_to_input, d.diagonal),
                 pct(d.mean, d.diagonal),
                 m.tets.len(),
                 m.report.min_dihedral_deg,
+                m.report.max_dihedral_deg,
                 median / base_ms,
                 m.tets.len() as f64 / base_tets as f64,
                 m.report.fitted_vertices,
                 m.report.sharp_edges,
             );
         }
+        if let (Some(runner), Some(baseline)) = (peers, baseline) {
+            peer_rows(runner, (name, p, t), baseline);
+        }
     }
+}
+
+/// The peers' rows of [`envelope_table`] for one surface, aiming at the
+/// plain stuffing's count in its volume; `baseline` is that stuffing's
+/// (median ms, tetrahedra, volume). A peer that is not installed, refuses
+/// the surface, crashes or passes the time cap gets its reason, one line.
+fn peer_rows(
+    runner: &peers::Runner,
+    (name, p, t): (&str, &[DVec3], &[[u32; 3]]),
+    (base_ms, base_tets, volume): (f64, usize, f64),
+) {
+    let pct = |x: f64, diag: f64| format!("{:.3} %", 100.0 * x / diag);
+    for (peer, installed) in &runner.installed {
+        let result = installed
+            .clone()
+            .map_err(|e| format!("not installed: {e}"))
+            .and_then(|()| runner.run(*peer, name, p, t, base_tets, volume));
+        let m = match result {
+            Ok(m) => m,
+            Err(e) => {
+                let label = format!("{peer:?}");
+                println!("| {name} | {label} | {e} | | | | | | | | | | |");
+                continue;
+            }
+        };
+        let d = &m.distance;
+        println!(
+            "| {name} | {} | {} | {} | {} | {} | {} | {:.0} | {:.2}° | {:.2}° | {:.2} | {:.2} | — |",
+            peer.label(m.param),
+            pct(d.hausdorff, d.diagonal),
+            pct(d.input_to_tets, d.diagonal),
+            pct(d.tets_to_input, d.diagonal),
+            pct(d.mean, d.diagonal),
+            m.tets,
+            m.ms,
+            m.min_dihedral_deg,
+            m.max_dihedral_deg,
+            m.ms / base_ms,
+            m.tets as f64 / base_tets as f64,
+        );
+    }
+}
+
+/// The volume a tetrahedral mesh fills, in the surface's unit cubed.
+fn volume(m: &stuffing::TetMesh) -> f64 {
+    m.tets
+        .iter()
+        .map(|tet| stuffing::signed_volume(tet.map(|v| m.positions[v as usize])))
+        .sum()
 }
 
 fn print_json(r: &Row) {
