@@ -368,7 +368,7 @@ impl Image {
             .collect()
     }
 
-    fn check(&self, path: &Path) -> Result<()> {
+    pub(crate) fn check(&self, path: &Path) -> Result<()> {
         let expected = u64::from(self.width) * u64::from(self.height);
         if self.pixels.len() as u64 != expected || self.width == 0 || self.height == 0 {
             return Err(Error::new(
@@ -422,21 +422,29 @@ pub fn write_png(path: impl AsRef<Path>, image: &Image, depth: PngDepth) -> Resu
 /// # Errors
 /// As for [`write_png`], without I/O.
 pub fn encode_png(image: &Image, depth: PngDepth, path: impl AsRef<Path>) -> Result<Vec<u8>> {
-    let path = path.as_ref();
+    encode(image, depth, path.as_ref(), true)
+}
+
+/// A PNG of data, not colour, in memory: every channel stored as it is
+/// (clamped to [0, 1], scaled and rounded), without the sRGB curve — what
+/// glTF asks of metallic-roughness and occlusion textures and any scalar
+/// map (roughness, a painted density).
+///
+/// # Errors
+/// As for [`encode_png`].
+pub fn encode_data_png(image: &Image, depth: PngDepth, path: impl AsRef<Path>) -> Result<Vec<u8>> {
+    encode(image, depth, path.as_ref(), false)
+}
+
+fn encode(image: &Image, depth: PngDepth, path: &Path, srgb: bool) -> Result<Vec<u8>> {
     image.check(path)?;
-    // sRGB-encode colour, keep alpha linear; image's conversion to 8 or
-    // 16 bits then clamps to [0, 1], scales and rounds.
+    // sRGB-encode colour (unless it is data), keep alpha linear; image's
+    // conversion to 8 or 16 bits then clamps to [0, 1], scales and rounds.
+    let curve = |c: f32| if srgb { linear_to_srgb(c) } else { c };
     let encoded: Vec<f32> = image
         .pixels
         .iter()
-        .flat_map(|p| {
-            [
-                linear_to_srgb(p[0]),
-                linear_to_srgb(p[1]),
-                linear_to_srgb(p[2]),
-                p[3],
-            ]
-        })
+        .flat_map(|p| [curve(p[0]), curve(p[1]), curve(p[2]), p[3]])
         .collect();
     let buffer = image::Rgba32FImage::from_raw(image.width, image.height, encoded)
         .ok_or_else(|| Error::new(path, ErrorKind::InvalidInput("pixel buffer size".into())))?;

@@ -94,6 +94,7 @@ fn run() -> Result<(), Box<dyn std::error::Error>> {
         diffuse_texture: None,
         diffuse_image: Some(image),
         wrap: Default::default(),
+        scalar_images: Vec::new(),
     });
     mesh.objects.push(Object {
         name: "spot".into(),

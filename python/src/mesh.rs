@@ -243,6 +243,7 @@ pub(crate) fn mesh_arg(
                 diffuse_texture: None,
                 diffuse_image: Some(image),
                 wrap: Default::default(),
+                scalar_images: Vec::new(),
             });
             for o in &mut mesh.objects {
                 o.material = Some(0);

@@ -240,6 +240,7 @@ fn textured_quad() -> TriMesh {
                 pixels,
             }),
             wrap: [Wrap::ClampToEdge; 2],
+            scalar_images: Vec::new(),
         }],
         ..TriMesh::default()
     }

@@ -101,6 +101,16 @@ pub struct Material {
     pub diffuse_image: Option<Image>,
     /// How the texture repeats outside `[0, 1]` along u and v.
     pub wrap: [Wrap; 2],
+    /// Scalar textures on the same UVs, by name: `roughness`, `metallic`,
+    /// `occlusion`, or any other (a painted `density`), the value in each
+    /// pixel's red channel, linear, 0–1. The glTF writer puts `roughness`
+    /// and `metallic` into the material's metallic-roughness texture (G
+    /// and B, factors 1), `occlusion` into its occlusion texture, and any
+    /// other into a texture of its own, named after it and listed in the
+    /// material's `extras` as `{"scalar_textures": {name: texture index}}`
+    /// (glTF has no slot for it; a viewer shows the material without it).
+    /// The OBJ writer and the readers leave them out.
+    pub scalar_images: Vec<(String, Image)>,
 }
 
 /// Texture wrap mode (glTF sampler modes; OBJ/MTL textures repeat unless
@@ -204,6 +214,7 @@ fn from_ply(path: &Path, ply: ply::PlyData) -> TriMesh {
             diffuse_texture: Some(file),
             diffuse_image: None,
             wrap: [Wrap::Repeat; 2],
+            scalar_images: Vec::new(),
         });
     }
     TriMesh {

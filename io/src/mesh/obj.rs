@@ -522,6 +522,7 @@ fn parse(data: &[u8], path: &Path) -> Result<Parsed> {
                             diffuse_texture: None,
                             diffuse_image: None,
                             wrap: [Wrap::Repeat; 2],
+                            scalar_images: Vec::new(),
                         });
                         usemtl_lines.push(line);
                         materials.len() - 1
@@ -681,6 +682,7 @@ fn parse_mtl(data: &[u8], path: &Path, folder: &Path) -> Result<MtlLibrary> {
                     diffuse_texture: None,
                     diffuse_image: None,
                     wrap: [Wrap::Repeat; 2],
+                    scalar_images: Vec::new(),
                 },
                 None,
             )),

@@ -126,6 +126,7 @@ fn random_mesh(rng: &mut Rng, n: usize) -> TriMesh {
                 diffuse_texture: None,
                 diffuse_image: (rng.below(2) == 0).then(|| image(rng)),
                 wrap: [0, 1].map(|_| wraps[rng.below(3) as usize]),
+                scalar_images: Vec::new(),
             });
             mesh.objects.push(Object {
                 name: format!("part {k}"),
@@ -355,6 +356,7 @@ fn a_texture_file_is_embedded_as_it_is() {
             diffuse_texture: Some(texture.clone()),
             diffuse_image: None,
             wrap: [Wrap::ClampToEdge; 2],
+            scalar_images: Vec::new(),
         }],
         ..TriMesh::default()
     };
@@ -539,4 +541,127 @@ fn colour_rounding_just_outside_zero_to_one_is_clamped_and_more_is_refused() {
     };
     assert!(refused([1.01, 0.0, 0.0, 1.0]).contains("is not in [0, 1]"));
     assert!(refused([f32::NAN, 0.0, 0.0, 1.0]).contains("is not finite"));
+}
+
+/// A scalar image of `w × h` with its values in red.
+fn scalar(rng: &mut Rng, w: u32, h: u32) -> Image {
+    let pixels = (0..w * h).map(|_| [rng.f32(), 0.5, 0.5, 1.0]).collect();
+    Image {
+        width: w,
+        height: h,
+        pixels,
+    }
+}
+
+/// The 8-bit RGBA pixels of the image behind texture `index`.
+fn texture_pixels(doc: &::gltf::Gltf, blob: &[u8], index: usize) -> Vec<[u8; 4]> {
+    let texture = doc.textures().nth(index).unwrap();
+    let ::gltf::image::Source::View { view, .. } = texture.source().unwrap().source() else {
+        panic!("an embedded image")
+    };
+    let png = &blob[view.offset()..view.offset() + view.length()];
+    let decoded = ::image::load_from_memory(png).unwrap().to_rgba8();
+    decoded.pixels().map(|p| p.0).collect()
+}
+
+#[test]
+fn scalar_textures_fill_the_metallic_roughness_and_occlusion_slots_or_their_own() {
+    let dir = scratch("gltf-scalar-textures");
+    let mut rng = Rng(45);
+    let (w, h) = (5, 3);
+    let names = ["roughness", "metallic", "occlusion", "density"];
+    let images: Vec<Image> = names.iter().map(|_| scalar(&mut rng, w, h)).collect();
+    let mut mesh = TriMesh {
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+        indices: vec![[0, 1, 2]],
+        uvs: Some(vec![Vec2::ZERO, Vec2::X, Vec2::Y]),
+        objects: vec![Object {
+            name: "part".into(),
+            triangles: 0..1,
+            material: Some(0),
+        }],
+        materials: vec![Material {
+            name: "painted".into(),
+            diffuse: [1.0; 3],
+            diffuse_texture: None,
+            diffuse_image: Some(image(&mut rng)),
+            wrap: [Wrap::ClampToEdge; 2],
+            scalar_images: names
+                .iter()
+                .map(|n| n.to_string())
+                .zip(images.clone())
+                .collect(),
+        }],
+        ..TriMesh::default()
+    };
+    let path = dir.join("scalars.glb");
+    mesh.write(&path).unwrap();
+    test_support::gltf::validate(&path);
+
+    let bytes = std::fs::read(&path).unwrap();
+    let doc = ::gltf::Gltf::from_slice(&bytes).unwrap();
+    let blob = doc.blob.as_deref().unwrap();
+    let material = doc.materials().next().unwrap();
+    let pbr = material.pbr_metallic_roughness();
+    assert_eq!((pbr.metallic_factor(), pbr.roughness_factor()), (1.0, 1.0));
+    // Stored as data (no sRGB curve), 8 bits, in the channels glTF names.
+    let byte = |v: f32| (v * 255.0).round() as u8;
+    let packed = texture_pixels(
+        &doc,
+        blob,
+        pbr.metallic_roughness_texture().unwrap().texture().index(),
+    );
+    let occlusion = texture_pixels(
+        &doc,
+        blob,
+        material.occlusion_texture().unwrap().texture().index(),
+    );
+    let extras: serde_json::Value =
+        serde_json::from_str(material.extras().as_ref().unwrap().get()).unwrap();
+    let density_index = extras["scalar_textures"]["density"].as_u64().unwrap() as usize;
+    assert_eq!(
+        doc.textures().nth(density_index).unwrap().name(),
+        Some("density")
+    );
+    let density = texture_pixels(&doc, blob, density_index);
+    for i in 0..(w * h) as usize {
+        assert_eq!(
+            packed[i][1],
+            byte(images[0].pixels[i][0]),
+            "roughness in G, texel {i}"
+        );
+        assert_eq!(
+            packed[i][2],
+            byte(images[1].pixels[i][0]),
+            "metallic in B, texel {i}"
+        );
+        assert_eq!(
+            occlusion[i][0],
+            byte(images[2].pixels[i][0]),
+            "occlusion in R, texel {i}"
+        );
+        assert_eq!(
+            density[i][0],
+            byte(images[3].pixels[i][0]),
+            "density, texel {i}"
+        );
+    }
+    // The base colour still reads back as written.
+    let read = gltf::read(&path).unwrap();
+    assert!(read.materials[0].diffuse_image.is_some());
+
+    // Refused, naming the problem: two of a name, and roughness and
+    // metallic of different sizes (glTF packs them into one texture).
+    let mut twice = mesh.clone();
+    twice.materials[0]
+        .scalar_images
+        .push(("density".into(), scalar(&mut rng, w, h)));
+    let err = twice.write(dir.join("twice.glb")).unwrap_err().to_string();
+    assert!(
+        err.contains("two scalar textures named \"density\""),
+        "{err}"
+    );
+    mesh.materials[0].scalar_images[1].1 = scalar(&mut rng, w + 1, h);
+    let err = mesh.write(dir.join("sizes.glb")).unwrap_err().to_string();
+    assert!(err.contains("roughness is 5×3 and metallic 6×3"), "{err}");
 }

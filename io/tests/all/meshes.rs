@@ -467,6 +467,7 @@ fn obj_written_with_materials_reads_back_with_them() {
                 diffuse_texture: Some(texture.clone()),
                 diffuse_image: None,
                 wrap: [Wrap::ClampToEdge; 2],
+                scalar_images: Vec::new(),
             },
             Material {
                 name: String::new(),
@@ -474,6 +475,7 @@ fn obj_written_with_materials_reads_back_with_them() {
                 diffuse_texture: None,
                 diffuse_image: Some(pixels.clone()),
                 wrap: [Wrap::Repeat; 2],
+                scalar_images: Vec::new(),
             },
         ],
         ..TriMesh::default()

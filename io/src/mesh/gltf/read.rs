@@ -773,6 +773,7 @@ impl Reader<'_> {
             diffuse_texture: None,
             diffuse_image: None,
             wrap: [Wrap::Repeat; 2],
+            scalar_images: Vec::new(),
         };
         let Some(info) = pbr.base_color_texture() else {
             return Ok(out);

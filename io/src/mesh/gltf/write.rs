@@ -784,9 +784,10 @@ impl<'a> Document<'a> {
         self.root.push(material)
     }
 
-    /// A metallic-roughness material for `m`, with its texture embedded.
+    /// A metallic-roughness material for `m`, with its textures embedded.
     fn material(&mut self, m: &Material) -> Result<Index<json::Material>> {
         let texture = self.texture(m)?;
+        let scalars = self.scalar_textures(m)?;
         let [r, g, b] = m.diffuse;
         if let Some(bad) = [r, g, b].into_iter().find(|v| !v.is_finite()) {
             return Err(invalid(
@@ -797,6 +798,14 @@ impl<'a> Document<'a> {
                 ),
             ));
         }
+        let info = |index| json::texture::Info {
+            index,
+            tex_coord: 0,
+            extensions: None,
+            extras: Default::default(),
+        };
+        // With a metallic-roughness texture the factors scale it: 1.
+        let textured = scalars.metallic_roughness.is_some();
         let pbr = json::material::PbrMetallicRoughness {
             base_color_factor: json::material::PbrBaseColorFactor([
                 r.max(0.0),
@@ -804,22 +813,29 @@ impl<'a> Document<'a> {
                 b.max(0.0),
                 1.0,
             ]),
-            base_color_texture: texture.map(|index| json::texture::Info {
+            base_color_texture: texture.map(info),
+            metallic_factor: json::material::StrengthFactor(if textured { 1.0 } else { 0.0 }),
+            roughness_factor: json::material::StrengthFactor(1.0),
+            metallic_roughness_texture: scalars.metallic_roughness.map(info),
+            ..Default::default()
+        };
+        let occlusion_texture = scalars
+            .occlusion
+            .map(|index| json::material::OcclusionTexture {
                 index,
+                strength: json::material::StrengthFactor(1.0),
                 tex_coord: 0,
                 extensions: None,
                 extras: Default::default(),
-            }),
-            metallic_factor: json::material::StrengthFactor(0.0),
-            roughness_factor: json::material::StrengthFactor(1.0),
-            ..Default::default()
-        };
+            });
         Ok(self.root.push(json::Material {
             name: (!m.name.is_empty()).then(|| m.name.clone()),
             pbr_metallic_roughness: pbr,
+            occlusion_texture,
             // Scanned and converted meshes often have faces wound both
             // ways; a viewer must not show them as holes.
             double_sided: true,
+            extras: scalars.extras,
             ..Default::default()
         }))
     }
@@ -857,8 +873,98 @@ impl<'a> Document<'a> {
             }
             (None, None) => return Ok(None),
         };
-        let view = self.view(&bytes, None);
         let name = (!m.name.is_empty()).then(|| m.name.clone());
+        Ok(Some(self.embed_texture(&bytes, mime, name, m.wrap)))
+    }
+
+    /// The material's scalar textures ([`Material::scalar_images`]) as
+    /// data PNGs: roughness and metallic packed into one
+    /// metallic-roughness texture (G, B), occlusion in R of its own, the
+    /// others each in a gray texture listed in the extras.
+    fn scalar_textures(&mut self, m: &Material) -> Result<ScalarTextures> {
+        let mut out = ScalarTextures::default();
+        let images = &m.scalar_images;
+        for (k, (name, image)) in images.iter().enumerate() {
+            image.check(self.path)?;
+            if images[..k].iter().any(|(other, _)| other == name) {
+                return Err(invalid(
+                    self.path,
+                    format!(
+                        "material {:?} has two scalar textures named {name:?}",
+                        m.name
+                    ),
+                ));
+            }
+        }
+        let find = |wanted: &str| images.iter().find(|(n, _)| n == wanted).map(|(_, i)| i);
+        let (roughness, metallic) = (find("roughness"), find("metallic"));
+        if let Some(first) = roughness.or(metallic) {
+            if let (Some(r), Some(mt)) = (roughness, metallic)
+                && (r.width, r.height) != (mt.width, mt.height)
+            {
+                return Err(invalid(
+                    self.path,
+                    format!(
+                        "material {:?}: roughness is {}×{} and metallic {}×{}; glTF packs them \
+                         into one texture, so they must be the same size",
+                        m.name, r.width, r.height, mt.width, mt.height
+                    ),
+                ));
+            }
+            // Absent, roughness is 1 and metallic 0: glTF's factors then
+            // leave the material as it would be without the texture.
+            let value = |image: Option<&image::Image>, i: usize, default: f32| {
+                image.map_or(default, |image| image.pixels[i][0])
+            };
+            let pixels = (0..first.pixels.len())
+                .map(|i| [1.0, value(roughness, i, 1.0), value(metallic, i, 0.0), 1.0])
+                .collect();
+            let packed = image::Image {
+                width: first.width,
+                height: first.height,
+                pixels,
+            };
+            let name = format!("{} metallic-roughness", m.name).trim().to_string();
+            out.metallic_roughness = Some(self.data_texture(&packed, name, m.wrap)?);
+        }
+        if let Some(occlusion) = find("occlusion") {
+            let name = format!("{} occlusion", m.name).trim().to_string();
+            out.occlusion = Some(self.data_texture(&gray(occlusion), name, m.wrap)?);
+        }
+        let mut listed = serde_json::Map::new();
+        for (name, image) in images {
+            if !["roughness", "metallic", "occlusion"].contains(&name.as_str()) {
+                let index = self.data_texture(&gray(image), name.clone(), m.wrap)?;
+                listed.insert(name.clone(), index.value().into());
+            }
+        }
+        if !listed.is_empty() {
+            let extras = serde_json::json!({ "scalar_textures": listed });
+            out.extras = serde_json::value::to_raw_value(&extras).ok();
+        }
+        Ok(out)
+    }
+
+    /// A data texture (no sRGB curve) embedded as PNG.
+    fn data_texture(
+        &mut self,
+        image: &image::Image,
+        name: String,
+        wrap: [Wrap; 2],
+    ) -> Result<Index<json::Texture>> {
+        let bytes = image::encode_data_png(image, PngDepth::Eight, self.path)?;
+        Ok(self.embed_texture(&bytes, "image/png", Some(name), wrap))
+    }
+
+    /// An image in the binary buffer, its sampler and its texture.
+    fn embed_texture(
+        &mut self,
+        bytes: &[u8],
+        mime: &str,
+        name: Option<String>,
+        wrap: [Wrap; 2],
+    ) -> Index<json::Texture> {
+        let view = self.view(bytes, None);
         let source = self.root.push(json::Image {
             buffer_view: Some(view),
             mime_type: Some(json::image::MimeType(mime.into())),
@@ -867,7 +973,7 @@ impl<'a> Document<'a> {
             extensions: None,
             extras: Default::default(),
         });
-        let wrap = |w: Wrap| {
+        let mode = |w: Wrap| {
             Valid(match w {
                 Wrap::Repeat => json::texture::WrappingMode::Repeat,
                 Wrap::MirroredRepeat => json::texture::WrappingMode::MirroredRepeat,
@@ -875,17 +981,17 @@ impl<'a> Document<'a> {
             })
         };
         let sampler = self.root.push(json::texture::Sampler {
-            wrap_s: wrap(m.wrap[0]),
-            wrap_t: wrap(m.wrap[1]),
+            wrap_s: mode(wrap[0]),
+            wrap_t: mode(wrap[1]),
             ..Default::default()
         });
-        Ok(Some(self.root.push(json::Texture {
+        self.root.push(json::Texture {
             name,
             sampler: Some(sampler),
             source,
             extensions: None,
             extras: Default::default(),
-        })))
+        })
     }
 
     /// Writes the file (and the `.bin` of a `.gltf`).
@@ -958,6 +1064,29 @@ impl<'a> Document<'a> {
 }
 
 /// The name of a `.gltf`'s buffer file: its own name with `.bin`.
+/// What [`Document::scalar_textures`] embedded for one material.
+#[derive(Default)]
+struct ScalarTextures {
+    metallic_roughness: Option<Index<json::Texture>>,
+    occlusion: Option<Index<json::Texture>>,
+    /// `{"scalar_textures": {name: index}}` for the ones glTF has no slot for.
+    extras: json::extras::Extras,
+}
+
+/// A scalar image (its red channel) as gray, opaque.
+fn gray(image: &image::Image) -> image::Image {
+    let pixels = image
+        .pixels
+        .iter()
+        .map(|p| [p[0], p[0], p[0], 1.0])
+        .collect();
+    image::Image {
+        width: image.width,
+        height: image.height,
+        pixels,
+    }
+}
+
 fn bin_name(path: &Path) -> String {
     path.with_extension("bin")
         .file_name()
