@@ -391,6 +391,7 @@ pub fn atlas_mesh(
         diffuse_texture: texture_file,
         diffuse_image: Some(image.clone()),
         wrap: [trilux_io::mesh::Wrap::ClampToEdge; 2],
+        scalar_images: Vec::new(),
     };
     let mesh = TriMesh {
         origin: surface.origin,
@@ -410,6 +411,56 @@ pub fn atlas_mesh(
         warnings: Vec::new(),
     };
     (mesh, image)
+}
+
+/// Splits a baked atlas of colours with scalar channels (`trilux paint`'s
+/// RGB then `names`, e.g. `roughness`, `density`) between the material
+/// [`atlas_mesh`] made: its base colour keeps RGB only, opaque (the fourth
+/// channel is not alpha), and each scalar channel becomes one of its
+/// [`Material::scalar_images`], which the glTF writer puts into the
+/// metallic-roughness or occlusion texture or a texture of its own.
+///
+/// # Errors
+/// [`Error::Invalid`] when `baked` has no material or the atlas does not
+/// have `3 + names.len()` channels.
+pub fn attach_scalar_channels(baked: &mut TriMesh, atlas: &Atlas, names: &[String]) -> Result<()> {
+    let texture = &atlas.texture;
+    let c = texture.channels();
+    if c != 3 + names.len() {
+        return Err(Error::Invalid(format!(
+            "the atlas has {c} channels, not RGB and the {} scalar channels {names:?}",
+            names.len()
+        )));
+    }
+    let material = baked
+        .materials
+        .first_mut()
+        .ok_or_else(|| Error::Invalid("the baked mesh has no material for its textures".into()))?;
+    let (width, height) = (texture.width() as u32, texture.height() as u32);
+    let channel = |k: usize| Image {
+        width,
+        height,
+        pixels: texture
+            .data()
+            .chunks_exact(c)
+            .map(|t| [t[k], t[k], t[k], 1.0])
+            .collect(),
+    };
+    material.diffuse_image = Some(Image {
+        width,
+        height,
+        pixels: texture
+            .data()
+            .chunks_exact(c)
+            .map(|t| [t[0], t[1], t[2], 1.0])
+            .collect(),
+    });
+    material.scalar_images = names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| (n.clone(), channel(3 + k)))
+        .collect();
+    Ok(())
 }
 
 /// One channel of mesh colours as a sampling density: the colours baked

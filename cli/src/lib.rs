@@ -66,7 +66,9 @@ pub mod view;
 #[cfg(feature = "web")]
 pub mod web;
 
-pub use colors::{ColorMesh, ConvertOptions, SurfaceTexture, atlas_mesh, to_mesh_colors};
+pub use colors::{
+    ColorMesh, ConvertOptions, SurfaceTexture, atlas_mesh, attach_scalar_channels, to_mesh_colors,
+};
 pub use density::{density_texture, emission_texture, sampling_wrap};
 pub use error::{Error, Result};
 pub use mesh::mesh_ref;

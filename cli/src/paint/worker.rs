@@ -388,7 +388,10 @@ impl Worker {
                     self.session.colors(),
                     &mesh_colors::atlas::Options::default(),
                 )?;
-                let (baked, _) = crate::colors::atlas_mesh(&self.doc.surface, &atlas, None);
+                let (mut baked, _) = crate::colors::atlas_mesh(&self.doc.surface, &atlas, None);
+                // The scalar channels as textures of their own (GLB), not
+                // as the base colour's alpha.
+                crate::colors::attach_scalar_channels(&mut baked, &atlas, &self.doc.scalars)?;
                 if kind == ExportKind::Glb {
                     crate::output::write_gltf(path, overwrite, |tmp| baked.write(tmp)).map(drop)
                 } else {

@@ -262,6 +262,7 @@ async fn paint_detail_undo_save_and_replay_through_the_protocol() {
     .await;
     until(&mut s, "export", &mut seen).await;
     test_support::gltf::validate(&d.join("blob.glb"));
+    glb_has_the_density_as_its_own_texture(&d.join("blob.glb"));
     r.stop().await.unwrap();
 
     // The session file replays to the saved colours, bit for bit.
@@ -540,4 +541,42 @@ async fn the_scatter_follows_the_painted_density() {
     let st = status_of(&mut s, 41, &mut seen).await;
     assert_eq!(st["points"], 300, "the refused requests kept the points");
     r.stop().await.unwrap();
+}
+
+/// The GLB's scalar channel `density` (filled with 0.5 above) is a texture
+/// of its own, named and listed in the material's extras, stored as data
+/// (byte 128, no sRGB curve); the base colour is opaque (the density is
+/// not its alpha).
+fn glb_has_the_density_as_its_own_texture(path: &std::path::Path) {
+    let bytes = std::fs::read(path).unwrap();
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let doc: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    let bin = &bytes[20 + json_len + 8..];
+    let material = &doc["materials"][0];
+    let density = material["extras"]["scalar_textures"]["density"]
+        .as_u64()
+        .unwrap() as usize;
+    assert_eq!(doc["textures"][density]["name"], "density", "{doc:#}");
+    let image = |texture: usize| {
+        let source = doc["textures"][texture]["source"].as_u64().unwrap() as usize;
+        let view =
+            &doc["bufferViews"][doc["images"][source]["bufferView"].as_u64().unwrap() as usize];
+        let at = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+        let png = &bin[at..at + view["byteLength"].as_u64().unwrap() as usize];
+        trilux_io::image::decode(png, std::path::Path::new("t.png"), Default::default()).unwrap()
+    };
+    // decode reads colour as sRGB: undo it to see the stored byte.
+    let stored = |v: f32| (trilux_io::image::linear_to_srgb(v) * 255.0).round() as u8;
+    let values = image(density);
+    assert!(
+        values.pixels.iter().any(|p| stored(p[0]) == 128),
+        "no texel of the 0.5 fill"
+    );
+    let base = material["pbrMetallicRoughness"]["baseColorTexture"]["index"]
+        .as_u64()
+        .unwrap();
+    assert!(
+        image(base as usize).pixels.iter().all(|p| p[3] == 1.0),
+        "the base colour is opaque"
+    );
 }
