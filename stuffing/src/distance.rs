@@ -8,9 +8,18 @@
 //! status by the winding number (an open sheet, a fin, a doubled wall)
 //! bounds nothing, so the stuffing leaves it out and
 //! [`SurfaceDistance::left_out_triangles`] counts it instead. The other
-//! direction measures the boundary against every input triangle, so a
-//! boundary that spans a hole counts as far from the input by the hole's
-//! size.
+//! direction measures the boundary against every input triangle, except
+//! where the boundary caps a hole of the input: there the ½ level set runs
+//! through space the input does not reach, and its distance is the hole's
+//! size, not an error of the mesh. A boundary point counts as on a cap when
+//! it lies farther than [`CAP_MIN_DISTANCE`] of the diagonal from the input
+//! and the winding number there is between ¼ and ¾ ([`on_hole_cap`]): along
+//! the input the winding number jumps by 1 across its triangles, so a
+//! boundary point off them (a chord across a concavity or a thin part)
+//! sees nearly 0 or 1, whereas over a hole no triangle separates the
+//! sides and it stays near ½. Cap points are reported apart
+//! ([`SurfaceDistance::hole_caps`], [`SurfaceDistance::hole_caps_to_input`]),
+//! not hidden.
 //!
 //! Sampling is deterministic: point `i` of `n` falls in the triangle where
 //! the area's cumulative sum passes `(i + ½) / n` (stratified by area) at
@@ -40,10 +49,18 @@ pub struct SurfaceDistance {
     /// tetrahedra miss, such as thin parts.
     pub input_to_tets: f64,
     /// The largest distance from a sampled point of the boundary to the
-    /// input.
+    /// input, over the points not on hole caps (see the module docs).
     pub tets_to_input: f64,
-    /// The mean over both directions' samples of the distance to the other
-    /// surface.
+    /// The share of the boundary's sampled points, 0 to 1, that lie on caps
+    /// over holes of the input (farther than [`CAP_MIN_DISTANCE`] of the
+    /// diagonal from it, winding number between ¼ and ¾): left out of
+    /// `tets_to_input` and of the mean. 0 on a closed input.
+    pub hole_caps: f64,
+    /// The largest distance from a cap point to the input (0 without caps):
+    /// about the size of the largest hole.
+    pub hole_caps_to_input: f64,
+    /// The mean over both directions' samples (cap points left out) of the
+    /// distance to the other surface.
     pub mean: f64,
     /// The length of the diagonal of the input's bounding box (of the
     /// vertices triangles use), the scale the figures are usually quoted
@@ -281,24 +298,79 @@ pub(crate) fn encloses_volume(wn: &WindingNumber, [a, b, c]: [DVec3; 3]) -> bool
     w > 0.0 && w <= 1.0
 }
 
+/// Whether a point of the ½ level set (a stuffed boundary) lies on a cap
+/// over a hole of the input rather than along the input: there the winding
+/// number is near ½ (between ¼ and ¾, [`CAP_WINDING`]) because no input
+/// triangle separates inside from outside, whereas along the input it
+/// jumps by 1 across the triangles and a boundary point a discretization
+/// step off them sees nearly 0 or 1.
+pub(crate) fn on_hole_cap(wn: &WindingNumber, q: DVec3) -> bool {
+    let w = wn.fast(q);
+    (CAP_WINDING.0..CAP_WINDING.1).contains(&w)
+}
+
+/// The winding numbers, exclusive, between which a boundary point farther
+/// than [`CAP_MIN_DISTANCE`] from the input counts as capping a hole of
+/// it (see [`SurfaceDistance::hole_caps`]).
+pub const CAP_WINDING: (f64, f64) = (0.25, 0.75);
+
 /// Samples per parallel chunk: fixed, so the sum's order (and the mean's
 /// last bits) does not depend on the number of threads.
 const CHUNK: usize = 4096;
 
-/// The largest and the summed distance from `points` to `surface`.
-fn one_way(points: &[DVec3], surface: &Surface<'_>) -> (f64, f64) {
-    let partial: Vec<(f64, f64)> = points
+/// The boundary distance a point must exceed before it can count as on a
+/// hole cap, as a fraction of the diagonal (the default envelope,
+/// 2·10⁻³): nearer points are along the input for every purpose here, and
+/// the winding number is evaluated only for the farther ones.
+pub const CAP_MIN_DISTANCE: f64 = 2e-3;
+
+/// How [`one_way`] tells cap points apart.
+struct Caps<'a> {
+    wn: &'a WindingNumber,
+    /// [`CAP_MIN_DISTANCE`] in the input's unit.
+    min_distance: f64,
+}
+
+/// Points left out as on hole caps: how many and their largest distance.
+#[derive(Default, Clone, Copy)]
+struct CapPoints {
+    count: usize,
+    max: f64,
+}
+
+/// The largest and the summed distance from `points` to `surface`, over
+/// the points not on hole caps when `caps` is given, and those cap points.
+fn one_way(
+    points: &[DVec3],
+    surface: &Surface<'_>,
+    caps: Option<&Caps<'_>>,
+) -> (f64, f64, CapPoints) {
+    let partial: Vec<(f64, f64, CapPoints)> = points
         .par_chunks(CHUNK)
         .map(|chunk| {
-            chunk.iter().fold((0.0f64, 0.0f64), |(max, sum), &p| {
+            let mut cap = CapPoints::default();
+            let (max, sum) = chunk.iter().fold((0.0f64, 0.0f64), |(max, sum), &p| {
                 let d = surface.distance(p);
+                if caps.is_some_and(|c| d > c.min_distance && on_hole_cap(c.wn, p)) {
+                    cap.count += 1;
+                    cap.max = cap.max.max(d);
+                    return (max, sum);
+                }
                 (max.max(d), sum + d)
-            })
+            });
+            (max, sum, cap)
         })
         .collect();
-    partial
-        .iter()
-        .fold((0.0, 0.0), |(max, sum), &(m, s)| (max.max(m), sum + s))
+    partial.iter().fold(
+        (0.0, 0.0, CapPoints::default()),
+        |(max, sum, cap), &(m, s, c)| {
+            let cap = CapPoints {
+                count: cap.count + c.count,
+                max: cap.max.max(c.max),
+            };
+            (max.max(m), sum + s, cap)
+        },
+    )
 }
 
 /// Measures the boundary `(positions, boundary)` against the input
@@ -343,15 +415,20 @@ pub(crate) fn measure(
     let on_input = input.sample(&kept, samples);
     let all: Vec<u32> = (0..output.triangles.len() as u32).collect();
     let on_boundary = output.sample(&all, samples);
-    let (input_to_tets, sum_in) = one_way(&on_input, &output);
-    let (tets_to_input, sum_out) = one_way(&on_boundary, &input);
-    let count = on_input.len() + on_boundary.len();
     let mut bounds = Aabb::EMPTY;
     for t in input.triangles {
         for &v in t {
             bounds.grow(input.positions[v as usize]);
         }
     }
+    let diagonal = (bounds.max - bounds.min).length();
+    let (input_to_tets, sum_in, _) = one_way(&on_input, &output, None);
+    let caps = Caps {
+        wn,
+        min_distance: CAP_MIN_DISTANCE * diagonal,
+    };
+    let (tets_to_input, sum_out, cap) = one_way(&on_boundary, &input, Some(&caps));
+    let count = on_input.len() + on_boundary.len() - cap.count;
     SurfaceDistance {
         hausdorff: input_to_tets.max(tets_to_input),
         input_to_tets,
@@ -361,7 +438,9 @@ pub(crate) fn measure(
         } else {
             0.0
         },
-        diagonal: (bounds.max - bounds.min).length(),
+        hole_caps: fraction(cap.count as f64, on_boundary.len() as f64),
+        hole_caps_to_input: cap.max,
+        diagonal,
         input_samples: on_input.len(),
         boundary_samples: on_boundary.len(),
         left_out_triangles: left_out,

@@ -20,7 +20,10 @@
 //!    first, pulls the boundary vertex nearest to it onto itself (or a half
 //!    or a quarter of the way), once per vertex; a few rounds, each against
 //!    the boundary as the last one left it;
-//! 3. the other boundary vertices are projected onto their nearest point of
+//! 3. where points stay far, boundary edges near them are split with the
+//!    new vertex on them ([`crate::refine`], driven by the same distances
+//!    both ways);
+//! 4. the other boundary vertices are projected onto their nearest point of
 //!    the input (the same partial steps), which brings back the ones a
 //!    chord between two pulled vertices left off the surface.
 //!
@@ -29,7 +32,8 @@
 //! [`MAX_DIHEDRAL_DEG`] (or, for one already outside that range, gets no
 //! worse). Moves are made one after another in a fixed order, so the
 //! result does not depend on the number of threads. What the fit cannot
-//! reach — a part thinner than the lattice with no tetrahedron near it —
+//! reach — a part with no boundary vertex within a spacing, or whose
+//! tetrahedra the angle check will not let bend or split towards it —
 //! stays missing, and [`super::Report::distance`] says by how much.
 
 use glam::DVec3;
@@ -37,7 +41,9 @@ use rayon::prelude::*;
 
 use crate::bvh::Bvh;
 use crate::distance::{Surface, closest_point_on_triangle, encloses_volume};
+use crate::mesh::Assembled;
 use crate::quality::{dihedral_angles, signed_volume};
+use crate::refine;
 use crate::winding::WindingNumber;
 
 /// The smallest dihedral angle, degrees, a fitted tetrahedron may have.
@@ -50,7 +56,7 @@ pub(crate) const SHARP_DEG: f64 = 140.0;
 /// Most points put along the creases (about 24 MB), whatever their length.
 const MAX_CREASE_POINTS: usize = 1 << 20;
 /// Fractions of a move tried, in order.
-const STEPS: [f64; 4] = [1.0, 0.5, 0.25, 0.125];
+pub(crate) const STEPS: [f64; 4] = [1.0, 0.5, 0.25, 0.125];
 /// Rounds of pulling vertices towards far input points.
 const ROUNDS: usize = 8;
 /// Farthest a vertex is moved, in lattice spacings: beyond it the point
@@ -62,6 +68,8 @@ const REACH: f64 = 1.0;
 pub(crate) struct Fitted {
     /// Boundary vertices moved.
     pub(crate) moved: usize,
+    /// Edges split by the refinement (their new vertices count as moved).
+    pub(crate) split_edges: usize,
     /// Sharp input edges found.
     pub(crate) sharp_edges: usize,
 }
@@ -72,11 +80,10 @@ pub(crate) struct Fitted {
 /// is left that keeps the angles; `h` is the lattice spacing.
 pub(crate) fn fit(
     wn: &WindingNumber,
-    positions: &mut [DVec3],
-    tets: &[[u32; 4]],
-    boundary: &[[u32; 3]],
+    mesh: &mut Assembled,
     h: f64,
     eps: f64,
+    max_tets: usize,
 ) -> Fitted {
     let input_positions = wn.positions();
     let kept: Vec<[u32; 3]> = wn
@@ -85,28 +92,66 @@ pub(crate) fn fit(
         .filter(|t| encloses_volume(wn, t.map(|v| input_positions[v as usize])))
         .copied()
         .collect();
-    if kept.is_empty() || boundary.is_empty() {
+    if kept.is_empty() || mesh.boundary.is_empty() {
         return Fitted::default();
     }
     let sharp = sharp_edges(input_positions, &kept);
-    let targets = points_to_hold(input_positions, &kept, &sharp, h, boundary.len());
-    let incident = Incidence::new(positions.len(), tets);
-    let faces = Incidence::new(positions.len(), boundary);
+    let targets = points_to_hold(input_positions, &kept, &sharp, h, mesh.boundary.len());
     let input_bvh = Bvh::build(input_positions, &kept);
     let input = Surface {
         positions: input_positions,
         triangles: &kept,
         bvh: &input_bvh,
     };
+    let (mut moved, mut touched) = pull_rounds(&input, mesh, &targets, h, eps);
+    // What the moves could not reach: split edges near it (`refine`).
+    let refined = refine::refine(wn, &input, mesh, &targets, eps, max_tets);
+    moved.resize(mesh.positions.len(), false);
+    touched.resize(mesh.positions.len(), false);
+    for &v in &refined.on_input {
+        moved[v as usize] = true;
+    }
+    let incident = Incidence::new(mesh.positions.len(), &mesh.tets);
+    let faces = Incidence::new(mesh.positions.len(), &mesh.boundary);
     let mut mover = Mover {
-        tets,
+        tets: &mesh.tets,
         incident: &incident,
-        boundary,
+        boundary: &mesh.boundary,
         faces: &faces,
         input: &input,
         eps,
-        moved: vec![false; positions.len()],
-        touched: vec![false; positions.len()],
+        moved,
+        touched,
+    };
+    mover.project(&mut mesh.positions, &mesh.boundary, h);
+    let touched = mover.touched.iter().filter(|&&m| m).count();
+    Fitted {
+        moved: touched + refined.splits,
+        split_edges: refined.splits,
+        sharp_edges: sharp.len(),
+    }
+}
+
+/// Step 2: rounds of pulls on the stuffed mesh; the vertices pulled all
+/// the way and those moved at all.
+fn pull_rounds(
+    input: &Surface<'_>,
+    mesh: &mut Assembled,
+    targets: &[DVec3],
+    h: f64,
+    eps: f64,
+) -> (Vec<bool>, Vec<bool>) {
+    let incident = Incidence::new(mesh.positions.len(), &mesh.tets);
+    let faces = Incidence::new(mesh.positions.len(), &mesh.boundary);
+    let mut mover = Mover {
+        tets: &mesh.tets,
+        incident: &incident,
+        boundary: &mesh.boundary,
+        faces: &faces,
+        input,
+        eps,
+        moved: vec![false; mesh.positions.len()],
+        touched: vec![false; mesh.positions.len()],
     };
     // Later rounds look again only at the points that were far and still
     // had a vertex to move: a pull uncovers at most half the distance it
@@ -114,16 +159,12 @@ pub(crate) fn fit(
     let mut far: Vec<u32> = (0..targets.len() as u32).collect();
     for _ in 0..ROUNDS {
         let moved;
-        (far, moved) = mover.pull(positions, boundary, &targets, &far, h, eps);
+        (far, moved) = mover.pull(&mut mesh.positions, &mesh.boundary, targets, &far, h, eps);
         if moved == 0 {
             break;
         }
     }
-    mover.project(positions, boundary, h);
-    Fitted {
-        moved: mover.touched.iter().filter(|&&m| m).count(),
-        sharp_edges: sharp.len(),
-    }
+    (mover.moved, mover.touched)
 }
 
 /// Edges shared by exactly two of `triangles` whose faces meet at an
@@ -436,7 +477,7 @@ impl Mover<'_> {
 /// Whether a positively oriented tetrahedron moved from `before` to
 /// `after` stays positive with its angles within the fit's range, or no
 /// worse than before where it already was outside it.
-fn keeps_angles(before: [DVec3; 4], after: [DVec3; 4]) -> bool {
+pub(crate) fn keeps_angles(before: [DVec3; 4], after: [DVec3; 4]) -> bool {
     if signed_volume(after) <= 0.0 {
         return false;
     }

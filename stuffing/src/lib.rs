@@ -22,7 +22,9 @@
 //!    deep inside, with the fine BCC lattice kept near the surface;
 //! 6. optionally ([`Options::envelope`]) boundary vertices moved onto the
 //!    tips, creases and thin parts of the input the lattice cut across,
-//!    each move kept only if the tetrahedra around it keep 10°–165°.
+//!    and boundary edges split where no vertex could move far enough,
+//!    each move and split kept only if the tetrahedra around it keep
+//!    10°–165°.
 //!
 //! The crate depends on `glam`, `rayon`, `thiserror` and `std` only: a
 //! user who wants tetrahedra from a surface gets no solver, sparse-matrix
@@ -61,6 +63,7 @@ mod graded;
 mod lattice;
 mod mesh;
 mod quality;
+mod refine;
 mod stencils;
 mod warp;
 pub mod winding;
@@ -70,7 +73,7 @@ use std::time::{Duration, Instant};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
-pub use distance::SurfaceDistance;
+pub use distance::{CAP_MIN_DISTANCE, CAP_WINDING, SurfaceDistance};
 pub use error::Error;
 
 pub use glam;
@@ -206,13 +209,19 @@ pub struct Options {
     /// points spread over the area, farthest first), then projects the
     /// other boundary vertices onto the input; each move is kept only if
     /// every tetrahedron around the vertex keeps its dihedral angles within
-    /// 10°–165° (or gets no worse), else a half or a quarter of it. So the
-    /// smallest angle can drop from the stuffing's to 10°, never below
-    /// the lower of the two. Parts farther than `h` from any boundary
-    /// vertex (thinner than the lattice) stay missing: it is not a
-    /// guarantee, and [`Report::distance`] gives what was achieved. Costs
-    /// a nearest-point query per input vertex and sample and a few rounds
-    /// over the boundary (the `stuffing` example's `--envelope` table).
+    /// 10°–165° (or gets no worse), else a half or a quarter of it. Where
+    /// no vertex can move far enough (a part 0.2–2 spacings thick, a tip),
+    /// boundary edges near the far points, and near boundary points farther
+    /// than this from the input, are split with the new vertex on the input
+    /// (longest-edge bisection of the tetrahedra below where that is what
+    /// the angle check refuses), each split kept only under the same check,
+    /// up to three times the stuffed count ([`Report::split_edges`]). So
+    /// the smallest angle can drop from the stuffing's to 10°, never below
+    /// the lower of the two. Parts with no boundary vertex within a spacing
+    /// can stay missing: it is not a guarantee, and [`Report::distance`]
+    /// gives what was achieved. Costs a nearest-point query per input
+    /// vertex and sample and a few rounds over the boundary (the
+    /// `stuffing` example's `--envelope` table).
     pub envelope: Option<f64>,
 }
 
@@ -277,6 +286,11 @@ pub struct Report {
     /// Sharp input edges (creases, faces at less than 140°) the envelope
     /// fit held the boundary to (0 without it).
     pub sharp_edges: usize,
+    /// Boundary edges the envelope fit split where moving vertices could
+    /// not bring the boundary within the envelope (each split adds a
+    /// vertex on or towards the input and splits the tetrahedra around the
+    /// edge; 0 without the envelope).
+    pub split_edges: usize,
     /// How far the boundary lies from the input, both ways
     /// ([`Options::distance_samples`]; `None` when that is 0). Its time is
     /// part of [`elapsed`](Self::elapsed).
@@ -432,14 +446,10 @@ fn run<P: Position>(
     let fitted = options.envelope.map(|eps| {
         let (lo, hi) = used_bounds(&pos, triangles);
         let diagonal = lo.distance(hi);
-        envelope::fit(
-            &wn,
-            &mut m.positions,
-            &m.tets,
-            &m.boundary,
-            h,
-            eps * diagonal,
-        )
+        // The refinement may triple the stuffed count (the cost
+        // bound), never beyond the caller's limit.
+        let budget = m.tets.len().saturating_mul(3).min(options.max_tets);
+        envelope::fit(&wn, &mut m, h, eps * diagonal, budget)
     });
     let q = quality::quality(&m.positions, &m.tets);
     let distance = (options.distance_samples > 0)
@@ -457,6 +467,7 @@ fn run<P: Position>(
         warped_vertices: warped.len(),
         fitted_vertices: fitted.map_or(0, |f| f.moved),
         sharp_edges: fitted.map_or(0, |f| f.sharp_edges),
+        split_edges: fitted.map_or(0, |f| f.split_edges),
         distance,
         elapsed: start.elapsed(),
     };

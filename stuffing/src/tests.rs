@@ -627,3 +627,33 @@ fn a_stuffed_sphere_reports_its_distance_within_the_lattice_spacing() {
             .is_none()
     );
 }
+
+/// A sphere with a hole around its north pole (the triangles above
+/// z = 0.8 removed, a hole of radius 0.6): the boundary caps the hole on
+/// the ½ level set, and those cap points are counted apart instead of
+/// setting `tets_to_input` to about the hole's radius; the closed sphere
+/// has no cap points. (Item 2 of issue #48.)
+#[test]
+fn a_boundary_capping_a_hole_is_reported_apart_from_the_distance() {
+    let (p, t) = sphere(32, 1.0, DVec3::ZERO);
+    let h = 0.08;
+    let closed = tetrahedralize(&p, &t, &Options::new(h)).unwrap();
+    let d = closed.report.distance.unwrap();
+    assert_eq!(d.hole_caps, 0.0, "{d:?}");
+    assert_eq!(d.hole_caps_to_input, 0.0, "{d:?}");
+    let open: Vec<[u32; 3]> = t
+        .iter()
+        .copied()
+        .filter(|f| f.iter().any(|&v| p[v as usize].z < 0.8))
+        .collect();
+    let holed = tetrahedralize(&p, &open, &Options::new(h)).unwrap();
+    let d = holed.report.distance.unwrap();
+    // The cap is a few percent of the boundary, and its farthest point is
+    // most of the hole's radius away from the input.
+    assert!(d.hole_caps > 0.01 && d.hole_caps < 0.15, "{d:?}");
+    assert!(d.hole_caps_to_input > 0.3, "{d:?}");
+    // Without the cap, the boundary is as near the input as the closed
+    // sphere's, within the lattice spacing.
+    assert!(d.tets_to_input < 0.5 * h, "{d:?}");
+    assert!(d.hausdorff < 0.5 * h, "{d:?}");
+}
