@@ -279,9 +279,9 @@ fn distance_table(inputs: &[Surface]) {
 /// surface at a count near the plain stuffing's, measured the same way.
 fn envelope_table(inputs: &[Surface], runs: usize, peers: Option<&peers::Runner>) {
     println!(
-        "| mesh | options | Hausdorff / diag | input → tets | tets → input | mean | tets | ms | min dihedral | max dihedral | time ratio | tet ratio | fitted vertices, sharp edges |"
+        "| mesh | options | Hausdorff / diag | input → tets | tets → input | mean | tets | ms | min dihedral | max dihedral | time ratio | tet ratio | fitted vertices, split edges, sharp edges | hole caps (share, farthest) |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let pct = |x: f64, diag: f64| format!("{:.3} %", 100.0 * x / diag);
     for (name, p, t) in inputs {
         let (lo, hi) = bounds(p, t);
@@ -309,7 +309,7 @@ fn envelope_table(inputs: &[Surface], runs: usize, peers: Option<&peers::Runner>
                 }
             }
             if let Some(e) = failed {
-                println!("| {name} | {label} | {e} | | | | | | | | | | |");
+                println!("| {name} | {label} | {e} | | | | | | | | | | | |");
                 continue;
             }
             ms.sort_by(f64::total_cmp);
@@ -318,7 +318,7 @@ fn envelope_table(inputs: &[Surface], runs: usize, peers: Option<&peers::Runner>
             let m = match stuffing::tetrahedralize(p, t, &options) {
                 Ok(m) => m,
                 Err(e) => {
-                    println!("| {name} | {label} | {e} | | | | | | | | | | |");
+                    println!("| {name} | {label} | {e} | | | | | | | | | | | |");
                     continue;
                 }
             };
@@ -328,7 +328,7 @@ fn envelope_table(inputs: &[Surface], runs: usize, peers: Option<&peers::Runner>
             let (base_ms, base_tets, _) =
                 *baseline.get_or_insert_with(|| (median, m.tets.len(), volume(&m)));
             println!(
-                "| {name} | {label} | {} | {} | {} | {} | {} | {median:.0} | {:.2}° | {:.2}° | {:.2} | {:.2} | {}, {} |",
+                "| {name} | {label} | {} | {} | {} | {} | {} | {median:.0} | {:.2}° | {:.2}° | {:.2} | {:.2} | {}, {}, {} | {:.2} %, {} |",
                 pct(d.hausdorff, d.diagonal),
                 pct(d.input_to_tets, d.diagonal),
                 pct(d.tets_to_input, d.diagonal),
@@ -339,7 +339,10 @@ fn envelope_table(inputs: &[Surface], runs: usize, peers: Option<&peers::Runner>
                 median / base_ms,
                 m.tets.len() as f64 / base_tets as f64,
                 m.report.fitted_vertices,
+                m.report.split_edges,
                 m.report.sharp_edges,
+                100.0 * d.hole_caps,
+                pct(d.hole_caps_to_input, d.diagonal),
             );
         }
         if let (Some(runner), Some(baseline)) = (peers, baseline) {
@@ -367,13 +370,13 @@ fn peer_rows(
             Ok(m) => m,
             Err(e) => {
                 let label = format!("{peer:?}");
-                println!("| {name} | {label} | {e} | | | | | | | | | | |");
+                println!("| {name} | {label} | {e} | | | | | | | | | | | |");
                 continue;
             }
         };
         let d = &m.distance;
         println!(
-            "| {name} | {} | {} | {} | {} | {} | {} | {:.0} | {:.2}° | {:.2}° | {:.2} | {:.2} | — |",
+            "| {name} | {} | {} | {} | {} | {} | {} | {:.0} | {:.2}° | {:.2}° | {:.2} | {:.2} | — | {:.2} %, {} |",
             peer.label(m.param),
             pct(d.hausdorff, d.diagonal),
             pct(d.input_to_tets, d.diagonal),
@@ -385,6 +388,8 @@ fn peer_rows(
             m.max_dihedral_deg,
             m.ms / base_ms,
             m.tets as f64 / base_tets as f64,
+            100.0 * d.hole_caps,
+            pct(d.hole_caps_to_input, d.diagonal),
         );
     }
 }
