@@ -5,6 +5,8 @@
 use crate::filter::{FINEST, Place, Store, check, edge_point, eval_at, lattice, place, triangle};
 use crate::structure::{MeshColors, interior_index, move_segments, samples_per_face};
 use crate::topology::NO_FACE;
+use std::sync::OnceLock;
+
 use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
 
 /// Offset of level `l` within a face's levels: `Σ_{m<l} (2^m−1)(2^m−2)/2`.
@@ -165,23 +167,85 @@ const HEX: [[i32; 3]; 6] = [
 /// per vertex, edge and face reaches all of them (Sec. 4.2). A query at
 /// level `l` reads each primitive at `min(l, its finest)`, so every level
 /// is one continuous colouring, identical on an edge from both sides.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct MipMap {
     pub(crate) colors: MeshColors,
     pub(crate) vertex_offset: Vec<usize>,
     pub(crate) edge_offset: Vec<usize>,
     pub(crate) face_offset: Vec<usize>,
     pub(crate) data: Vec<f32>,
-    /// A lookup cache: per face, every level's full lattice (vertex and
-    /// edge values copied in, interpolated where the edge is coarser), so
-    /// a lookup inside a face reads three values without branching. Slot
-    /// `l ≤ n_f` is the face seen at query level `l`; slot `n_f + 1` at any
-    /// level from the finest of its corners up (vertices keep refining
-    /// after a coarse face stops).
-    pub(crate) flat_offset: Vec<usize>,
-    pub(crate) flat: Vec<f32>,
+    /// The lookup cache (see [`Cache`]), built by the first CPU lookup:
+    /// a caller that only packs the pyramid for the GPU
+    /// ([`crate::gpu::GpuLayout`]) never pays for it, and the refreshes
+    /// keep it up to date only once it exists.
+    pub(crate) cache: OnceLock<Cache>,
+}
+
+/// A lookup cache of a [`MipMap`]: per face, every level's full lattice
+/// (vertex and edge values copied in, interpolated where the edge is
+/// coarser), so a lookup inside a face reads three values without
+/// branching. Slot `l ≤ n_f` is the face seen at query level `l`; slot
+/// `n_f + 1` at any level from the finest of its corners up (vertices
+/// keep refining after a coarse face stops). Derived data: two pyramids
+/// are equal whatever their caches hold.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Cache {
+    /// Per face, its first value in `flat`.
+    offset: Vec<usize>,
+    flat: Vec<f32>,
     /// Per face, the finest level of its three corners.
-    pub(crate) corner_level: Vec<u8>,
+    corner_level: Vec<u8>,
+}
+
+impl Cache {
+    /// Moves the caches of the faces not `listed` to the layout of
+    /// `colors` (whose resolutions differ only on listed faces); the
+    /// listed faces' caches are left for the caller to fill.
+    fn relayout(&mut self, colors: &MeshColors, listed: &[bool]) {
+        let nf = colors.face_level.len();
+        let mut segments = Vec::with_capacity(nf);
+        let mut next = 0;
+        let mut offset = Vec::with_capacity(nf);
+        for (f, &n) in colors.face_level.iter().enumerate() {
+            let len = FLAT_SLOT_OFFSET[n as usize + 2];
+            segments.push((self.offset[f], next, len, !listed[f]));
+            offset.push(next);
+            next += len;
+        }
+        move_segments(&mut self.flat, colors.channels, &segments, next);
+        self.offset = offset;
+        self.corner_level = corner_levels(colors);
+    }
+}
+
+/// Per face, the finest level of its three corners.
+fn corner_levels(colors: &MeshColors) -> Vec<u8> {
+    colors
+        .topology
+        .faces
+        .iter()
+        .map(|face| {
+            face.iter()
+                .map(|&v| colors.vertex_level[v as usize])
+                .max()
+                .unwrap_or(0)
+        })
+        .collect()
+}
+
+impl PartialEq for MipMap {
+    fn eq(&self, other: &Self) -> bool {
+        // The cache is a function of the rest.
+        self.colors == other.colors
+            && self.vertex_offset == other.vertex_offset
+            && self.edge_offset == other.edge_offset
+            && self.face_offset == other.face_offset
+            && self
+                .data
+                .iter()
+                .map(|x| x.to_bits())
+                .eq(other.data.iter().map(|x| x.to_bits()))
+    }
 }
 
 /// Lattice points of a face of resolution `r`: `(r + 1)(r + 2)/2`.
@@ -260,7 +324,6 @@ impl MipMap {
         for l in (0..top).rev() {
             mip.build_level(l, &vertex_edges, None);
         }
-        mip.build_cache();
         mip
     }
 
@@ -273,9 +336,7 @@ impl MipMap {
             edge_offset,
             face_offset,
             colors,
-            flat_offset: Vec::new(),
-            flat: Vec::new(),
-            corner_level: Vec::new(),
+            cache: OnceLock::new(),
         }
     }
 
@@ -325,38 +386,29 @@ impl MipMap {
             });
         }
         self.data = data;
-        self.build_cache();
+        self.cache = OnceLock::new();
         Ok(())
     }
 
-    /// Fills the lookup cache from the pyramid (see the `flat` field).
-    fn build_cache(&mut self) {
+    /// The lookup cache of the pyramid as it is (see [`Cache`]).
+    fn build_cache(&self) -> Cache {
         let mc = &self.colors;
         let c = mc.channels;
-        let mut offsets = Vec::with_capacity(mc.face_level.len());
+        let mut offset = Vec::with_capacity(mc.face_level.len());
         let mut next = 0;
         for &n in &mc.face_level {
-            offsets.push(next);
+            offset.push(next);
             next += FLAT_SLOT_OFFSET[n as usize + 2];
         }
-        let corner_level: Vec<u8> = mc
-            .topology
-            .faces
-            .iter()
-            .map(|face| {
-                face.iter()
-                    .map(|&v| mc.vertex_level[v as usize])
-                    .max()
-                    .unwrap_or(0)
-            })
-            .collect();
         let mut flat = vec![0.0f32; next * c];
-        for (f, &first) in offsets.iter().enumerate() {
+        for (f, &first) in offset.iter().enumerate() {
             self.fill_face_cache(f, first, &mut flat);
         }
-        self.flat_offset = offsets;
-        self.flat = flat;
-        self.corner_level = corner_level;
+        Cache {
+            offset,
+            flat,
+            corner_level: corner_levels(mc),
+        }
     }
 
     /// Writes face `f`'s cache, from `first` (in values), into `flat`.
@@ -562,18 +614,10 @@ impl MipMap {
             segments.push((self.face_offset[f], fo[f], len, !listed[f]));
         }
         move_segments(&mut self.data, c, &segments, total);
-        let mut segments = Vec::with_capacity(nf);
-        let mut next = 0;
-        let mut flat_offset = Vec::with_capacity(nf);
-        for (f, &n) in colors.face_level.iter().enumerate() {
-            let len = FLAT_SLOT_OFFSET[n as usize + 2];
-            segments.push((self.flat_offset[f], next, len, !listed[f]));
-            flat_offset.push(next);
-            next += len;
-        }
-        move_segments(&mut self.flat, c, &segments, next);
         (self.vertex_offset, self.edge_offset, self.face_offset) = (vo, eo, fo);
-        self.flat_offset = flat_offset;
+        if let Some(cache) = self.cache.get_mut() {
+            cache.relayout(colors, &listed);
+        }
         // The finest values of the primitives that did not move.
         for v in (0..t.vertex_count).filter(|&v| !keep_vertex[v]) {
             let at = (self.vertex_offset[v] + colors.vertex_level[v] as usize) * c;
@@ -611,16 +655,6 @@ impl MipMap {
         mine.vertex_level.clone_from(&colors.vertex_level);
         mine.edge_offset.clone_from(&colors.edge_offset);
         mine.face_offset.clone_from(&colors.face_offset);
-        self.corner_level = t
-            .faces
-            .iter()
-            .map(|face| {
-                face.iter()
-                    .map(|&v| colors.vertex_level[v as usize])
-                    .max()
-                    .unwrap_or(0)
-            })
-            .collect();
         self.recompute(colors, &adjacency, dirty, list);
         Ok(())
     }
@@ -686,13 +720,15 @@ impl MipMap {
                 _ => {}
             }
         }
-        // Caches of every face touching a rewritten primitive.
-        grow(&mut dirty, &mut list);
-        let mut flat = std::mem::take(&mut self.flat);
-        for &f in &list {
-            self.fill_face_cache(f, self.flat_offset[f], &mut flat);
+        // Caches of every face touching a rewritten primitive, when there
+        // is a cache.
+        if let Some(mut cache) = self.cache.take() {
+            grow(&mut dirty, &mut list);
+            for &f in &list {
+                self.fill_face_cache(f, cache.offset[f], &mut cache.flat);
+            }
+            self.cache = OnceLock::from(cache);
         }
-        self.flat = flat;
         merged
     }
 
@@ -704,10 +740,11 @@ impl MipMap {
             eval_at(self, f, at, q, false, out);
             return;
         };
+        let cache = self.cache.get_or_init(|| self.build_cache());
         let n = self.colors.face_level[f];
         let (slot, lf) = if q <= n {
             (q, q)
-        } else if q >= self.corner_level[f] {
+        } else if q >= cache.corner_level[f] {
             (n + 1, n)
         } else {
             eval_at(self, f, at, q, false, out);
@@ -716,11 +753,11 @@ impl MipMap {
         let r = 1u32 << lf;
         let (pts, ws) = triangle(bc, r);
         let c = self.colors.channels;
-        let base = self.flat_offset[f] + FLAT_SLOT_OFFSET[slot as usize];
+        let base = cache.offset[f] + FLAT_SLOT_OFFSET[slot as usize];
         out.fill(0.0);
         for t in 0..3 {
             let at = (base + lattice_row_index(r, pts[t][0], pts[t][1])) * c;
-            for (o, &x) in out.iter_mut().zip(&self.flat[at..at + c]) {
+            for (o, &x) in out.iter_mut().zip(&cache.flat[at..at + c]) {
                 *o += ws[t] * x;
             }
         }

@@ -4,8 +4,6 @@
 //! cells it overlaps (a small multiple of the samples it touches when the
 //! cell size is about the brush radius), not the size of the mesh.
 
-use std::collections::HashMap;
-
 use glam::Vec3;
 
 use crate::structure::MeshColors;
@@ -67,10 +65,65 @@ pub struct Stroke {
 /// change or a vertex move.
 #[derive(Debug, Clone)]
 pub struct Painter {
-    cell: f32,
     positions: Vec<Vec3>,
-    grid: HashMap<[i32; 3], Vec<u32>>,
+    grid: Grid,
     channels: usize,
+}
+
+/// A spatial hash of sample positions: cells of side `cell`, hashed into
+/// `2^k` buckets (about one per two samples), the samples of each bucket
+/// listed in increasing order in one array (compressed rows). Building it
+/// is two passes over the samples with no per-cell allocation, so a
+/// resolution change that renumbers the samples can rebuild it cheaply.
+#[derive(Debug, Clone)]
+struct Grid {
+    cell: f32,
+    /// `start[b] .. start[b + 1]` are bucket `b`'s entries in `items`.
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Grid {
+    fn new(positions: &[Vec3], cell: f32) -> Self {
+        let buckets = (positions.len() / 2).max(1).next_power_of_two();
+        let bucket: Vec<u32> = positions
+            .iter()
+            .map(|&p| bucket_of(cell_of(p, cell), buckets))
+            .collect();
+        let mut start = vec![0u32; buckets + 1];
+        for &b in &bucket {
+            start[b as usize + 1] += 1;
+        }
+        for b in 0..buckets {
+            start[b + 1] += start[b];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; positions.len()];
+        for (i, &b) in bucket.iter().enumerate() {
+            items[fill[b as usize] as usize] = i as u32;
+            fill[b as usize] += 1;
+        }
+        Self { cell, start, items }
+    }
+
+    fn buckets(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    fn bucket(&self, b: usize) -> &[u32] {
+        &self.items[self.start[b] as usize..self.start[b + 1] as usize]
+    }
+}
+
+/// The bucket of grid cell `c` among `buckets` (a power of two).
+#[inline]
+fn bucket_of(c: [i32; 3], buckets: usize) -> u32 {
+    let h = (c[0] as u32).wrapping_mul(73_856_093)
+        ^ (c[1] as u32).wrapping_mul(19_349_663)
+        ^ (c[2] as u32).wrapping_mul(83_492_791);
+    // Mix the high bits down: the primes leave the low bits weak.
+    let h = h ^ (h >> 15);
+    h.wrapping_mul(0x2c1b_3c6d) & (buckets as u32 - 1)
 }
 
 impl Painter {
@@ -120,16 +173,31 @@ impl Painter {
                     .map_or_else(|| positions[i], |p| p.as_vec3())
             })
             .collect();
-        let mut grid: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
-        for (i, p) in sample_positions.iter().enumerate() {
-            grid.entry(cell_of(*p, cell)).or_default().push(i as u32);
-        }
-        Ok(Self {
+        Ok(Self::from_positions(
+            sample_positions,
             cell,
-            positions: sample_positions,
-            grid,
-            channels: colors.channels(),
-        })
+            colors.channels(),
+        ))
+    }
+
+    /// The index of samples at `positions` (finite), in cells of `cell`.
+    pub(crate) fn from_positions(positions: Vec<Vec3>, cell: f32, channels: usize) -> Self {
+        Self {
+            grid: Grid::new(&positions, cell),
+            positions,
+            channels,
+        }
+    }
+
+    /// Gives the sample positions back (to move them to a new numbering
+    /// and index them again with [`Painter::from_positions`]).
+    pub(crate) fn into_positions(self) -> Vec<Vec3> {
+        self.positions
+    }
+
+    /// The grid's cell size.
+    pub(crate) fn cell(&self) -> f32 {
+        self.grid.cell
     }
 
     /// The 3D position of every sample.
@@ -145,13 +213,14 @@ impl Painter {
         radius: f32,
         mut f: impl FnMut(usize, f32),
     ) -> usize {
-        let lo = cell_of(center - Vec3::splat(radius), self.cell);
-        let hi = cell_of(center + Vec3::splat(radius), self.cell);
+        let grid = &self.grid;
+        let lo = cell_of(center - Vec3::splat(radius), grid.cell);
+        let hi = cell_of(center + Vec3::splat(radius), grid.cell);
         let span = (0..3).fold(1u64, |s, k| {
             s.saturating_mul((i64::from(hi[k]) - i64::from(lo[k]) + 1) as u64)
         });
         let mut examined = 0;
-        let mut visit = |list: &Vec<u32>| {
+        let mut visit = |list: &[u32]| {
             for &i in list {
                 examined += 1;
                 let d = self.positions[i as usize].distance(center);
@@ -160,22 +229,24 @@ impl Painter {
                 }
             }
         };
-        if span > self.grid.len() as u64 {
-            // A brush larger than the occupied grid: scan occupied cells.
-            for (c, list) in &self.grid {
-                if (0..3).all(|k| c[k] >= lo[k] && c[k] <= hi[k]) {
-                    visit(list);
-                }
-            }
+        if span > grid.buckets() as u64 {
+            // A brush larger than the grid: every sample.
+            visit(&grid.items);
         } else {
+            // Each bucket once: cells that share a bucket would otherwise
+            // report its samples twice.
+            let mut buckets = Vec::with_capacity(span as usize);
             for x in lo[0]..=hi[0] {
                 for y in lo[1]..=hi[1] {
                     for z in lo[2]..=hi[2] {
-                        if let Some(list) = self.grid.get(&[x, y, z]) {
-                            visit(list);
-                        }
+                        buckets.push(bucket_of([x, y, z], grid.buckets()));
                     }
                 }
+            }
+            buckets.sort_unstable();
+            buckets.dedup();
+            for b in buckets {
+                visit(grid.bucket(b as usize));
             }
         }
         examined

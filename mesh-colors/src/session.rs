@@ -26,7 +26,9 @@ use glam::Vec3;
 use crate::Error;
 use crate::edit::ResolutionChange;
 use crate::paint::Painter;
-use crate::structure::{MeshColors, Site, lattice_points};
+use crate::structure::{
+    MeshColors, Site, lattice_points, move_segments, samples_per_edge, samples_per_face,
+};
 use crate::undo::{History, Recorder, Step};
 
 /// Answers whether the surface hides a point from an eye.
@@ -217,9 +219,11 @@ pub struct PaintSession {
     colors: MeshColors,
     base: Vec<f32>,
     occluder: Option<Arc<dyn Occluder>>,
-    cell: f32,
     painter: Painter,
+    /// Per sample, its shading normal (see [`normal_at`]).
     normals: Vec<Vec3>,
+    /// Per vertex, the area-weighted sum of its faces' normals.
+    vertex_normals: Vec<Vec3>,
     history: History,
     log: Vec<Edit>,
     open: Option<OpenStroke>,
@@ -266,15 +270,20 @@ impl PaintSession {
         let cell = grid_cell(&positions, colors.topology().faces());
         let sites = colors.sites();
         let painter = Painter::with_sites(&colors, &positions, &sites, cell)?;
-        let normals = sample_normals(&colors, &positions, &sites);
+        let vertex_normals = vertex_normals(colors.topology().faces(), &positions);
+        let faces = colors.topology().faces();
+        let normals = sites
+            .iter()
+            .map(|s| normal_at(faces, &vertex_normals, s))
+            .collect();
         Ok(Self {
             positions,
             colors,
             base,
             occluder,
-            cell,
             painter,
             normals,
+            vertex_normals,
             history: History::new(history),
             log: Vec::new(),
             open: None,
@@ -605,43 +614,137 @@ impl PaintSession {
         if changes.is_empty() {
             return Ok(Changed::Nothing);
         }
+        let before = Numbering::of(&self.colors);
         let change = self.colors.set_face_resolutions(changes)?;
         let faces = resampled(&change);
+        self.reindex(&before, &Resampled::of(&self.colors, &change));
         self.history.push(Step::Resolution(change));
-        self.reindex()?;
         Ok(Changed::Layout(faces))
     }
 
     /// Undo (`back`) or redo one step.
     fn walk(&mut self, back: bool) -> Result<Changed, Error> {
+        let before = Numbering::of(&self.colors);
         let step = if back {
             self.history.undo(&mut self.colors)?
         } else {
             self.history.redo(&mut self.colors)?
         };
-        let changed = match step {
-            None => Changed::Nothing,
-            Some(Step::Paint(d)) => {
-                Changed::Samples(d.runs().iter().flat_map(|&(s, n)| s..s + n).collect())
-            }
-            Some(Step::Resolution(r)) => Changed::Layout(resampled(r)),
+        let (changed, change) = match step {
+            None => (Changed::Nothing, None),
+            Some(Step::Paint(d)) => (
+                Changed::Samples(d.runs().iter().flat_map(|&(s, n)| s..s + n).collect()),
+                None,
+            ),
+            Some(Step::Resolution(r)) => (
+                Changed::Layout(resampled(r)),
+                Some(Resampled::of(&self.colors, r)),
+            ),
         };
-        if let Changed::Layout(_) = changed {
-            self.reindex()?;
+        if let Some(resampled) = change {
+            self.reindex(&before, &resampled);
         }
         Ok(changed)
     }
 
-    /// Rebuilds what depends on the sample numbering (and returns the
-    /// spare capacity the change left, so the memory reported is what the
-    /// colours need).
-    fn reindex(&mut self) -> Result<(), Error> {
+    /// Brings what depends on the sample numbering (the brush's grid, the
+    /// samples' positions and normals) to the numbering after `change`,
+    /// which left the colours numbered as `before` said. The samples of
+    /// the primitives `change` resampled get new positions and normals;
+    /// the others move to their new numbers (one pass, as the colours'
+    /// samples moved); the grid is indexed again (two passes, no
+    /// geometry). The result equals a session built on these colours
+    /// from scratch. Also gives back the spare capacity the change left,
+    /// so the memory reported is what the colours need.
+    fn reindex(&mut self, before: &Numbering, resampled: &Resampled) {
         self.colors.shrink_to_fit();
-        // One pass over the samples' sites serves the grid and the normals.
-        let sites = self.colors.sites();
-        self.painter = Painter::with_sites(&self.colors, &self.positions, &sites, self.cell)?;
-        self.normals = sample_normals(&self.colors, &self.positions, &sites);
-        Ok(())
+        let mc = &self.colors;
+        let Resampled { edge_new, face_new } = resampled;
+        let segments = before.segments(mc, edge_new, face_new);
+        let total = mc.sample_count();
+        let cell = self.painter.cell();
+        let painter = std::mem::replace(
+            &mut self.painter,
+            Painter::from_positions(Vec::new(), cell, mc.channels()),
+        );
+        let mut positions = painter.into_positions();
+        move_segments(&mut positions, 1, &segments, total);
+        move_segments(&mut self.normals, 1, &segments, total);
+        let faces = mc.topology().faces();
+        let mut place = |i: usize, site: Site| {
+            positions[i] = site
+                .position(mc.topology(), &self.positions)
+                .map_or_else(|| self.positions[i], |p| p.as_vec3());
+            self.normals[i] = normal_at(faces, &self.vertex_normals, &site);
+        };
+        for e in (0..edge_new.len()).filter(|&e| edge_new[e]) {
+            mc.edge_sites(e, &mut place);
+        }
+        for f in (0..face_new.len()).filter(|&f| face_new[f]) {
+            mc.face_sites(f, &mut place);
+        }
+        // No shrink_to_fit: the spare capacity a raise leaves serves the
+        // next one without another copy (these are not the colours'
+        // reported memory).
+        self.painter = Painter::from_positions(positions, cell, mc.channels());
+    }
+}
+
+/// Which edges and faces a resolution change (or its undo) resampled.
+struct Resampled {
+    edge_new: Vec<bool>,
+    face_new: Vec<bool>,
+}
+
+impl Resampled {
+    fn of(colors: &MeshColors, change: &ResolutionChange) -> Self {
+        let mut edge_new = vec![false; colors.edge_level.len()];
+        for (e, _, _) in change.edges() {
+            edge_new[e] = true;
+        }
+        let mut face_new = vec![false; colors.face_level.len()];
+        for (f, _, _) in change.faces() {
+            face_new[f] = true;
+        }
+        Self { edge_new, face_new }
+    }
+}
+
+/// Where the edges' and faces' samples started before a resolution change
+/// (the vertices' never move): what [`PaintSession::reindex`] moves the
+/// per-sample data from.
+struct Numbering {
+    edge_offset: Vec<usize>,
+    face_offset: Vec<usize>,
+}
+
+impl Numbering {
+    fn of(colors: &MeshColors) -> Self {
+        Self {
+            edge_offset: colors.edge_offset.clone(),
+            face_offset: colors.face_offset.clone(),
+        }
+    }
+
+    /// The moves `(old first sample, new first sample, samples, kept)`
+    /// from this numbering to that of `colors`, in layout order, for
+    /// `move_segments`; resampled primitives (`edge_new`, `face_new`) are
+    /// not kept.
+    fn segments(
+        &self,
+        colors: &MeshColors,
+        edge_new: &[bool],
+        face_new: &[bool],
+    ) -> Vec<(usize, usize, usize, bool)> {
+        let edges = (0..edge_new.len()).map(|e| {
+            let n = samples_per_edge(1 << colors.edge_level[e]) as usize;
+            (self.edge_offset[e], colors.edge_offset[e], n, !edge_new[e])
+        });
+        let faces = (0..face_new.len()).map(|f| {
+            let n = samples_per_face(1 << colors.face_level[f]) as usize;
+            (self.face_offset[f], colors.face_offset[f], n, !face_new[f])
+        });
+        edges.chain(faces).collect()
     }
 }
 
@@ -671,10 +774,8 @@ fn grid_cell(positions: &[Vec3], faces: &[[u32; 3]]) -> f32 {
     }
 }
 
-/// Each sample's shading normal: the area-weighted vertex normals
-/// interpolated at its site (what the page shades with).
-fn sample_normals(colors: &MeshColors, positions: &[Vec3], sites: &[Site]) -> Vec<Vec3> {
-    let faces = colors.topology().faces();
+/// Per vertex, the sum of its faces' normals weighted by area.
+fn vertex_normals(faces: &[[u32; 3]], positions: &[Vec3]) -> Vec<Vec3> {
     let mut vertex = vec![Vec3::ZERO; positions.len()];
     for f in faces {
         let [a, b, c] = f.map(|v| positions[v as usize]);
@@ -684,19 +785,20 @@ fn sample_normals(colors: &MeshColors, positions: &[Vec3], sites: &[Site]) -> Ve
             vertex[v as usize] += n;
         }
     }
-    sites
-        .iter()
-        .map(|s| {
-            let Some(f) = faces.get(s.face as usize) else {
-                return Vec3::ZERO;
-            };
-            let mut n = Vec3::ZERO;
-            for (b, &v) in s.barycentric.iter().zip(f) {
-                n += *b as f32 * vertex[v as usize];
-            }
-            n.normalize_or_zero()
-        })
-        .collect()
+    vertex
+}
+
+/// A sample's shading normal: the area-weighted vertex normals
+/// interpolated at its site (what the page shades with).
+fn normal_at(faces: &[[u32; 3]], vertex: &[Vec3], site: &Site) -> Vec3 {
+    let Some(f) = faces.get(site.face as usize) else {
+        return Vec3::ZERO;
+    };
+    let mut n = Vec3::ZERO;
+    for (b, &v) in site.barycentric.iter().zip(f) {
+        n += *b as f32 * vertex[v as usize];
+    }
+    n.normalize_or_zero()
 }
 
 /// The faces joined to `face` through shared edges, in increasing order.
@@ -746,4 +848,102 @@ fn distance_to_triangle(q: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
             (p + d * t).distance(q)
         })
         .fold(f32::INFINITY, f32::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Topology;
+
+    /// A wavy `n × n` grid of quads, two triangles each, at mixed levels.
+    fn wavy(n: u32) -> (Vec<Vec3>, MeshColors) {
+        let mut positions = Vec::new();
+        for y in 0..=n {
+            for x in 0..=n {
+                let (u, v) = (x as f32 / n as f32, y as f32 / n as f32);
+                positions.push(Vec3::new(u, v, 0.1 * (7.0 * u).sin() * (5.0 * v).cos()));
+            }
+        }
+        let at = |x: u32, y: u32| y * (n + 1) + x;
+        let mut faces = Vec::new();
+        for y in 0..n {
+            for x in 0..n {
+                faces.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+                faces.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+            }
+        }
+        let topology = Topology::new(positions.len(), &faces).unwrap();
+        let levels: Vec<u32> = (0..faces.len()).map(|f| 1 << (f * 7 % 4)).collect();
+        let mut colors = MeshColors::new(topology, &levels, 3).unwrap();
+        for (i, x) in colors.samples_mut().iter_mut().enumerate() {
+            *x = (i as f32 * 0.37).sin();
+        }
+        (positions, colors)
+    }
+
+    /// What a session built from scratch on the colours indexes.
+    fn assert_index_as_new(s: &PaintSession, what: &str) {
+        let fresh = PaintSession::new(
+            s.positions.clone(),
+            s.colors.clone(),
+            s.base.clone(),
+            1,
+            None,
+        )
+        .unwrap();
+        let bits = |v: &[Vec3]| -> Vec<[u32; 3]> {
+            v.iter().map(|p| p.to_array().map(f32::to_bits)).collect()
+        };
+        assert_eq!(
+            bits(s.painter.sample_positions()),
+            bits(fresh.painter.sample_positions()),
+            "{what}: positions"
+        );
+        assert_eq!(bits(&s.normals), bits(&fresh.normals), "{what}: normals");
+        for k in 0..20 {
+            let centre = s.positions[(k * 37) % s.positions.len()];
+            let radius = 0.02 + 0.05 * (k % 5) as f32;
+            let hits = |p: &Painter| {
+                let mut v = Vec::new();
+                p.for_each_within(centre, radius, |i, d| v.push((i, d.to_bits())));
+                v.sort_unstable();
+                v
+            };
+            assert_eq!(hits(&s.painter), hits(&fresh.painter), "{what}: dab {k}");
+        }
+    }
+
+    #[test]
+    fn the_index_after_detail_undo_and_redo_equals_one_built_from_scratch() {
+        let (positions, colors) = wavy(8);
+        let mut s = PaintSession::new(positions, colors, vec![0.5; 3], 50, None).unwrap();
+        // A fixed pseudo-random sequence (SplitMix64-like, seed 7).
+        let mut state = 7u64;
+        let mut next = move || {
+            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+            let mut z = state;
+            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+            z ^ (z >> 31)
+        };
+        for step in 0..40 {
+            let edit = match next() % 6 {
+                0 | 1 => {
+                    let v = s.positions[(next() % s.positions.len() as u64) as usize];
+                    Edit::Detail {
+                        center: v,
+                        radius: 0.05 + 0.3 * (next() % 100) as f32 / 100.0,
+                        levels: [1, 2, -1, -2][(next() % 4) as usize],
+                    }
+                }
+                2 => Edit::Resolution {
+                    level: (next() % 4) as u8,
+                },
+                3 | 4 => Edit::Undo,
+                _ => Edit::Redo,
+            };
+            s.apply(edit.clone()).unwrap();
+            assert_index_as_new(&s, &format!("step {step}, {edit:?}"));
+        }
+    }
 }

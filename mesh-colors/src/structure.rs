@@ -357,6 +357,61 @@ impl MeshColors {
         sites
     }
 
+    /// The sites of edge `e`'s samples, as [`MeshColors::sites`] gives
+    /// them (on the edge's first face, in face order): `f(sample, site)`.
+    pub(crate) fn edge_sites(&self, e: usize, mut f: impl FnMut(usize, Site)) {
+        let t = &self.topology;
+        let Some(g) = t.edge_faces[e]
+            .iter()
+            .copied()
+            .filter(|&g| g != NO_FACE)
+            .min()
+        else {
+            return;
+        };
+        let g = g as usize;
+        let Some(k) = (0..3).find(|&k| t.face_edges[g][k] as usize == e) else {
+            return;
+        };
+        // Every face of an edge is at least as fine as the edge, so its
+        // lattice reaches each of the edge's samples.
+        let r = 1u32 << self.face_level[g];
+        for s in 1..r {
+            let mut a = [0u32; 3];
+            a[k] = r - s;
+            a[(k + 1) % 3] = s;
+            if let Some(i) = self.lattice_index(g, a)
+                && i >= self.topology.vertex_count
+            {
+                let barycentric = sample_position(r, a[0], a[1]);
+                f(
+                    i,
+                    Site {
+                        face: g as u32,
+                        barycentric,
+                    },
+                );
+            }
+        }
+    }
+
+    /// The sites of face `f`'s interior samples (on `f`): `out(sample,
+    /// site)`.
+    pub(crate) fn face_sites(&self, f: usize, mut out: impl FnMut(usize, Site)) {
+        let r = 1u32 << self.face_level[f];
+        for i in 1..r {
+            for j in 1..r - i {
+                out(
+                    self.face_offset[f] + interior_index(r, i, j),
+                    Site {
+                        face: f as u32,
+                        barycentric: sample_position(r, i, j),
+                    },
+                );
+            }
+        }
+    }
+
     /// Sets every sample from a function of its 3D position, `f(p, out)`
     /// writing `channels()` values.
     ///
@@ -462,14 +517,14 @@ pub fn lattice_points(r: u32) -> impl Iterator<Item = [u32; 3]> {
 /// moving towards the front go first, front to back, then those moving
 /// towards the back, back to front: neither overwrites a segment still to
 /// be moved. Only a grown tail is newly allocated.
-pub(crate) fn move_segments(
-    buf: &mut Vec<f32>,
+pub(crate) fn move_segments<T: Copy + Default>(
+    buf: &mut Vec<T>,
     c: usize,
     segments: &[(usize, usize, usize, bool)],
     total: usize,
 ) {
     if buf.len() < total * c {
-        buf.resize(total * c, 0.0);
+        buf.resize(total * c, T::default());
     }
     for &(from, to, len, keep) in segments {
         if keep && to < from {

@@ -123,3 +123,28 @@ fn a_dab_touches_exactly_the_samples_within_its_radius() {
         "a stale index is refused"
     );
 }
+
+#[test]
+fn the_grid_finds_each_sample_within_the_radius_once_at_any_cell_size() {
+    let (positions, faces) = support::grid(12, 0.3);
+    let mc = MeshColors::uniform(Topology::new(positions.len(), &faces).unwrap(), 4, 3).unwrap();
+    // Cells far smaller than the brush (many cells share a bucket), about
+    // its size, and larger than the mesh.
+    for cell in [0.004, 0.05, 3.0] {
+        let painter = Painter::new(&mc, &positions, cell).unwrap();
+        let all = painter.sample_positions();
+        for k in 0..25 {
+            let center = positions[(k * 31) % positions.len()] + Vec3::new(0.01, -0.02, 0.03);
+            let radius = [0.01, 0.07, 0.3, 2.0, 0.0][k % 5];
+            let mut found = Vec::new();
+            painter.for_each_within(center, radius, |i, d| found.push((i, d.to_bits())));
+            found.sort_unstable();
+            let want: Vec<(usize, u32)> = (0..all.len())
+                .map(|i| (i, all[i].distance(center)))
+                .filter(|&(_, d)| d <= radius)
+                .map(|(i, d)| (i, d.to_bits()))
+                .collect();
+            assert_eq!(found, want, "cell {cell}, dab {k}");
+        }
+    }
+}

@@ -215,6 +215,11 @@ fn the_mip_map_follows_a_resolution_change_as_a_rebuild_would() {
     for round in 0..30 {
         let mut mc = random_colors(&mut rng);
         let mut mip = mc.mip_map();
+        if round % 2 == 0 {
+            // A lookup builds the lookup cache, which the refresh must
+            // then keep up to date (odd rounds: it is built afterwards).
+            mip.at_level(0, [0.2, 0.3, 0.5], 1, &mut [0.0; 3]).unwrap();
+        }
         let changes = random_changes(&mc, &mut rng);
         let change = mc.set_face_resolutions(&changes).unwrap();
         let faces: Vec<usize> = change.faces().map(|f| f.0).collect();
@@ -232,10 +237,12 @@ fn the_mip_map_follows_a_resolution_change_as_a_rebuild_would() {
             bad.len(),
             &bad[..bad.len().min(10)]
         );
-        assert!(mip == want, "round {round}: the caches differ");
+        assert!(mip == want, "round {round}: the pyramids differ");
+        assert_same_lookups(&mip, &want, &format!("round {round}"));
         mc.revert_resolutions(&change).unwrap();
         mip.refresh_resolutions(&mc, &faces).unwrap();
         assert_eq!(mip, mc.mip_map(), "round {round}: reverted");
+        assert_same_lookups(&mip, &mc.mip_map(), &format!("round {round}, reverted"));
     }
     // Leaving out a changed face, or another mesh, is refused by name.
     let mut mc = random_colors(&mut rng);
@@ -256,4 +263,24 @@ fn the_mip_map_follows_a_resolution_change_as_a_rebuild_would() {
     let e = mip.refresh_resolutions(&other, &[0]).unwrap_err();
     assert!(e.to_string().contains("`colors`"), "{e}");
     assert_eq!(mip, before);
+}
+
+/// Every level's lookups (which read the pyramid's lookup cache inside
+/// faces) are the same bits from `a` and `b`.
+fn assert_same_lookups(a: &mesh_colors::MipMap, b: &mesh_colors::MipMap, what: &str) {
+    let points = [[0.2, 0.3, 0.5], [0.61, 0.13, 0.26], [0.05, 0.9, 0.05]];
+    let (mut x, mut y) = ([0.0f32; 3], [0.0f32; 3]);
+    for f in 0..a.colors().face_count() {
+        for b3 in points {
+            for q in (0..=6).chain([mesh_colors::FINEST_LEVEL]) {
+                a.at_level(f, b3, q, &mut x).unwrap();
+                b.at_level(f, b3, q, &mut y).unwrap();
+                assert_eq!(
+                    x.map(f32::to_bits),
+                    y.map(f32::to_bits),
+                    "{what}: face {f} at {b3:?}, level {q}"
+                );
+            }
+        }
+    }
 }
