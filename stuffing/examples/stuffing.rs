@@ -369,8 +369,7 @@ fn peer_rows(
         let m = match result {
             Ok(m) => m,
             Err(e) => {
-                let label = format!("{peer:?}");
-                println!("| {name} | {label} | {e} | | | | | | | | | | | |");
+                println!("| {name} | {} | {e} | | | | | | | | | | | |", peer.name());
                 continue;
             }
         };

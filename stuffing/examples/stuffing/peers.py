@@ -43,6 +43,8 @@ def gmsh(v, f, size):
     gmsh.initialize(["-noenv"], readConfigFiles=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
+        # Gmsh logs most failures instead of raising: keep the log to say why.
+        gmsh.logger.start()
         gmsh.model.add("surface")
         start = time.perf_counter()
         s = gmsh.model.addDiscreteEntity(2)
@@ -60,7 +62,12 @@ def gmsh(v, f, size):
         tags, coords, _ = gmsh.model.mesh.getNodes()
         _, tet_tags, tet_nodes = gmsh.model.mesh.getElements(3)
         if not tet_nodes:
-            raise RuntimeError("no tetrahedra")
+            # An open surface floods its volume: Gmsh only warns.
+            log = gmsh.logger.get()
+            said = [m for m in log if m.startswith("Error")] or [
+                m for m in log if m.startswith("Warning")
+            ]
+            raise RuntimeError("no tetrahedra" + (f" ({said[-1]})" if said else ""))
         index = np.zeros(int(tags.max()) + 1, dtype=np.int64)
         index[tags.astype(np.int64)] = np.arange(len(tags))
         elems = index[np.concatenate(tet_nodes).astype(np.int64)].reshape(-1, 4)

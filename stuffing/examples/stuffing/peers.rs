@@ -38,6 +38,15 @@ impl Peer {
     /// Every peer, in the table's order.
     pub(crate) const ALL: [Peer; 3] = [Peer::TetGen, Peer::Gmsh, Peer::FTetWild];
 
+    /// The name the table gives it.
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Peer::TetGen => "TetGen",
+            Peer::Gmsh => "Gmsh",
+            Peer::FTetWild => "fTetWild",
+        }
+    }
+
     /// The name `peers.py` takes and the output files carry.
     fn tool(self) -> &'static str {
         match self {
