@@ -67,9 +67,20 @@ pub(crate) fn refine(
     let mut mesh = Dynamic::new(&mut mesh.positions, &mut mesh.tets, &mut mesh.boundary);
     let mut refined = Refined::default();
     let mut candidates: Vec<u32> = (0..targets.len() as u32).collect();
+    // Boundary vertices whose edges to look at: all at first, then those
+    // of far edges and of changed triangles (elsewhere nothing moved).
+    let mut watched = vec![true; mesh.positions.len()];
     for _ in 0..ROUNDS {
         let mut jobs = far_input(&mesh, targets, &candidates, eps);
-        jobs.extend(far_boundary(wn, input, &mesh, eps));
+        let far_edges = far_boundary(wn, input, &mesh, eps, &watched);
+        watched = vec![false; mesh.positions.len()];
+        for job in &far_edges {
+            if let Some((a, b)) = job.edge {
+                watched[a as usize] = true;
+                watched[b as usize] = true;
+            }
+        }
+        jobs.extend(far_edges);
         jobs.sort_unstable_by(|a, b| b.d2.total_cmp(&a.d2).then(a.order.cmp(&b.order)));
         let mut busy = vec![false; mesh.positions.len()];
         let mut again = Vec::new();
@@ -97,8 +108,10 @@ pub(crate) fn refine(
             splits += 1;
             again.extend(job.input_point);
             busy.resize(mesh.positions.len(), false);
+            watched.resize(mesh.positions.len(), false);
             for v in changed {
                 busy[v as usize] = true;
+                watched[v as usize] = true;
             }
             if mesh.positions[m as usize] == job.target {
                 refined.on_input.push(m);
@@ -160,8 +173,14 @@ fn far_input(mesh: &Dynamic<'_>, targets: &[DVec3], candidates: &[u32], eps: f64
 /// midpoint of every boundary edge (where a chord between two vertices on
 /// the input is farthest from it), but not on hole caps
 /// ([`on_hole_cap`]): split that edge towards the input point nearest its
-/// midpoint.
-fn far_boundary(wn: &WindingNumber, input: &Surface<'_>, mesh: &Dynamic<'_>, eps: f64) -> Vec<Job> {
+/// midpoint. Only edges with a `watched` end are looked at.
+fn far_boundary(
+    wn: &WindingNumber,
+    input: &Surface<'_>,
+    mesh: &Dynamic<'_>,
+    eps: f64,
+    watched: &[bool],
+) -> Vec<Job> {
     let edges: Vec<(u32, u32, u32)> = mesh
         .boundary
         .iter()
@@ -171,7 +190,7 @@ fn far_boundary(wn: &WindingNumber, input: &Surface<'_>, mesh: &Dynamic<'_>, eps
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 // Each edge once (from the triangle that has it as a→b
                 // with a < b; a closed boundary has both directions).
-                (a < b).then_some((a, b, f as u32))
+                (a < b && (watched[a as usize] || watched[b as usize])).then_some((a, b, f as u32))
             })
         })
         .collect();
