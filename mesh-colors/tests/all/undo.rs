@@ -257,7 +257,7 @@ fn any_bit_pattern_survives_undo_and_redo_in_any_channel_count() {
 #[test]
 fn strokes_over_a_flat_base_colour_cost_little() {
     // A new document: one base colour everywhere; the old values of the
-    // first strokes are all that colour and code to a tag byte each.
+    // first strokes are all that colour and compress to almost nothing.
     let (positions, faces) = support::grid(60, 0.0);
     let mut mc =
         MeshColors::uniform(Topology::new(positions.len(), &faces).unwrap(), 8, 3).unwrap();
