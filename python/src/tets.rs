@@ -53,8 +53,11 @@ pub(crate) fn tets_in(
 /// `mean_distance_fraction` of the bounding box's `diagonal`, measured at
 /// `distance_points` (input, boundary) points — `left_out_triangles` and
 /// `left_out_area_fraction` (input triangles that enclose no volume, also
-/// a `UserWarning`), `envelope`, `fitted_vertices` and `sharp_edges` (the
-/// fit, see below), and `seconds`. Measuring the distances costs up to
+/// a `UserWarning`), `hole_caps_fraction` and `hole_caps_to_input` (the
+/// share of boundary points capping holes of the surface, left out of
+/// `tets_to_input`, and their farthest distance), `envelope`,
+/// `fitted_vertices`, `split_edges` and `sharp_edges` (the fit, see
+/// below), and `seconds`. Measuring the distances costs up to
 /// as much again as the stuffing on inputs of 10⁵ triangles.
 ///
 /// `spacing`: the lattice spacing in mesh units (default: 1/40 of the
@@ -63,8 +66,10 @@ pub(crate) fn tets_in(
 /// the diagonal between 0 and 1, e.g. 0.002; default None, off) fits the
 /// boundary to the surface: boundary vertices move onto tips, creases and
 /// thin parts farther than it from the boundary, keeping every dihedral
-/// angle at 10° or more; not a guarantee, the report's `hausdorff` says
-/// how near it came, `fitted_vertices` and `sharp_edges` what it did. The
+/// angle at 10° or more, and splits boundary edges where moves are not
+/// enough (at most 3× the tetrahedra); not a guarantee, the report's
+/// `hausdorff` says how near it came, `fitted_vertices`, `split_edges`
+/// and `sharp_edges` what it did. The
 /// GIL is released.
 #[pyfunction]
 #[pyo3(signature = (mesh, *, spacing = None, graded = false, envelope = None, return_report = false))]
@@ -106,6 +111,7 @@ pub(crate) fn tetrahedralize<'py>(
         d.set_item("envelope", envelope)?;
         d.set_item("fitted_vertices", r.fitted_vertices)?;
         d.set_item("sharp_edges", r.sharp_edges)?;
+        d.set_item("split_edges", r.split_edges)?;
         if let Some(m) = &r.distance {
             d.set_item("hausdorff", m.hausdorff)?;
             d.set_item("hausdorff_fraction", m.hausdorff_fraction())?;
@@ -117,6 +123,8 @@ pub(crate) fn tetrahedralize<'py>(
             d.set_item("distance_points", (m.input_samples, m.boundary_samples))?;
             d.set_item("left_out_triangles", m.left_out_triangles)?;
             d.set_item("left_out_area_fraction", m.left_out_area)?;
+            d.set_item("hole_caps_fraction", m.hole_caps)?;
+            d.set_item("hole_caps_to_input", m.hole_caps_to_input)?;
         }
         d.set_item("seconds", r.elapsed.as_secs_f64())?;
         items.push(d.into_any());

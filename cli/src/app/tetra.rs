@@ -29,9 +29,10 @@ pub(crate) struct Args {
     pub(crate) graded: bool,
     /// Fit the boundary to the surface: move boundary vertices onto tips,
     /// creases and thin parts farther than EPS (a fraction of the bounding
-    /// box's diagonal, e.g. 0.002) from it, keeping every dihedral angle
-    /// at 10° or more. Not a guarantee: the summary prints the distance
-    /// reached.
+    /// box's diagonal, e.g. 0.002) from it, splitting boundary edges where
+    /// moves are not enough (at most 3x the tetrahedra), keeping every
+    /// dihedral angle at 10° or more. Not a guarantee: the summary prints
+    /// the distance reached.
     #[arg(long, value_name = "EPS")]
     pub(crate) envelope: Option<f64>,
     /// The tetrahedral mesh: .node (with .ele), .mesh or .vtu.
@@ -124,9 +125,10 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         if args.graded { " (graded)" } else { "" },
         args.envelope
             .map(|eps| format!(
-                ", fitted to an envelope of {}% of the diagonal ({} boundary vertices moved, {} creases)",
+                ", fitted to an envelope of {}% of the diagonal ({} boundary vertices moved, {} edges split, {} creases)",
                 significant(100.0 * eps),
                 r.fitted_vertices,
+                r.split_edges,
                 r.sharp_edges
             ))
             .unwrap_or_default(),
@@ -152,6 +154,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "envelope": args.envelope,
         "fitted_vertices": r.fitted_vertices,
         "sharp_edges": r.sharp_edges,
+        "split_edges": r.split_edges,
         "dihedral_degrees": [r.min_dihedral_deg, r.max_dihedral_deg],
         "distance": r.distance.as_ref().map(distance_json),
         "stuffing_seconds": r.elapsed.as_secs_f64(),
@@ -198,8 +201,19 @@ fn significant(x: f64) -> String {
 
 /// The summary's clause on how far the boundary lies from the surface.
 fn distance_text(d: &tet_stuffing::SurfaceDistance) -> String {
+    // Caps over the surface's holes are measured apart: their distance is
+    // the hole's size, not the mesh's error.
+    let caps = if d.hole_caps > 0.0 {
+        format!(
+            "; {:.1}% of the boundary caps holes of the surface, up to {:.3}% from it",
+            100.0 * d.hole_caps,
+            100.0 * d.hole_caps_to_input / d.diagonal.max(f64::MIN_POSITIVE)
+        )
+    } else {
+        String::new()
+    };
     format!(
-        "; boundary within {:.3}% of the diagonal of the surface (Hausdorff; mean {:.3}%; {} + {} points measured)",
+        "; boundary within {:.3}% of the diagonal of the surface (Hausdorff; mean {:.3}%; {} + {} points measured{caps})",
         100.0 * d.hausdorff_fraction(),
         100.0 * d.mean_fraction(),
         d.input_samples,
@@ -222,5 +236,7 @@ fn distance_json(d: &tet_stuffing::SurfaceDistance) -> serde_json::Value {
         "boundary_points": d.boundary_samples,
         "left_out_triangles": d.left_out_triangles,
         "left_out_area_fraction": d.left_out_area,
+        "hole_caps_fraction": d.hole_caps,
+        "hole_caps_to_input": d.hole_caps_to_input,
     })
 }

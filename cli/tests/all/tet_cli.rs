@@ -151,7 +151,13 @@ fn tetra_fits_the_boundary_to_an_envelope_and_says_how_near_it_came() {
     let fitted = json(d, &args);
     assert_eq!(fitted["envelope"], 0.002, "{fitted}");
     assert!(fitted["fitted_vertices"].as_u64().unwrap() > 0, "{fitted}");
-    assert_eq!(fitted["tetrahedra"], plain["tetrahedra"]);
+    // The fit may split boundary edges where moves are not enough, within
+    // three times the stuffed count.
+    let count = |r: &serde_json::Value| r["tetrahedra"].as_u64().unwrap();
+    assert!(
+        count(&fitted) >= count(&plain) && count(&fitted) <= 3 * count(&plain),
+        "{fitted} vs {plain}"
+    );
     assert!(
         fitted["dihedral_degrees"][0].as_f64().unwrap() >= 10.0,
         "{fitted}"
