@@ -71,15 +71,30 @@ impl Header {
 
 /// Appends `values` as little-endian f32.
 pub fn put_f32(out: &mut Vec<u8>, values: impl IntoIterator<Item = f32>) {
-    for v in values {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
+    put_words(out, values.into_iter().map(f32::to_bits));
 }
 
 /// Appends `values` as little-endian u32.
 pub fn put_u32(out: &mut Vec<u8>, values: impl IntoIterator<Item = u32>) {
-    for v in values {
-        out.extend_from_slice(&v.to_le_bytes());
+    put_words(out, values.into_iter());
+}
+
+/// Appends `words` little-endian, reserving their size once: a paint
+/// page's sample texture is tens of megabytes, which growing by doubling
+/// would copy again and again.
+fn put_words(out: &mut Vec<u8>, mut words: impl Iterator<Item = u32>) {
+    // The words the iterator promises go into bytes allocated at once (a
+    // loop without a capacity check per word); any beyond, one by one.
+    let start = out.len();
+    out.resize(start + words.size_hint().0 * 4, 0);
+    let mut written = start;
+    for (bytes, w) in out[start..].chunks_exact_mut(4).zip(&mut words) {
+        bytes.copy_from_slice(&w.to_le_bytes());
+        written += 4;
+    }
+    out.truncate(written);
+    for w in words {
+        out.extend_from_slice(&w.to_le_bytes());
     }
 }
 
@@ -108,5 +123,22 @@ mod tests {
         put_f32(&mut v, [1.0]);
         put_u32(&mut v, [2]);
         assert_eq!(v, [0, 0, 128, 63, 2, 0, 0, 0]);
+    }
+
+    #[test]
+    fn words_are_the_same_bytes_whatever_the_iterator_promises() {
+        let words: Vec<u32> = (0..1000u32).map(|i| i.wrapping_mul(0x9E37_79B9)).collect();
+        let want: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        // Exact size, no size known (filter), and after earlier bytes.
+        let mut exact = Vec::new();
+        put_u32(&mut exact, words.iter().copied());
+        let mut unknown = Vec::new();
+        put_u32(&mut unknown, words.iter().copied().filter(|_| true));
+        let mut after = vec![9u8];
+        put_f32(&mut after, words.iter().map(|&w| f32::from_bits(w)));
+        assert_eq!(exact, want);
+        assert_eq!(unknown, want);
+        assert_eq!(after[0], 9);
+        assert_eq!(&after[1..], &want[..]);
     }
 }
