@@ -28,7 +28,11 @@
 //! playwright-core in `target/browser-e2e`, installed by `.ci/run`);
 //! without them the test prints a notice and passes, unless `CI` is set.
 //! `TRILUX_PAINT_BENCH=1` also measures the Table I ratios (mesh-colour
-//! shader against the baked atlas as a plain 2D texture) and prints them.
+//! shader against the baked atlas as a plain 2D texture) and prints them;
+//! its scene stays in `target/paint-shader/bench`, and `node
+//! target/browser-e2e/meshcolors_parity.mjs cli/src/paint/page/meshcolors.js
+//! target/paint-shader/bench --bench` (from the workspace root) times the
+//! browser side again alone.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -520,7 +524,11 @@ fn the_mesh_colour_shader_matches_the_cpu_filters_in_chromium() {
     assert!(differ("trilinear", "linear") > 5_000);
     assert!(differ("anisotropic", "trilinear") > 1_000);
     if std::env::var_os("TRILUX_PAINT_BENCH").is_some() {
-        bench(&h, dir, &colors, &positions, &layout);
+        // The bench's scene stays in target/paint-shader/bench, so that
+        // the browser side can be timed again alone (cli/README.md).
+        let kept = h.root.join("target/paint-shader/bench");
+        std::fs::create_dir_all(&kept).unwrap();
+        bench(&h, &kept, &colors, &positions, &layout);
     }
 }
 

@@ -9,8 +9,16 @@
 //
 // Geometry: unindexed triangles, three vertices per face in face order, so
 // the face id is gl_VertexID / 3 and corner k of a face gets the
-// barycentric e_k. No attribute but the position is needed, and a face's
-// table entry is fetched once per fragment by that flat id.
+// barycentric e_k. No attribute but the position is needed: the vertex
+// shader fetches its face's table entry by that id and passes it decoded
+// as flat varyings, so no fragment reads the table.
+//
+// Cost in SwiftShader (software WebGL: four fragments run at once through
+// every path any of them takes, integer division lane by lane) shaped the
+// code: one program per filter, display and output; no integer division;
+// the rare corner and edge cases in loops that run once or not at all
+// (a quad that needs neither skips them). The Table I bench is in
+// cli/tests/all/paint_shader.rs.
 //
 // Usage:
 //   const mc = new MeshColorsRenderer(gl);
@@ -22,18 +30,49 @@
 
 // Face table words (gpu.rs, "Face table"): w0 = F, w1..w3 = V_k, w4..w6 =
 // E_k, w7 = packed levels and edge directions.
-const VS = `#version 300 es
+const VS = `
+precision highp float;
+precision highp int;
+precision highp usampler2D;
 in vec3 position;
 uniform mat4 viewProj;
-flat out int vFace;
+uniform usampler2D faces;    // RGBA32UI, GpuLayout::face_texels
 out vec3 vBary;
 out vec3 vWorld;
+// The face's table entry, decoded here (three times a face) instead of in
+// every fragment: flat, so each fragment reads its face's words as they are.
+flat out int vFace;
+flat out float vTag;          // (face id mod 255 + 1) / 255 (tagAlpha)
+flat out uvec4 vFV;          // w0..w3: F, V_0, V_1, V_2
+flat out uvec3 vE;           // w4..w6: E_0, E_1, E_2
+flat out ivec4 vLevels;      // n, vl_0, vl_1, vl_2 (at most MAX_LEVEL)
+flat out ivec4 vEdges;       // el_0, el_1, el_2 (at most n), edge direction bits 0-2
+const int MAX_LEVEL = 10;    // mesh_colors::MAX_LEVEL
 void main() {
   vWorld = position;
   // drawArrays from 0: vertex 3f + k is corner k of face f.
   vFace = gl_VertexID / 3;
   int k = gl_VertexID - 3 * vFace;
+  vTag = float(vFace % 255 + 1) / 255.0;
   vBary = vec3(k == 0, k == 1, k == 2);
+  int w = textureSize(faces, 0).x;
+  int t = 2 * vFace;
+  uvec4 a = texelFetch(faces, ivec2(t % w, t / w), 0);
+  uvec4 b = texelFetch(faces, ivec2((t + 1) % w, (t + 1) / w), 0);
+  uint bits = b.w;
+  vFV = a;
+  vE = b.xyz;
+  int n = min(int(bits & 15u), MAX_LEVEL);
+  uvec3 shift = uvec3(0u, 4u, 8u);
+  vLevels = ivec4(n, min(ivec3((uvec3(bits) >> (shift + 4u)) & 15u), ivec3(MAX_LEVEL)));
+  // An edge is never finer than its face (as the CPU clamps it).
+  ivec3 el = min(ivec3((uvec3(bits) >> (shift + 16u)) & 15u), ivec3(n));
+#ifdef TWIN_EDGE_DIRECTION
+  int fwd = 7;               // the wrong twin: every edge read from corner k
+#else
+  int fwd = int((bits >> 28u) & 7u);
+#endif
+  vEdges = ivec4(el, fwd);
   gl_Position = viewProj * vec4(position, 1.0);
 }`;
 
@@ -44,20 +83,27 @@ precision highp sampler2D;
 precision highp usampler2D;
 
 uniform sampler2D samples;   // RGBA32F, GpuLayout::sample_texels
-uniform usampler2D faces;    // RGBA32UI, GpuLayout::face_texels
 uniform int perValue;        // P = ceil(channels / 4) texels per value
 uniform int group;           // which texel of a value is shown (channel / 4)
-uniform int filterMode;      // 0 nearest, 1 linear, 2 level, 3 trilinear, 4 anisotropic
+// The filter, display and output are compile-time constants: one program
+// per combination (MeshColorsRenderer.program), so that a program holds only
+// its own path (SwiftShader runs every path of a program it cannot rule out).
+const int filterMode = FILTER_MODE;  // 0 nearest, 1 linear, 2 level, 3 trilinear, 4 anisotropic
 uniform int level;           // the level of filterMode 2
 uniform int maxSamples;      // anisotropic probes at most
-uniform int display;         // 0 RGB of the group, 1 grey of one component, 2 heat map of it
+const int display = DISPLAY;  // 0 RGB of the group, 1 grey of one component, 2 heat map of it
 uniform int component;       // the component (channel % 4) displays 1 and 2 show
 uniform vec2 heatRange;      // the values mapped to the ends of the heat map
-uniform int outputMode;      // 0 colour; 1 pick: face, barycentrics and their derivatives
+const int outputMode = OUTPUT_MODE;  // 0 colour; 1 pick: face, barycentrics and their derivatives
 uniform bool tagAlpha;       // alpha = (face id mod 255 + 1) / 255, never 0 (lets a
                              // reader of the canvas tell which face a pixel shows; tests)
 
 flat in int vFace;
+flat in float vTag;
+flat in uvec4 vFV;
+flat in uvec3 vE;
+flat in ivec4 vLevels;
+flat in ivec4 vEdges;
 in vec3 vBary;
 in vec3 vWorld;
 uniform float shade;         // 0: the colours as stored; > 0: lit by a headlight,
@@ -78,7 +124,7 @@ int pick(ivec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 bool pick(bvec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 float pick(vec3 v, int k) { return k == 0 ? v.x : (k == 1 ? v.y : v.z); }
 
-// One face's table entry, decoded once per fragment (View::decode).
+// One face's table entry (View::decode), as the vertex shader decoded it.
 struct Face {
   uint F; uvec3 V; uvec3 E;
   int n; ivec3 vl; ivec3 el;
@@ -86,45 +132,48 @@ struct Face {
 };
 Face face;
 
-void decode(int f) {
-  int w = textureSize(faces, 0).x;
-  int t = 2 * f;
-  uvec4 a = texelFetch(faces, ivec2(t % w, t / w), 0);
-  uvec4 b = texelFetch(faces, ivec2((t + 1) % w, (t + 1) / w), 0);
-  uint bits = b.w;
-  face.F = a.x;
-  face.V = a.yzw;
-  face.E = b.xyz;
-  face.n = min(int(bits & 15u), MAX_LEVEL);
-  uvec3 shift = uvec3(0u, 4u, 8u);
-  face.vl = min(ivec3((uvec3(bits) >> (shift + 4u)) & 15u), ivec3(MAX_LEVEL));
-  // An edge is never finer than its face (as the CPU clamps it).
-  face.el = min(ivec3((uvec3(bits) >> (shift + 16u)) & 15u), ivec3(face.n));
-#ifdef TWIN_EDGE_DIRECTION
-  face.fwd = bvec3(true);    // the wrong twin: every edge read from corner k
-#else
-  face.fwd = notEqual(uvec3(bits) & (uvec3(1u) << uvec3(28u, 29u, 30u)), uvec3(0u));
-#endif
+void decode() {
+  face.F = vFV.x;
+  face.V = vFV.yzw;
+  face.E = vE;
+  face.n = vLevels.x;
+  face.vl = vLevels.yzw;
+  face.el = vEdges.xyz;
+  face.fwd = notEqual(ivec3(vEdges.w) & ivec3(1, 2, 4), ivec3(0));
 }
 
 // Pyramid value i's shown texel: linear texel index t = i * P + group at
 // (t % W, t / W), W the texture's width (WebGL2 has no texture buffers).
-uint rowTexels;               // W, read once per fragment (main)
+// The row comes from a float product and one correction step instead of
+// an integer division, which a SIMD CPU (SwiftShader) does lane by lane:
+// t < 2^24 (rows <= W <= 4096) is exact as a float, and the product's
+// error is far below a row, so the estimate is the row or a neighbour.
+uniform int rowTexels;        // W
+uniform float rowScale;       // 1 / W
 vec4 value(uint i) {
-  uint t = i * uint(perValue) + uint(group);
-  return texelFetch(samples, ivec2(int(t % rowTexels), int(t / rowTexels)), 0);
+  int t = int(i * uint(perValue) + uint(group));
+  int y = int(float(t) * rowScale);
+  int x = t - y * rowTexels;
+  y += x < 0 ? -1 : (x >= rowTexels ? 1 : 0);
+  x += x < 0 ? rowTexels : (x >= rowTexels ? -rowTexels : 0);
+  return texelFetch(samples, ivec2(x, y), 0);
 }
+
+// k + 1 mod 3. No integer division or remainder anywhere: SwiftShader
+// divides lane by lane, even by a constant.
+int next(int k) { return k == 2 ? 0 : k + 1; }
 
 // Offsets of a level within an edge's and a face's levels (mip.rs):
 // sum over m < l of 2^m - 1, and of (2^m - 1)(2^m - 2) / 2 in closed form
-// ((4^l - 1) / 3 - 3 (2^l - 1) + 2l) / 2 (0, 0, 0, 3, 24, 129, ...).
+// ((4^l - 1) / 3 - 3 (2^l - 1) + 2l) / 2 (0, 0, 0, 3, 24, 129, ...), where
+// (4^l - 1) / 3 = 4^0 + ... + 4^(l-1) is the bits of 0x55555 below bit 2l.
 uint edgeLevelOffset(int l) { return uint((1 << l) - 1 - l); }
 uint faceLevelOffset(int l) {
-  uint quads = ((1u << uint(2 * l)) - 1u) / 3u;
-  return (quads + uint(2 * l) - 3u * (uint(1 << l) - 1u)) / 2u;
+  uint quads = 0x55555u & ((1u << uint(2 * l)) - 1u);
+  return (quads + uint(2 * l) - 3u * (uint(1 << l) - 1u)) >> 1;
 }
 // Interior sample C_ij of a face of resolution r (structure.rs).
-uint interiorIndex(uint r, uint i, uint j) { return (i - 1u) * (r - 1u) - (i - 1u) * i / 2u + (j - 1u); }
+uint interiorIndex(uint r, uint i, uint j) { return (i - 1u) * (r - 1u) - (((i - 1u) * i) >> 1) + (j - 1u); }
 
 // Corner k seen at query level q (its own level, at most).
 uint cornerIndex(int k, int q) { return pick(face.V, k) + uint(min(q, pick(face.vl, k))); }
@@ -134,7 +183,7 @@ uint cornerIndex(int k, int q) { return pick(face.V, k) + uint(min(q, pick(face.
 uint nodeIndex(int k, int q, int le, uint i) {
   bool fwd = pick(face.fwd, k), atStart = i == 0u, atEnd = i == uint(1 << le);
   // The start is corner k on a forward edge, the end is then corner k + 1.
-  uint corner = cornerIndex(atStart == fwd ? k : (k + 1) % 3, q);
+  uint corner = cornerIndex(atStart == fwd ? k : next(k), q);
   return atStart || atEnd ? corner : pick(face.E, k) + edgeLevelOffset(le) + i - 1u;
 }
 
@@ -149,7 +198,7 @@ Place place(vec3 b) {
   if (zeros == 3) return Place(2, 0, 0.0, vec3(1.0));
   if (zeros == 2) return Place(0, c.x > 0.0 ? 0 : (c.y > 0.0 ? 1 : 2), 0.0, c);
   int m = c.x == 0.0 ? 0 : (c.y == 0.0 ? 1 : 2);
-  int k = (m + 1) % 3, k1 = (k + 1) % 3;
+  int k = next(m), k1 = next(k);
   float cs = pick(face.fwd, k) ? pick(c, k) : pick(c, k1);
   float ce = pick(face.fwd, k) ? pick(c, k1) : pick(c, k);
   return Place(1, k, ce / (cs + ce), c);
@@ -203,36 +252,44 @@ vec4 levelValue(Place at, int q, bool nearest, bool mipOrder) {
   // Nearest: the largest weight, the first on a tie.
   int best = (w.x >= w.y && w.x >= w.z) ? 0 : (w.y >= w.z ? 1 : 2);
   vec4 acc = vec4(0.0);
+  uint faceBase = face.F + faceLevelOffset(lf);
   for (int t = 0; t < (inside ? 3 : 1); t++) {
     if (inside && nearest && t != best) continue;
     uvec3 a = t == 0 ? p0 : (t == 1 ? p1 : p2);
     float wt = !inside || cached || nearest ? 1.0 : pick(w, t);
-    bvec3 atCorner = equal(a, uvec3(r)), zero = equal(a, uvec3(0u));
-    bool isCorner = inside ? any(atCorner) : at.kind == 0;
-    bool isEdge = inside ? !isCorner && any(zero) : at.kind == 1;
-    int ck = inside ? (atCorner.x ? 0 : (atCorner.y ? 1 : 2)) : at.k;
-    int ek = inside ? (zero.x ? 1 : (zero.y ? 2 : 0)) : at.k;  // opposite the zero
-    int le = min(q, pick(face.el, ek));
-    // On the edge: a lattice point at canonical position p / 2^lf, exact
-    // in steps of the edge's 2^-le; a placed point at parameter at.t.
-    uint s = pick(a, (ek + 1) % 3);
-    uint p = pick(face.fwd, ek) ? s : r - s;
-    int d = max(lf - le, 0);
-    float x = at.t * float(1 << le);
-    uint i = inside ? p >> uint(d) : min(uint(x), uint(1 << le) - 1u);
-    float fr = inside ? float(p & uint((1 << d) - 1)) / float(1 << d) : x - float(i);
-    bool two = isEdge && !nearest && (fr != 0.0 || !inside);
-    uint i0 = isCorner ? cornerIndex(ck, q)
-      : isEdge ? nodeIndex(ek, q, le, i + (nearest && fr >= 0.5 ? 1u : 0u))
-      : face.F + faceLevelOffset(lf) + interiorIndex(r, a.x, a.y);
-    uint i1 = nodeIndex(ek, q, le, i + 1u);
-    vec2 tw = two ? vec2(wt * (1.0 - fr), wt * fr) : vec2(wt, 0.0);
-    vec4 v = vec4(0.0);
-    for (int j = 0; j < (two ? 2 : 1); j++) {
-      vec4 y = (j == 0 ? tw.x : tw.y) * value(j == 0 ? i0 : i1);
-      if (cached) v += y; else acc += y;
+    // An interior lattice point (the common case): one sample.
+    uint i0 = faceBase + interiorIndex(r, a.x, a.y), i1 = i0;
+    bool two = false;
+    vec2 tw = vec2(wt, 0.0);
+    // A corner or an edge's node(s) otherwise. The loops below run once or
+    // not at all: SwiftShader runs four fragments at once through both
+    // sides of every if, but skips a loop none of the four enters, so
+    // quads of interior points pay for neither this nor a second fetch.
+    bool interior = inside && all(notEqual(a, uvec3(0u)));
+    for (int g = interior ? 1 : 0; g < 1; g++) {
+      bvec3 atCorner = equal(a, uvec3(r)), zero = equal(a, uvec3(0u));
+      bool isCorner = inside ? any(atCorner) : at.kind == 0;
+      bool isEdge = inside ? !isCorner && any(zero) : at.kind == 1;
+      int ck = inside ? (atCorner.x ? 0 : (atCorner.y ? 1 : 2)) : at.k;
+      int ek = inside ? (zero.x ? 1 : (zero.y ? 2 : 0)) : at.k;  // opposite the zero
+      int le = min(q, pick(face.el, ek));
+      // On the edge: a lattice point at canonical position p / 2^lf, exact
+      // in steps of the edge's 2^-le; a placed point at parameter at.t.
+      uint s = pick(a, next(ek));
+      uint p = pick(face.fwd, ek) ? s : r - s;
+      int d = max(lf - le, 0);
+      float x = at.t * float(1 << le);
+      uint i = inside ? p >> uint(d) : min(uint(x), uint(1 << le) - 1u);
+      float fr = inside ? float(p & uint((1 << d) - 1)) / float(1 << d) : x - float(i);
+      two = isEdge && !nearest && (fr != 0.0 || !inside);
+      i0 = isCorner ? cornerIndex(ck, q) : nodeIndex(ek, q, le, i + (nearest && fr >= 0.5 ? 1u : 0u));
+      i1 = nodeIndex(ek, q, le, i + 1u);
+      tw = two ? vec2(wt * (1.0 - fr), wt * fr) : vec2(wt, 0.0);
     }
-    if (cached) acc += pick(w, t) * v;
+    vec4 y0 = tw.x * value(i0), y1 = vec4(0.0);
+    for (int g = two ? 0 : 1; g < 1; g++) y1 = tw.y * value(i1);
+    vec4 v = two ? y0 + y1 : y0;
+    acc = cached ? acc + pick(w, t) * v : (two ? acc + y0 + y1 : acc + y0);
   }
   return acc;
 }
@@ -336,11 +393,7 @@ void main() {
     out2 = vec4(dy, 0.0);
     return;
   }
-  decode(vFace);
-  rowTexels = uint(textureSize(samples, 0).x);
-#ifdef TWIN_ROW_WIDTH
-  rowTexels -= 1u;           // the wrong twin: rows one texel short
-#endif
+  decode();
   vec4 v = filtered(vBary, dx, dy);
   // The painter's view lit from the eye, so the shape reads (the parity
   // test and exports see shade = 0: the colours alone). The face's own
@@ -354,13 +407,13 @@ void main() {
   if (display == 0) rgb = vec3(srgb(light * v.r), srgb(light * v.g), srgb(light * v.b));
   else if (display == 1) rgb = vec3(srgb(light * v[component]));
   else rgb = light * heat(v[component]);
-  out0 = vec4(rgb, tagAlpha ? float(vFace % 255 + 1) / 255.0 : 1.0);
+  out0 = vec4(rgb, tagAlpha ? vTag : 1.0);
 }`;
 
 /** The shaders' sources; `defines` (names) go after the version line. */
 export function sources(defines = []) {
   const head = '#version 300 es\n' + defines.map((d) => `#define ${d}\n`).join('');
-  return { vertex: VS, fragment: head + FS };
+  return { vertex: head + VS, fragment: head + FS };
 }
 
 /** The filters and their shader codes. */
@@ -380,10 +433,16 @@ function link(gl, defines) {
   const p = gl.createProgram();
   gl.attachShader(p, compile(gl, gl.VERTEX_SHADER, src.vertex));
   gl.attachShader(p, compile(gl, gl.FRAGMENT_SHADER, src.fragment));
+  // Every program reads the positions from one vertex array.
+  gl.bindAttribLocation(p, POSITION, 'position');
   gl.linkProgram(p);
   if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(p));
   return p;
 }
+
+const POSITION = 0;
+const UNIFORMS = ['viewProj', 'samples', 'faces', 'rowTexels', 'rowScale', 'perValue', 'group', 'level', 'maxSamples', 'component',
+  'heatRange', 'tagAlpha', 'shade', 'eye'];
 
 // Texture formats of the two layout textures (gpu.rs, "Textures").
 const SAMPLES = (gl) => ({ internal: gl.RGBA32F, format: gl.RGBA, type: gl.FLOAT, unit: 0 });
@@ -391,22 +450,39 @@ const FACES = (gl) => ({ internal: gl.RGBA32UI, format: gl.RGBA_INTEGER, type: g
 
 export class MeshColorsRenderer {
   /**
-   * gl: a WebGL2 context. defines: extra shader defines (the tests' wrong
-   * twins TWIN_EDGE_DIRECTION and TWIN_ROW_WIDTH).
+   * gl: a WebGL2 context. defines: the tests' wrong twins,
+   * TWIN_EDGE_DIRECTION (a shader define: every edge read from corner k)
+   * and TWIN_ROW_WIDTH (the shader told rows are one texel short).
    */
   constructor(gl, { defines = [] } = {}) {
     this.gl = gl;
-    this.program = link(gl, defines);
-    this.loc = {};
-    for (const u of ['viewProj', 'samples', 'faces', 'perValue', 'group', 'filterMode', 'level', 'maxSamples',
-      'display', 'component', 'heatRange', 'outputMode', 'tagAlpha', 'shade', 'eye'])
-      this.loc[u] = gl.getUniformLocation(this.program, u);
+    this.defines = defines;
+    this.programs = new Map();
     this.vao = gl.createVertexArray();
     this.buffer = gl.createBuffer();
     this.textures = { samples: gl.createTexture(), faces: gl.createTexture() };
     this.count = 0;
     this.layout = null;
     this.pickTarget = null;
+    // Linked now: a shader that does not compile fails here, not at the
+    // first frame.
+    this.program(FILTERS.linear, DISPLAYS.color, 0);
+  }
+
+  /**
+   * The program of one filter, display and output (0 colour, 1 pick) with
+   * its uniform locations, linked on first use and kept.
+   */
+  program(filter, display, output) {
+    const key = `${filter} ${display} ${output}`;
+    if (!this.programs.has(key)) {
+      const gl = this.gl;
+      const p = link(gl, [...this.defines, `FILTER_MODE ${filter}`, `DISPLAY ${display}`, `OUTPUT_MODE ${output}`]);
+      const loc = {};
+      for (const u of UNIFORMS) loc[u] = gl.getUniformLocation(p, u);
+      this.programs.set(key, { program: p, loc });
+    }
+    return this.programs.get(key);
   }
 
   /**
@@ -426,9 +502,8 @@ export class MeshColorsRenderer {
     gl.bindVertexArray(this.vao);
     gl.bindBuffer(gl.ARRAY_BUFFER, this.buffer);
     gl.bufferData(gl.ARRAY_BUFFER, corners, gl.STATIC_DRAW);
-    const l = gl.getAttribLocation(this.program, 'position');
-    gl.enableVertexAttribArray(l);
-    gl.vertexAttribPointer(l, 3, gl.FLOAT, false, 0, 0);
+    gl.enableVertexAttribArray(POSITION);
+    gl.vertexAttribPointer(POSITION, 3, gl.FLOAT, false, 0, 0);
     gl.bindVertexArray(null);
     this.count = corners.length / 3;
   }
@@ -495,16 +570,14 @@ export class MeshColorsRenderer {
    * the default, draws the colours alone) and eye (the camera's position).
    */
   draw(viewProj, opts = {}) {
-    const gl = this.gl, loc = this.loc;
+    const gl = this.gl;
     const channel = opts.channel || 0;
-    this.bind(viewProj);
-    gl.uniform1i(loc.outputMode, 0);
-    gl.uniform1i(loc.filterMode, FILTERS[opts.filter || 'linear']);
+    const display = DISPLAYS[opts.display || 'color'];
+    const loc = this.bind(viewProj, this.program(FILTERS[opts.filter || 'linear'], display, 0));
     gl.uniform1i(loc.level, opts.level || 0);
     gl.uniform1i(loc.maxSamples, opts.maxSamples || 8);
-    gl.uniform1i(loc.display, DISPLAYS[opts.display || 'color']);
     // RGB shows the first texel's .rgb; one channel is its texel's component.
-    gl.uniform1i(loc.group, (opts.display || 'color') === 'color' ? 0 : Math.floor(channel / 4));
+    gl.uniform1i(loc.group, display === DISPLAYS.color ? 0 : Math.floor(channel / 4));
     gl.uniform1i(loc.component, channel % 4);
     gl.uniform2fv(loc.heatRange, opts.range || [0, 1]);
     gl.uniform1i(loc.tagAlpha, opts.tagAlpha ? 1 : 0);
@@ -519,8 +592,7 @@ export class MeshColorsRenderer {
    * (db/dy, 0); where nothing is drawn they keep the clear value.
    */
   drawPick(viewProj) {
-    this.bind(viewProj);
-    this.gl.uniform1i(this.loc.outputMode, 1);
+    this.bind(viewProj, this.program(FILTERS.linear, DISPLAYS.color, 1));
     this.drawArrays();
   }
 
@@ -568,18 +640,25 @@ export class MeshColorsRenderer {
     return this.pickTarget;
   }
 
-  bind(viewProj) {
-    const gl = this.gl, loc = this.loc;
-    gl.useProgram(this.program);
+  /** Uses program `p` with the layout's textures bound; its uniform locations. */
+  bind(viewProj, p) {
+    const gl = this.gl, loc = p.loc;
+    gl.useProgram(p.program);
     gl.enable(gl.DEPTH_TEST);
     gl.uniformMatrix4fv(loc.viewProj, false, viewProj);
     gl.uniform1i(loc.samples, SAMPLES(gl).unit);
     gl.uniform1i(loc.faces, FACES(gl).unit);
     gl.uniform1i(loc.perValue, this.layout ? this.layout.perValue : 1);
+    const w = this.layout ? this.layout.width : 1;
+    // The wrong twin TWIN_ROW_WIDTH: rows one texel short.
+    const rowTexels = this.defines.includes('TWIN_ROW_WIDTH') ? w - 1 : w;
+    gl.uniform1i(loc.rowTexels, rowTexels);
+    gl.uniform1f(loc.rowScale, 1 / rowTexels);
     gl.activeTexture(gl.TEXTURE0 + SAMPLES(gl).unit);
     gl.bindTexture(gl.TEXTURE_2D, this.textures.samples);
     gl.activeTexture(gl.TEXTURE0 + FACES(gl).unit);
     gl.bindTexture(gl.TEXTURE_2D, this.textures.faces);
+    return loc;
   }
 
   drawArrays() {
