@@ -305,6 +305,20 @@ impl PaintSession {
         &self.history
     }
 
+    /// Keeps the undo history within `bytes` from now on (the oldest
+    /// steps are dropped, the newest always kept; see
+    /// [`History::with_budget`]). A replay must set the same budget to
+    /// allow the same undos.
+    pub fn limit_history_bytes(&mut self, bytes: usize) {
+        self.history.set_budget(bytes);
+    }
+
+    /// Heap bytes the undo holds: the history's steps and the delta of a
+    /// stroke still being painted.
+    pub fn undo_memory_bytes(&self) -> usize {
+        self.history.memory_bytes() + self.open.as_ref().map_or(0, |o| o.recorder.memory_bytes())
+    }
+
     /// Every edit applied, in order (undo and redo included).
     pub fn log(&self) -> &[Edit] {
         &self.log

@@ -96,6 +96,15 @@ impl Recorder {
         true
     }
 
+    /// Heap bytes the recorder holds: one bit per sample of the colours
+    /// and the old values recorded so far, uncompressed.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.seen.capacity() * 8
+            + self.indices.capacity() * 4
+            + self.values.capacity() * 4
+    }
+
     /// The number of samples recorded so far.
     pub fn len(&self) -> usize {
         self.indices.len()
@@ -315,24 +324,61 @@ impl Step {
     }
 }
 
-/// A linear undo history of at most `limit` steps: pushing a step drops
-/// the steps undone before it (no branches) and, beyond the limit, the
-/// oldest one.
+/// A linear undo history of at most `limit` steps and, optionally, at
+/// most a budget of bytes: pushing a step drops the steps undone before
+/// it (no branches) and then the oldest steps while there are more than
+/// `limit` or they hold more than the budget — the newest step is always
+/// kept, whatever it holds.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct History {
     steps: VecDeque<Step>,
     /// Steps `0..done` are applied, `done..` undone.
     done: usize,
     limit: usize,
+    /// The most bytes ([`History::memory_bytes`]) kept.
+    budget: usize,
 }
 
 impl History {
-    /// An empty history keeping up to `limit` steps (0: none).
+    /// An empty history keeping up to `limit` steps (0: none), of any
+    /// size.
     pub fn new(limit: usize) -> Self {
+        Self::with_budget(limit, usize::MAX)
+    }
+
+    /// An empty history keeping up to `limit` steps that together hold at
+    /// most `budget` bytes ([`History::memory_bytes`]; the newest step is
+    /// kept even when it alone holds more).
+    pub fn with_budget(limit: usize, budget: usize) -> Self {
         Self {
             steps: VecDeque::new(),
             done: 0,
             limit,
+            budget,
+        }
+    }
+
+    /// The most bytes the steps kept may hold.
+    pub fn budget(&self) -> usize {
+        self.budget
+    }
+
+    /// Sets the budget and drops the oldest applied steps beyond it
+    /// (undone steps stay, so redo still walks them in order).
+    pub fn set_budget(&mut self, budget: usize) {
+        self.budget = budget;
+        self.trim();
+    }
+
+    /// Drops the oldest applied steps while more than `limit` are kept or
+    /// they hold more than the budget; the newest step stays.
+    fn trim(&mut self) {
+        while self.done > 0
+            && self.steps.len() > 1
+            && (self.steps.len() > self.limit || self.memory_bytes() > self.budget)
+        {
+            self.steps.pop_front();
+            self.done -= 1;
         }
     }
 
@@ -340,10 +386,13 @@ impl History {
     pub fn push(&mut self, step: Step) {
         self.steps.truncate(self.done);
         self.steps.push_back(step);
-        while self.steps.len() > self.limit {
-            self.steps.pop_front();
-        }
         self.done = self.steps.len();
+        self.trim();
+        // A limit of 0 keeps nothing.
+        if self.limit == 0 {
+            self.steps.clear();
+            self.done = 0;
+        }
     }
 
     /// Undoes the last applied step; returns it (`None` when there is

@@ -131,9 +131,15 @@ pub struct Options {
     pub export_dir: PathBuf,
     /// Where the colours are autosaved (none: no autosave).
     pub autosave: Option<PathBuf>,
-    /// Undo steps kept.
+    /// Undo steps kept (within [`HISTORY_BYTES`]).
     pub history: usize,
 }
+
+/// The most bytes the undo steps may hold together, 256 MiB: the oldest
+/// steps are dropped first, the newest always kept (a detail change keeps
+/// the old samples of every face it resampled, megabytes for a large
+/// brush, so a count of steps alone does not bound the memory).
+pub const HISTORY_BYTES: usize = 256 << 20;
 
 impl Default for Options {
     fn default() -> Self {
@@ -185,6 +191,8 @@ pub fn open_session(doc: &Document, log: &[Edit], history: usize) -> Result<Pain
         Some(occluder),
     )
     .map_err(|e| e.to_string())?;
+    // Before the replay, which then drops the steps the live session did.
+    session.limit_history_bytes(HISTORY_BYTES);
     for (k, edit) in log.iter().enumerate() {
         session
             .apply(edit.clone())

@@ -190,7 +190,7 @@ impl Worker {
                 "type": "status", "seqs": seqs,
                 "samples": colors.sample_count(),
                 "memory": colors.memory_bytes(),
-                "undo_memory": h.memory_bytes(),
+                "undo_memory": self.session.undo_memory_bytes(),
                 "finest_level": finest,
                 "undo": h.undo_len(), "redo": h.redo_len(), "history": steps,
                 "edits": self.session.log().len(),

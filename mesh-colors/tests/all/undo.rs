@@ -284,3 +284,50 @@ fn strokes_over_a_flat_base_colour_cost_little() {
     // still far below the 12 bytes of three raw f32s.
     assert!(per_sample < 8.0, "{per_sample:.2} bytes per sample");
 }
+
+#[test]
+fn a_history_with_a_budget_drops_its_oldest_steps_and_undoes_the_rest_exactly() {
+    let (positions, faces) = support::grid(30, 0.05);
+    let mut mc =
+        MeshColors::uniform(Topology::new(positions.len(), &faces).unwrap(), 4, 3).unwrap();
+    let mut rng = Rng(11);
+    for x in mc.samples_mut() {
+        *x = rng.f32();
+    }
+    let painter = Painter::new(&mc, &positions, 0.05).unwrap();
+    let mut states = vec![mc.clone()];
+    let mut deltas = Vec::new();
+    for _ in 0..12 {
+        deltas.push(stroke(&painter, &positions, &mut mc, &mut rng, 0.08, 0.3));
+        states.push(mc.clone());
+    }
+    // A budget of about four strokes.
+    let budget = deltas[..4].iter().map(|d| d.memory_bytes()).sum::<usize>()
+        + std::mem::size_of::<History>();
+    let mut history = History::with_budget(100, budget);
+    for d in deltas {
+        history.push(Step::Paint(d));
+        assert!(history.memory_bytes() <= budget || history.undo_len() == 1);
+    }
+    let kept = history.undo_len();
+    assert!((2..12).contains(&kept), "{kept} steps kept");
+    // The kept steps undo to the state before the oldest of them.
+    while history.undo(&mut mc).unwrap().is_some() {}
+    assert_eq!(mc, states[12 - kept]);
+    // A smaller budget drops nothing undone (redo walks them in order)...
+    history.set_budget(0);
+    assert_eq!(history.redo_len(), kept);
+    while history.redo(&mut mc).unwrap().is_some() {}
+    assert_eq!(mc, states[12]);
+    // ...and, once they are applied again, keeps the newest alone.
+    history.set_budget(0);
+    assert_eq!((history.undo_len(), history.redo_len()), (1, 0));
+    history.undo(&mut mc).unwrap();
+    assert_eq!(mc, states[11]);
+    // A step larger than the budget is kept (the newest always is).
+    let mut tiny = History::with_budget(100, 1);
+    tiny.push(Step::Paint(stroke(
+        &painter, &positions, &mut mc, &mut rng, 0.08, 0.3,
+    )));
+    assert_eq!(tiny.undo_len(), 1);
+}
