@@ -212,6 +212,25 @@ async fn the_page_paints_picks_adds_detail_undoes_saves_and_exports_in_chromium(
     assert_eq!(v["console_errors"], json!([]), "{v:#}");
     assert_eq!(v["errors"], json!([]), "{v:#}");
 
+    // The hovering brush's ring lies on the surface: centred on the
+    // cursor, and no wider than the radius in pixels (narrower across a
+    // face seen at an angle, never below a quarter of it on this view).
+    let ring = step("ring");
+    assert_eq!(ring["shown"], true, "{ring}");
+    assert_eq!(ring["points"], 65, "{ring}");
+    let radius = ring["radius"].as_f64().unwrap();
+    let centroid = ring["centroid"].as_array().unwrap();
+    let off = (centroid[0].as_f64().unwrap() - 400.0).hypot(centroid[1].as_f64().unwrap() - 300.0);
+    assert!(off < 0.2 * radius, "{ring}");
+    let (lo, hi) = (
+        ring["min_radius"].as_f64().unwrap(),
+        ring["max_radius"].as_f64().unwrap(),
+    );
+    assert!(
+        hi > 0.8 * radius && hi < 1.2 * radius && lo > 0.25 * radius,
+        "{ring}"
+    );
+
     // The stroke changed pixels, all within the brush's reach of its path
     // (y = 300, x from 330 to 470, radius in pixels), and nowhere else.
     let stroke = step("stroke");

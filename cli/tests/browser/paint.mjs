@@ -53,6 +53,18 @@ try {
   lap('load');
   if (only === 'load-only') throw null;
 
+  // The brush ring under a hovering cursor: a circle in the plane of the
+  // face there, so about the radius across and centred on the cursor.
+  await page.mouse.move(400, 300);
+  out.steps.ring = await page.evaluate(() => {
+    const el = document.getElementById('brush');
+    const pts = el.firstElementChild.getAttribute('points').trim().split(' ').map((p) => p.split(',').map(Number));
+    const c = pts.reduce((a, p) => [a[0] + p[0] / pts.length, a[1] + p[1] / pts.length], [0, 0]);
+    const r = pts.map((p) => Math.hypot(p[0] - 400, p[1] - 300));
+    return { shown: el.style.display === 'block', points: pts.length, centroid: c,
+      min_radius: Math.min(...r), max_radius: Math.max(...r), radius: Number(document.getElementById('radius').value) };
+  });
+
   // A stroke across the middle, left to right.
   const path = [[330, 300], [470, 300]];
   await page.mouse.move(...path[0]);

@@ -3,7 +3,7 @@
 // changed. The mesh colours are drawn by the paper's real-time shader
 // (meshcolors.js, Sec. 5.3).
 
-import { Camera } from './camera.js';
+import { Camera, cross, normalize } from './camera.js';
 import { Connection } from './net.js';
 import { readHeader } from './frame.js';
 import { fitCanvas } from './glutil.js';
@@ -252,7 +252,10 @@ function dab(hit, e) {
 }
 
 canvas.addEventListener('pointermove', (e) => {
-  showBrush(e);
+  // The ring is hidden while the camera moves (each new view would need a
+  // new pick pass per event) and comes back with the next move.
+  state.pointer = { clientX: e.clientX, clientY: e.clientY };
+  if (drag && drag.kind === 'camera') $('brush').style.display = 'none'; else showBrush(e);
   if (!drag) return;
   if (drag.kind === 'camera') {
     const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
@@ -282,20 +285,61 @@ function endDrag() {
 }
 canvas.addEventListener('pointerup', endDrag);
 canvas.addEventListener('pointercancel', endDrag);
+canvas.addEventListener('pointerleave', () => { $('brush').style.display = 'none'; state.pointer = null; });
 canvas.addEventListener('wheel', (e) => {
   e.preventDefault();
+  $('brush').style.display = 'none';
   state.camera.zoom(Math.exp(e.deltaY * 0.001));
   dirty = pickDirty = true;
 }, { passive: false });
 
+// The brush ring lies on the surface: a circle of the brush's radius in
+// the plane of the face under the cursor, projected as the camera sees it
+// (as Blender's paint cursor), so it shows the area a dab covers even at
+// a grazing angle. Off the model it is the screen circle of the radius.
 function showBrush(e) {
   const el = $('brush');
-  const r = $('worldRadius').checked ? null : Number($('radius').value);
-  $('radiusText').textContent = $('worldRadius').checked ? '' : r + ' px';
-  if (!r || state.tool === 'fill' || state.tool === 'pick') { el.style.display = 'none'; return; }
+  const world = $('worldRadius').checked;
+  const r = Number($('radius').value);
+  $('radiusText').textContent = world ? '' : r + ' px';
+  if (state.tool === 'fill' || state.tool === 'pick' || !state.camera) { el.style.display = 'none'; return; }
+  const hit = pickAt(e.clientX, e.clientY);
+  const ring = hit ? surfaceRing(hit) : (world ? null : screenRing(e.clientX, e.clientY, r));
+  if (!ring) { el.style.display = 'none'; return; }
+  el.firstElementChild.setAttribute('points', ring.map((p) => p[0].toFixed(1) + ',' + p[1].toFixed(1)).join(' '));
   el.style.display = 'block';
-  el.style.left = e.clientX + 'px'; el.style.top = e.clientY + 'px';
-  el.style.width = el.style.height = 2 * r + 'px';
+}
+
+const RING_POINTS = 64;
+
+function screenRing(x, y, r) {
+  return Array.from({ length: RING_POINTS + 1 }, (_, k) => {
+    const t = 2 * Math.PI * k / RING_POINTS;
+    return [x + r * Math.cos(t), y + r * Math.sin(t)];
+  });
+}
+
+// The circle of radius worldRadius(point) around the hit point in its
+// face's plane, in CSS pixels; null if a point falls behind the camera.
+function surfaceRing(hit) {
+  const P = state.mesh.positions, T = state.mesh.triangles;
+  const v = [0, 1, 2].map((k) => [0, 1, 2].map((c) => P[3 * T[3 * hit.face + k] + c]));
+  const sub = (a, b) => a.map((x, c) => x - b[c]);
+  const n = normalize(cross(sub(v[1], v[0]), sub(v[2], v[0])));
+  // Any unit vector in the plane, then its perpendicular.
+  const helper = Math.abs(n[0]) < 0.9 ? [1, 0, 0] : [0, 1, 0];
+  const u = normalize(cross(n, helper)), w = cross(n, u);
+  const r = worldRadius(hit.point);
+  const m = state.camera.viewProj(canvas.clientWidth / canvas.clientHeight);
+  const ring = [];
+  for (let k = 0; k <= RING_POINTS; k++) {
+    const t = 2 * Math.PI * k / RING_POINTS, c = Math.cos(t) * r, s = Math.sin(t) * r;
+    const p = [0, 1, 2].map((i) => hit.point[i] + c * u[i] + s * w[i]);
+    const clip = [0, 1, 3].map((j) => m[j] * p[0] + m[4 + j] * p[1] + m[8 + j] * p[2] + m[12 + j]);
+    if (clip[2] <= 1e-9) return null;
+    ring.push([(clip[0] / clip[2] + 1) / 2 * canvas.clientWidth, (1 - clip[1] / clip[2]) / 2 * canvas.clientHeight]);
+  }
+  return ring;
 }
 
 // ---- the scatter panel ------------------------------------------------
@@ -469,6 +513,7 @@ addEventListener('keydown', (e) => {
   else if (k === '[' || k === ']') {
     const r = $('radius');
     r.value = Math.max(2, Math.min(200, Number(r.value) * (k === ']' ? 1.25 : 0.8)));
+    if (state.pointer) showBrush(state.pointer);
   } else if (e.key === '?') $('helpbox').hidden = !$('helpbox').hidden;
 });
 
