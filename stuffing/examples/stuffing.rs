@@ -785,13 +785,20 @@ fn read_raw(prefix: &Path) -> Option<(Vec<DVec3>, Vec<[u32; 4]>)> {
     Some((nodes, elems))
 }
 
-/// The value of `"key": value` in a one-line JSON object from the script.
+/// The value of `"key": value` in a one-line JSON object from the Python
+/// scripts (TetGen's here, the peers' in `peers.rs`): a string as written
+/// (escapes kept, ended by the first unescaped quote), else the number.
 fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {
     let pat = format!("\"{key}\": ");
     let start = line.find(&pat)? + pat.len();
     let rest = &line[start..];
     if let Some(s) = rest.strip_prefix('"') {
-        let end = s.find('"')?;
+        let mut escaped = false;
+        let end = s.char_indices().find_map(|(i, c)| {
+            let ends = c == '"' && !escaped;
+            escaped = c == '\\' && !escaped;
+            ends.then_some(i)
+        })?;
         Some(&s[..end])
     } else {
         let end = rest.find([',', '}']).unwrap_or(rest.len());

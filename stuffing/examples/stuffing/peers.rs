@@ -17,6 +17,8 @@ use std::time::{Duration, Instant};
 use tet_stuffing::glam::DVec3;
 use tet_stuffing::{self as stuffing, Options, SurfaceDistance};
 
+use super::field;
+
 /// The script that runs one peer once (see its docstring for the files).
 const SCRIPT: &str = include_str!("peers.py");
 
@@ -384,22 +386,6 @@ fn boundary(tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
     out
 }
 
-/// The value of `"key": value` in the one-line JSON object `peers.py`
-/// prints (its keys are fixed and its strings hold no quotes it escaped
-/// that matter for one line of a table).
-fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {
-    let pat = format!("\"{key}\": ");
-    let start = line.find(&pat)? + pat.len();
-    let rest = &line[start..];
-    if let Some(s) = rest.strip_prefix('"') {
-        let end = s.rfind('"')?;
-        Some(&s[..end])
-    } else {
-        let end = rest.find([',', '}']).unwrap_or(rest.len());
-        Some(rest[..end].trim())
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -418,5 +404,9 @@ mod tests {
         assert_eq!(field(line, "tets"), Some("40"));
         let line = r#"{"error": "surface is not closed"}"#;
         assert_eq!(field(line, "error"), Some("surface is not closed"));
+        // An escaped quote inside the message does not end it.
+        let line = r#"{"error": "no \"volume\" here", "ms": 3}"#;
+        assert_eq!(field(line, "error"), Some(r#"no \"volume\" here"#));
+        assert_eq!(field(line, "ms"), Some("3"));
     }
 }
