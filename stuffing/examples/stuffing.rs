@@ -664,17 +664,7 @@ fn run_tetgen(
         error: None,
     };
     let prefix = work.join(name.replace(' ', "_"));
-    let write = || -> std::io::Result<()> {
-        let pos: Vec<u8> = p
-            .iter()
-            .flat_map(|v| v.to_array())
-            .flat_map(f64::to_le_bytes)
-            .collect();
-        std::fs::write(prefix.with_extension("pos"), pos)?;
-        let tri: Vec<u8> = t.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-        std::fs::write(prefix.with_extension("tri"), tri)
-    };
-    if let Err(e) = write() {
+    if let Err(e) = peers::write_surface(&prefix, p, t) {
         row.error = Some(format!("could not write the surface: {e}"));
         return row;
     }

@@ -316,8 +316,9 @@ fn last_line(bytes: &[u8]) -> String {
         .to_string()
 }
 
-/// The surface as `peers.py` reads it: `.pos` (f64 × 3) and `.tri` (u32 × 3).
-fn write_surface(prefix: &Path, p: &[DVec3], t: &[[u32; 3]]) -> std::io::Result<()> {
+/// The surface as `peers.py` and TetGen's script read it: `.pos`
+/// (f64 × 3) and `.tri` (u32 × 3).
+pub(super) fn write_surface(prefix: &Path, p: &[DVec3], t: &[[u32; 3]]) -> std::io::Result<()> {
     let pos: Vec<u8> = p
         .iter()
         .flat_map(|v| v.to_array())
