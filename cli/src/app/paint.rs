@@ -98,16 +98,28 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
 /// Channel names: plain words, none repeated, not "color".
 fn check_channels(names: &[String]) -> Result<()> {
     for (k, n) in names.iter().enumerate() {
-        let plain = !n.is_empty()
-            && n.len() <= 32
-            && n.chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
-        if !plain || n == "color" || names[..k].contains(n) {
+        let problem = if n.is_empty() {
+            Some("an empty name (two commas, or one at an end)".to_string())
+        } else if n.len() > 32 {
+            Some(format!("{n:?} is longer than 32 characters"))
+        } else if let Some(c) = n
+            .chars()
+            .find(|&c| !(c.is_ascii_alphanumeric() || c == '_' || c == '-'))
+        {
+            Some(format!(
+                "{n:?} has {c:?}: a channel name is letters, digits, - and _"
+            ))
+        } else if n == "color" {
+            Some("\"color\" is the RGB channel every model has; name the scalar channels".into())
+        } else if names[..k].contains(n) {
+            Some(format!("{n:?} is named twice"))
+        } else {
+            None
+        };
+        if let Some(problem) = problem {
             return Err(arg_error(
                 format!("--channels {}", names.join(",")),
-                format!(
-                    "{n:?}: a channel needs a new plain name (letters, digits, - _), not \"color\""
-                ),
+                problem,
             ));
         }
     }
@@ -268,5 +280,38 @@ mod tests {
         assert_eq!(flat_resolution(10_000_000), 1);
         assert_eq!(resolution("8"), Ok(8));
         assert!(resolution("6").is_err() && resolution("x").is_err());
+    }
+
+    #[test]
+    fn a_bad_channel_list_is_told_its_own_problem() {
+        let check = |names: &[&str]| {
+            let names: Vec<String> = names.iter().map(|n| n.to_string()).collect();
+            check_channels(&names).map_err(|e| {
+                // The placement, then the problem below it.
+                let mut text = e.to_string();
+                let mut source = std::error::Error::source(&e);
+                while let Some(s) = source {
+                    text += &format!(": {s}");
+                    source = s.source();
+                }
+                text
+            })
+        };
+        assert_eq!(check(&["roughness", "density"]), Ok(()));
+        let long = "x".repeat(33);
+        let cases: [(&[&str], &str); 5] = [
+            (&["roughness", "roughness"], "\"roughness\" is named twice"),
+            (&["density", ""], "an empty name"),
+            (&["a b"], "\"a b\" has ' '"),
+            (&["color"], "\"color\" is the RGB channel"),
+            (&[long.as_str()], "longer than 32 characters"),
+        ];
+        for (names, want) in cases {
+            let e = check(names).unwrap_err();
+            assert!(
+                e.contains("--channels") && e.contains(want),
+                "{names:?}: {e}"
+            );
+        }
     }
 }

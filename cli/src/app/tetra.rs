@@ -33,7 +33,7 @@ pub(crate) struct Args {
     /// moves are not enough (at most 3x the tetrahedra), keeping every
     /// dihedral angle at 10° or more. Not a guarantee: the summary prints
     /// the distance reached.
-    #[arg(long, value_name = "EPS")]
+    #[arg(long, value_name = "EPS", allow_negative_numbers = true)]
     pub(crate) envelope: Option<f64>,
     /// The tetrahedral mesh: .node (with .ele), .mesh or .vtu.
     #[arg(short, long, value_name = "OUT.node")]
@@ -135,7 +135,10 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         r.elapsed.as_secs_f64(),
         r.min_dihedral_deg,
         r.max_dihedral_deg,
-        r.distance.as_ref().map(distance_text).unwrap_or_default(),
+        r.distance
+            .as_ref()
+            .map(|d| distance_text(d, args.envelope))
+            .unwrap_or_default(),
         files
             .iter()
             .map(|f| f.display().to_string())
@@ -157,6 +160,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "split_edges": r.split_edges,
         "dihedral_degrees": [r.min_dihedral_deg, r.max_dihedral_deg],
         "distance": r.distance.as_ref().map(distance_json),
+        // Whether the measured distance is within the envelope asked for.
+        "envelope_reached": args.envelope.zip(r.distance.as_ref()).map(|(eps, d)| d.hausdorff_fraction() <= eps),
         "stuffing_seconds": r.elapsed.as_secs_f64(),
         "files": files.iter().map(|f| super::shown(f)).collect::<Vec<_>>(),
         "seconds": context.timings_json(),
@@ -200,20 +205,29 @@ fn significant(x: f64) -> String {
 }
 
 /// The summary's clause on how far the boundary lies from the surface.
-fn distance_text(d: &tet_stuffing::SurfaceDistance) -> String {
+fn distance_text(d: &tet_stuffing::SurfaceDistance, envelope: Option<f64>) -> String {
     // Caps over the surface's holes are measured apart: their distance is
     // the hole's size, not the mesh's error.
     let caps = if d.hole_caps > 0.0 {
         format!(
-            "; {:.1}% of the boundary caps holes of the surface, up to {:.3}% from it",
+            "; not counted: {:.1}% of the boundary closes holes of the surface, up to {:.3}% from it",
             100.0 * d.hole_caps,
             100.0 * d.hole_caps_to_input / d.diagonal.max(f64::MIN_POSITIVE)
         )
     } else {
         String::new()
     };
+    // Say plainly whether the envelope asked for was reached.
+    let verdict = match envelope {
+        Some(eps) if d.hausdorff_fraction() <= eps => ", within the envelope".to_string(),
+        Some(eps) => format!(
+            ", NOT within the {}% envelope (parts about a spacing thick; a smaller --spacing helps)",
+            significant(100.0 * eps)
+        ),
+        None => String::new(),
+    };
     format!(
-        "; boundary within {:.3}% of the diagonal of the surface (Hausdorff; mean {:.3}%; {} + {} points measured{caps})",
+        "; boundary within {:.3}% of the diagonal of the surface{verdict} (Hausdorff; mean {:.3}%; {} + {} points measured{caps})",
         100.0 * d.hausdorff_fraction(),
         100.0 * d.mean_fraction(),
         d.input_samples,

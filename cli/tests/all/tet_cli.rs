@@ -177,12 +177,28 @@ fn tetra_fits_the_boundary_to_an_envelope_and_says_how_near_it_came() {
         stdout.contains("fitted to an envelope of 0.2% of the diagonal"),
         "{stdout}"
     );
-    // A wrong argument: exit code 2.
+    // Whether the envelope was reached, said in words and in --json.
+    let reached = hausdorff(&fitted) / fitted["diagonal"].as_f64().unwrap() <= 0.002;
+    assert_eq!(fitted["envelope_reached"], reached, "{fitted}");
+    let verdict = if reached {
+        ", within the envelope"
+    } else {
+        ", NOT within the 0.2% envelope"
+    };
+    assert!(stdout.contains(verdict), "{stdout}");
+    assert!(plain["envelope_reached"].is_null(), "{plain}");
+    // A wrong argument: exit code 2, naming the option, negative too.
     fails_with(
         d,
         2,
         &["tetra", blob, "--envelope", "1.5", "-o", "bad.node"],
         &["--envelope 1.5", "between 0 and 1"],
+    );
+    fails_with(
+        d,
+        2,
+        &["tetra", blob, "--envelope", "-1", "-o", "bad.node"],
+        &["--envelope -1", "between 0 and 1"],
     );
 }
 

@@ -503,6 +503,7 @@ $('shade').onchange = () => { dirty = true; };
 addEventListener('keydown', (e) => {
   if (e.target.tagName === 'INPUT' && e.target.type !== 'range' && e.target.type !== 'checkbox') return;
   const k = e.key.toLowerCase();
+  if (e.key === 'Escape') { $('helpbox').hidden = true; return; }
   if ((e.ctrlKey || e.metaKey) && k === 'z') { net.send(e.shiftKey ? 'redo' : 'undo'); e.preventDefault(); return; }
   if ((e.ctrlKey || e.metaKey) && k === 'y') { net.send('redo'); e.preventDefault(); return; }
   if ((e.ctrlKey || e.metaKey) && k === 's') { $('save').onclick(); e.preventDefault(); return; }
