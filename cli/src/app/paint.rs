@@ -36,8 +36,10 @@ pub(crate) struct Args {
     /// the mesh's size, about 400,000 samples).
     #[arg(long, value_name = "R", value_parser = resolution)]
     pub(crate) resolution: Option<u32>,
-    /// Scalar channels to paint besides colour, comma-separated (e.g.
-    /// density,roughness), each shown as a heat map.
+    /// Scalar channels to paint besides colour, comma-separated, each
+    /// shown as a heat map and starting at 0, or at the value after `=`
+    /// (e.g. density,roughness=0.5: an unpainted roughness of 0 is a
+    /// mirror in Blender).
     #[arg(long, value_name = "NAMES", value_delimiter = ',')]
     pub(crate) channels: Vec<String>,
     /// Replay a session file the page exported (its edits, on this mesh).
@@ -60,7 +62,7 @@ fn resolution(text: &str) -> std::result::Result<u32, String> {
 }
 
 pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
-    check_channels(&args.channels)?;
+    channel_starts(&args.channels)?;
     if !args.export_dir.is_dir() {
         return Err(file_error(
             &args.export_dir,
@@ -93,6 +95,32 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     };
     let start = trilux::paint::start(doc, log, options);
     super::web::serve(context, "paint", (faces, "faces"), args.serve.open, start)
+}
+
+/// `--channels` as typed (`NAME` or `NAME=START`): the names and the
+/// values they start at (0 unless given).
+fn channel_starts(specs: &[String]) -> Result<(Vec<String>, Vec<f32>)> {
+    let mut names = Vec::with_capacity(specs.len());
+    let mut starts = Vec::with_capacity(specs.len());
+    for spec in specs {
+        let (name, start) = match spec.split_once('=') {
+            Some((name, value)) => {
+                let start = value.trim().parse::<f32>().ok().filter(|v| v.is_finite());
+                let start = start.ok_or_else(|| {
+                    arg_error(
+                        format!("--channels {}", specs.join(",")),
+                        format!("{spec:?}: the value after = is the channel's start, a number"),
+                    )
+                })?;
+                (name, start)
+            }
+            None => (spec.as_str(), 0.0),
+        };
+        names.push(name.to_string());
+        starts.push(start);
+    }
+    check_channels(&names)?;
+    Ok((names, starts))
 }
 
 /// Channel names: plain words, none repeated, not "color".
@@ -156,9 +184,11 @@ fn load(context: &mut Context, args: &Args) -> Result<Document> {
             surface.detached
         );
     }
-    let colors = with_scalars(colors, args.channels.len())?;
+    let (names, starts) = channel_starts(&args.channels)?;
+    let colors = with_scalars(colors, &starts)?;
+    // Erasing goes back to the base: grey, and each channel's start.
     let mut base = vec![0.8f32; 3];
-    base.extend(std::iter::repeat_n(0.0, args.channels.len()));
+    base.extend(&starts);
     let source = json!({
         "mesh": args.mesh.as_ref().map(|p| p.display().to_string()),
         "colors": args.colors.as_ref().map(|p| p.display().to_string()),
@@ -170,7 +200,7 @@ fn load(context: &mut Context, args: &Args) -> Result<Document> {
         surface,
         colors,
         base,
-        scalars: args.channels.clone(),
+        scalars: names,
         source,
     })
 }
@@ -238,8 +268,9 @@ fn flat_resolution(faces: usize) -> u32 {
     1 << level
 }
 
-/// `colors` with `scalars` more channels, 0 to start.
-fn with_scalars(colors: MeshColors, scalars: usize) -> Result<MeshColors> {
+/// `colors` with one more channel per value of `starts`, which it starts at.
+fn with_scalars(colors: MeshColors, starts: &[f32]) -> Result<MeshColors> {
+    let scalars = starts.len();
     if scalars == 0 {
         return Ok(colors);
     }
@@ -254,6 +285,7 @@ fn with_scalars(colors: MeshColors, scalars: usize) -> Result<MeshColors> {
         .zip(colors.samples().chunks(c))
     {
         to[..c].copy_from_slice(from);
+        to[c..].copy_from_slice(starts);
     }
     Ok(wide)
 }
@@ -283,6 +315,17 @@ mod tests {
     }
 
     #[test]
+    fn scalar_channels_start_at_their_values_beside_the_colours() {
+        let blob = trilux::shapes::blob(1);
+        let surface = ColorMesh::new(&blob).unwrap();
+        let mut colors = MeshColors::uniform(surface.topology().unwrap(), 2, 3).unwrap();
+        colors.samples_mut().fill(0.25);
+        let wide = with_scalars(colors, &[0.5, 0.0]).unwrap();
+        assert_eq!(wide.channels(), 5);
+        assert!(wide.samples().chunks(5).all(|s| s == [0.25, 0.25, 0.25, 0.5, 0.0]));
+    }
+
+    #[test]
     fn a_bad_channel_list_is_told_its_own_problem() {
         let check = |names: &[&str]| {
             let names: Vec<String> = names.iter().map(|n| n.to_string()).collect();
@@ -298,6 +341,14 @@ mod tests {
             })
         };
         assert_eq!(check(&["roughness", "density"]), Ok(()));
+        let specs = ["roughness=0.5".to_string(), "density".to_string()];
+        let (names, starts) = channel_starts(&specs).unwrap();
+        assert_eq!(
+            (names, starts),
+            (vec!["roughness".into(), "density".into()], vec![0.5, 0.0])
+        );
+        let bad = channel_starts(&["roughness=rough".to_string()]).unwrap_err();
+        assert!(format!("{bad:?}").contains("start, a number"), "{bad:?}");
         let long = "x".repeat(33);
         let cases: [(&[&str], &str); 5] = [
             (&["roughness", "roughness"], "\"roughness\" is named twice"),
