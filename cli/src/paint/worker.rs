@@ -628,7 +628,16 @@ impl App for Worker {
 
     fn stop(&mut self, _out: &Outbox) {
         self.session.end_stroke();
+        let unsaved = self.unsaved;
         self.autosave();
+        // Say where the colours are as the server stops (Ctrl+C).
+        if let (Some(path), true) = (&self.autosave, unsaved > 0 && self.unsaved == 0) {
+            eprintln!(
+                "trilux paint: {unsaved} unsaved edits autosaved to {} (resume with --colors {})",
+                path.display(),
+                path.display()
+            );
+        }
     }
 }
 
