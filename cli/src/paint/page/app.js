@@ -133,7 +133,7 @@ function showStatus(s) {
   const scatter = $('scatterMode').value === 'off' ? '' : ` · ${s.points.toLocaleString()} points` +
     (s.strands ? ` (${s.strands.toLocaleString()} strands shown)` : '') + ` in ${s.scatter_ms.toFixed(1)} ms`;
   $('stats').textContent = `${s.samples.toLocaleString()} samples · ${mb(s.memory)} · finest level ${s.finest_level}` +
-    ` · undo ${s.undo} (${mb(s.undo_memory)}) · redo ${s.redo}` + scatter;
+    ` · undo ${s.undo} · redo ${s.redo} (history ${mb(s.undo_memory)})` + scatter;
   const list = $('history');
   list.textContent = '';
   s.history.forEach((h, k) => {
