@@ -15,14 +15,15 @@ use std::collections::{HashMap, HashSet};
 
 use glam::Vec3;
 
-use crate::Error;
 use crate::filter::{FINEST, Store, edge_point, eval, lattice};
+use crate::parallel::map_ordered;
 use crate::structure::{
     MeshColors, lattice_points, level_of, move_segments, sample_position, samples_per_edge,
     samples_per_face,
 };
 use crate::topology::NO_FACE;
 use crate::topology::Topology;
+use crate::{Error, MAX_CHANNELS};
 
 /// Corners of the four children of a face, as lattice points of the
 /// parent at resolution 2: `v0, v1, v2` at `2·e_k`, midpoints between.
@@ -446,6 +447,157 @@ impl Overlay {
     }
 }
 
+/// One face's resolution change within a batch, planned before any value
+/// is computed.
+struct Step {
+    face: usize,
+    /// The face's level before this step.
+    from: u8,
+    /// The face's level after it.
+    to: u8,
+    /// Each local edge: `(edge, level before this step, level after)`.
+    plan: [(usize, u8, u8); 3],
+    /// The wave this step is computed in: after every earlier step that
+    /// wrote what it reads, and not before any earlier step that read what
+    /// it writes.
+    wave: u32,
+}
+
+impl MeshColors {
+    /// The steps of a batch with their edge plans and waves, the record's
+    /// old values taken at each primitive's first change, and whether a
+    /// face was lowered. Leaves the levels as they were (the plan needs the
+    /// levels each step sees, so they are set as the batch would, then put
+    /// back for the values to be computed wave by wave).
+    fn plan_steps(&mut self, record: &mut ResolutionChange) -> (Vec<Step>, bool) {
+        let c = self.channels;
+        // Per face and edge: 1 + the wave of the last step that wrote it
+        // (0: none yet, so not yet in the record), and the latest wave
+        // that read it.
+        let mut face_written = vec![0u32; self.face_level.len()];
+        let mut face_read = vec![0u32; self.face_level.len()];
+        let mut edge_written = vec![0u32; self.edge_level.len()];
+        let mut edge_read = vec![0u32; self.edge_level.len()];
+        let mut steps = Vec::new();
+        let mut lowered = false;
+        for &(f, n1) in &record.requests {
+            let f = f as usize;
+            let n0 = self.face_level[f];
+            if n0 == n1 {
+                continue;
+            }
+            lowered |= n1 < n0;
+            let plan = self.edge_plan(f, n1);
+            // A step reads its face and its three edges, and writes the
+            // face and the edges whose level changes.
+            let mut wave = face_written[f].max(face_read[f]);
+            for &(e, le0, le1) in &plan {
+                wave = wave.max(edge_written[e]);
+                if le0 != le1 {
+                    wave = wave.max(edge_read[e]);
+                }
+            }
+            face_read[f] = face_read[f].max(wave);
+            if face_written[f] == 0 {
+                record.faces.push((f as u32, n0, n1));
+                let at = self.face_offset[f] * c;
+                let len = samples_per_face(1 << n0) as usize * c;
+                record
+                    .face_values
+                    .extend_from_slice(&self.samples[at..at + len]);
+            }
+            face_written[f] = wave + 1;
+            self.face_level[f] = n1;
+            for &(e, le0, le1) in &plan {
+                edge_read[e] = edge_read[e].max(wave);
+                if le0 == le1 {
+                    continue;
+                }
+                if edge_written[e] == 0 {
+                    record.edges.push((e as u32, le0, le1));
+                    let at = self.edge_offset[e] * c;
+                    let len = samples_per_edge(1 << le0) as usize * c;
+                    record
+                        .edge_values
+                        .extend_from_slice(&self.samples[at..at + len]);
+                }
+                edge_written[e] = wave + 1;
+                self.edge_level[e] = le1;
+            }
+            steps.push(Step {
+                face: f,
+                from: n0,
+                to: n1,
+                plan,
+                wave,
+            });
+        }
+        for step in steps.iter().rev() {
+            for &(e, le0, le1) in step.plan.iter().rev() {
+                if le0 != le1 {
+                    self.edge_level[e] = le0;
+                }
+            }
+            self.face_level[step.face] = step.from;
+        }
+        (steps, lowered)
+    }
+
+    /// Face `f`'s local edges: `(edge, level now, level once `f` is at
+    /// level `n1`)` — the lowest level of an edge's faces (Sec. 3.2).
+    fn edge_plan(&self, f: usize, n1: u8) -> [(usize, u8, u8); 3] {
+        self.topology.face_edges[f].map(|e| {
+            let e = e as usize;
+            let after = self.topology.edge_faces[e]
+                .iter()
+                .filter(|&&g| g != NO_FACE)
+                .map(|&g| {
+                    if g as usize == f {
+                        n1
+                    } else {
+                        self.face_level[g as usize]
+                    }
+                })
+                .min()
+                .unwrap_or(n1);
+            (e, self.edge_level[e], after)
+        })
+    }
+}
+
+/// The new samples of one step's face and of its edges whose level
+/// changes (`None` for the others), computed from `staged`, which holds
+/// the colours as the step sees them.
+fn resample_step(staged: &Staged<'_>, step: &Step) -> (Vec<f32>, [Option<Vec<f32>>; 3]) {
+    let c = staged.mc.channels;
+    let mut value = [0.0f32; MAX_CHANNELS];
+    let value = &mut value[..c];
+    let r = 1u32 << step.to;
+    let mut fv = Vec::with_capacity(samples_per_face(r) as usize * c);
+    for i in 1..r {
+        for j in 1..r - i {
+            let b = sample_position(r, i, j).map(|x| x as f32);
+            eval(staged, step.face, b, FINEST, false, value);
+            fv.extend_from_slice(value);
+        }
+    }
+    let mut ev: [Option<Vec<f32>>; 3] = [None, None, None];
+    for (slot, &(e, le0, le1)) in ev.iter_mut().zip(&step.plan) {
+        if le0 == le1 {
+            continue;
+        }
+        let lp = le0.max(le1);
+        let mut v = Vec::with_capacity(samples_per_edge(1 << le1) as usize * c);
+        for s in 1..1u32 << le1 {
+            value.fill(0.0);
+            edge_point(staged, e, FINEST, lp, s << (lp - le1), 1.0, false, value);
+            v.extend_from_slice(value);
+        }
+        *slot = Some(v);
+    }
+    (fv, ev)
+}
+
 /// The mesh colours as a batch sees them between two of its steps: levels
 /// already updated in `mc`, the new samples of resampled faces and edges
 /// in the overlays, every other sample where it was.
@@ -502,7 +654,12 @@ impl MeshColors {
     /// faces and edges touched; the layout of Fig. 10 stays contiguous, so
     /// the samples after the first touched primitive move once (one
     /// `memcpy`-speed pass, not one per face), and the per-edge and
-    /// per-face indices after it are renumbered.
+    /// per-face indices after it are renumbered. The steps are resampled
+    /// in waves: a step joins the first wave after every earlier step that
+    /// changed its face or edges, and not before an earlier step that read
+    /// what it changes; a wave's steps (the faces of a detail brush fall
+    /// into a handful of waves) are resampled on all threads with the
+    /// `rayon` feature, with the same result at any thread count.
     ///
     /// Returns what undoes it ([`MeshColors::revert_resolutions`]).
     ///
@@ -554,100 +711,38 @@ impl MeshColors {
             edges: Vec::new(),
             edge_values: Vec::new(),
         };
+        let (steps, lowered) = self.plan_steps(&mut record);
         let mut face_new = Overlay::new(face_count);
         let mut edge_new = Overlay::new(self.edge_level.len());
-        let mut value = vec![0.0f32; c];
-        let mut lowered = false;
-        for &(f, n1) in &record.requests {
-            let f = f as usize;
-            let n0 = self.face_level[f];
-            if n0 == n1 {
-                continue;
-            }
-            lowered |= n1 < n0;
-            // Each local edge: its level now and after this step.
-            let plan = self.topology.face_edges[f].map(|e| {
-                let e = e as usize;
-                let after = self.topology.edge_faces[e]
-                    .iter()
-                    .filter(|&&g| g != NO_FACE)
-                    .map(|&g| {
-                        if g as usize == f {
-                            n1
-                        } else {
-                            self.face_level[g as usize]
-                        }
-                    })
-                    .min()
-                    .unwrap_or(n1);
-                (e, self.edge_level[e], after)
-            });
-            // New values, all computed from the state before this step
-            // (as `rebuild` computes them from the old colours).
-            let (face_values, edge_values) = {
-                let staged = Staged {
-                    mc: self,
-                    faces: &face_new,
-                    edges: &edge_new,
-                };
-                let r = 1u32 << n1;
-                let mut fv = Vec::with_capacity(samples_per_face(r) as usize * c);
-                for i in 1..r {
-                    for j in 1..r - i {
-                        let b = sample_position(r, i, j).map(|x| x as f32);
-                        eval(&staged, f, b, FINEST, false, &mut value);
-                        fv.extend_from_slice(&value);
-                    }
-                }
-                let mut ev: [Option<Vec<f32>>; 3] = [None, None, None];
-                for (slot, &(e, le0, le1)) in ev.iter_mut().zip(&plan) {
-                    if le0 == le1 {
-                        continue;
-                    }
-                    let lp = le0.max(le1);
-                    let mut v = Vec::with_capacity(samples_per_edge(1 << le1) as usize * c);
-                    for s in 1..1u32 << le1 {
-                        value.fill(0.0);
-                        edge_point(
-                            &staged,
-                            e,
-                            FINEST,
-                            lp,
-                            s << (lp - le1),
-                            1.0,
-                            false,
-                            &mut value,
-                        );
-                        v.extend_from_slice(&value);
-                    }
-                    *slot = Some(v);
-                }
-                (fv, ev)
+        let waves = steps.iter().map(|s| s.wave).max().map_or(0, |w| w + 1);
+        let mut order: Vec<usize> = (0..steps.len()).collect();
+        order.sort_by_key(|&k| steps[k].wave); // stable: sequence order within a wave
+        let mut at = 0;
+        for _ in 0..waves {
+            let len = order[at..]
+                .iter()
+                .take_while(|&&k| steps[k].wave == steps[order[at]].wave)
+                .count();
+            let wave = &order[at..at + len];
+            at += len;
+            // Every step of a wave reads what the earlier waves left and
+            // writes what no other step of the wave reads, so computing
+            // them at once gives the values of the sequential order.
+            let staged = Staged {
+                mc: self,
+                faces: &face_new,
+                edges: &edge_new,
             };
-            // The record keeps each primitive's state before the batch,
-            // taken when the batch first touches it.
-            if !face_new.contains(f) {
-                record.faces.push((f as u32, n0, n1));
-                let at = self.face_offset[f] * c;
-                let len = samples_per_face(1 << n0) as usize * c;
-                record
-                    .face_values
-                    .extend_from_slice(&self.samples[at..at + len]);
-            }
-            face_new.insert(f, face_values);
-            self.face_level[f] = n1;
-            for ((e, le0, le1), v) in plan.into_iter().zip(edge_values) {
-                let Some(v) = v else { continue };
-                if !edge_new.contains(e) {
-                    record.edges.push((e as u32, le0, le1));
-                    let at = self.edge_offset[e] * c;
-                    let len = samples_per_edge(1 << le0) as usize * c;
-                    record
-                        .edge_values
-                        .extend_from_slice(&self.samples[at..at + len]);
+            let values = map_ordered(wave, |&k| resample_step(&staged, &steps[k]));
+            for (&k, (fv, ev)) in wave.iter().zip(values) {
+                let step = &steps[k];
+                face_new.insert(step.face, fv);
+                self.face_level[step.face] = step.to;
+                for (&(e, _, le1), v) in step.plan.iter().zip(ev) {
+                    let Some(v) = v else { continue };
+                    edge_new.insert(e, v);
+                    self.edge_level[e] = le1;
                 }
-                edge_new.insert(e, v);
-                self.edge_level[e] = le1;
             }
         }
         for x in &mut record.faces {

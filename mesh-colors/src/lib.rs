@@ -71,6 +71,7 @@ pub mod gpu;
 mod luminance;
 mod mip;
 mod paint;
+mod parallel;
 pub mod session;
 mod structure;
 mod texture;

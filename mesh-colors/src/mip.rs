@@ -3,6 +3,7 @@
 //! anisotropic filtering from screen-space derivatives (Sec. 4.3).
 
 use crate::filter::{FINEST, Place, Store, check, edge_point, eval_at, lattice, place, triangle};
+use crate::parallel::map_ordered;
 use crate::structure::{MeshColors, interior_index, move_segments, samples_per_face};
 use crate::topology::NO_FACE;
 use std::sync::OnceLock;
@@ -293,6 +294,13 @@ impl Store for MipMap {
         let c = self.colors.channels;
         let i = self.face_offset[f] + FACE_LEVEL_OFFSET[level as usize] + idx;
         &self.data[i * c..(i + 1) * c]
+    }
+}
+
+/// Adds `x` to the running sums `sum` (in f64, as Eq. 5 and 6 average).
+fn accumulate(sum: &mut [f64], x: &[f32]) {
+    for (s, &x) in sum.iter_mut().zip(x) {
+        *s += f64::from(x);
     }
 }
 
@@ -789,118 +797,150 @@ impl MipMap {
     /// Computes level `l` of every primitive finer than `l` from level
     /// `l + 1` (all of which exists already).
     /// (Only the faces, edges and vertices of `subset` when given.)
+    ///
+    /// Each primitive's values read level `l + 1` only and land in its own
+    /// span of level `l`, so they are computed on all threads (see
+    /// [`map_ordered`]) and written afterwards, the same at any thread
+    /// count.
     fn build_level(&mut self, l: u8, vertex_edges: &[Vec<u32>], subset: Option<&Subset>) {
+        let mc = &self.colors;
+        let r = 1u32 << l;
+        let faces: Vec<usize> = ids(subset.map(|s| &s.faces[..]), mc.face_level.len())
+            .filter(|&f| mc.face_level[f] > l && r >= 3)
+            .collect();
+        let edges: Vec<usize> = ids(subset.map(|s| &s.edges[..]), mc.edge_level.len())
+            .filter(|&e| mc.edge_level[e] > l && r >= 2)
+            .collect();
+        let vertices: Vec<usize> = ids(subset.map(|s| &s.vertices[..]), vertex_edges.len())
+            .filter(|&v| mc.vertex_level[v] > l)
+            .collect();
+        let this = &*self;
+        let mut writes = map_ordered(&faces, |&f| this.face_level_values(f, l));
+        writes.extend(map_ordered(&edges, |&e| this.edge_level_values(e, l)));
+        writes.extend(map_ordered(&vertices, |&v| {
+            this.vertex_level_value(v, l, &vertex_edges[v])
+        }));
+        let c = self.colors.channels;
+        for (at, values) in writes {
+            self.data[at * c..at * c + values.len()].copy_from_slice(&values);
+        }
+    }
+
+    /// Face `f`'s interior samples at level `l` (Eq. 5), from level
+    /// `l + 1`: the first sample's index in `data` and the values, in
+    /// interior order.
+    fn face_level_values(&self, f: usize, l: u8) -> (usize, Vec<f32>) {
         let c = self.colors.channels;
         let q = l + 1;
-        let mut writes: Vec<(usize, Vec<f32>)> = Vec::new();
-        let mut tmp = vec![0.0f32; c];
-        let mut sum = vec![0.0f64; c];
-        let mut val = vec![0.0f32; c];
-        let mc = &self.colors;
-        let accumulate = |sum: &mut [f64], tmp: &[f32]| {
-            for (s, &x) in sum.iter_mut().zip(tmp) {
-                *s += f64::from(x);
-            }
-        };
-        // Faces, Eq. 5.
         let r = 1u32 << l;
-        for f in ids(subset.map(|s| &s.faces[..]), mc.face_level.len()) {
-            if mc.face_level[f] <= l || r < 3 {
-                continue;
-            }
-            for i in 1..r {
-                for j in 1..r - i {
-                    let k = r - i - j;
-                    let centre = [2 * i, 2 * j, 2 * k];
-                    sum.fill(0.0);
-                    for d in HEX {
-                        let a = [0, 1, 2].map(|m| (centre[m] as i32 + d[m]) as u32);
-                        tmp.fill(0.0);
-                        lattice(self, f, q, q, a, 1.0, false, &mut tmp);
-                        accumulate(&mut sum, &tmp);
-                    }
-                    let idx = interior_index(1 << q, centre[0], centre[1]);
-                    combine(self.face_at(f, q, idx), &sum, 6, &mut val);
-                    let at = self.face_offset[f]
-                        + FACE_LEVEL_OFFSET[l as usize]
-                        + interior_index(r, i, j);
-                    writes.push((at, val.clone()));
+        let (mut tmp, mut sum, mut val) = (
+            [0.0f32; MAX_CHANNELS],
+            [0.0f64; MAX_CHANNELS],
+            [0.0f32; MAX_CHANNELS],
+        );
+        let (tmp, sum, val) = (&mut tmp[..c], &mut sum[..c], &mut val[..c]);
+        let first = self.face_offset[f] + FACE_LEVEL_OFFSET[l as usize];
+        let mut values = vec![0.0f32; samples_per_face(r) as usize * c];
+        for i in 1..r {
+            for j in 1..r - i {
+                let k = r - i - j;
+                let centre = [2 * i, 2 * j, 2 * k];
+                sum.fill(0.0);
+                for d in HEX {
+                    let a = [0, 1, 2].map(|m| (centre[m] as i32 + d[m]) as u32);
+                    tmp.fill(0.0);
+                    lattice(self, f, q, q, a, 1.0, false, tmp);
+                    accumulate(sum, tmp);
                 }
+                let idx = interior_index(1 << q, centre[0], centre[1]);
+                combine(self.face_at(f, q, idx), sum, 6, val);
+                let at = interior_index(r, i, j) * c;
+                values[at..at + c].copy_from_slice(val);
             }
         }
-        // Edges: the six-neighbour rule.
-        for e in ids(subset.map(|s| &s.edges[..]), mc.edge_level.len()) {
-            if mc.edge_level[e] <= l || r < 2 {
-                continue;
+        (first, values)
+    }
+
+    /// Edge `e`'s samples at level `l` (the six-neighbour rule), from
+    /// level `l + 1`: the first sample's index in `data` and the values.
+    fn edge_level_values(&self, e: usize, l: u8) -> (usize, Vec<f32>) {
+        let mc = &self.colors;
+        let c = mc.channels;
+        let q = l + 1;
+        let r = 1u32 << l;
+        let r2 = 1u32 << q;
+        let (mut tmp, mut sum, mut val) = (
+            [0.0f32; MAX_CHANNELS],
+            [0.0f64; MAX_CHANNELS],
+            [0.0f32; MAX_CHANNELS],
+        );
+        let (tmp, sum, val) = (&mut tmp[..c], &mut sum[..c], &mut val[..c]);
+        let mut values = Vec::with_capacity((r as usize - 1) * c);
+        for s in 1..r {
+            sum.fill(0.0);
+            let mut n = 0;
+            for p in [2 * s - 1, 2 * s + 1] {
+                accumulate(sum, self.edge_at(e, q, p));
+                n += 1;
             }
-            let r2 = 1u32 << q;
-            for s in 1..r {
-                sum.fill(0.0);
-                let mut n = 0;
-                for p in [2 * s - 1, 2 * s + 1] {
-                    accumulate(&mut sum, self.edge_at(e, q, p));
+            for &f in &mc.topology.edge_faces[e] {
+                if f == NO_FACE {
+                    continue;
+                }
+                let f = f as usize;
+                let face = mc.topology.faces[f];
+                let Some(k) = (0..3).find(|&k| mc.topology.face_edges[f][k] as usize == e) else {
+                    continue;
+                };
+                let (k1, m) = ((k + 1) % 3, (k + 2) % 3);
+                let t = if face[k] < face[k1] {
+                    2 * s
+                } else {
+                    r2 - 2 * s
+                };
+                let mut a = [0u32; 3];
+                a[k] = r2 - t;
+                a[k1] = t;
+                for (dk, dk1) in [(1, 0), (0, 1)] {
+                    let mut b = a;
+                    b[k] -= dk;
+                    b[k1] -= dk1;
+                    b[m] += 1;
+                    tmp.fill(0.0);
+                    lattice(self, f, q, q, b, 1.0, false, tmp);
+                    accumulate(sum, tmp);
                     n += 1;
                 }
-                for &f in &mc.topology.edge_faces[e] {
-                    if f == NO_FACE {
-                        continue;
-                    }
-                    let f = f as usize;
-                    let face = mc.topology.faces[f];
-                    let Some(k) = (0..3).find(|&k| mc.topology.face_edges[f][k] as usize == e)
-                    else {
-                        continue;
-                    };
-                    let (k1, m) = ((k + 1) % 3, (k + 2) % 3);
-                    let t = if face[k] < face[k1] {
-                        2 * s
-                    } else {
-                        r2 - 2 * s
-                    };
-                    let mut a = [0u32; 3];
-                    a[k] = r2 - t;
-                    a[k1] = t;
-                    for (dk, dk1) in [(1, 0), (0, 1)] {
-                        let mut b = a;
-                        b[k] -= dk;
-                        b[k1] -= dk1;
-                        b[m] += 1;
-                        tmp.fill(0.0);
-                        lattice(self, f, q, q, b, 1.0, false, &mut tmp);
-                        accumulate(&mut sum, &tmp);
-                        n += 1;
-                    }
-                }
-                combine(self.edge_at(e, q, 2 * s), &sum, n, &mut val);
-                let at = self.edge_offset[e] + edge_level_offset(l) + s as usize - 1;
-                writes.push((at, val.clone()));
             }
+            combine(self.edge_at(e, q, 2 * s), sum, n, val);
+            values.extend_from_slice(val);
         }
-        // Vertices, Eq. 6.
-        for v in ids(subset.map(|s| &s.vertices[..]), vertex_edges.len()) {
-            let edges = &vertex_edges[v];
-            if mc.vertex_level[v] <= l {
-                continue;
-            }
-            sum.fill(0.0);
-            let r2 = 1u32 << q;
-            for &e in edges {
-                let e = e as usize;
-                let p = if mc.topology.edges[e][0] as usize == v {
-                    1
-                } else {
-                    r2 - 1
-                };
-                tmp.fill(0.0);
-                edge_point(self, e, q, q, p, 1.0, false, &mut tmp);
-                accumulate(&mut sum, &tmp);
-            }
-            combine(self.vertex_at(v, q), &sum, edges.len(), &mut val);
-            writes.push((self.vertex_offset[v] + l as usize, val.clone()));
+        (self.edge_offset[e] + edge_level_offset(l), values)
+    }
+
+    /// Vertex `v`'s value at level `l` (Eq. 6) from level `l + 1` along
+    /// its `edges`: its index in `data` and the value.
+    fn vertex_level_value(&self, v: usize, l: u8, edges: &[u32]) -> (usize, Vec<f32>) {
+        let mc = &self.colors;
+        let c = mc.channels;
+        let q = l + 1;
+        let r2 = 1u32 << q;
+        let (mut tmp, mut sum) = ([0.0f32; MAX_CHANNELS], [0.0f64; MAX_CHANNELS]);
+        let (tmp, sum) = (&mut tmp[..c], &mut sum[..c]);
+        for &e in edges {
+            let e = e as usize;
+            let p = if mc.topology.edges[e][0] as usize == v {
+                1
+            } else {
+                r2 - 1
+            };
+            tmp.fill(0.0);
+            edge_point(self, e, q, q, p, 1.0, false, tmp);
+            accumulate(sum, tmp);
         }
-        for (at, v) in writes {
-            self.data[at * c..(at + 1) * c].copy_from_slice(&v);
-        }
+        let mut val = vec![0.0f32; c];
+        combine(self.vertex_at(v, q), sum, edges.len(), &mut val);
+        (self.vertex_offset[v] + l as usize, val)
     }
 
     /// Linear filtering at MIP level `level` (clamped per primitive to its

@@ -284,3 +284,43 @@ fn assert_same_lookups(a: &mesh_colors::MipMap, b: &mesh_colors::MipMap, what: &
         }
     }
 }
+
+/// A batch large enough that its independent steps are resampled on all
+/// threads (waves of 16 steps or more) still equals one change at a time:
+/// the detail brush's case, many neighbouring faces up or down at once.
+#[test]
+fn a_large_batch_of_neighbours_equals_one_change_at_a_time() {
+    let mut rng = Rng(451);
+    let (positions, faces) = support::grid(20, 0.3);
+    let topology = Topology::new(positions.len(), &faces).unwrap();
+    for round in 0..3 {
+        let levels: Vec<u32> = (0..faces.len()).map(|_| 1 << rng.below(4)).collect();
+        let mut mc = MeshColors::new(topology.clone(), &levels, 3).unwrap();
+        for x in mc.samples_mut() {
+            *x = rng.f32();
+        }
+        // Most faces once, up or down one level, some twice.
+        let mut changes: Vec<(usize, u32)> = Vec::new();
+        for f in 0..mc.face_count() {
+            let r = mc.face_resolution(f).unwrap();
+            match rng.below(4) {
+                0 => {}
+                1 => changes.push((f, (r / 2).max(1))),
+                _ => changes.push((f, r * 2)),
+            }
+        }
+        for _ in 0..40 {
+            let f = rng.below(mc.face_count() as u64) as usize;
+            changes.push((f, 1 << rng.below(5)));
+        }
+        let mut one_by_one = mc.clone();
+        for &(f, r) in &changes {
+            one_by_one = one_by_one.set_face_resolution(f, r).unwrap();
+        }
+        let before = mc.clone();
+        let change = mc.set_face_resolutions(&changes).unwrap();
+        assert_eq!(mc, one_by_one, "round {round}");
+        mc.revert_resolutions(&change).unwrap();
+        assert_eq!(mc, before, "round {round}: undo");
+    }
+}
