@@ -6,6 +6,7 @@
 
 use glam::Vec3;
 
+use crate::parallel::map_ordered;
 use crate::structure::MeshColors;
 use crate::undo::Recorder;
 use crate::{Error, MAX_CHANNELS};
@@ -86,10 +87,10 @@ struct Grid {
 impl Grid {
     fn new(positions: &[Vec3], cell: f32) -> Self {
         let buckets = (positions.len() / 2).max(1).next_power_of_two();
-        let bucket: Vec<u32> = positions
-            .iter()
-            .map(|&p| bucket_of(cell_of(p, cell), buckets))
-            .collect();
+        // The hashing on all threads for a whole mesh; the counting sort
+        // after it stays in order, so the buckets list samples in
+        // increasing order at any thread count.
+        let bucket: Vec<u32> = map_ordered(positions, |&p| bucket_of(cell_of(p, cell), buckets));
         let mut start = vec![0u32; buckets + 1];
         for &b in &bucket {
             start[b as usize + 1] += 1;

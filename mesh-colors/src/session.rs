@@ -26,6 +26,7 @@ use glam::Vec3;
 use crate::Error;
 use crate::edit::ResolutionChange;
 use crate::paint::Painter;
+use crate::parallel::map_ordered;
 use crate::structure::{
     MeshColors, Site, lattice_points, move_segments, samples_per_edge, samples_per_face,
 };
@@ -684,18 +685,31 @@ impl PaintSession {
         let mut positions = painter.into_positions();
         move_segments(&mut positions, 1, &segments, total);
         move_segments(&mut self.normals, 1, &segments, total);
+        // Each resampled primitive's samples on their own (on all threads
+        // for a large change), then written in order.
+        let (vertices, vertex_normals) = (&self.positions, &self.vertex_normals);
         let faces = mc.topology().faces();
-        let mut place = |i: usize, site: Site| {
-            positions[i] = site
-                .position(mc.topology(), &self.positions)
-                .map_or_else(|| self.positions[i], |p| p.as_vec3());
-            self.normals[i] = normal_at(faces, &self.vertex_normals, &site);
+        let place = |out: &mut Vec<(usize, Vec3, Vec3)>, i: usize, site: Site| {
+            let p = site
+                .position(mc.topology(), vertices)
+                .map_or_else(|| vertices[i], |p| p.as_vec3());
+            out.push((i, p, normal_at(faces, vertex_normals, &site)));
         };
-        for e in (0..edge_new.len()).filter(|&e| edge_new[e]) {
-            mc.edge_sites(e, &mut place);
-        }
-        for f in (0..face_new.len()).filter(|&f| face_new[f]) {
-            mc.face_sites(f, &mut place);
+        let edges: Vec<usize> = (0..edge_new.len()).filter(|&e| edge_new[e]).collect();
+        let new_faces: Vec<usize> = (0..face_new.len()).filter(|&f| face_new[f]).collect();
+        let mut placed = map_ordered(&edges, |&e| {
+            let mut out = Vec::new();
+            mc.edge_sites(e, |i, site| place(&mut out, i, site));
+            out
+        });
+        placed.extend(map_ordered(&new_faces, |&f| {
+            let mut out = Vec::new();
+            mc.face_sites(f, |i, site| place(&mut out, i, site));
+            out
+        }));
+        for (i, p, n) in placed.into_iter().flatten() {
+            positions[i] = p;
+            self.normals[i] = n;
         }
         // No shrink_to_fit: the spare capacity a raise leaves serves the
         // next one without another copy (these are not the colours'
