@@ -733,7 +733,11 @@ impl MeshColors {
                 faces: &face_new,
                 edges: &edge_new,
             };
-            let values = map_ordered(wave, |&k| resample_step(&staged, &steps[k]));
+            let samples = wave
+                .iter()
+                .map(|&k| samples_per_face(1 << steps[k].to) as usize)
+                .sum();
+            let values = map_ordered(wave, samples, |&k| resample_step(&staged, &steps[k]));
             for (&k, (fv, ev)) in wave.iter().zip(values) {
                 let step = &steps[k];
                 face_new.insert(step.face, fv);

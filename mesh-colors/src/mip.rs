@@ -815,9 +815,15 @@ impl MipMap {
             .filter(|&v| mc.vertex_level[v] > l)
             .collect();
         let this = &*self;
-        let mut writes = map_ordered(&faces, |&f| this.face_level_values(f, l));
-        writes.extend(map_ordered(&edges, |&e| this.edge_level_values(e, l)));
-        writes.extend(map_ordered(&vertices, |&v| {
+        // About the samples each computes (a vertex or an edge sample
+        // averages about six).
+        let face_samples = faces.len() * samples_per_face(r) as usize;
+        let edge_samples = edges.len() * r as usize * 6;
+        let mut writes = map_ordered(&faces, face_samples, |&f| this.face_level_values(f, l));
+        writes.extend(map_ordered(&edges, edge_samples, |&e| {
+            this.edge_level_values(e, l)
+        }));
+        writes.extend(map_ordered(&vertices, vertices.len() * 6, |&v| {
             this.vertex_level_value(v, l, &vertex_edges[v])
         }));
         let c = self.colors.channels;

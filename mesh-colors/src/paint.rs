@@ -90,7 +90,9 @@ impl Grid {
         // The hashing on all threads for a whole mesh; the counting sort
         // after it stays in order, so the buckets list samples in
         // increasing order at any thread count.
-        let bucket: Vec<u32> = map_ordered(positions, |&p| bucket_of(cell_of(p, cell), buckets));
+        let bucket: Vec<u32> = map_ordered(positions, positions.len(), |&p| {
+            bucket_of(cell_of(p, cell), buckets)
+        });
         let mut start = vec![0u32; buckets + 1];
         for &b in &bucket {
             start[b as usize + 1] += 1;

@@ -697,12 +697,20 @@ impl PaintSession {
         };
         let edges: Vec<usize> = (0..edge_new.len()).filter(|&e| edge_new[e]).collect();
         let new_faces: Vec<usize> = (0..face_new.len()).filter(|&f| face_new[f]).collect();
-        let mut placed = map_ordered(&edges, |&e| {
+        let edge_samples = edges
+            .iter()
+            .map(|&e| samples_per_edge(1 << mc.edge_level[e]) as usize)
+            .sum();
+        let face_samples = new_faces
+            .iter()
+            .map(|&f| samples_per_face(1 << mc.face_level[f]) as usize)
+            .sum();
+        let mut placed = map_ordered(&edges, edge_samples, |&e| {
             let mut out = Vec::new();
             mc.edge_sites(e, |i, site| place(&mut out, i, site));
             out
         });
-        placed.extend(map_ordered(&new_faces, |&f| {
+        placed.extend(map_ordered(&new_faces, face_samples, |&f| {
             let mut out = Vec::new();
             mc.face_sites(f, |i, site| place(&mut out, i, site));
             out

@@ -286,15 +286,17 @@ fn assert_same_lookups(a: &mesh_colors::MipMap, b: &mesh_colors::MipMap, what: &
 }
 
 /// A batch large enough that its independent steps are resampled on all
-/// threads (waves of 16 steps or more) still equals one change at a time:
+/// threads (waves of 16,384 samples or more) still equals one change at a time:
 /// the detail brush's case, many neighbouring faces up or down at once.
 #[test]
 fn a_large_batch_of_neighbours_equals_one_change_at_a_time() {
     let mut rng = Rng(451);
-    let (positions, faces) = support::grid(20, 0.3);
+    let (positions, faces) = support::grid(24, 0.3);
     let topology = Topology::new(positions.len(), &faces).unwrap();
     for round in 0..3 {
-        let levels: Vec<u32> = (0..faces.len()).map(|_| 1 << rng.below(4)).collect();
+        // Fine enough that a wave holds more samples than the threshold
+        // for other threads.
+        let levels: Vec<u32> = (0..faces.len()).map(|_| 8 << rng.below(3)).collect();
         let mut mc = MeshColors::new(topology.clone(), &levels, 3).unwrap();
         for x in mc.samples_mut() {
             *x = rng.f32();
