@@ -322,7 +322,11 @@ mod tests {
         colors.samples_mut().fill(0.25);
         let wide = with_scalars(colors, &[0.5, 0.0]).unwrap();
         assert_eq!(wide.channels(), 5);
-        assert!(wide.samples().chunks(5).all(|s| s == [0.25, 0.25, 0.25, 0.5, 0.0]));
+        assert!(
+            wide.samples()
+                .chunks(5)
+                .all(|s| s == [0.25, 0.25, 0.25, 0.5, 0.0])
+        );
     }
 
     #[test]
