@@ -46,8 +46,10 @@ pub(crate) fn tets_in(
 /// `(n, 3)` float64 positions in the mesh's coordinates and `(m, 4)`
 /// int64 node indices (positive volume), plus a report dict when
 /// `return_report=True`: `tets`, `vertices`, `boundary_triangles`,
-/// `spacing`, `min_dihedral_deg`, `max_dihedral_deg` (the dihedral-angle
-/// range, the stuffing's quality bound), how far the tets' boundary lies
+/// `spacing`, `min_dihedral_deg`, `max_dihedral_deg` (this mesh's
+/// dihedral-angle range), `dihedral_bound_deg` (the `(min, max)` any
+/// surface gets with these options: 9°–162°, 9°–165° with `envelope`),
+/// how far the tets' boundary lies
 /// from the surface — `hausdorff` (symmetric), `input_to_tets`,
 /// `tets_to_input`, `mean_distance` in mesh units, `hausdorff_fraction` and
 /// `mean_distance_fraction` of the bounding box's `diagonal`, measured at
@@ -108,6 +110,7 @@ pub(crate) fn tetrahedralize<'py>(
         d.set_item("spacing", h)?;
         d.set_item("min_dihedral_deg", r.min_dihedral_deg)?;
         d.set_item("max_dihedral_deg", r.max_dihedral_deg)?;
+        d.set_item("dihedral_bound_deg", options.dihedral_bounds_deg())?;
         d.set_item("envelope", envelope)?;
         d.set_item("fitted_vertices", r.fitted_vertices)?;
         d.set_item("sharp_edges", r.sharp_edges)?;

@@ -88,6 +88,7 @@ def test_tetrahedralize_fits_a_box_to_an_envelope():
     assert fitted["envelope"] == 0.001 and fitted["fitted_vertices"] > 0 and fitted["sharp_edges"] == 12
     # The fit may split boundary edges where moves are not enough (at most 3x).
     assert len(plain_tets) <= len(tets) <= 3 * len(plain_tets) and fitted["min_dihedral_deg"] >= 10
+    assert fitted["dihedral_bound_deg"] == (9.0, 165.0) and plain["dihedral_bound_deg"] == (9.0, 162.0)
     assert fitted["input_to_tets"] < 0.5 * plain["input_to_tets"]
     corners = np.asarray(box.vertices)
     gap = max(np.linalg.norm(nodes - c, axis=1).min() for c in corners)

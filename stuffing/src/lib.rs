@@ -240,6 +240,22 @@ impl Options {
             envelope: None,
         }
     }
+
+    /// The `(smallest, largest)` dihedral angle, degrees, that every output
+    /// of [`tetrahedralize`] with these options stays within, whatever the
+    /// surface: the stencils' [`Params::dihedral_bounds_deg`], widened to
+    /// 10°–165° by [`Options::envelope`]'s fit where it moves or splits
+    /// (9°–165° with the default parameters).
+    pub fn dihedral_bounds_deg(&self) -> (f64, f64) {
+        let (lo, hi) = self.params.dihedral_bounds_deg();
+        match self.envelope {
+            Some(_) => (
+                lo.min(envelope::MIN_DIHEDRAL_DEG),
+                hi.max(envelope::MAX_DIHEDRAL_DEG),
+            ),
+            None => (lo, hi),
+        }
+    }
 }
 
 /// A tetrahedral mesh and how it was made.

@@ -304,6 +304,17 @@ fn every_shape_gives_a_valid_mesh_within_the_angle_bounds() {
 }
 
 #[test]
+fn the_stated_bounds_widen_only_with_the_envelope() {
+    let mut options = Options::new(0.1);
+    assert_eq!(options.dihedral_bounds_deg(), (9.0, 162.0));
+    options.params = Params::Angles8_9;
+    assert_eq!(options.dihedral_bounds_deg(), (7.0, 165.0));
+    options.params = Params::Angles10_7;
+    options.envelope = Some(2e-3);
+    assert_eq!(options.dihedral_bounds_deg(), (9.0, 165.0));
+}
+
+#[test]
 fn a_stencil_table_without_the_parity_rule_fails_the_same_check() {
     let mut failures = 0;
     for (name, (p, t), h) in shapes() {

@@ -116,8 +116,14 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let diagonal = trilux::mesh::bounds(&mesh)
         .map(|(lo, hi)| (hi.as_dvec3() - lo.as_dvec3()).length())
         .unwrap_or(0.0);
+    // What the options guarantee, beside what this surface got.
+    let bound = tet_stuffing::Options {
+        envelope: args.envelope,
+        ..tet_stuffing::Options::new(h)
+    }
+    .dihedral_bounds_deg();
     let text = format!(
-        "{} tetrahedra, {} vertices, {} boundary triangles at spacing {}{}{} in {:.2} s; dihedral angles {:.2}° .. {:.2}°{}; written to {}\n",
+        "{} tetrahedra, {} vertices, {} boundary triangles at spacing {}{}{} in {:.2} s; dihedral angles {:.2}° .. {:.2}° (within {}°–{}° on any surface){}; written to {}\n",
         r.tets,
         r.vertices,
         r.boundary_triangles,
@@ -135,6 +141,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         r.elapsed.as_secs_f64(),
         r.min_dihedral_deg,
         r.max_dihedral_deg,
+        bound.0,
+        bound.1,
         r.distance
             .as_ref()
             .map(|d| distance_text(d, args.envelope))
@@ -159,6 +167,8 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         "sharp_edges": r.sharp_edges,
         "split_edges": r.split_edges,
         "dihedral_degrees": [r.min_dihedral_deg, r.max_dihedral_deg],
+        // The bound any surface gets with these options.
+        "dihedral_bound_degrees": [bound.0, bound.1],
         "distance": r.distance.as_ref().map(distance_json),
         // Whether the measured distance is within the envelope asked for.
         "envelope_reached": args.envelope.zip(r.distance.as_ref()).map(|(eps, d)| d.hausdorff_fraction() <= eps),

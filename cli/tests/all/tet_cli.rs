@@ -162,6 +162,9 @@ fn tetra_fits_the_boundary_to_an_envelope_and_says_how_near_it_came() {
         fitted["dihedral_degrees"][0].as_f64().unwrap() >= 10.0,
         "{fitted}"
     );
+    // The stated bound: the stencils' 9°–162° widened to 165° by the fit.
+    assert_eq!(fitted["dihedral_bound_degrees"], serde_json::json!([9.0, 165.0]));
+    assert_eq!(plain["dihedral_bound_degrees"], serde_json::json!([9.0, 162.0]));
     let hausdorff = |r: &serde_json::Value| r["distance"]["hausdorff"].as_f64().unwrap();
     assert!(
         hausdorff(&fitted) <= hausdorff(&plain),
@@ -485,7 +488,8 @@ fn tetra_stuffs_the_raw_bunny_and_diffuse_accepts_it() {
     let bunny = data("meshes/stanford-bunny.obj");
     let report = json(d, &["tetra", bunny.to_str().unwrap(), "-o", "bunny.node"]);
     let min = report["dihedral_degrees"][0].as_f64().unwrap();
-    assert!(min >= 8.9, "minimum dihedral {min}°");
+    let bound = report["dihedral_bound_degrees"][0].as_f64().unwrap();
+    assert!(min >= bound && bound >= 8.9, "minimum dihedral {min}°, bound {bound}°");
     let mesh = trilux_io::tet::read(d.join("bunny.node")).unwrap();
     assert_eq!(report["tetrahedra"], mesh.tets.len());
     trilux(d)
