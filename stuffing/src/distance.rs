@@ -373,11 +373,24 @@ fn one_way(
     )
 }
 
+/// Per triangle of the input `wn` was built on, whether it encloses volume
+/// ([`encloses_volume`]): one winding number each, computed once and shared
+/// by the envelope fit and the measurement.
+pub(crate) fn bounding_triangles(wn: &WindingNumber) -> Vec<bool> {
+    let p = wn.positions();
+    wn.triangles()
+        .par_iter()
+        .map(|t| encloses_volume(wn, t.map(|v| p[v as usize])))
+        .collect()
+}
+
 /// Measures the boundary `(positions, boundary)` against the input
 /// surface `wn` was built on, with `samples` points on each surface (plus
-/// their vertices when there are no more of them).
+/// their vertices when there are no more of them); `bounding` is
+/// [`bounding_triangles`] of `wn`.
 pub(crate) fn measure(
     wn: &WindingNumber,
+    bounding: &[bool],
     positions: &[DVec3],
     boundary: &[[u32; 3]],
     samples: usize,
@@ -396,10 +409,6 @@ pub(crate) fn measure(
     let all_area: Vec<f64> = (0..input.triangles.len())
         .into_par_iter()
         .map(|t| area(input.corners(t)))
-        .collect();
-    let bounding: Vec<bool> = (0..input.triangles.len())
-        .into_par_iter()
-        .map(|t| encloses_volume(wn, input.corners(t)))
         .collect();
     let kept: Vec<u32> = (0..input.triangles.len() as u32)
         .filter(|&t| bounding[t as usize])

@@ -40,7 +40,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::bvh::Bvh;
-use crate::distance::{Surface, closest_point_on_triangle, encloses_volume};
+use crate::distance::{Surface, closest_point_on_triangle};
 use crate::mesh::Assembled;
 use crate::quality::{dihedral_angles, signed_volume};
 use crate::refine;
@@ -77,9 +77,12 @@ pub(crate) struct Fitted {
 /// Moves boundary vertices of the tetrahedral mesh `(positions, tets)`
 /// with boundary `boundary` towards the input `wn` was built on, until
 /// the input's sampled points lie within `eps` of the boundary or no move
-/// is left that keeps the angles; `h` is the lattice spacing.
+/// is left that keeps the angles; `h` is the lattice spacing, `bounding`
+/// the input triangles that enclose volume
+/// ([`crate::distance::bounding_triangles`]).
 pub(crate) fn fit(
     wn: &WindingNumber,
+    bounding: &[bool],
     mesh: &mut Assembled,
     h: f64,
     eps: f64,
@@ -88,21 +91,21 @@ pub(crate) fn fit(
     let input_positions = wn.positions();
     let kept: Vec<[u32; 3]> = wn
         .triangles()
-        .par_iter()
-        .filter(|t| encloses_volume(wn, t.map(|v| input_positions[v as usize])))
-        .copied()
+        .iter()
+        .zip(bounding)
+        .filter_map(|(t, &b)| b.then_some(*t))
         .collect();
     if kept.is_empty() || mesh.boundary.is_empty() {
         return Fitted::default();
     }
     let sharp = sharp_edges(input_positions, &kept);
-    let targets = points_to_hold(input_positions, &kept, &sharp, h, mesh.boundary.len());
     let input_bvh = Bvh::build(input_positions, &kept);
     let input = Surface {
         positions: input_positions,
         triangles: &kept,
         bvh: &input_bvh,
     };
+    let targets = points_to_hold(&input, &sharp, h, mesh.boundary.len());
     let (mut moved, mut touched) = pull_rounds(&input, mesh, &targets, h, eps);
     // What the moves could not reach: split edges near it (`refine`).
     let refined = refine::refine(wn, &input, mesh, &targets, eps, max_tets);
@@ -210,12 +213,12 @@ pub(crate) fn sharp_edges(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<[u
 /// [`MAX_CREASE_POINTS`] of them), and
 /// `4 × boundary triangles` points spread by area (at most 2^18).
 fn points_to_hold(
-    positions: &[DVec3],
-    kept: &[[u32; 3]],
+    surface: &Surface<'_>,
     sharp: &[[u32; 2]],
     h: f64,
     boundary_triangles: usize,
 ) -> Vec<DVec3> {
+    let (positions, kept) = (surface.positions, surface.triangles);
     let mut used: Vec<u32> = kept.iter().flatten().copied().collect();
     used.par_sort_unstable();
     used.dedup();
@@ -234,12 +237,6 @@ fn points_to_hold(
             .min(MAX_CREASE_POINTS as f64) as usize;
         points.extend((1..steps).map(|k| pa.lerp(pb, k as f64 / steps as f64)));
     }
-    let bvh = Bvh::build(positions, kept);
-    let surface = Surface {
-        positions,
-        triangles: kept,
-        bvh: &bvh,
-    };
     let all: Vec<u32> = (0..kept.len() as u32).collect();
     let n = (4 * boundary_triangles).min(1 << 18);
     // `sample` adds the vertices again when there are few; they are
@@ -390,12 +387,18 @@ impl Mover<'_> {
         let mut vertices: Vec<u32> = boundary.iter().flatten().copied().collect();
         vertices.sort_unstable();
         vertices.dedup();
-        for v in vertices {
-            if self.moved[v as usize] {
-                continue;
-            }
-            let p = positions[v as usize];
-            let (q, d2, _) = self.input.nearest(p);
+        vertices.retain(|&v| !self.moved[v as usize]);
+        // Each vertex's nearest input point, all found at once: a move
+        // changes only the moved vertex's position, so where each one
+        // stands when its turn comes is where it stands now.
+        let nearest: Vec<(DVec3, f64)> = vertices
+            .par_iter()
+            .map(|&v| {
+                let (q, d2, _) = self.input.nearest(positions[v as usize]);
+                (q, d2)
+            })
+            .collect();
+        for (v, (q, d2)) in vertices.into_iter().zip(nearest) {
             // Already on the surface (cut points are), or too far to be
             // this part of it (across a hole).
             if d2 <= (1e-9 * h).powi(2) || d2 > (0.5 * REACH * h).powi(2) {

@@ -459,17 +459,29 @@ fn run<P: Position>(
         return Err(empty(&wn, h));
     }
     let mut m = mesh::assemble(cells);
+    // Which input triangles enclose volume: the fit and the measurement
+    // both leave the others out.
+    let bounding = (options.envelope.is_some() || options.distance_samples > 0)
+        .then(|| distance::bounding_triangles(&wn))
+        .unwrap_or_default();
     let fitted = options.envelope.map(|eps| {
         let (lo, hi) = used_bounds(&pos, triangles);
         let diagonal = lo.distance(hi);
         // The refinement may triple the stuffed count (the cost
         // bound), never beyond the caller's limit.
         let budget = m.tets.len().saturating_mul(3).min(options.max_tets);
-        envelope::fit(&wn, &mut m, h, eps * diagonal, budget)
+        envelope::fit(&wn, &bounding, &mut m, h, eps * diagonal, budget)
     });
     let q = quality::quality(&m.positions, &m.tets);
-    let distance = (options.distance_samples > 0)
-        .then(|| distance::measure(&wn, &m.positions, &m.boundary, options.distance_samples));
+    let distance = (options.distance_samples > 0).then(|| {
+        distance::measure(
+            &wn,
+            &bounding,
+            &m.positions,
+            &m.boundary,
+            options.distance_samples,
+        )
+    });
     let report = Report {
         tets: m.tets.len(),
         vertices: m.positions.len(),
@@ -525,7 +537,10 @@ pub fn surface_distance<P: Position, Q: Position>(
             return Err(in_boundary(Error::NonFinitePosition { vertex: v as usize }));
         }
     }
-    Ok(distance::measure(&wn, &output, boundary, samples))
+    let bounding = distance::bounding_triangles(&wn);
+    Ok(distance::measure(
+        &wn, &bounding, &output, boundary, samples,
+    ))
 }
 
 /// Why no tetrahedron came out at spacing `h`: no triangle bounds a volume

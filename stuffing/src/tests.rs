@@ -555,7 +555,7 @@ fn the_distance_between_concentric_spheres_is_the_difference_of_their_radii() {
     let (p, t) = sphere(48, 1.0, DVec3::ZERO);
     let (q, u) = sphere(48, 1.1, DVec3::ZERO);
     let wn = winding::WindingNumber::new(&p, &t, winding::DEFAULT_BETA).unwrap();
-    let d = distance::measure(&wn, &q, &u, 20_000);
+    let d = distance::measure(&wn, &distance::bounding_triangles(&wn), &q, &u, 20_000);
     // Each facet of the 48-ring spheres sags at most r (1 - cos(pi/48))
     // (0.0024 at r = 1.1) below the round sphere.
     for x in [d.hausdorff, d.input_to_tets, d.tets_to_input, d.mean] {
