@@ -461,9 +461,11 @@ fn run<P: Position>(
     let mut m = mesh::assemble(cells);
     // Which input triangles enclose volume: the fit and the measurement
     // both leave the others out.
-    let bounding = (options.envelope.is_some() || options.distance_samples > 0)
-        .then(|| distance::bounding_triangles(&wn))
-        .unwrap_or_default();
+    let bounding = if options.envelope.is_some() || options.distance_samples > 0 {
+        distance::bounding_triangles(&wn)
+    } else {
+        Vec::new()
+    };
     let fitted = options.envelope.map(|eps| {
         let (lo, hi) = used_bounds(&pos, triangles);
         let diagonal = lo.distance(hi);
