@@ -7,8 +7,11 @@
 //! [`GpuLayout::new`] packs a [`MipMap`]; after a stroke,
 //! [`MipMap::refresh`] and [`GpuLayout::refresh`] rewrite only the values
 //! near the stroke and say which texel rectangles changed (for
-//! `texSubImage2D`); after a resolution change [`GpuLayout::update`]
-//! repacks a new pyramid and says the same; [`GpuLayout::lookup`] is the CPU
+//! `texSubImage2D`); after a resolution change
+//! [`MipMap::refresh_resolutions`] and [`GpuLayout::refresh_resolutions`]
+//! do the same for the resampled faces (which move to blocks of their new
+//! size when they grew) and the table entries that point to them
+//! ([`GpuLayout::update`] repacks everything); [`GpuLayout::lookup`] is the CPU
 //! reference of the shader: it reads *only* the packed arrays, with the
 //! formulas below, and equals [`MeshColors::nearest`],
 //! [`MeshColors::linear`], [`MipMap::at_level`], [`MipMap::trilinear`] and
@@ -23,14 +26,20 @@
 //! - **Samples**: `RGBA32F` (`internalFormat = gl.RGBA32F, format =
 //!   gl.RGBA, type = gl.FLOAT`, read with `texelFetch` on a `sampler2D`
 //!   with `NEAREST` filtering), [`GpuLayout::sample_texels`]: 4 `f32` per
-//!   texel, little-endian as a `Float32Array` over the same bytes. The MIP
-//!   pyramid's value `i` (the [`MipMap::data`] index divided by the
-//!   channel count) occupies `P = ⌈channels / 4⌉` texels from `t = i · P`;
-//!   channel `ch` is component `ch % 4` of texel `i · P + ch / 4`; unused
+//!   texel, little-endian as a `Float32Array` over the same bytes. Value
+//!   `i` occupies `P = ⌈channels / 4⌉` texels from `t = i · P`; channel
+//!   `ch` is component `ch % 4` of texel `i · P + ch / 4`; unused
 //!   components are 0. Values are the colours' own, in their own units
-//!   (no sRGB encoding: output conversion is the page's).
-//!   `sample_height() = ⌈(values · P) / W⌉` rows; the last row is padded
-//!   with zeros.
+//!   (no sRGB encoding: output conversion is the page's). Each vertex's,
+//!   edge's and face's levels are a block of consecutive values, where
+//!   the face table says. [`GpuLayout::new`] and [`GpuLayout::update`]
+//!   lay the blocks out in [`MipMap::data`]'s order (value `i` is the
+//!   `MipMap::data` index divided by the channel count) in
+//!   `sample_height() = ⌈(values · P) / W⌉` rows, the last padded with
+//!   zeros; [`GpuLayout::refresh_resolutions`] moves a primitive that
+//!   grew to a block of its new size and leaves the others in place, so
+//!   blocks may then come in any order with unused values between them
+//!   (never read), and a repack for lack of room adds spare rows.
 //! - **Face table**: `RGBA32UI` (`gl.RGBA32UI, gl.RGBA_INTEGER,
 //!   gl.UNSIGNED_INT`, a `usampler2D`), [`GpuLayout::face_texels`]: face
 //!   `f`'s [`FACE_WORDS`] = 8 words are texels `2f` and `2f + 1` (words
@@ -38,9 +47,9 @@
 //!
 //!   | word | meaning |
 //!   |---|---|
-//!   | `w0` | `F`: pyramid index of the face's interior, level 0 |
-//!   | `w1, w2, w3` | `V_k`: pyramid index of corner `k`'s vertex, level 0 |
-//!   | `w4, w5, w6` | `E_k`: pyramid index of local edge `k` (corner `k` → `k+1`), level 0 |
+//!   | `w0` | `F`: value index of the face's interior, level 0 |
+//!   | `w1, w2, w3` | `V_k`: value index of corner `k`'s vertex, level 0 |
+//!   | `w4, w5, w6` | `E_k`: value index of local edge `k` (corner `k` → `k+1`), level 0 |
 //!   | `w7` | bits 0–3 `n` (face level, `R = 2^n`), 4–7 / 8–11 / 12–15 `vl_k` (vertex levels), 16–19 / 20–23 / 24–27 `el_k` (edge levels), bit `28 + k` set when edge `k` runs canonically from corner `k` to corner `k + 1` (the corner's vertex index is the smaller) |
 //!
 //!   Levels are at most [`crate::MAX_LEVEL`]; `el_k ≤ n ≤ max vl_k`.
@@ -116,9 +125,11 @@
 //! [`MeshColors::nearest`]: crate::MeshColors::nearest
 //! [`MeshColors::linear`]: crate::MeshColors::linear
 
+use std::collections::BTreeMap;
+
 use crate::filter::triangle;
 use crate::mip::{FACE_LEVEL_OFFSET, MipMap, edge_level_offset, level_of_footprint};
-use crate::structure::interior_index;
+use crate::structure::{MeshColors, interior_index};
 use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
 
 /// Words per face in the face table (two `RGBA32UI` texels).
@@ -212,6 +223,103 @@ pub struct GpuParts {
 pub struct GpuLayout {
     max_width: u32,
     parts: GpuParts,
+    /// Where each primitive's levels are in the sample texture (`None`
+    /// for a layout built from parts: then value `i` of the pyramid is at
+    /// texel `i · P`, as [`GpuLayout::new`] packs it).
+    blocks: Option<Blocks>,
+}
+
+/// The sample texture's allocation: per vertex, edge and face, its block
+/// of values `(first, room)` (its levels from `first`, `room` values
+/// reserved), the free blocks by room, and the end of the values in use.
+#[derive(Debug, Clone, PartialEq, Default)]
+struct Blocks {
+    vertex: Vec<(u32, u32)>,
+    edge: Vec<(u32, u32)>,
+    face: Vec<(u32, u32)>,
+    /// The face levels the blocks hold (a pyramid of other levels needs
+    /// [`GpuLayout::refresh_resolutions`]).
+    face_level: Vec<u8>,
+    /// Blocks given up by primitives that grew, by room (a `BTreeMap`
+    /// so that allocation is the same on every run).
+    free: BTreeMap<u32, Vec<u32>>,
+    /// Values from here on are unused.
+    end: usize,
+}
+
+impl Blocks {
+    /// A block of `len` values: a free one of that room, else at the end.
+    fn allocate(&mut self, len: u32) -> (u32, u32) {
+        if let Some(at) = self.free.get_mut(&len).and_then(Vec::pop) {
+            return (at, len);
+        }
+        let at = self.end as u32;
+        self.end += len as usize;
+        (at, len)
+    }
+
+    /// Gives up `block` (empty blocks are not kept).
+    fn release(&mut self, block: (u32, u32)) {
+        if block.1 > 0 {
+            self.free.entry(block.1).or_default().push(block.0);
+        }
+    }
+
+    /// The block of the primitive whose levels start at pyramid value
+    /// `start`, as `(pyramid start, values, first value in the texture)`,
+    /// for primitive `g` in pyramid order (vertices, edges, faces).
+    fn primitive(&self, mip: &MipMap, g: usize) -> (usize, usize, usize) {
+        let mc = &mip.colors;
+        let (nv, ne) = (self.vertex.len(), self.edge.len());
+        if g < nv {
+            let len = mc.vertex_level[g] as usize + 1;
+            (mip.vertex_offset[g], len, self.vertex[g].0 as usize)
+        } else if g < nv + ne {
+            let e = g - nv;
+            let len = edge_level_offset(mc.edge_level[e] + 1);
+            (mip.edge_offset[e], len, self.edge[e].0 as usize)
+        } else {
+            let f = g - nv - ne;
+            let len = FACE_LEVEL_OFFSET[mc.face_level[f] as usize + 1];
+            (mip.face_offset[f], len, self.face[f].0 as usize)
+        }
+    }
+
+    /// Calls `copy(pyramid value, texture value, count)` for each part of
+    /// `spans` (sorted, disjoint value spans of `mip`, which has these
+    /// blocks' levels) within one primitive.
+    fn pieces(
+        &self,
+        mip: &MipMap,
+        spans: &[(usize, usize)],
+        mut copy: impl FnMut(usize, usize, usize),
+    ) {
+        let n = self.vertex.len() + self.edge.len() + self.face.len();
+        for &(a, b) in spans {
+            // The last primitive starting at or before `a`.
+            let (mut lo, mut hi) = (0, n);
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if self.primitive(mip, mid).0 <= a {
+                    lo = mid + 1;
+                } else {
+                    hi = mid;
+                }
+            }
+            let mut g = lo.saturating_sub(1);
+            while g < n {
+                let (start, len, at) = self.primitive(mip, g);
+                if start >= b {
+                    break;
+                }
+                let (from, to) = (a.max(start), b.min(start + len));
+                if from < to {
+                    copy(from, at + (from - start), to - from);
+                }
+                g += 1;
+            }
+        }
+    }
 }
 
 /// Changed spans closer than this many texels are uploaded as one.
@@ -234,9 +342,11 @@ impl GpuLayout {
                 reason: "must be at least 1 texel",
             });
         }
+        let (parts, blocks) = pack(mip, max_width, false)?;
         Ok(Self {
             max_width,
-            parts: pack(mip, max_width)?,
+            parts,
+            blocks: Some(blocks),
         })
     }
 
@@ -270,6 +380,7 @@ impl GpuLayout {
         Ok(Self {
             max_width: parts.width,
             parts,
+            blocks: None,
         })
     }
 
@@ -328,7 +439,7 @@ impl GpuLayout {
     /// # Errors
     /// As for [`GpuLayout::new`] (the layout is unchanged then).
     pub fn update(&mut self, mip: &MipMap) -> Result<Changes, Error> {
-        let new = pack(mip, self.max_width)?;
+        let (new, blocks) = pack(mip, self.max_width, false)?;
         let w = new.width as usize;
         let resized = new.width != self.parts.width
             || new.samples.len() != self.parts.samples.len()
@@ -353,6 +464,7 @@ impl GpuLayout {
             }
         };
         self.parts = new;
+        self.blocks = Some(blocks);
         Ok(changes)
     }
 
@@ -361,62 +473,210 @@ impl GpuLayout {
     /// returns the rectangles whose texels changed. The cost follows the
     /// spans, not the mesh. `mip` must have the layout this was packed
     /// from (same resolutions); after a resolution change use
-    /// [`GpuLayout::update`].
+    /// [`GpuLayout::refresh_resolutions`] (or [`GpuLayout::update`]).
     ///
     /// # Errors
     /// [`Error::InvalidArgument`] naming `mip` when its channel, face or
-    /// value counts differ from this layout's, or `spans` when a span
-    /// leaves the values; nothing changes then.
+    /// value counts or its face resolutions differ from this layout's, or
+    /// `spans` when a span leaves the values; nothing changes then.
     pub fn refresh(&mut self, mip: &MipMap, spans: &[(usize, usize)]) -> Result<Changes, Error> {
         let c = mip.colors.channels;
         let p = c.div_ceil(4);
         let values = mip.data.len() / c;
         let w = self.parts.width as usize;
-        if c != self.parts.channels
-            || mip.colors.face_level.len() != self.parts.face_count
-            || (values * p).div_ceil(w).max(1) != self.sample_height() as usize
+        let same = match &self.blocks {
+            Some(b) => {
+                b.face_level == mip.colors.face_level
+                    && b.vertex.len() == mip.vertex_offset.len()
+                    && b.edge.len() == mip.edge_offset.len()
+            }
+            None => (values * p).div_ceil(w).max(1) == self.sample_height() as usize,
+        };
+        if c != self.parts.channels || mip.colors.face_level.len() != self.parts.face_count || !same
         {
             return Err(Error::InvalidArgument {
                 argument: "mip",
                 reason: "does not have this layout's channels, faces or values \
-                         (after a resolution change, use update)",
+                         (after a resolution change, use refresh_resolutions)",
             });
         }
-        if spans.iter().any(|&(a, b)| a > b || b > values) {
-            return Err(Error::InvalidArgument {
-                argument: "spans",
-                reason: "has a span beyond the pyramid's values",
-            });
-        }
+        let spans = checked_spans(spans, values)?;
+        let samples = &mut self.parts.samples;
         let mut changed: Vec<(usize, usize)> = Vec::new();
-        for &(a, b) in spans {
-            for i in a..b {
-                let value = &mip.data[i * c..(i + 1) * c];
-                for (g, chunk) in value.chunks(4).enumerate() {
-                    let t = i * p + g;
-                    let texel = &mut self.parts.samples[t * 4..t * 4 + 4];
-                    let mut new = [0.0f32; 4];
-                    new[..chunk.len()].copy_from_slice(chunk);
-                    if texel
-                        .iter()
-                        .zip(&new)
-                        .all(|(x, y)| x.to_bits() == y.to_bits())
-                    {
-                        continue;
-                    }
-                    texel.copy_from_slice(&new);
-                    match changed.last_mut() {
-                        Some((_, end)) if t >= *end && t - *end < MERGE_GAP => *end = t + 1,
-                        _ => changed.push((t, t + 1)),
+        // Value `i` of the pyramid into texture value `at`, when it differs.
+        let mut write = |i: usize, at: usize| {
+            let value = &mip.data[i * c..(i + 1) * c];
+            for (g, chunk) in value.chunks(4).enumerate() {
+                let t = at * p + g;
+                let Some(texel) = samples.get_mut(t * 4..t * 4 + 4) else {
+                    continue;
+                };
+                let mut new = [0.0f32; 4];
+                new[..chunk.len()].copy_from_slice(chunk);
+                if texel
+                    .iter()
+                    .zip(&new)
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
+                {
+                    continue;
+                }
+                texel.copy_from_slice(&new);
+                match changed.last_mut() {
+                    Some((_, end)) if t >= *end && t - *end < MERGE_GAP => *end = t + 1,
+                    _ => changed.push((t, t + 1)),
+                }
+            }
+        };
+        match &self.blocks {
+            Some(blocks) => blocks.pieces(mip, &spans, |from, at, len| {
+                for k in 0..len {
+                    write(from + k, at + k);
+                }
+            }),
+            None => {
+                for &(a, b) in &spans {
+                    for i in a..b {
+                        write(i, i);
                     }
                 }
             }
         }
         Ok(Changes {
             resized: false,
-            samples: rects(w, changed),
+            samples: rects(w, merged(changed)),
             faces: Vec::new(),
         })
+    }
+
+    /// Brings the textures up to date after a resolution change: `mip`
+    /// as [`MipMap::refresh_resolutions`] left it, `spans` the value spans
+    /// it returned. Each primitive keeps its block of the sample texture
+    /// while its levels fit there (a face lowered keeps its room); one
+    /// that grew gets a block of its new size — one given up by an earlier
+    /// change, else after the values in use — and the block it left is
+    /// kept for later. So only the values of `spans` and of the moved
+    /// primitives are written, and only the table entries of faces whose
+    /// levels or blocks changed: the rectangles returned, for
+    /// `texSubImage2D`. The textures keep their size unless the sample
+    /// texture is full: then everything is packed again as by
+    /// [`GpuLayout::new`] with spare rows (half the rows needed again, up
+    /// to `max_width` rows) for the changes to come, and `resized` is set.
+    /// Either way [`GpuLayout::lookup`] gives what a new layout of `mip`
+    /// gives, bit for bit. The cost is a pass over the faces, edges and
+    /// vertices (no values) and the values written.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] naming `mip` when its channels or face
+    /// count differ from this layout's, or `spans` when a span leaves the
+    /// values; [`Error::TooLarge`] as for [`GpuLayout::new`] when a repack
+    /// does not fit. Nothing changes then.
+    pub fn refresh_resolutions(
+        &mut self,
+        mip: &MipMap,
+        spans: &[(usize, usize)],
+    ) -> Result<Changes, Error> {
+        let mc = &mip.colors;
+        let c = mc.channels;
+        if c != self.parts.channels || mc.face_level.len() != self.parts.face_count {
+            return Err(Error::InvalidArgument {
+                argument: "mip",
+                reason: "does not have this layout's channels or faces",
+            });
+        }
+        let spans = checked_spans(spans, mip.data.len() / c)?;
+        let Some(mut blocks) = self.blocks.clone().filter(|b| {
+            b.vertex.len() == mc.vertex_level.len() && b.edge.len() == mc.edge_level.len()
+        }) else {
+            return self.regrow(mip);
+        };
+        let (nv, ne) = (blocks.vertex.len(), blocks.edge.len());
+        let n = nv + ne + blocks.face.len();
+        let mut moved = Vec::new();
+        for g in 0..n {
+            let len = blocks.primitive(mip, g).1 as u32;
+            let slot = if g < nv {
+                blocks.vertex[g]
+            } else if g < nv + ne {
+                blocks.edge[g - nv]
+            } else {
+                blocks.face[g - nv - ne]
+            };
+            if len <= slot.1 {
+                continue;
+            }
+            let new = blocks.allocate(len);
+            blocks.release(slot);
+            *(if g < nv {
+                &mut blocks.vertex[g]
+            } else if g < nv + ne {
+                &mut blocks.edge[g - nv]
+            } else {
+                &mut blocks.face[g - nv - ne]
+            }) = new;
+            moved.push(g);
+        }
+        let p = c.div_ceil(4);
+        let room = self.parts.samples.len() / 4 / p;
+        if blocks.end > room || blocks.end > u32::MAX as usize {
+            return self.regrow(mip);
+        }
+        blocks.face_level.clone_from(&mc.face_level);
+        let samples = &mut self.parts.samples;
+        let mut changed: Vec<(usize, usize)> = Vec::new();
+        // Values `from..from + len` of the pyramid into texture values
+        // from `at`.
+        let mut write = |from: usize, at: usize, len: usize| {
+            for k in 0..len {
+                let value = &mip.data[(from + k) * c..(from + k + 1) * c];
+                for (g, chunk) in value.chunks(4).enumerate() {
+                    let t = (at + k) * p + g;
+                    if let Some(texel) = samples.get_mut(t * 4..t * 4 + 4) {
+                        texel[..chunk.len()].copy_from_slice(chunk);
+                        texel[chunk.len()..].fill(0.0);
+                    }
+                }
+            }
+            changed.push((at * p, (at + len) * p));
+        };
+        for &g in &moved {
+            let (start, len, at) = blocks.primitive(mip, g);
+            write(start, at, len);
+        }
+        blocks.pieces(mip, &spans, &mut write);
+        let mut faces_changed = Vec::new();
+        for f in 0..mc.face_level.len() {
+            let words = face_words(mc, &blocks, f);
+            if let Some(old) = self
+                .parts
+                .faces
+                .get_mut(f * FACE_WORDS..(f + 1) * FACE_WORDS)
+                && old != words
+            {
+                old.copy_from_slice(&words);
+                faces_changed.push((2 * f, 2 * f + 2));
+            }
+        }
+        self.blocks = Some(blocks);
+        let w = self.parts.width as usize;
+        Ok(Changes {
+            resized: false,
+            samples: rects(w, merged(changed)),
+            faces: rects(w, merged(faces_changed)),
+        })
+    }
+
+    /// Packs `mip` again with spare rows: every texel is new.
+    fn regrow(&mut self, mip: &MipMap) -> Result<Changes, Error> {
+        let (parts, blocks) = pack(mip, self.max_width, true)?;
+        let w = parts.width as usize;
+        let changes = Changes {
+            resized: true,
+            samples: whole(w, parts.samples.len() / 4),
+            faces: whole(w, parts.faces.len() / 4),
+        };
+        self.parts = parts;
+        self.blocks = Some(blocks);
+        Ok(changes)
     }
 
     /// The filtered value at barycentrics `b` of face `face` into `out`
@@ -487,8 +747,10 @@ impl GpuLayout {
     }
 }
 
-/// Packs a pyramid at width `max_width` (checked ≥ 1).
-fn pack(mip: &MipMap, max_width: u32) -> Result<GpuParts, Error> {
+/// Packs a pyramid at width `max_width` (checked ≥ 1), value `i` at
+/// texel `i · P`; with `spare`, the sample texture gets half as many rows
+/// again as it needs (at least one, at most `max_width` in all).
+fn pack(mip: &MipMap, max_width: u32, spare: bool) -> Result<(GpuParts, Blocks), Error> {
     let mc = &mip.colors;
     let c = mc.channels;
     let p = c.div_ceil(4);
@@ -518,43 +780,105 @@ fn pack(mip: &MipMap, max_width: u32) -> Result<GpuParts, Error> {
             unit: "values",
         });
     }
-    let mut samples = vec![0.0f32; rows(texels) * w * 4];
+    let sample_rows = if spare {
+        (rows(texels) + (rows(texels) / 2).max(1)).min(max_width as usize)
+    } else {
+        rows(texels)
+    };
+    let mut samples = vec![0.0f32; sample_rows * w * 4];
     for (i, value) in mip.data.chunks_exact(c).enumerate() {
         for (ch, &x) in value.iter().enumerate() {
             samples[(i * p + ch / 4) * 4 + ch % 4] = x;
         }
     }
+    let block = |at: usize, len: usize| (at as u32, len as u32);
+    let blocks = Blocks {
+        vertex: (0..mc.vertex_level.len())
+            .map(|v| block(mip.vertex_offset[v], mc.vertex_level[v] as usize + 1))
+            .collect(),
+        edge: (0..mc.edge_level.len())
+            .map(|e| block(mip.edge_offset[e], edge_level_offset(mc.edge_level[e] + 1)))
+            .collect(),
+        face: (0..mc.face_level.len())
+            .map(|f| {
+                block(
+                    mip.face_offset[f],
+                    FACE_LEVEL_OFFSET[mc.face_level[f] as usize + 1],
+                )
+            })
+            .collect(),
+        face_level: mc.face_level.clone(),
+        free: BTreeMap::new(),
+        end: values,
+    };
     let mut faces = vec![0u32; rows(face_texels) * w * 4];
-    let t = &mc.topology;
     for (f, words) in faces
         .chunks_exact_mut(FACE_WORDS)
         .take(mc.face_level.len())
         .enumerate()
     {
-        let face = t.faces[f];
-        let fe = t.face_edges[f];
-        words[0] = mip.face_offset[f] as u32;
-        let mut bits = u32::from(mc.face_level[f]);
-        for k in 0..3 {
-            let v = face[k] as usize;
-            let e = fe[k] as usize;
-            words[1 + k] = mip.vertex_offset[v] as u32;
-            words[4 + k] = mip.edge_offset[e] as u32;
-            bits |= u32::from(mc.vertex_level[v]) << (4 + 4 * k);
-            bits |= u32::from(mc.edge_level[e]) << (16 + 4 * k);
-            if face[k] < face[(k + 1) % 3] {
-                bits |= 1 << (28 + k);
-            }
-        }
-        words[7] = bits;
+        words.copy_from_slice(&face_words(mc, &blocks, f));
     }
-    Ok(GpuParts {
+    let parts = GpuParts {
         width: w as u32,
         channels: c,
         face_count: mc.face_level.len(),
         samples,
         faces,
-    })
+    };
+    Ok((parts, blocks))
+}
+
+/// Face `f`'s entry in the table (see the module documentation), its
+/// primitives where `blocks` put them.
+fn face_words(mc: &MeshColors, blocks: &Blocks, f: usize) -> [u32; FACE_WORDS] {
+    let t = &mc.topology;
+    let face = t.faces[f];
+    let fe = t.face_edges[f];
+    let mut words = [0u32; FACE_WORDS];
+    words[0] = blocks.face[f].0;
+    let mut bits = u32::from(mc.face_level[f]);
+    for k in 0..3 {
+        let v = face[k] as usize;
+        let e = fe[k] as usize;
+        words[1 + k] = blocks.vertex[v].0;
+        words[4 + k] = blocks.edge[e].0;
+        bits |= u32::from(mc.vertex_level[v]) << (4 + 4 * k);
+        bits |= u32::from(mc.edge_level[e]) << (16 + 4 * k);
+        if face[k] < face[(k + 1) % 3] {
+            bits |= 1 << (28 + k);
+        }
+    }
+    words[7] = bits;
+    words
+}
+
+/// `spans` sorted, or an error naming them when one leaves `values`.
+fn checked_spans(spans: &[(usize, usize)], values: usize) -> Result<Vec<(usize, usize)>, Error> {
+    if spans.iter().any(|&(a, b)| a > b || b > values) {
+        return Err(Error::InvalidArgument {
+            argument: "spans",
+            reason: "has a span beyond the pyramid's values",
+        });
+    }
+    let mut spans = spans.to_vec();
+    spans.sort_unstable();
+    Ok(spans)
+}
+
+/// Texel spans `[start, end)` sorted and joined across gaps of fewer than
+/// [`MERGE_GAP`] texels.
+fn merged(mut spans: Vec<(usize, usize)>) -> Vec<(usize, usize)> {
+    spans.sort_unstable();
+    let mut out: Vec<(usize, usize)> = Vec::with_capacity(spans.len());
+    for (a, b) in spans {
+        match out.last_mut() {
+            Some((_, end)) if a < *end + MERGE_GAP => *end = (*end).max(b),
+            _ if a < b => out.push((a, b)),
+            _ => {}
+        }
+    }
+    out
 }
 
 /// Spans `[start, end)` (in texels, 4 values each) where `a` and `b`

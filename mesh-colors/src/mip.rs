@@ -550,6 +550,11 @@ impl MipMap {
     /// around them that [`MipMap::refresh`] describes are recomputed. The
     /// result equals [`MipMap::new`] of `colors` bit for bit.
     ///
+    /// Returns the spans `[start, end)` of values (in the new layout) that
+    /// were rewritten, sorted and disjoint, as [`MipMap::refresh`] does,
+    /// for [`crate::gpu::GpuLayout::refresh_resolutions`]: every value of
+    /// a primitive whose levels changed is in them.
+    ///
     /// # Errors
     /// [`Error::InvalidArgument`] naming `colors` when they are on another
     /// mesh or have other channels, or `faces` when it leaves out a face
@@ -559,7 +564,7 @@ impl MipMap {
         &mut self,
         colors: &MeshColors,
         faces: &[usize],
-    ) -> Result<(), Error> {
+    ) -> Result<Vec<(usize, usize)>, Error> {
         if colors.channels != self.colors.channels || colors.topology != self.colors.topology {
             return Err(Error::InvalidArgument {
                 argument: "colors",
@@ -663,8 +668,7 @@ impl MipMap {
         mine.vertex_level.clone_from(&colors.vertex_level);
         mine.edge_offset.clone_from(&colors.edge_offset);
         mine.face_offset.clone_from(&colors.face_offset);
-        self.recompute(colors, &adjacency, dirty, list);
-        Ok(())
+        Ok(self.recompute(colors, &adjacency, dirty, list))
     }
 
     /// Recomputes the levels below the finest of the faces `list` (marked

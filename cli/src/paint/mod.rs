@@ -23,8 +23,14 @@
 //! | 4 sample texels | rectangles, width | per rectangle `x, y, w, h` (u32), then its `w·h` texels |
 //! | 5 scatter points | points, 0 | positions (3 f32 each) |
 //! | 6 strands | strands, points per strand | polylines' points (3 f32 each), strand by strand |
+//! | 7 layout texels | sample rectangles, face-table rectangles | kind 4's rectangles of the samples, then the face table's the same way (`w·h` texels of 4 u32) |
 //!
-//! Kind 4 carries absolute values: applied twice it changes nothing.
+//! Kinds 4 and 7 carry absolute values: applied twice they change
+//! nothing. A resolution change that fits the textures' room sends kind 7
+//! (the resampled faces' new blocks, the MIP levels around them and the
+//! face-table entries that point to them, as
+//! [`mesh_colors::gpu::GpuLayout::refresh_resolutions`] reports them);
+//! one that does not sends kinds 2 and 3 again, with spare rows.
 
 use std::net::IpAddr;
 use std::path::PathBuf;

@@ -3,9 +3,10 @@
 //!
 //! Snapshot slots (what a page that connects is sent first, in order):
 //! 0 the hello, 1 the mesh, 2 the face table and the samples (then the
-//! texel updates of the stroke in progress, appended, folded back into
-//! one samples frame when the server is idle), 3 the status, 4 the
-//! scatter panel's points and strands.
+//! texel updates since, appended: strokes' and resolution changes',
+//! folded back into one face table and one samples frame once the
+//! requests pause), 3 the status, 4 the scatter panel's points and
+//! strands.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -13,7 +14,7 @@ use std::time::{Duration, Instant};
 
 use axum::body::Bytes;
 use mesh_colors::MipMap;
-use mesh_colors::gpu::{GpuLayout, TexelRect};
+use mesh_colors::gpu::{Changes, GpuLayout, TexelRect};
 use mesh_colors::session::{Changed, Edit, PaintSession};
 use serde_json::json;
 
@@ -29,6 +30,10 @@ const TEXTURE_WIDTH: u32 = 2048;
 const AUTOSAVE_EVERY: usize = 5;
 /// A pause after which unsaved edits are autosaved.
 const AUTOSAVE_PAUSE: Duration = Duration::from_secs(10);
+/// A pause after which the texel updates appended to the textures' slot
+/// are folded into it (folding copies the whole texture, tens of ms for
+/// a large one: not between one gesture and the next).
+const FOLD_PAUSE: Duration = Duration::from_millis(500);
 
 const SLOT_HELLO: usize = 0;
 const SLOT_MESH: usize = 1;
@@ -52,6 +57,8 @@ pub(crate) struct Worker {
     /// Texel updates appended to the textures' slot since it was last
     /// folded.
     appended: usize,
+    /// Their bytes (folded at once when they outgrow the textures).
+    appended_bytes: usize,
     /// A stroke is being painted (its updates are folded after it ends:
     /// folding copies the whole texture).
     stroke_open: bool,
@@ -89,6 +96,7 @@ impl Worker {
             autosave: options.autosave,
             unsaved,
             appended: 0,
+            appended_bytes: 0,
             stroke_open: false,
             answered: Vec::new(),
             last_request: Instant::now(),
@@ -155,19 +163,53 @@ impl Worker {
     /// The sample texels of `rects`, as absolute values.
     fn sample_rects(&self, rects: &[TexelRect]) -> Out {
         let w = self.gpu.width() as usize;
-        let texels = self.gpu.sample_texels();
         let mut payload = Vec::new();
-        for r in rects {
-            put_u32(&mut payload, [r.x, r.y, r.width, r.height]);
-            for y in r.y..r.y + r.height {
-                let start = (y as usize * w + r.x as usize) * 4;
-                put_f32(
-                    &mut payload,
-                    texels[start..start + r.width as usize * 4].iter().copied(),
-                );
-            }
-        }
+        put_rects(&mut payload, w, rects, self.gpu.sample_texels(), |x| {
+            x.to_bits()
+        });
         Self::frame(4, rects.len() as u32, w as u32, &payload)
+    }
+
+    /// Kind 7: the sample and face-table texels a resolution change
+    /// rewrote, as absolute values, in one frame (the page applies both
+    /// before it draws again).
+    fn layout_rects(&self, changes: &Changes) -> Out {
+        let w = self.gpu.width() as usize;
+        let texels = |rs: &[TexelRect]| {
+            rs.iter()
+                .map(|r| 16 + 16 * r.width as usize * r.height as usize)
+                .sum::<usize>()
+        };
+        let mut payload = Vec::with_capacity(texels(&changes.samples) + texels(&changes.faces));
+        put_rects(
+            &mut payload,
+            w,
+            &changes.samples,
+            self.gpu.sample_texels(),
+            |x| x.to_bits(),
+        );
+        put_rects(
+            &mut payload,
+            w,
+            &changes.faces,
+            self.gpu.face_texels(),
+            |x| x,
+        );
+        Self::frame(
+            7,
+            changes.samples.len() as u32,
+            changes.faces.len() as u32,
+            &payload,
+        )
+    }
+
+    /// Sends `frame` and appends it to the textures' slot.
+    fn append(&mut self, out: &Outbox, frame: Out) {
+        if let Out::Binary(b) = &frame {
+            self.appended_bytes += b.len();
+        }
+        out.append(SLOT_TEXTURES, frame);
+        self.appended += 1;
     }
 
     fn status(&mut self) -> Out {
@@ -227,20 +269,29 @@ impl Worker {
                     .refresh(&self.mip, &spans)
                     .map_err(|e| e.to_string())?;
                 if !changes.samples.is_empty() {
-                    out.append(SLOT_TEXTURES, self.sample_rects(&changes.samples));
-                    self.appended += 1;
+                    let frame = self.sample_rects(&changes.samples);
+                    self.append(out, frame);
                 }
             }
             Changed::Layout(faces) => {
-                self.mip
+                let spans = self
+                    .mip
                     .refresh_resolutions(colors, &faces)
                     .map_err(|e| e.to_string())?;
-                self.gpu.update(&self.mip).map_err(|e| e.to_string())?;
-                out.publish(SLOT_TEXTURES, self.textures());
-                self.appended = 0;
+                let changes = self
+                    .gpu
+                    .refresh_resolutions(&self.mip, &spans)
+                    .map_err(|e| e.to_string())?;
+                if changes.resized {
+                    out.publish(SLOT_TEXTURES, self.textures());
+                    (self.appended, self.appended_bytes) = (0, 0);
+                } else if !changes.is_empty() {
+                    let frame = self.layout_rects(&changes);
+                    self.append(out, frame);
+                }
                 if let Some(scatter) = &mut self.scatter {
                     let updated = scatter
-                        .layout_changed(&self.doc.surface, colors, &self.doc.scalars)
+                        .layout_changed(&self.doc.surface, self.session.colors(), &self.doc.scalars)
                         .map_err(|(f, m)| format!("{f}: {m}"))?;
                     self.scatter_dirty |= updated == Updated::Points;
                 }
@@ -548,6 +599,27 @@ fn has_extension(path: &Path, ext: &str) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case(ext))
 }
 
+/// Appends each of `rects` of `texels` (a texture `w` texels wide, 4
+/// words a texel): `x, y, w, h`, then its rows.
+fn put_rects<T: Copy>(
+    payload: &mut Vec<u8>,
+    w: usize,
+    rects: &[TexelRect],
+    texels: &[T],
+    word: impl Fn(T) -> u32 + Copy,
+) {
+    for r in rects {
+        put_u32(payload, [r.x, r.y, r.width, r.height]);
+        for y in r.y..r.y + r.height {
+            let start = (y as usize * w + r.x as usize) * 4;
+            let row = texels
+                .get(start..start + r.width as usize * 4)
+                .unwrap_or(&[]);
+            put_u32(payload, row.iter().map(|&x| word(x)));
+        }
+    }
+}
+
 /// Sorted, distinct sample indices as runs `(first, count)`.
 fn runs(list: &[u32]) -> Vec<(u32, u32)> {
     let mut runs: Vec<(u32, u32)> = Vec::new();
@@ -609,21 +681,33 @@ impl App for Worker {
             }
             self.send_scatter(out);
         }
-        // Fold the stroke's texel updates into one samples frame for
-        // pages that connect later (every page has them already).
-        if self.appended > 0 && !self.stroke_open {
-            out.keep(SLOT_TEXTURES, self.textures());
-            self.appended = 0;
-        }
-        if self.unsaved == 0 {
-            return Idle::Wait;
-        }
+        // Fold the texel updates into one face table and one samples
+        // frame for pages that connect later (every page has them
+        // already), once the requests pause or the updates outgrow the
+        // textures.
         let waited = self.last_request.elapsed();
-        if waited >= AUTOSAVE_PAUSE {
-            self.autosave();
-            return Idle::Wait;
+        let mut fold_in = None;
+        if self.appended > 0 && !self.stroke_open {
+            let whole = 4 * (self.gpu.sample_texels().len() + self.gpu.face_texels().len());
+            if waited >= FOLD_PAUSE || self.appended_bytes >= whole {
+                out.keep(SLOT_TEXTURES, self.textures());
+                (self.appended, self.appended_bytes) = (0, 0);
+            } else {
+                fold_in = Some(FOLD_PAUSE - waited);
+            }
         }
-        Idle::WaitAtMost(AUTOSAVE_PAUSE - waited)
+        let autosave_in = if self.unsaved == 0 {
+            None
+        } else if waited >= AUTOSAVE_PAUSE {
+            self.autosave();
+            None
+        } else {
+            Some(AUTOSAVE_PAUSE - waited)
+        };
+        match fold_in.into_iter().chain(autosave_in).min() {
+            Some(wait) => Idle::WaitAtMost(wait),
+            None => Idle::Wait,
+        }
     }
 
     fn stop(&mut self, _out: &Outbox) {

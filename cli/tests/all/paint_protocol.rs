@@ -205,7 +205,8 @@ async fn paint_detail_undo_save_and_replay_through_the_protocol() {
     .await;
     status_of(&mut s, 6, &mut seen).await;
 
-    // Detail up under a brush: more samples, the new layout sent.
+    // Detail up under a brush: more samples; the textures had no room
+    // for them, so the new layout is sent whole (with spare rows).
     seen.frames.clear();
     send(
         &mut s,
@@ -221,19 +222,24 @@ async fn paint_detail_undo_save_and_replay_through_the_protocol() {
         seen.frames
     );
 
-    // Undo the detail, redo it.
+    // Undo the detail, redo it: both fit the textures as they are, so
+    // only the changed runs go (kind 7), not the textures.
+    seen.frames.clear();
     send(&mut s, json!({"seq": 8, "op": "undo"})).await;
     let undone = status_of(&mut s, 8, &mut seen).await;
+    assert_eq!(seen.frames, vec![7], "{:?}", seen.frames);
     assert_eq!(undone["samples"], start["samples"]);
     assert_eq!(
         (undone["undo"].clone(), undone["redo"].clone()),
         (json!(2), json!(1))
     );
+    seen.frames.clear();
     send(&mut s, json!({"seq": 9, "op": "redo"})).await;
     assert_eq!(
         status_of(&mut s, 9, &mut seen).await["samples"],
         detailed["samples"]
     );
+    assert_eq!(seen.frames, vec![7], "{:?}", seen.frames);
 
     // Save, refuse to save over it, then export the session and a GLB.
     send(

@@ -460,3 +460,132 @@ fn the_documented_addresses_find_the_values() {
     }
     assert!(checked > 1000, "{checked}");
 }
+
+/// A page's copy of the textures after `changes`: allocated again from
+/// the whole arrays when `resized`, else the rectangles of both textures
+/// written (`texSubImage2D`).
+fn apply_on_page(page: &mut GpuParts, layout: &GpuLayout, changes: &mesh_colors::gpu::Changes) {
+    if changes.resized {
+        *page = layout.clone().into_parts();
+        return;
+    }
+    let w = layout.width() as usize;
+    upload(
+        &mut page.samples,
+        layout.sample_texels(),
+        w,
+        &changes.samples,
+    );
+    for r in &changes.faces {
+        for y in r.y as usize..(r.y + r.height) as usize {
+            let from = (y * w + r.x as usize) * 4;
+            let to = from + r.width as usize * 4;
+            page.faces[from..to].copy_from_slice(&layout.face_texels()[from..to]);
+        }
+    }
+}
+
+/// A wider bumpy grid than [`mixed`], levels 0..=2: a change of a few
+/// faces reaches a small part of it.
+fn wide(seed: u64) -> MeshColors {
+    let (positions, faces) = support::grid(16, 0.4);
+    let mut rng = Rng(seed);
+    let levels: Vec<u32> = (0..faces.len()).map(|_| 1 << rng.below(3)).collect();
+    let topology = Topology::new(positions.len(), &faces).unwrap();
+    let mut mc = MeshColors::new(topology, &levels, 3).unwrap();
+    for x in mc.samples_mut() {
+        *x = rng.f32();
+    }
+    mc
+}
+
+#[test]
+fn resolution_changes_send_only_the_runs_that_changed() {
+    let mut mc = wide(11);
+    let mut mip = mc.mip_map();
+    let mut layout = GpuLayout::new(&mip, 256).unwrap();
+    let mut page = layout.clone().into_parts();
+    let mut rng = Rng(12);
+    let mut undo = Vec::new();
+    let (mut partial, mut grown) = (0, 0);
+    for round in 0..12u64 {
+        // Raise or lower a few faces, or undo an earlier change.
+        let change = if round % 3 == 2 {
+            let change: mesh_colors::edit::ResolutionChange = undo.pop().unwrap();
+            mc.revert_resolutions(&change).unwrap();
+            change
+        } else {
+            let requests: Vec<(usize, u32)> = (0..1 + rng.below(4))
+                .map(|_| {
+                    let f = rng.below(mc.face_count() as u64) as usize;
+                    let level = mc.face_level(f).unwrap();
+                    let to = if rng.below(3) == 0 {
+                        level.saturating_sub(1)
+                    } else {
+                        (level + 1).min(4)
+                    };
+                    (f, 1u32 << to)
+                })
+                .collect();
+            let change = mc.set_face_resolutions(&requests).unwrap();
+            undo.push(change.clone());
+            change
+        };
+        let faces: Vec<usize> = change.faces().map(|f| f.0).collect();
+        let before = layout.clone();
+        let spans = mip.refresh_resolutions(&mc, &faces).unwrap();
+        let changes = layout.refresh_resolutions(&mip, &spans).unwrap();
+        apply_on_page(&mut page, &layout, &changes);
+        // The page's copy is the server's, bit for bit.
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(&page.samples),
+            bits(layout.sample_texels()),
+            "round {round}"
+        );
+        assert_eq!(page.faces, layout.face_texels(), "round {round}");
+        // And it filters as the CPU does (as a new layout would).
+        let on_page = GpuLayout::from_parts(page.clone()).unwrap();
+        assert_eq!(mismatches(&on_page, &mc, round).0, 0, "round {round}");
+        if changes.resized {
+            continue;
+        }
+        partial += 1;
+        let uploaded: u32 = changes.samples.iter().map(|r| r.width * r.height).sum();
+        assert!(
+            (uploaded as usize) < layout.sample_texels().len() / 4,
+            "round {round}: {uploaded} texels of {} for a few faces {:?}",
+            layout.sample_texels().len() / 4,
+            change.faces().collect::<Vec<_>>()
+        );
+        // A face that grew moved to a new block: its table entry is new,
+        // and a page without the table's rectangles filters wrongly.
+        let grew = change.faces().any(|(f, from, to)| {
+            to > from && before.face_texels()[8 * f] != layout.face_texels()[8 * f]
+        });
+        if grew {
+            grown += 1;
+            assert!(!changes.faces.is_empty());
+            let mut stale = page.clone();
+            stale.faces.copy_from_slice(before.face_texels());
+            let stale = GpuLayout::from_parts(stale).unwrap();
+            assert!(mismatches(&stale, &mc, round).0 > 0, "round {round}");
+        }
+    }
+    assert!(
+        partial >= 6 && grown >= 2,
+        "{partial} partial, {grown} grown"
+    );
+    // Without the spans the pyramid rewrote, the rings around the change
+    // keep their old MIP levels: wrong (the spans are needed).
+    let requests: Vec<(usize, u32)> = (0..2)
+        .map(|f| (f, 2 * mc.face_resolution(f).unwrap()))
+        .collect();
+    let change = mc.set_face_resolutions(&requests).unwrap();
+    let faces: Vec<usize> = change.faces().map(|f| f.0).collect();
+    mip.refresh_resolutions(&mc, &faces).unwrap();
+    let mut wrong = layout.clone();
+    let changes = wrong.refresh_resolutions(&mip, &[]).unwrap();
+    assert!(!changes.resized);
+    assert!(mismatches(&wrong, &mc, 77).0 > 0);
+}

@@ -84,7 +84,13 @@ function onFrame(f) {
     state.layout = { width: f.a, channels: state.hello.channels.length + 2, samples: new Float32Array(f.payload), faces: state.pendingFaces };
     renderer.setLayout(state.layout);
   } else if (f.kind === 4) {
-    renderer.updateRects({ resized: false, samples: readRects(f), faces: [] }, null);
+    renderer.updateRects({ resized: false, samples: readRects(f, f.a, 0, Float32Array).rects, faces: [] }, null);
+  } else if (f.kind === 7) {
+    // A resolution change that fitted the textures: both tables' runs,
+    // applied together so no frame draws new faces over old samples.
+    const samples = readRects(f, f.a, 0, Float32Array);
+    const faces = readRects(f, f.b, samples.end, Uint32Array);
+    renderer.updateRects({ resized: false, samples: samples.rects, faces: faces.rects }, null);
   } else if (f.kind === 5) {
     layer.setPoints(new Float32Array(f.payload, 0, 3 * f.a));
     // A points frame without strands after it clears the old ones.
@@ -99,18 +105,19 @@ function onFrame(f) {
   dirty = true;
 }
 
-// Kind 4: per rectangle x, y, w, h (u32), then its w·h RGBA32F texels.
-function readRects(f) {
+// Kinds 4 and 7: `count` rectangles from byte `at`, each x, y, w, h
+// (u32) then its w·h RGBA texels (`Type`: Float32Array for the samples,
+// Uint32Array for the face table). Returns them and where they end.
+function readRects(f, count, at, Type) {
   const rects = [];
-  let at = 0;
   const v = new DataView(f.payload);
-  for (let i = 0; i < f.a; i++) {
+  for (let i = 0; i < count; i++) {
     const [x, y, width, height] = [0, 1, 2, 3].map((k) => v.getUint32(at + 4 * k, true));
     at += 16;
-    rects.push({ x, y, width, height, data: new Float32Array(f.payload.slice(at, at + 16 * width * height)) });
+    rects.push({ x, y, width, height, data: new Type(f.payload.slice(at, at + 16 * width * height)) });
     at += 16 * width * height;
   }
-  return rects;
+  return { rects, end: at };
 }
 
 // ---- the panel --------------------------------------------------------
