@@ -27,7 +27,7 @@ pub(crate) struct Args {
     /// the camera the page saved unless --view is given.
     #[cfg(feature = "view")]
     #[arg(long, value_name = "SESSION.json", conflicts_with_all = [
-        "input", "material", "unit_mm", "light", "envmap", "cut", "relax_cut", "paint", "fracture",
+        "input", "material", "unit_mm", "envelope", "light", "envmap", "cut", "relax_cut", "paint", "fracture",
         "solver",
     ])]
     pub(crate) session: Option<PathBuf>,
@@ -38,6 +38,11 @@ pub(crate) struct Args {
     /// under 5 units, as for scans in metres; 1 otherwise).
     #[arg(long, value_name = "X", allow_negative_numbers = true, value_parser = super::args::unit_mm)]
     pub(crate) unit_mm: Option<f64>,
+    /// For a surface: fit the tetrahedra's boundary to it within EPS (a
+    /// fraction of the bounding box's diagonal, e.g. 0.002), so thin parts
+    /// and creases stay (as `trilux tetra --envelope`).
+    #[arg(long, value_name = "EPS", allow_negative_numbers = true)]
+    pub(crate) envelope: Option<f64>,
     /// dir:x,y,z[:r,g,b] (toward the light) or point:x,y,z[:r,g,b];
     /// repeatable. Default: one light from the upper front.
     #[arg(long, value_name = "SPEC", value_parser = LightSpec::parse)]
@@ -140,7 +145,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         super::check_input(path)?;
     }
     check_volume(input, "diffuse", false)?;
-    let (positions, tets, dropped) = read_volume(context, input, false)?;
+    let (positions, tets, dropped) = read_volume(context, input, false, args.envelope)?;
     let mesh = tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_cause(input, e))?;
     let diagonal = diagonal(&positions);
     let unit_mm = unit_mm(args.unit_mm, diagonal);
@@ -505,6 +510,7 @@ fn report(context: &Context, args: &Args, input: &Path, solved: &Solved, files: 
         "tetrahedra": tets,
         "objects": objects.len(),
         "unit_mm": solved.unit_mm,
+        "envelope": args.envelope,
         "material": args.material.spec,
         "paint": args
             .paint

@@ -32,12 +32,17 @@ pub(crate) struct Args {
     /// under 5 units, as for scans in metres; 1 otherwise).
     #[arg(long, value_name = "X", allow_negative_numbers = true, value_parser = super::args::unit_mm)]
     pub(crate) unit_mm: Option<f64>,
+    /// For a surface: fit the tetrahedra's boundary to it within EPS (a
+    /// fraction of the bounding box's diagonal, e.g. 0.002), so thin parts
+    /// and creases stay (as `trilux tetra --envelope`).
+    #[arg(long, value_name = "EPS", allow_negative_numbers = true)]
+    pub(crate) envelope: Option<f64>,
     #[command(flatten)]
     pub(crate) serve: super::web::ServeArgs,
     /// Start from a session file the page exported (its source and edits).
     // The file names its own mesh, material and unit: given beside it they
     // would be ignored, so they are refused (as `diffuse --session` does).
-    #[arg(long, value_name = "SESSION.json", conflicts_with_all = ["input", "material", "unit_mm"])]
+    #[arg(long, value_name = "SESSION.json", conflicts_with_all = ["input", "material", "unit_mm", "envelope"])]
     pub(crate) replay: Option<PathBuf>,
     /// Folder the page's exports are written to.
     #[arg(long, value_name = "DIR", default_value = ".")]
@@ -61,6 +66,15 @@ fn replay(context: &mut Context, path: &Path) -> Result<(Object, Value, Log, Env
         .map(|m| Material::parse(m).map_err(|e| file_error(path, format!("material {m:?}: {e}"))))
         .transpose()?;
     let unit = source.get("unit_mm").and_then(Value::as_f64);
+    let envelope = source.get("envelope").and_then(Value::as_f64);
+    if let Some(eps) = envelope
+        && !(eps > 0.0 && eps <= 1.0)
+    {
+        return Err(file_error(
+            path,
+            format!("envelope {eps}: a fraction of the bounding box's diagonal, between 0 and 1"),
+        ));
+    }
     if let Some(mm) = unit
         && !(mm.is_finite() && mm > 0.0)
     {
@@ -83,7 +97,7 @@ fn replay(context: &mut Context, path: &Path) -> Result<(Object, Value, Log, Env
             ),
         ));
     }
-    let (object, mut loaded) = load(context, mesh.as_deref(), material.as_ref(), unit)?;
+    let (object, mut loaded) = load(context, mesh.as_deref(), material.as_ref(), unit, envelope)?;
     // The camera it was saved with: the page starts there.
     if let (Some(v), Some(o)) = (view, loaded.as_object_mut()) {
         o.insert("view".into(), json!(v.to_array()));
@@ -97,13 +111,20 @@ pub(crate) fn load(
     input: Option<&Path>,
     material: Option<&Material>,
     unit_mm: Option<f64>,
+    envelope: Option<f64>,
 ) -> Result<(Object, Value)> {
     let source = json!({
         "mesh": input.map(|p| p.display().to_string()),
         "material": material.map(|m| m.spec.as_str()),
         "unit_mm": unit_mm,
+        "envelope": envelope,
     });
     let Some(input) = input else {
+        if envelope.is_some() {
+            return Err(super::usage(
+                "--envelope fits the tetrahedra of a surface: give one (the built-in object is made in code)",
+            ));
+        }
         let mut object =
             trilux::view::builtin::object(16).map_err(|e| super::invalid(e.to_string()))?;
         if let Some(m) = material {
@@ -115,7 +136,7 @@ pub(crate) fn load(
         return Ok((object, source));
     };
     check_volume(input, "view", true)?;
-    let (positions, tets, _) = read_volume(context, input, true)?;
+    let (positions, tets, _) = read_volume(context, input, true, envelope)?;
     let mesh = tet_diffusion::TetMesh::new(&positions, &tets).map_err(|e| file_error(input, e))?;
     let diagonal = diagonal(&positions);
     let unit = super::ops::object::unit_mm(unit_mm, diagonal);
@@ -311,6 +332,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
                 args.input.as_deref(),
                 args.material.as_ref(),
                 args.unit_mm,
+                args.envelope,
             )?;
             (o, s, None)
         }

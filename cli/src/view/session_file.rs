@@ -11,7 +11,8 @@
 //!             "lights": [{"kind": "dir", "dir": [0.3, 1, 0.6], "rgb": [1, 1, 1]}]}]}
 //! ```
 //!
-//! `source` also keeps `"view"`, the direction from the object toward the
+//! `source` keeps `"envelope"` when the surface was stuffed with its
+//! boundary fitted (`trilux view --envelope`), and also `"view"`, the direction from the object toward the
 //! camera when the page saved the file: `trilux view --replay` starts
 //! there and `trilux diffuse --session` renders from there unless given
 //! `--view`.

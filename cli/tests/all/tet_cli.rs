@@ -163,8 +163,14 @@ fn tetra_fits_the_boundary_to_an_envelope_and_says_how_near_it_came() {
         "{fitted}"
     );
     // The stated bound: the stencils' 9°–162° widened to 165° by the fit.
-    assert_eq!(fitted["dihedral_bound_degrees"], serde_json::json!([9.0, 165.0]));
-    assert_eq!(plain["dihedral_bound_degrees"], serde_json::json!([9.0, 162.0]));
+    assert_eq!(
+        fitted["dihedral_bound_degrees"],
+        serde_json::json!([9.0, 165.0])
+    );
+    assert_eq!(
+        plain["dihedral_bound_degrees"],
+        serde_json::json!([9.0, 162.0])
+    );
     let hausdorff = |r: &serde_json::Value| r["distance"]["hausdorff"].as_f64().unwrap();
     assert!(
         hausdorff(&fitted) <= hausdorff(&plain),
@@ -489,7 +495,10 @@ fn tetra_stuffs_the_raw_bunny_and_diffuse_accepts_it() {
     let report = json(d, &["tetra", bunny.to_str().unwrap(), "-o", "bunny.node"]);
     let min = report["dihedral_degrees"][0].as_f64().unwrap();
     let bound = report["dihedral_bound_degrees"][0].as_f64().unwrap();
-    assert!(min >= bound && bound >= 8.9, "minimum dihedral {min}°, bound {bound}°");
+    assert!(
+        min >= bound && bound >= 8.9,
+        "minimum dihedral {min}°, bound {bound}°"
+    );
     let mesh = trilux_io::tet::read(d.join("bunny.node")).unwrap();
     assert_eq!(report["tetrahedra"], mesh.tets.len());
     trilux(d)
@@ -1008,4 +1017,61 @@ fn diffuse_lists_every_file_it_writes_and_info_shows_the_gltf_attributes() {
             assert!(text.contains(line), "{line:?} not in {text}");
         }
     }
+}
+
+#[test]
+fn diffuse_and_view_fit_a_surface_to_an_envelope_and_refuse_it_for_tets() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let blob = blob(d);
+    let blob = blob.to_str().unwrap();
+    // The surface stuffed with its boundary fitted: the run says how near
+    // it came, and the tetrahedra are those `tetra --envelope` writes.
+    let args = [
+        "diffuse",
+        blob,
+        "--envelope",
+        "0.002",
+        "--size",
+        "32",
+        "-o",
+        "e.png",
+    ];
+    let out = trilux(d).args(args).arg("--json").output().unwrap();
+    assert!(out.status.success(), "{}", common::stderr(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["envelope"], 0.002, "{report}");
+    let stderr = common::stderr(&out);
+    assert!(
+        stderr.contains("the tetrahedra's boundary lies within") && stderr.contains("envelope"),
+        "{stderr}"
+    );
+    let tetra = json(d, &["tetra", blob, "--envelope", "0.002", "-o", "t.node"]);
+    assert_eq!(
+        report["tetrahedra"], tetra["tetrahedra"],
+        "{report} vs {tetra}"
+    );
+    let plain = json(d, &["diffuse", blob, "--size", "32", "-o", "p.png"]);
+    assert!(plain["envelope"].is_null());
+    // Already tetrahedral: nothing to fit, said rather than ignored.
+    stuffed_blob(d, "0.12");
+    for command in ["diffuse", "view"] {
+        let mut args = vec![command, "blob.node", "--envelope", "0.002"];
+        if command == "diffuse" {
+            args.extend(["-o", "x.png"]);
+        }
+        fails_with(
+            d,
+            2,
+            &args,
+            &["--envelope 0.002", "blob.node", "already tetrahedral"],
+        );
+    }
+    fails_with(
+        d,
+        2,
+        &["diffuse", blob, "--envelope", "2", "-o", "x.png"],
+        &["--envelope 2", "between 0 and 1"],
+    );
+    assert!(!d.join("x.png").exists());
 }

@@ -273,6 +273,12 @@ fn a_bad_session_file_is_an_error_naming_the_file_and_the_entry() {
             .to_string(),
             "within f32's range",
         ),
+        (
+            json!({"format": "trilux-session", "version": 1, "refined_initially": true,
+                   "source": {"mesh": null, "envelope": 2.0}, "edits": []})
+            .to_string(),
+            "envelope 2: a fraction of the bounding box's diagonal",
+        ),
     ];
     for (k, (text, needle)) in cases.iter().enumerate() {
         let name = format!("bad{k}.json");

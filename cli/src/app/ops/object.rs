@@ -59,11 +59,28 @@ pub(crate) type Volume = (Vec<DVec3>, Vec<[u32; 4]>, Option<trilux::tet::Dropped
 
 /// The positions and tetrahedra of `input`: read (without the nodes no
 /// tetrahedron uses, which are returned for writing results back), or
-/// stuffed from a surface at the default spacing. [`check_volume`] said
-/// it is read here.
-pub(crate) fn read_volume(context: &mut Context, input: &Path, with_vtu: bool) -> Result<Volume> {
+/// stuffed from a surface at the default spacing, its boundary fitted to
+/// the surface when `envelope` is given (`trilux tetra --envelope`; then
+/// the distance reached is said on stderr). [`check_volume`] said it is
+/// read here.
+pub(crate) fn read_volume(
+    context: &mut Context,
+    input: &Path,
+    with_vtu: bool,
+    envelope: Option<f64>,
+) -> Result<Volume> {
     let ext = crate::app::extension(input);
     if tet_extensions(with_vtu).contains(&ext.as_str()) {
+        if let Some(eps) = envelope {
+            return Err(crate::app::arg_error(
+                format!("--envelope {}", super::stuff::number(eps)),
+                format!(
+                    "{} is already tetrahedral; the envelope fits the tetrahedra of a surface \
+                     (.obj, .gltf, .glb, .ply) to it",
+                    input.display()
+                ),
+            ));
+        }
         // Nodes no tetrahedron uses (TetGen and meshio files keep them)
         // would be empty rows of the solver's system: dropped, said.
         let (tet, dropped) = trilux::tet::drop_unused_nodes(crate::app::read_tets(context, input)?);
@@ -81,8 +98,31 @@ pub(crate) fn read_volume(context: &mut Context, input: &Path, with_vtu: bool) -
         eprintln!("warning: {}", open_surface(input, &shape));
     }
     let (stuffed, _) = context.step("tetrahedralizing", || {
-        stuff(&surface, input, Spacing::Default, false, false, None)
+        stuff(
+            &surface,
+            input,
+            Spacing::Default,
+            false,
+            envelope.is_some(),
+            envelope,
+        )
     })?;
+    if let (Some(eps), Some(d)) = (envelope, &stuffed.report.distance) {
+        let reached = if d.hausdorff_fraction() <= eps {
+            "within"
+        } else {
+            "NOT within"
+        };
+        eprintln!(
+            "note: {}: the tetrahedra's boundary lies within {:.3}% of the diagonal of the surface \
+             (Hausdorff), {reached} the {}% envelope; dihedral angles {:.2}°..{:.2}°",
+            input.display(),
+            100.0 * d.hausdorff_fraction(),
+            super::stuff::number(100.0 * eps),
+            stuffed.report.min_dihedral_deg,
+            stuffed.report.max_dihedral_deg
+        );
+    }
     let out = trilux::tet::from_stuffing(&stuffed, surface.origin);
     Ok((out.positions, out.tets, None))
 }
