@@ -126,8 +126,14 @@ pub(crate) fn lattice<S: Store>(
     nearest: bool,
     out: &mut [f32],
 ) {
-    let mc = s.colors();
     let r = 1u32 << lf;
+    // Inside first (the common case, a MIP level's neighbours above all):
+    // with all three positive none is `r`, so neither test below holds.
+    if a[0] > 0 && a[1] > 0 && a[2] > 0 {
+        add(out, s.face_at(f, lf, interior_index(r, a[0], a[1])), w);
+        return;
+    }
+    let mc = s.colors();
     let face = mc.topology.faces[f];
     for k in 0..3 {
         if a[k] == r {
