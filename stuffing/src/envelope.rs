@@ -114,18 +114,7 @@ pub(crate) fn fit(
     for &v in &refined.on_input {
         moved[v as usize] = true;
     }
-    let incident = Incidence::new(mesh.positions.len(), &mesh.tets);
-    let faces = Incidence::new(mesh.positions.len(), &mesh.boundary);
-    let mut mover = Mover {
-        tets: &mesh.tets,
-        incident: &incident,
-        boundary: &mesh.boundary,
-        faces: &faces,
-        input: &input,
-        eps,
-        moved,
-        touched,
-    };
+    let mut mover = Mover::new(&mesh.tets, &mesh.boundary, &input, eps, moved, touched);
     mover.project(&mut mesh.positions, &mesh.boundary, h);
     let touched = mover.touched.iter().filter(|&&m| m).count();
     Fitted {
@@ -144,18 +133,9 @@ fn pull_rounds(
     h: f64,
     eps: f64,
 ) -> (Vec<bool>, Vec<bool>) {
-    let incident = Incidence::new(mesh.positions.len(), &mesh.tets);
-    let faces = Incidence::new(mesh.positions.len(), &mesh.boundary);
-    let mut mover = Mover {
-        tets: &mesh.tets,
-        incident: &incident,
-        boundary: &mesh.boundary,
-        faces: &faces,
-        input,
-        eps,
-        moved: vec![false; mesh.positions.len()],
-        touched: vec![false; mesh.positions.len()],
-    };
+    let n = mesh.positions.len();
+    let (moved, touched) = (vec![false; n], vec![false; n]);
+    let mut mover = Mover::new(&mesh.tets, &mesh.boundary, input, eps, moved, touched);
     // Later rounds look again only at the points that were far and still
     // had a vertex to move: a pull uncovers at most half the distance it
     // closes (or `eps`), see `Mover::pull`.
@@ -285,10 +265,11 @@ impl Incidence {
 /// Moves vertices under the angle check.
 struct Mover<'a> {
     tets: &'a [[u32; 4]],
-    incident: &'a Incidence,
+    /// The tetrahedra around each vertex.
+    incident: Incidence,
     boundary: &'a [[u32; 3]],
     /// The boundary triangles around each vertex.
-    faces: &'a Incidence,
+    faces: Incidence,
     /// The input where it encloses volume.
     input: &'a Surface<'a>,
     /// The envelope, in the input's unit.
@@ -299,7 +280,30 @@ struct Mover<'a> {
     touched: Vec<bool>,
 }
 
-impl Mover<'_> {
+impl<'a> Mover<'a> {
+    /// A mover over the tetrahedra `tets` with boundary `boundary`, whose
+    /// vertices are flagged in `moved` and `touched` (one flag each).
+    fn new(
+        tets: &'a [[u32; 4]],
+        boundary: &'a [[u32; 3]],
+        input: &'a Surface<'a>,
+        eps: f64,
+        moved: Vec<bool>,
+        touched: Vec<bool>,
+    ) -> Self {
+        let vertices = moved.len();
+        Mover {
+            tets,
+            incident: Incidence::new(vertices, tets),
+            boundary,
+            faces: Incidence::new(vertices, boundary),
+            input,
+            eps,
+            moved,
+            touched,
+        }
+    }
+
     /// One round of step 2: every point of `targets` (those indexed by
     /// `candidates`) farther than `eps` from the boundary, farthest first,
     /// pulls the nearest corner of its nearest boundary triangle that is
