@@ -21,14 +21,15 @@
 
 use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use crate::Error;
 use crate::edit::ResolutionChange;
 use crate::paint::Painter;
-use crate::parallel::map_ordered;
+use crate::parallel::for_each_mut;
 use crate::structure::{
-    MeshColors, Site, lattice_points, move_segments, samples_per_edge, samples_per_face,
+    MeshColors, Site, lattice_points, move_segments, sample_position, samples_per_edge,
+    samples_per_face,
 };
 use crate::undo::{History, Recorder, Step};
 
@@ -686,44 +687,78 @@ impl PaintSession {
         move_segments(&mut positions, 1, &segments, total);
         move_segments(&mut self.normals, 1, &segments, total);
         // Each resampled primitive's samples on their own (on all threads
-        // for a large change), then written in order.
+        // for a large change), written in place: no list of them to
+        // gather and copy after.
         let (vertices, vertex_normals) = (&self.positions, &self.vertex_normals);
         let faces = mc.topology().faces();
-        let place = |out: &mut Vec<(usize, Vec3, Vec3)>, i: usize, site: Site| {
-            let p = site
-                .position(mc.topology(), vertices)
-                .map_or_else(|| vertices[i], |p| p.as_vec3());
-            out.push((i, p, normal_at(faces, vertex_normals, &site)));
-        };
-        let edges: Vec<usize> = (0..edge_new.len()).filter(|&e| edge_new[e]).collect();
-        let new_faces: Vec<usize> = (0..face_new.len()).filter(|&f| face_new[f]).collect();
-        let edge_samples = edges
-            .iter()
-            .map(|&e| samples_per_edge(1 << mc.edge_level[e]) as usize)
-            .sum();
-        let face_samples = new_faces
-            .iter()
-            .map(|&f| samples_per_face(1 << mc.face_level[f]) as usize)
-            .sum();
-        let mut placed = map_ordered(&edges, edge_samples, |&e| {
-            let mut out = Vec::new();
-            mc.edge_sites(e, |i, site| place(&mut out, i, site));
-            out
-        });
-        placed.extend(map_ordered(&new_faces, face_samples, |&f| {
-            let mut out = Vec::new();
-            mc.face_sites(f, |i, site| place(&mut out, i, site));
-            out
+        // Each resampled edge's and face's samples are one run of the new
+        // numbering, the runs in increasing order (edges before faces):
+        // each gets its own part of the positions and normals to write.
+        let mut runs: Vec<(Run, usize, usize)> = (0..edge_new.len())
+            .filter(|&e| edge_new[e])
+            .map(|e| {
+                let n = samples_per_edge(1 << mc.edge_level[e]) as usize;
+                (Run::Edge(e), mc.edge_offset[e], n)
+            })
+            .collect();
+        runs.extend((0..face_new.len()).filter(|&f| face_new[f]).map(|f| {
+            let n = samples_per_face(1 << mc.face_level[f]) as usize;
+            (Run::Face(f), mc.face_offset[f], n)
         }));
-        for (i, p, n) in placed.into_iter().flatten() {
-            positions[i] = p;
-            self.normals[i] = n;
+        let samples = runs.iter().map(|r| r.2).sum();
+        let mut jobs = Vec::with_capacity(runs.len());
+        let (mut rest_p, mut rest_n) = (&mut positions[..], &mut self.normals[..]);
+        let mut done = 0;
+        for (run, start, len) in runs {
+            let skip = start.saturating_sub(done);
+            let (Some((_, p)), Some((_, n))) = (
+                std::mem::take(&mut rest_p).split_at_mut_checked(skip),
+                std::mem::take(&mut rest_n).split_at_mut_checked(skip),
+            ) else {
+                break;
+            };
+            let (Some((mine_p, p)), Some((mine_n, n))) =
+                (p.split_at_mut_checked(len), n.split_at_mut_checked(len))
+            else {
+                break;
+            };
+            (rest_p, rest_n) = (p, n);
+            done = start + len;
+            jobs.push((run, start, mine_p, mine_n));
         }
+        for_each_mut(&mut jobs, samples, |(run, start, p, n)| {
+            if let Run::Face(f) = *run
+                && place_face(mc, f, vertices, vertex_normals, p, n)
+            {
+                return;
+            }
+            let mut place = |i: usize, site: Site| {
+                let Some(k) = i.checked_sub(*start).filter(|&k| k < p.len()) else {
+                    return;
+                };
+                p[k] = site.position(mc.topology(), vertices).map_or_else(
+                    || vertices.get(i).copied().unwrap_or_default(),
+                    |x| x.as_vec3(),
+                );
+                n[k] = normal_at(faces, vertex_normals, &site);
+            };
+            match *run {
+                Run::Edge(e) => mc.edge_sites(e, &mut place),
+                Run::Face(f) => mc.face_sites(f, &mut place),
+            }
+        });
         // No shrink_to_fit: the spare capacity a raise leaves serves the
         // next one without another copy (these are not the colours'
         // reported memory).
         self.painter = Painter::from_positions(positions, cell, mc.channels());
     }
+}
+
+/// A resampled primitive whose samples [`PaintSession::reindex`] places.
+#[derive(Clone, Copy)]
+enum Run {
+    Edge(usize),
+    Face(usize),
 }
 
 /// Which edges and faces a resolution change (or its undo) resampled.
@@ -835,6 +870,51 @@ fn normal_at(faces: &[[u32; 3]], vertex: &[Vec3], site: &Site) -> Vec3 {
         n += *b as f32 * vertex[v as usize];
     }
     n.normalize_or_zero()
+}
+
+/// Face `f`'s interior samples' positions and normals into `p` and `n`
+/// (in the order of its samples): what [`Site::position`] and
+/// [`normal_at`] give, the same sums in the same order, with the corners
+/// read once per face instead of per sample. False (nothing written)
+/// when a corner is missing.
+fn place_face(
+    mc: &MeshColors,
+    f: usize,
+    vertices: &[Vec3],
+    vertex_normals: &[Vec3],
+    p: &mut [Vec3],
+    n: &mut [Vec3],
+) -> bool {
+    let (Some(face), Some(r)) = (mc.topology().faces().get(f), mc.face_resolution(f)) else {
+        return false;
+    };
+    let corner = |k: usize| {
+        let v = face[k] as usize;
+        Some((vertices.get(v)?.as_dvec3(), *vertex_normals.get(v)?))
+    };
+    let (Some(c0), Some(c1), Some(c2)) = (corner(0), corner(1), corner(2)) else {
+        return false;
+    };
+    let corners = [c0, c1, c2];
+    let mut slots = p.iter_mut().zip(n.iter_mut());
+    for i in 1..r {
+        for j in 1..r - i {
+            let b = sample_position(r, i, j);
+            let mut q = DVec3::ZERO;
+            let mut m = Vec3::ZERO;
+            for (&b, &(cp, _)) in b.iter().zip(&corners) {
+                q += b * cp;
+            }
+            for (&b, &(_, cn)) in b.iter().zip(&corners) {
+                m += b as f32 * cn;
+            }
+            if let Some((ps, ns)) = slots.next() {
+                *ps = q.as_vec3();
+                *ns = m.normalize_or_zero();
+            }
+        }
+    }
+    true
 }
 
 /// The faces joined to `face` through shared edges, in increasing order.
