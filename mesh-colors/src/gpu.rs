@@ -626,15 +626,15 @@ impl GpuLayout {
         // Values `from..from + len` of the pyramid into texture values
         // from `at`.
         let mut write = |from: usize, at: usize, len: usize| {
-            for k in 0..len {
-                let value = &mip.data[(from + k) * c..(from + k + 1) * c];
-                for (g, chunk) in value.chunks(4).enumerate() {
-                    let t = (at + k) * p + g;
-                    if let Some(texel) = samples.get_mut(t * 4..t * 4 + 4) {
-                        texel[..chunk.len()].copy_from_slice(chunk);
-                        texel[chunk.len()..].fill(0.0);
-                    }
-                }
+            let (Some(values), Some(texels)) = (
+                mip.data.get(from * c..(from + len) * c),
+                samples.get_mut(at * p * 4..(at + len) * p * 4),
+            ) else {
+                return;
+            };
+            for (texels, value) in texels.chunks_exact_mut(4 * p).zip(values.chunks_exact(c)) {
+                texels[..c].copy_from_slice(value);
+                texels[c..].fill(0.0);
             }
             changed.push((at * p, (at + len) * p));
         };

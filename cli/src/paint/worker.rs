@@ -21,7 +21,7 @@ use serde_json::json;
 use super::protocol::{ExportKind, Request};
 use super::scatter::{ScatterState, Updated};
 use super::{Document, LIMITS, MAGIC, Options, PAGE, VERSION};
-use crate::web::frame::{Header, put_f32, put_u32};
+use crate::web::frame::{HEADER, Header, put_f32, put_u32};
 use crate::web::{App, Idle, Inbox, Limits, Out, Outbox, ReplyTo};
 
 /// Widest texture row the page is sent (WebGL2 guarantees 2048).
@@ -175,32 +175,35 @@ impl Worker {
     /// before it draws again).
     fn layout_rects(&self, changes: &Changes) -> Out {
         let w = self.gpu.width() as usize;
-        let texels = |rs: &[TexelRect]| {
+        let bytes = |rs: &[TexelRect]| {
             rs.iter()
                 .map(|r| 16 + 16 * r.width as usize * r.height as usize)
                 .sum::<usize>()
         };
-        let mut payload = Vec::with_capacity(texels(&changes.samples) + texels(&changes.faces));
+        // The header's room first, so that the payload (megabytes after a
+        // large detail change) is not copied again behind it.
+        let mut frame =
+            Vec::with_capacity(HEADER + bytes(&changes.samples) + bytes(&changes.faces));
+        frame.resize(HEADER, 0);
         put_rects(
-            &mut payload,
+            &mut frame,
             w,
             &changes.samples,
             self.gpu.sample_texels(),
             |x| x.to_bits(),
         );
-        put_rects(
-            &mut payload,
-            w,
-            &changes.faces,
-            self.gpu.face_texels(),
-            |x| x,
-        );
-        Self::frame(
-            7,
-            changes.samples.len() as u32,
-            changes.faces.len() as u32,
-            &payload,
-        )
+        put_rects(&mut frame, w, &changes.faces, self.gpu.face_texels(), |x| x);
+        let header = Header {
+            magic: *MAGIC,
+            version: VERSION,
+            kind: 7,
+            flags: 0,
+            tag: 0,
+            a: changes.samples.len() as u32,
+            b: changes.faces.len() as u32,
+        };
+        frame[..HEADER].copy_from_slice(&header.bytes());
+        Out::Binary(Bytes::from(frame))
     }
 
     /// Sends `frame` and appends it to the textures' slot.
