@@ -503,41 +503,14 @@ impl GpuLayout {
         let spans = checked_spans(spans, values)?;
         let samples = &mut self.parts.samples;
         let mut changed: Vec<(usize, usize)> = Vec::new();
-        // Value `i` of the pyramid into texture value `at`, when it differs.
-        let mut write = |i: usize, at: usize| {
-            let value = &mip.data[i * c..(i + 1) * c];
-            for (g, chunk) in value.chunks(4).enumerate() {
-                let t = at * p + g;
-                let Some(texel) = samples.get_mut(t * 4..t * 4 + 4) else {
-                    continue;
-                };
-                let mut new = [0.0f32; 4];
-                new[..chunk.len()].copy_from_slice(chunk);
-                if texel
-                    .iter()
-                    .zip(&new)
-                    .all(|(x, y)| x.to_bits() == y.to_bits())
-                {
-                    continue;
-                }
-                texel.copy_from_slice(&new);
-                match changed.last_mut() {
-                    Some((_, end)) if t >= *end && t - *end < MERGE_GAP => *end = t + 1,
-                    _ => changed.push((t, t + 1)),
-                }
-            }
+        let mut run = |from: usize, at: usize, len: usize| {
+            rewrite_run(samples, &mip.data, (from, at, len), (c, p), &mut changed);
         };
         match &self.blocks {
-            Some(blocks) => blocks.pieces(mip, &spans, |from, at, len| {
-                for k in 0..len {
-                    write(from + k, at + k);
-                }
-            }),
+            Some(blocks) => blocks.pieces(mip, &spans, run),
             None => {
                 for &(a, b) in &spans {
-                    for i in a..b {
-                        write(i, i);
-                    }
+                    run(a, a, b - a);
                 }
             }
         }
@@ -851,6 +824,48 @@ fn face_words(mc: &MeshColors, blocks: &Blocks, f: usize) -> [u32; FACE_WORDS] {
     }
     words[7] = bits;
     words
+}
+
+/// Writes the pyramid's values `from..from + len` (of `data`, `c`
+/// channels, `p` texels each) into texture values from `at`, those that
+/// differ only, and adds the texels written to `changed` (joined across
+/// gaps of fewer than [`MERGE_GAP`] texels).
+fn rewrite_run(
+    samples: &mut [f32],
+    data: &[f32],
+    (from, at, len): (usize, usize, usize),
+    (c, p): (usize, usize),
+    changed: &mut Vec<(usize, usize)>,
+) {
+    let (Some(values), Some(texels)) = (
+        data.get(from * c..(from + len) * c),
+        samples.get_mut(at * p * 4..(at + len) * p * 4),
+    ) else {
+        return;
+    };
+    for (k, (texels, value)) in texels
+        .chunks_exact_mut(4 * p)
+        .zip(values.chunks_exact(c))
+        .enumerate()
+    {
+        for (g, (texel, chunk)) in texels.chunks_exact_mut(4).zip(value.chunks(4)).enumerate() {
+            let mut new = [0.0f32; 4];
+            new[..chunk.len()].copy_from_slice(chunk);
+            if texel
+                .iter()
+                .zip(&new)
+                .all(|(x, y)| x.to_bits() == y.to_bits())
+            {
+                continue;
+            }
+            texel.copy_from_slice(&new);
+            let t = (at + k) * p + g;
+            match changed.last_mut() {
+                Some((_, end)) if t >= *end && t - *end < MERGE_GAP => *end = t + 1,
+                _ => changed.push((t, t + 1)),
+            }
+        }
+    }
 }
 
 /// `spans` sorted, or an error naming them when one leaves `values`.
