@@ -6,7 +6,7 @@ use crate::filter::{FINEST, Place, Store, check, edge_point, eval_at, lattice, p
 use crate::parallel::map_ordered;
 use crate::structure::{MeshColors, interior_index, move_segments, samples_per_face};
 use crate::topology::NO_FACE;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use crate::{Error, MAX_CHANNELS, MAX_LEVEL};
 
@@ -30,6 +30,7 @@ pub(crate) fn edge_level_offset(l: u8) -> usize {
 
 /// Which faces and edges meet at each vertex, in the orders
 /// [`MipMap::new`] uses.
+#[derive(Debug)]
 struct Adjacency {
     vf_start: Vec<u32>,
     vf: Vec<u32>,
@@ -180,6 +181,10 @@ pub struct MipMap {
     /// ([`crate::gpu::GpuLayout`]) never pays for it, and the refreshes
     /// keep it up to date only once it exists.
     pub(crate) cache: OnceLock<Cache>,
+    /// The faces and edges around each vertex, built by the first refresh
+    /// and kept (the mesh never changes; a stroke's refresh built it
+    /// again every dab).
+    adjacency: OnceLock<Arc<Adjacency>>,
 }
 
 /// A lookup cache of a [`MipMap`]: per face, every level's full lattice
@@ -345,6 +350,7 @@ impl MipMap {
             face_offset,
             colors,
             cache: OnceLock::new(),
+            adjacency: OnceLock::new(),
         }
     }
 
@@ -496,7 +502,7 @@ impl MipMap {
         let c = colors.channels;
         let t = &colors.topology;
         let (nv, nf) = (t.vertex_count, t.faces.len());
-        let adjacency = Adjacency::new(t);
+        let adjacency = Arc::clone(self.adjacency.get_or_init(|| Arc::new(Adjacency::new(t))));
         let faces_of = |v: usize| adjacency.faces_of(v);
         // Copy the new finest values, and mark their faces.
         let mut dirty = vec![false; nf];
@@ -587,7 +593,7 @@ impl MipMap {
         }
         let c = colors.channels;
         let t = &colors.topology;
-        let adjacency = Adjacency::new(t);
+        let adjacency = Arc::clone(self.adjacency.get_or_init(|| Arc::new(Adjacency::new(t))));
         let mut dirty = vec![false; nf];
         let mut list: Vec<usize> = Vec::new();
         let mut mark = |f: usize| {
