@@ -150,6 +150,7 @@ async fn the_scatter_panel_follows_a_stroke_of_density_in_chromium() {
     let v = run(&script, &browser, &shots, exports, doc, "test").await;
     assert_eq!(v["console_errors"], json!([]), "{v:#}");
     let step = |s: &str| &v["steps"][s];
+    assert_eq!(step("legend"), true, "{v:#}");
     assert_eq!(step("rate")["points"], 0, "{v:#}");
     assert_eq!(step("rate")["orange"], 0, "{v:#}");
     let empty = step("empty_export");
@@ -259,6 +260,12 @@ async fn the_page_paints_picks_adds_detail_undoes_saves_and_exports_in_chromium(
         "{detail}"
     );
     assert!(detail["changed"].as_u64().unwrap() < 2000, "{detail}");
+    // And the page said so (the HUD's notice: samples before → after).
+    let notice = detail["notice"].as_str().unwrap_or_default();
+    assert!(
+        notice.starts_with("samples ") && notice.contains(" → ") && notice.contains("(+"),
+        "{detail}"
+    );
 
     // Undo twice: the first picture again; redo: the stroke again.
     assert_eq!(step("undo")["changed"], 0, "{}", step("undo"));

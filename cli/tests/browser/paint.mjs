@@ -90,7 +90,8 @@ try {
   await page.mouse.click(400, 380);
   await waitUndo(2, 0);
   await pixels('detailed');
-  out.steps.detail = { status: await status(), ...(await diff('stroked', 'detailed')) };
+  out.steps.detail = { status: await status(), ...(await diff('stroked', 'detailed')),
+    notice: await page.evaluate(() => document.getElementById('busy').textContent) };
   lap('detail');
 
   // Undo both, redo the stroke.

@@ -38,6 +38,8 @@ try {
   // The density channel as the brush's, value 1.
   await page.selectOption('#channel', { label: 'density' });
   await page.evaluate(() => { const v = document.getElementById('value'); v.value = '1'; });
+  // A scalar channel shows as a heat map, with its legend in the panel.
+  out.steps.legend = await page.evaluate(() => !document.getElementById('heatLegend').hidden);
 
   let frames = (await t()).frames;
   if (mode === 'bench') {

@@ -141,6 +141,14 @@ function showStatus(s) {
     (s.strands ? ` (${s.strands.toLocaleString()} strands shown)` : '') + ` in ${s.scatter_ms.toFixed(1)} ms`;
   $('stats').textContent = `${s.samples.toLocaleString()} samples · ${mb(s.memory)} · finest level ${s.finest_level}` +
     ` · undo ${s.undo} · redo ${s.redo} (history ${mb(s.undo_memory)})` + scatter;
+  // A detail change (or its undo) shows little on screen at first: say
+  // what it did to the sample count.
+  if (state.samples !== undefined && s.samples !== state.samples) {
+    const d = s.samples - state.samples;
+    flash(`samples ${state.samples.toLocaleString()} → ${s.samples.toLocaleString()} ` +
+      `(${d > 0 ? '+' : '−'}${Math.abs(d).toLocaleString()})`);
+  }
+  state.samples = s.samples;
   const list = $('history');
   list.textContent = '';
   s.history.forEach((h, k) => {
@@ -502,7 +510,7 @@ $('help').onclick = () => { $('helpbox').hidden = !$('helpbox').hidden; };
 $('filter').onchange = () => { dirty = true; };
 $('channel').onchange = () => {
   const scalar = state.channelIndex() !== 0;
-  $('colorRow').hidden = scalar; $('valueRow').hidden = !scalar;
+  $('colorRow').hidden = scalar; $('valueRow').hidden = !scalar; $('heatLegend').hidden = !scalar;
   dirty = true;
 };
 $('shade').onchange = () => { dirty = true; };
