@@ -158,6 +158,44 @@ impl Surface<'_> {
         (point, best, triangle)
     }
 
+    /// Whether some triangle has a point within `r` of `q`: the same answer
+    /// as `nearest(q).1.sqrt() <= r` (the smallest square root is the
+    /// square root of the smallest square), found without looking past
+    /// `r`, and done at the first triangle that is near enough.
+    pub(crate) fn within(&self, q: DVec3, r: f64) -> bool {
+        // Boxes farther than this cannot hold such a triangle; the margin
+        // keeps a rounding of the box distance from pruning one that does.
+        let reach2 = r * r * (1.0 + 1e-9) + f64::MIN_POSITIVE;
+        let mut stack = [0u32; 64];
+        let mut len = 1;
+        while len > 0 {
+            len -= 1;
+            let node = &self.bvh.nodes[stack[len] as usize];
+            if box_distance2(&node.bounds, q) > reach2 {
+                continue;
+            }
+            if node.is_leaf() {
+                let s = node.start as usize;
+                for &t in &self.bvh.order[s..s + node.count as usize] {
+                    let [a, b, c] = self.corners(t as usize);
+                    if closest_point_on_triangle(q, a, b, c).distance_squared(q).sqrt() <= r {
+                        return true;
+                    }
+                }
+                continue;
+            }
+            // The nearer child on top, as `nearest` visits them.
+            let [l, rr] = node.children;
+            let dl = box_distance2(&self.bvh.nodes[l as usize].bounds, q);
+            let dr = box_distance2(&self.bvh.nodes[rr as usize].bounds, q);
+            let (near, far) = if dl <= dr { (l, rr) } else { (rr, l) };
+            stack[len] = far;
+            stack[len + 1] = near;
+            len += 2;
+        }
+        false
+    }
+
     /// `n` points spread over the triangles `chosen` by area (see the
     /// module docs), plus the vertices those triangles use when there are
     /// at most `n` of them.
@@ -490,6 +528,30 @@ mod tests {
             assert!(exact <= brute(q, a, b, c) + 1e-12, "{q}");
             assert!(brute(q, a, b, c) - exact < 0.01, "{q}");
         }
+    }
+
+    #[test]
+    fn a_bounded_query_answers_as_the_nearest_point_does() {
+        let (p, t) = crate::tests::sphere(16, 1.0, DVec3::ZERO);
+        let bvh = Bvh::build(&p, &t);
+        let s = Surface {
+            positions: &p,
+            triangles: &t,
+            bvh: &bvh,
+        };
+        let mut near = 0;
+        for k in 0..2000 {
+            let (x, y) = r2(k);
+            let q = DVec3::new(3.0 * x - 1.5, 3.0 * y - 1.5, (k as f64 * 0.37).sin() * 1.5);
+            let d = s.nearest(q).1.sqrt();
+            // Radii around the distance itself, where rounding decides.
+            for r in [0.5 * d, d * (1.0 - 1e-15), d, d * (1.0 + 1e-15), 2.0 * d + 1e-3] {
+                assert_eq!(s.within(q, r), d <= r, "{q} at {r} (distance {d})");
+            }
+            near += usize::from(s.within(q, 0.1));
+        }
+        // Both answers occur.
+        assert!(near > 50 && near < 1950, "{near}");
     }
 
     #[test]

@@ -456,7 +456,7 @@ impl<'a> Mover<'a> {
                 }
             }
             let before = *off_before.get_or_insert_with(|| self.ring_off_input(positions, v, from));
-            if self.ring_off_input(positions, v, to) > before.max(self.eps) {
+            if !self.ring_within(positions, v, to, before.max(self.eps)) {
                 continue;
             }
             positions[v as usize] = to;
@@ -478,6 +478,19 @@ impl Mover<'_> {
             off = off.max(self.input.nearest(centroid).1);
         }
         off.sqrt()
+    }
+
+    /// Whether every boundary triangle around `v`, with `v` at `at`, has
+    /// its centroid within `limit` of the input: the same answer as
+    /// `ring_off_input(..) <= limit`, with bounded queries that stop at
+    /// the first triangle near enough (the fit's most frequent query).
+    fn ring_within(&self, positions: &[DVec3], v: u32, at: DVec3, limit: f64) -> bool {
+        self.faces.of(v).iter().all(|&f| {
+            let corners =
+                self.boundary[f as usize].map(|u| if u == v { at } else { positions[u as usize] });
+            let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+            self.input.within(centroid, limit)
+        })
     }
 }
 
