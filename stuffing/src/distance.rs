@@ -178,7 +178,11 @@ impl Surface<'_> {
                 let s = node.start as usize;
                 for &t in &self.bvh.order[s..s + node.count as usize] {
                     let [a, b, c] = self.corners(t as usize);
-                    if closest_point_on_triangle(q, a, b, c).distance_squared(q).sqrt() <= r {
+                    if closest_point_on_triangle(q, a, b, c)
+                        .distance_squared(q)
+                        .sqrt()
+                        <= r
+                    {
                         return true;
                     }
                 }
@@ -545,7 +549,13 @@ mod tests {
             let q = DVec3::new(3.0 * x - 1.5, 3.0 * y - 1.5, (k as f64 * 0.37).sin() * 1.5);
             let d = s.nearest(q).1.sqrt();
             // Radii around the distance itself, where rounding decides.
-            for r in [0.5 * d, d * (1.0 - 1e-15), d, d * (1.0 + 1e-15), 2.0 * d + 1e-3] {
+            for r in [
+                0.5 * d,
+                d * (1.0 - 1e-15),
+                d,
+                d * (1.0 + 1e-15),
+                2.0 * d + 1e-3,
+            ] {
                 assert_eq!(s.within(q, r), d <= r, "{q} at {r} (distance {d})");
             }
             near += usize::from(s.within(q, 0.1));
