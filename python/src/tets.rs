@@ -110,7 +110,7 @@ pub(crate) fn tetrahedralize<'py>(
         d.set_item("spacing", h)?;
         d.set_item("min_dihedral_deg", r.min_dihedral_deg)?;
         d.set_item("max_dihedral_deg", r.max_dihedral_deg)?;
-        d.set_item("dihedral_bound_deg", options.dihedral_bounds_deg())?;
+        d.set_item("dihedral_bound_deg", r.dihedral_bounds_deg)?;
         d.set_item("envelope", envelope)?;
         d.set_item("fitted_vertices", r.fitted_vertices)?;
         d.set_item("sharp_edges", r.sharp_edges)?;

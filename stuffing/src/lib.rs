@@ -286,6 +286,10 @@ pub struct Report {
     pub min_dihedral_deg: f64,
     /// Largest dihedral angle, degrees.
     pub max_dihedral_deg: f64,
+    /// The `(smallest, largest)` dihedral angle, degrees, any surface gets
+    /// with the options used ([`Options::dihedral_bounds_deg`]): what
+    /// `min_dihedral_deg`/`max_dihedral_deg` are promised to stay within.
+    pub dihedral_bounds_deg: (f64, f64),
     /// Smallest cotangent of a dihedral angle (see [`Quality::min_cot`]).
     pub min_cot: f64,
     /// Largest cotangent of a dihedral angle.
@@ -490,6 +494,7 @@ fn run<P: Position>(
         boundary_triangles: m.boundary.len(),
         min_dihedral_deg: q.min_dihedral_deg,
         max_dihedral_deg: q.max_dihedral_deg,
+        dihedral_bounds_deg: options.dihedral_bounds_deg(),
         min_cot: q.min_cot,
         max_cot: q.max_cot,
         lattice_vertices: lattice.vertex_count(),

@@ -117,11 +117,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         .map(|(lo, hi)| (hi.as_dvec3() - lo.as_dvec3()).length())
         .unwrap_or(0.0);
     // What the options guarantee, beside what this surface got.
-    let bound = tet_stuffing::Options {
-        envelope: args.envelope,
-        ..tet_stuffing::Options::new(h)
-    }
-    .dihedral_bounds_deg();
+    let bound = r.dihedral_bounds_deg;
     let text = format!(
         "{} tetrahedra, {} vertices, {} boundary triangles at spacing {}{}{} in {:.2} s; dihedral angles {:.2}° .. {:.2}° (within {}°–{}° on any surface){}; written to {}\n",
         r.tets,

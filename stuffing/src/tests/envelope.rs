@@ -135,6 +135,8 @@ fn random_smooth_surfaces_are_held_within_the_envelope_with_the_angle_bound() {
         let result = check_mesh(&fitted, None, (10.0, 165.0));
         assert!(result.is_ok(), "{name}: {result:?}");
         assert!(fitted.report.min_dihedral_deg >= 10.0, "{name}");
+        let (lo, hi) = fitted.report.dihedral_bounds_deg;
+        assert!((lo, hi) == (9.0, 165.0) && plain.report.dihedral_bounds_deg == (9.0, 162.0));
         assert!(
             d.input_to_tets <= EPS * d.diagonal && d.tets_to_input <= EPS * d.diagonal,
             "{name}: {d:?}"
