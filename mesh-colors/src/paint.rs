@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 
-use crate::parallel::map_ordered;
+use crate::grid::Grid;
 use crate::structure::MeshColors;
 use crate::undo::Recorder;
 use crate::{Error, MAX_CHANNELS};
@@ -71,64 +71,6 @@ pub struct Painter {
     channels: usize,
 }
 
-/// A spatial hash of sample positions: cells of side `cell`, hashed into
-/// `2^k` buckets (about one per two samples), the samples of each bucket
-/// listed in increasing order in one array (compressed rows). Building it
-/// is two passes over the samples with no per-cell allocation, so a
-/// resolution change that renumbers the samples can rebuild it cheaply.
-#[derive(Debug, Clone)]
-struct Grid {
-    cell: f32,
-    /// `start[b] .. start[b + 1]` are bucket `b`'s entries in `items`.
-    start: Vec<u32>,
-    items: Vec<u32>,
-}
-
-impl Grid {
-    fn new(positions: &[Vec3], cell: f32) -> Self {
-        let buckets = (positions.len() / 2).max(1).next_power_of_two();
-        // The hashing on all threads for a whole mesh; the counting sort
-        // after it stays in order, so the buckets list samples in
-        // increasing order at any thread count.
-        let bucket: Vec<u32> = map_ordered(positions, positions.len(), |&p| {
-            bucket_of(cell_of(p, cell), buckets)
-        });
-        let mut start = vec![0u32; buckets + 1];
-        for &b in &bucket {
-            start[b as usize + 1] += 1;
-        }
-        for b in 0..buckets {
-            start[b + 1] += start[b];
-        }
-        let mut fill = start.clone();
-        let mut items = vec![0u32; positions.len()];
-        for (i, &b) in bucket.iter().enumerate() {
-            items[fill[b as usize] as usize] = i as u32;
-            fill[b as usize] += 1;
-        }
-        Self { cell, start, items }
-    }
-
-    fn buckets(&self) -> usize {
-        self.start.len() - 1
-    }
-
-    fn bucket(&self, b: usize) -> &[u32] {
-        &self.items[self.start[b] as usize..self.start[b + 1] as usize]
-    }
-}
-
-/// The bucket of grid cell `c` among `buckets` (a power of two).
-#[inline]
-fn bucket_of(c: [i32; 3], buckets: usize) -> u32 {
-    let h = (c[0] as u32).wrapping_mul(73_856_093)
-        ^ (c[1] as u32).wrapping_mul(19_349_663)
-        ^ (c[2] as u32).wrapping_mul(83_492_791);
-    // Mix the high bits down: the primes leave the low bits weak.
-    let h = h ^ (h >> 15);
-    h.wrapping_mul(0x2c1b_3c6d) & (buckets as u32 - 1)
-}
-
 impl Painter {
     /// Indexes the samples of `colors` on a mesh with vertex `positions`,
     /// in grid cells of size `cell` (about the usual brush radius).
@@ -137,40 +79,15 @@ impl Painter {
     /// [`Error::ChannelMismatch`] if `positions` is shorter than the vertex
     /// count, [`Error::NonFinite`] for a non-finite position or cell size.
     pub fn new(colors: &MeshColors, positions: &[Vec3], cell: f32) -> Result<Self, Error> {
-        Self::with_sites(colors, positions, &colors.sites(), cell)
-    }
-
-    /// [`Painter::new`] with the colours' [`MeshColors::sites`] already
-    /// computed (the paint session needs them for its normals too).
-    pub(crate) fn with_sites(
-        colors: &MeshColors,
-        positions: &[Vec3],
-        sites: &[crate::structure::Site],
-        cell: f32,
-    ) -> Result<Self, Error> {
         let t = colors.topology();
-        if positions.len() < t.vertex_count() {
-            return Err(Error::ChannelMismatch {
-                what: "vertex positions",
-                expected: t.vertex_count(),
-                got: positions.len(),
-            });
-        }
-        if let Some(i) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(Error::NonFinite {
-                what: "position",
-                index: i,
-            });
-        }
+        check_vertex_positions(t.vertex_count(), positions)?;
         if !(cell.is_finite() && cell > 0.0) {
             return Err(Error::NonFinite {
                 what: "cell size",
                 index: 0,
             });
         }
-        let sample_positions: Vec<Vec3> = sites
-            .iter()
-            .enumerate()
+        let sample_positions: Vec<Vec3> = (colors.sites().iter().enumerate())
             .map(|(i, s)| {
                 s.position(t, positions)
                     .map_or_else(|| positions[i], |p| p.as_vec3())
@@ -184,23 +101,12 @@ impl Painter {
     }
 
     /// The index of samples at `positions` (finite), in cells of `cell`.
-    pub(crate) fn from_positions(positions: Vec<Vec3>, cell: f32, channels: usize) -> Self {
+    fn from_positions(positions: Vec<Vec3>, cell: f32, channels: usize) -> Self {
         Self {
-            grid: Grid::new(&positions, cell),
+            grid: Grid::of_points(&positions, cell),
             positions,
             channels,
         }
-    }
-
-    /// Gives the sample positions back (to move them to a new numbering
-    /// and index them again with [`Painter::from_positions`]).
-    pub(crate) fn into_positions(self) -> Vec<Vec3> {
-        self.positions
-    }
-
-    /// The grid's cell size.
-    pub(crate) fn cell(&self) -> f32 {
-        self.grid.cell
     }
 
     /// The 3D position of every sample.
@@ -216,14 +122,8 @@ impl Painter {
         radius: f32,
         mut f: impl FnMut(usize, f32),
     ) -> usize {
-        let grid = &self.grid;
-        let lo = cell_of(center - Vec3::splat(radius), grid.cell);
-        let hi = cell_of(center + Vec3::splat(radius), grid.cell);
-        let span = (0..3).fold(1u64, |s, k| {
-            s.saturating_mul((i64::from(hi[k]) - i64::from(lo[k]) + 1) as u64)
-        });
         let mut examined = 0;
-        let mut visit = |list: &[u32]| {
+        self.grid.for_each_list_near(center, radius, |list| {
             for &i in list {
                 examined += 1;
                 let d = self.positions[i as usize].distance(center);
@@ -231,27 +131,7 @@ impl Painter {
                     f(i as usize, d);
                 }
             }
-        };
-        if span > grid.buckets() as u64 {
-            // A brush larger than the grid: every sample.
-            visit(&grid.items);
-        } else {
-            // Each bucket once: cells that share a bucket would otherwise
-            // report its samples twice.
-            let mut buckets = Vec::with_capacity(span as usize);
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        buckets.push(bucket_of([x, y, z], grid.buckets()));
-                    }
-                }
-            }
-            buckets.sort_unstable();
-            buckets.dedup();
-            for b in buckets {
-                visit(grid.bucket(b as usize));
-            }
-        }
+        });
         examined
     }
 
@@ -338,65 +218,24 @@ impl Painter {
     }
 }
 
-fn cell_of(p: Vec3, cell: f32) -> [i32; 3] {
-    (p / cell).to_array().map(floor_clamped)
-}
-
-/// `x.floor().clamp(-1e9, 1e9) as i32` without a call to `floorf`
-/// (x86-64's baseline has no rounding instruction; the grid hashes every
-/// sample after a resolution change): ±10⁹ are integers in `f32`, so
-/// clamping first gives the same, and within them the truncation is exact
-/// and one below it when it rounded a negative number up. NaN gives 0, as
-/// the cast of a NaN floor does.
-#[inline]
-fn floor_clamped(x: f32) -> i32 {
-    let x = x.clamp(-1e9, 1e9);
-    let t = x as i32;
-    if (t as f32) > x { t - 1 } else { t }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::floor_clamped;
-
-    #[test]
-    fn the_fast_floor_is_the_floor_it_replaces() {
-        let reference = |x: f32| x.floor().clamp(-1e9, 1e9) as i32;
-        let mut xs = vec![
-            0.0,
-            -0.0,
-            0.5,
-            -0.5,
-            1.0,
-            -1.0,
-            -1.5,
-            2.999_999_8,
-            -2.999_999_8,
-            8_388_607.5,
-            -8_388_607.5,
-            16_777_217.0,
-            -16_777_217.0,
-            1e9,
-            -1e9,
-            1.000_000_1e9,
-            -1.000_000_1e9,
-            3e38,
-            -3e38,
-            f32::MIN_POSITIVE,
-            -f32::MIN_POSITIVE,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-        ];
-        // Every 2^-20th of the range of bit patterns, and their neighbours.
-        for k in 0..(1u32 << 12) {
-            let bits = k << 20;
-            for b in [bits, bits.wrapping_add(1), bits.wrapping_sub(1)] {
-                xs.push(f32::from_bits(b));
-            }
-        }
-        for x in xs {
-            assert_eq!(floor_clamped(x), reference(x), "{x:e}");
-        }
+/// That a mesh of `vertex_count` vertices has a finite position for each.
+///
+/// # Errors
+/// [`Error::ChannelMismatch`] for too few positions, [`Error::NonFinite`]
+/// naming the first non-finite one.
+pub(crate) fn check_vertex_positions(vertex_count: usize, positions: &[Vec3]) -> Result<(), Error> {
+    if positions.len() < vertex_count {
+        return Err(Error::ChannelMismatch {
+            what: "vertex positions",
+            expected: vertex_count,
+            got: positions.len(),
+        });
+    }
+    match positions.iter().position(|p| !p.is_finite()) {
+        Some(i) => Err(Error::NonFinite {
+            what: "position",
+            index: i,
+        }),
+        None => Ok(()),
     }
 }

@@ -27,22 +27,3 @@ pub(crate) fn map_ordered<I: Sync, T: Send>(
     let _ = samples;
     items.iter().map(f).collect()
 }
-
-/// `f` on each item, in place: on all threads under the same conditions
-/// as [`map_ordered`]. Each call may change its own item only, so the
-/// result is the same at any thread count.
-pub(crate) fn for_each_mut<I: Send>(
-    items: &mut [I],
-    samples: usize,
-    f: impl Fn(&mut I) + Sync + Send,
-) {
-    #[cfg(feature = "rayon")]
-    if samples >= MIN_PARALLEL_SAMPLES && items.len() > 1 {
-        use rayon::prelude::*;
-        items.par_iter_mut().for_each(f);
-        return;
-    }
-    #[cfg(not(feature = "rayon"))]
-    let _ = samples;
-    items.iter_mut().for_each(f);
-}

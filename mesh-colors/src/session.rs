@@ -6,8 +6,9 @@
 //! passes — each one step of undo, and a log of edits that replays bit
 //! for bit.
 //!
-//! A [`PaintSession`] owns the colours and everything derived from them
-//! (the [`Painter`]'s spatial index, per-sample normals); a server or a
+//! A [`PaintSession`] owns the colours and an index of the mesh's faces
+//! that finds the samples under a brush (no resolution change touches
+//! it); a server or a
 //! script drives it with [`PaintSession::apply`] and reads back which
 //! samples changed ([`Changed`]) to update a GPU copy incrementally.
 //! Undo keeps deltas ([`crate::undo`]), never copies of the colours.
@@ -21,16 +22,12 @@
 
 use std::sync::Arc;
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
 use crate::Error;
 use crate::edit::ResolutionChange;
-use crate::paint::Painter;
-use crate::parallel::for_each_mut;
-use crate::structure::{
-    MeshColors, Site, lattice_points, move_segments, sample_position, samples_per_edge,
-    samples_per_face,
-};
+use crate::reach::{Hit, Reach};
+use crate::structure::{MeshColors, Site, lattice_points};
 use crate::undo::{History, Recorder, Step};
 
 /// Answers whether the surface hides a point from an eye.
@@ -221,9 +218,8 @@ pub struct PaintSession {
     colors: MeshColors,
     base: Vec<f32>,
     occluder: Option<Arc<dyn Occluder>>,
-    painter: Painter,
-    /// Per sample, its shading normal (see [`normal_at`]).
-    normals: Vec<Vec3>,
+    /// Finds the samples under a dab.
+    reach: Reach,
     /// Per vertex, the area-weighted sum of its faces' normals.
     vertex_normals: Vec<Vec3>,
     history: History,
@@ -269,22 +265,17 @@ impl PaintSession {
                 index: i,
             });
         }
-        let cell = grid_cell(&positions, colors.topology().faces());
-        let sites = colors.sites();
-        let painter = Painter::with_sites(&colors, &positions, &sites, cell)?;
-        let vertex_normals = vertex_normals(colors.topology().faces(), &positions);
-        let faces = colors.topology().faces();
-        let normals = sites
-            .iter()
-            .map(|s| normal_at(faces, &vertex_normals, s))
-            .collect();
+        let t = colors.topology();
+        crate::paint::check_vertex_positions(t.vertex_count(), &positions)?;
+        let faces = t.faces();
+        let reach = Reach::new(faces, &positions, grid_cell(&positions, faces));
+        let vertex_normals = vertex_normals(faces, &positions);
         Ok(Self {
             positions,
             colors,
             base,
             occluder,
-            painter,
-            normals,
+            reach,
             vertex_normals,
             history: History::new(history),
             log: Vec::new(),
@@ -489,31 +480,39 @@ impl PaintSession {
         changed: &mut Vec<u32>,
     ) -> Result<(), Error> {
         let mut hits = Vec::new();
-        self.painter
-            .for_each_within(dab.center, dab.radius, |i, d| hits.push((i, d)));
-        // The grid's cells come in hash order: sort so the recorder, and
-        // the list of changes, are the same on every run.
-        hits.sort_unstable_by_key(|&(i, _)| i);
-        for (i, d) in hits {
-            if !self.seen(brush.eye, i) {
+        self.reach.within(
+            &self.colors,
+            &self.positions,
+            dab.center,
+            dab.radius,
+            &mut hits,
+        );
+        for hit in hits {
+            if !self.seen(brush.eye, &hit) {
                 continue;
             }
-            let w = brush.weight(d, dab.radius, dab.pressure);
-            self.blend(brush, i, w, recorder, changed)?;
+            let w = brush.weight(hit.distance, dab.radius, dab.pressure);
+            self.blend(brush, hit.sample, w, recorder, changed)?;
         }
         Ok(())
     }
 
-    /// Whether sample `i` is painted from `eye`: facing it and unhidden.
-    fn seen(&self, eye: Option<Vec3>, i: usize) -> bool {
+    /// Whether a sample is painted from `eye`: facing it and unhidden.
+    fn seen(&self, eye: Option<Vec3>, hit: &Hit) -> bool {
         let Some(eye) = eye else {
             return true;
         };
-        let p = self.painter.sample_positions()[i];
-        if self.normals[i].dot(eye - p) <= 0.0 {
+        let normal = normal_at(
+            self.colors.topology().faces(),
+            &self.vertex_normals,
+            &hit.site,
+        );
+        if normal.dot(eye - hit.position) <= 0.0 {
             return false;
         }
-        self.occluder.as_ref().is_none_or(|o| !o.blocked(eye, p))
+        self.occluder
+            .as_ref()
+            .is_none_or(|o| !o.blocked(eye, hit.position))
     }
 
     /// Blends sample `i` with weight `w`, recording its old value first.
@@ -630,192 +629,33 @@ impl PaintSession {
         if changes.is_empty() {
             return Ok(Changed::Nothing);
         }
-        let before = Numbering::of(&self.colors);
         let change = self.colors.set_face_resolutions(changes)?;
         let faces = resampled(&change);
-        self.reindex(&before, &Resampled::of(&self.colors, &change));
+        // What the change left spare goes back, so the memory reported
+        // is what the colours need.
+        self.colors.shrink_to_fit();
         self.history.push(Step::Resolution(change));
         Ok(Changed::Layout(faces))
     }
 
     /// Undo (`back`) or redo one step.
     fn walk(&mut self, back: bool) -> Result<Changed, Error> {
-        let before = Numbering::of(&self.colors);
         let step = if back {
             self.history.undo(&mut self.colors)?
         } else {
             self.history.redo(&mut self.colors)?
         };
-        let (changed, change) = match step {
-            None => (Changed::Nothing, None),
-            Some(Step::Paint(d)) => (
-                Changed::Samples(d.runs().iter().flat_map(|&(s, n)| s..s + n).collect()),
-                None,
-            ),
-            Some(Step::Resolution(r)) => (
-                Changed::Layout(resampled(r)),
-                Some(Resampled::of(&self.colors, r)),
-            ),
-        };
-        if let Some(resampled) = change {
-            self.reindex(&before, &resampled);
-        }
-        Ok(changed)
-    }
-
-    /// Brings what depends on the sample numbering (the brush's grid, the
-    /// samples' positions and normals) to the numbering after `change`,
-    /// which left the colours numbered as `before` said. The samples of
-    /// the primitives `change` resampled get new positions and normals;
-    /// the others move to their new numbers (one pass, as the colours'
-    /// samples moved); the grid is indexed again (two passes, no
-    /// geometry). The result equals a session built on these colours
-    /// from scratch. Also gives back the spare capacity the change left,
-    /// so the memory reported is what the colours need.
-    fn reindex(&mut self, before: &Numbering, resampled: &Resampled) {
-        self.colors.shrink_to_fit();
-        let mc = &self.colors;
-        let Resampled { edge_new, face_new } = resampled;
-        let segments = before.segments(mc, edge_new, face_new);
-        let total = mc.sample_count();
-        let cell = self.painter.cell();
-        let painter = std::mem::replace(
-            &mut self.painter,
-            Painter::from_positions(Vec::new(), cell, mc.channels()),
-        );
-        let mut positions = painter.into_positions();
-        move_segments(&mut positions, 1, &segments, total);
-        move_segments(&mut self.normals, 1, &segments, total);
-        // Each resampled primitive's samples on their own (on all threads
-        // for a large change), written in place: no list of them to
-        // gather and copy after.
-        let (vertices, vertex_normals) = (&self.positions, &self.vertex_normals);
-        let faces = mc.topology().faces();
-        // Each resampled edge's and face's samples are one run of the new
-        // numbering, the runs in increasing order (edges before faces):
-        // each gets its own part of the positions and normals to write.
-        let mut runs: Vec<(Run, usize, usize)> = (0..edge_new.len())
-            .filter(|&e| edge_new[e])
-            .map(|e| {
-                let n = samples_per_edge(1 << mc.edge_level[e]) as usize;
-                (Run::Edge(e), mc.edge_offset[e], n)
-            })
-            .collect();
-        runs.extend((0..face_new.len()).filter(|&f| face_new[f]).map(|f| {
-            let n = samples_per_face(1 << mc.face_level[f]) as usize;
-            (Run::Face(f), mc.face_offset[f], n)
-        }));
-        let samples = runs.iter().map(|r| r.2).sum();
-        let mut jobs = Vec::with_capacity(runs.len());
-        let (mut rest_p, mut rest_n) = (&mut positions[..], &mut self.normals[..]);
-        let mut done = 0;
-        for (run, start, len) in runs {
-            let skip = start.saturating_sub(done);
-            let (Some((_, p)), Some((_, n))) = (
-                std::mem::take(&mut rest_p).split_at_mut_checked(skip),
-                std::mem::take(&mut rest_n).split_at_mut_checked(skip),
-            ) else {
-                break;
-            };
-            let (Some((mine_p, p)), Some((mine_n, n))) =
-                (p.split_at_mut_checked(len), n.split_at_mut_checked(len))
-            else {
-                break;
-            };
-            (rest_p, rest_n) = (p, n);
-            done = start + len;
-            jobs.push((run, start, mine_p, mine_n));
-        }
-        for_each_mut(&mut jobs, samples, |(run, start, p, n)| {
-            if let Run::Face(f) = *run
-                && place_face(mc, f, vertices, vertex_normals, p, n)
-            {
-                return;
+        Ok(match step {
+            None => Changed::Nothing,
+            Some(Step::Paint(d)) => {
+                Changed::Samples(d.runs().iter().flat_map(|&(s, n)| s..s + n).collect())
             }
-            let mut place = |i: usize, site: Site| {
-                let Some(k) = i.checked_sub(*start).filter(|&k| k < p.len()) else {
-                    return;
-                };
-                p[k] = site.position(mc.topology(), vertices).map_or_else(
-                    || vertices.get(i).copied().unwrap_or_default(),
-                    |x| x.as_vec3(),
-                );
-                n[k] = normal_at(faces, vertex_normals, &site);
-            };
-            match *run {
-                Run::Edge(e) => mc.edge_sites(e, &mut place),
-                Run::Face(f) => mc.face_sites(f, &mut place),
+            Some(Step::Resolution(r)) => {
+                let faces = resampled(r);
+                self.colors.shrink_to_fit();
+                Changed::Layout(faces)
             }
-        });
-        // No shrink_to_fit: the spare capacity a raise leaves serves the
-        // next one without another copy (these are not the colours'
-        // reported memory).
-        self.painter = Painter::from_positions(positions, cell, mc.channels());
-    }
-}
-
-/// A resampled primitive whose samples [`PaintSession::reindex`] places.
-#[derive(Clone, Copy)]
-enum Run {
-    Edge(usize),
-    Face(usize),
-}
-
-/// Which edges and faces a resolution change (or its undo) resampled.
-struct Resampled {
-    edge_new: Vec<bool>,
-    face_new: Vec<bool>,
-}
-
-impl Resampled {
-    fn of(colors: &MeshColors, change: &ResolutionChange) -> Self {
-        let mut edge_new = vec![false; colors.edge_level.len()];
-        for (e, _, _) in change.edges() {
-            edge_new[e] = true;
-        }
-        let mut face_new = vec![false; colors.face_level.len()];
-        for (f, _, _) in change.faces() {
-            face_new[f] = true;
-        }
-        Self { edge_new, face_new }
-    }
-}
-
-/// Where the edges' and faces' samples started before a resolution change
-/// (the vertices' never move): what [`PaintSession::reindex`] moves the
-/// per-sample data from.
-struct Numbering {
-    edge_offset: Vec<usize>,
-    face_offset: Vec<usize>,
-}
-
-impl Numbering {
-    fn of(colors: &MeshColors) -> Self {
-        Self {
-            edge_offset: colors.edge_offset.clone(),
-            face_offset: colors.face_offset.clone(),
-        }
-    }
-
-    /// The moves `(old first sample, new first sample, samples, kept)`
-    /// from this numbering to that of `colors`, in layout order, for
-    /// `move_segments`; resampled primitives (`edge_new`, `face_new`) are
-    /// not kept.
-    fn segments(
-        &self,
-        colors: &MeshColors,
-        edge_new: &[bool],
-        face_new: &[bool],
-    ) -> Vec<(usize, usize, usize, bool)> {
-        let edges = (0..edge_new.len()).map(|e| {
-            let n = samples_per_edge(1 << colors.edge_level[e]) as usize;
-            (self.edge_offset[e], colors.edge_offset[e], n, !edge_new[e])
-        });
-        let faces = (0..face_new.len()).map(|f| {
-            let n = samples_per_face(1 << colors.face_level[f]) as usize;
-            (self.face_offset[f], colors.face_offset[f], n, !face_new[f])
-        });
-        edges.chain(faces).collect()
+        })
     }
 }
 
@@ -870,51 +710,6 @@ fn normal_at(faces: &[[u32; 3]], vertex: &[Vec3], site: &Site) -> Vec3 {
         n += *b as f32 * vertex[v as usize];
     }
     n.normalize_or_zero()
-}
-
-/// Face `f`'s interior samples' positions and normals into `p` and `n`
-/// (in the order of its samples): what [`Site::position`] and
-/// [`normal_at`] give, the same sums in the same order, with the corners
-/// read once per face instead of per sample. False (nothing written)
-/// when a corner is missing.
-fn place_face(
-    mc: &MeshColors,
-    f: usize,
-    vertices: &[Vec3],
-    vertex_normals: &[Vec3],
-    p: &mut [Vec3],
-    n: &mut [Vec3],
-) -> bool {
-    let (Some(face), Some(r)) = (mc.topology().faces().get(f), mc.face_resolution(f)) else {
-        return false;
-    };
-    let corner = |k: usize| {
-        let v = face[k] as usize;
-        Some((vertices.get(v)?.as_dvec3(), *vertex_normals.get(v)?))
-    };
-    let (Some(c0), Some(c1), Some(c2)) = (corner(0), corner(1), corner(2)) else {
-        return false;
-    };
-    let corners = [c0, c1, c2];
-    let mut slots = p.iter_mut().zip(n.iter_mut());
-    for i in 1..r {
-        for j in 1..r - i {
-            let b = sample_position(r, i, j);
-            let mut q = DVec3::ZERO;
-            let mut m = Vec3::ZERO;
-            for (&b, &(cp, _)) in b.iter().zip(&corners) {
-                q += b * cp;
-            }
-            for (&b, &(_, cn)) in b.iter().zip(&corners) {
-                m += b as f32 * cn;
-            }
-            if let Some((ps, ns)) = slots.next() {
-                *ps = q.as_vec3();
-                *ns = m.normalize_or_zero();
-            }
-        }
-    }
-    true
 }
 
 /// The faces joined to `face` through shared edges, in increasing order.
@@ -997,40 +792,53 @@ mod tests {
         (positions, colors)
     }
 
-    /// What a session built from scratch on the colours indexes.
-    fn assert_index_as_new(s: &PaintSession, what: &str) {
-        let fresh = PaintSession::new(
-            s.positions.clone(),
-            s.colors.clone(),
-            s.base.clone(),
-            1,
-            None,
-        )
-        .unwrap();
-        let bits = |v: &[Vec3]| -> Vec<[u32; 3]> {
-            v.iter().map(|p| p.to_array().map(f32::to_bits)).collect()
-        };
-        assert_eq!(
-            bits(s.painter.sample_positions()),
-            bits(fresh.painter.sample_positions()),
-            "{what}: positions"
-        );
-        assert_eq!(bits(&s.normals), bits(&fresh.normals), "{what}: normals");
+    /// The samples a dab reaches through the faces are those an index of
+    /// the samples themselves, built from scratch on the colours as they
+    /// are now ([`Painter`]: every sample at its site), finds within the
+    /// radius: the same samples at the same distances, positions and
+    /// shading normals, bit for bit.
+    fn assert_reach_as_sample_index(s: &PaintSession, what: &str) {
+        let cell = grid_cell(&s.positions, s.colors.topology().faces());
+        let painter = crate::Painter::new(&s.colors, &s.positions, cell).unwrap();
+        let sites = s.colors.sites();
+        let faces = s.colors.topology().faces();
+        let mut found = Vec::new();
         for k in 0..20 {
             let centre = s.positions[(k * 37) % s.positions.len()];
             let radius = 0.02 + 0.05 * (k % 5) as f32;
-            let hits = |p: &Painter| {
-                let mut v = Vec::new();
-                p.for_each_within(centre, radius, |i, d| v.push((i, d.to_bits())));
-                v.sort_unstable();
-                v
-            };
-            assert_eq!(hits(&s.painter), hits(&fresh.painter), "{what}: dab {k}");
+            let mut expected = Vec::new();
+            painter.for_each_within(centre, radius, |i, d| {
+                let p = painter.sample_positions()[i];
+                let n = normal_at(faces, &s.vertex_normals, &sites[i]);
+                expected.push((
+                    i,
+                    d.to_bits(),
+                    p.to_array().map(f32::to_bits),
+                    n.to_array().map(f32::to_bits),
+                ));
+            });
+            expected.sort_unstable();
+            s.reach
+                .within(&s.colors, &s.positions, centre, radius, &mut found);
+            let got: Vec<_> = found
+                .iter()
+                .map(|h| {
+                    let n = normal_at(faces, &s.vertex_normals, &h.site);
+                    (
+                        h.sample,
+                        h.distance.to_bits(),
+                        h.position.to_array().map(f32::to_bits),
+                        n.to_array().map(f32::to_bits),
+                    )
+                })
+                .collect();
+            assert!(!expected.is_empty(), "{what}: dab {k} reaches nothing");
+            assert_eq!(got, expected, "{what}: dab {k}");
         }
     }
 
     #[test]
-    fn the_index_after_detail_undo_and_redo_equals_one_built_from_scratch() {
+    fn a_dab_reaches_the_samples_an_index_of_them_finds_after_detail_undo_and_redo() {
         let (positions, colors) = wavy(8);
         let mut s = PaintSession::new(positions, colors, vec![0.5; 3], 50, None).unwrap();
         // A fixed pseudo-random sequence (SplitMix64-like, seed 7).
@@ -1059,7 +867,7 @@ mod tests {
                 _ => Edit::Redo,
             };
             s.apply(edit.clone()).unwrap();
-            assert_index_as_new(&s, &format!("step {step}, {edit:?}"));
+            assert_reach_as_sample_index(&s, &format!("step {step}, {edit:?}"));
         }
     }
 }
