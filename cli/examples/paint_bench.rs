@@ -270,7 +270,11 @@ fn main() {
         c.status(seq).await;
 
         // 50 strokes of 20 dabs a quarter radius apart (each 5 radii, 5 %
-        // of the diagonal, long): undo memory against the colours'.
+        // of the diagonal, long): undo memory against the colours'. Their
+        // 150 messages come right after the 340 above: first let the
+        // server's rate limit (200 a second, bursts of 400) fill up again,
+        // as a page's pause between gestures would.
+        tokio::time::sleep(Duration::from_secs(2)).await;
         let mut status = Value::Null;
         for s in 0..50 {
             let seq = c.send("begin", json!({"brush": brush})).await;

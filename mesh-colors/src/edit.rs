@@ -18,8 +18,8 @@ use glam::Vec3;
 use crate::filter::{FINEST, Store, edge_point, eval, lattice};
 use crate::parallel::map_ordered;
 use crate::structure::{
-    MeshColors, lattice_points, level_of, move_segments, sample_position, samples_per_edge,
-    samples_per_face,
+    MeshColors, interior_index, lattice_points, level_of, move_segments, sample_position,
+    samples_per_edge, samples_per_face,
 };
 use crate::topology::NO_FACE;
 use crate::topology::Topology;
@@ -574,11 +574,15 @@ fn resample_step(staged: &Staged<'_>, step: &Step) -> (Vec<f32>, [Option<Vec<f32
     let value = &mut value[..c];
     let r = 1u32 << step.to;
     let mut fv = Vec::with_capacity(samples_per_face(r) as usize * c);
-    for i in 1..r {
-        for j in 1..r - i {
-            let b = sample_position(r, i, j).map(|x| x as f32);
-            eval(staged, step.face, b, FINEST, false, value);
-            fv.extend_from_slice(value);
+    if step.to > staged.mc.face_level[step.face] {
+        raise_face(staged, step, &mut fv, value);
+    } else {
+        for i in 1..r {
+            for j in 1..r - i {
+                let b = sample_position(r, i, j).map(|x| x as f32);
+                eval(staged, step.face, b, FINEST, false, value);
+                fv.extend_from_slice(value);
+            }
         }
     }
     let mut ev: [Option<Vec<f32>>; 3] = [None, None, None];
@@ -598,6 +602,64 @@ fn resample_step(staged: &Staged<'_>, step: &Step) -> (Vec<f32>, [Option<Vec<f32
     (fv, ev)
 }
 
+/// A raised face's new samples into `fv`: what `eval` at each new
+/// sample's barycentrics gives (the linear filter of the face's current
+/// colours), the same products summed in the same order, bit for bit.
+/// The new sample `(i, j)` of resolution `R = r·2^d` lies at `(i, j) / 2^d`
+/// on the current lattice of resolution `r`, exactly in `f32` (dyadic),
+/// so its lattice triangle and weights come from integers; a triangle of
+/// three interior samples (most of them) is read straight from the
+/// face's block, any other point through `lattice`.
+fn raise_face(staged: &Staged<'_>, step: &Step, fv: &mut Vec<f32>, value: &mut [f32]) {
+    let c = staged.mc.channels;
+    let f = step.face;
+    // The level `eval` reads the face at: the one the batch left it at.
+    let from = staged.mc.face_level[f];
+    let (r, d) = (1u32 << from, step.to - from);
+    let big = r << d;
+    let scale = 1.0 / (1u32 << d) as f32;
+    let old = staged.face_block(f, r);
+    for i in 1..big {
+        for j in 1..big - i {
+            // `triangle` of the point: x = c_0 · r, y = c_1 · r, exact.
+            let (x, y) = (i as f32 * scale, j as f32 * scale);
+            let i0 = (i >> d).min(r - 1);
+            let j0 = (j >> d).min(r - 1 - i0);
+            let (fx, fy) = (x - i0 as f32, y - j0 as f32);
+            let k0 = r - i0 - j0;
+            let (pts, ws) = if fx + fy <= 1.0 || k0 == 1 {
+                (
+                    [[i0, j0, k0], [i0 + 1, j0, k0 - 1], [i0, j0 + 1, k0 - 1]],
+                    [1.0 - fx - fy, fx, fy],
+                )
+            } else {
+                (
+                    [
+                        [i0 + 1, j0 + 1, k0 - 2],
+                        [i0 + 1, j0, k0 - 1],
+                        [i0, j0 + 1, k0 - 1],
+                    ],
+                    [fx + fy - 1.0, 1.0 - fy, 1.0 - fx],
+                )
+            };
+            value.fill(0.0);
+            if pts.iter().all(|p| p[0] >= 1 && p[1] >= 1 && p[2] >= 1) {
+                for (p, &w) in pts.iter().zip(&ws) {
+                    let at = interior_index(r, p[0], p[1]) * c;
+                    for (o, &x) in value.iter_mut().zip(&old[at..at + c]) {
+                        *o += w * x;
+                    }
+                }
+            } else {
+                for (p, &w) in pts.iter().zip(&ws) {
+                    lattice(staged, f, FINEST, from, *p, w, false, value);
+                }
+            }
+            fv.extend_from_slice(value);
+        }
+    }
+}
+
 /// The mesh colours as a batch sees them between two of its steps: levels
 /// already updated in `mc`, the new samples of resampled faces and edges
 /// in the overlays, every other sample where it was.
@@ -605,6 +667,20 @@ struct Staged<'a> {
     mc: &'a MeshColors,
     faces: &'a Overlay,
     edges: &'a Overlay,
+}
+
+impl Staged<'_> {
+    /// Face `f`'s interior samples at its current resolution `r`.
+    fn face_block(&self, f: usize, r: u32) -> &[f32] {
+        let len = samples_per_face(r) as usize * self.mc.channels;
+        match self.faces.get(f) {
+            Some(values) => &values[..len],
+            None => {
+                let at = self.mc.face_offset[f] * self.mc.channels;
+                &self.mc.samples[at..at + len]
+            }
+        }
+    }
 }
 
 impl Store for Staged<'_> {

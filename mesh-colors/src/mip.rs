@@ -514,6 +514,7 @@ impl MipMap {
             }
         };
         let faces_start = colors.face_offset.first().copied().unwrap_or(count);
+        let mut written = Vec::new();
         for &(start, len) in changed {
             for i in start as usize..start as usize + len as usize {
                 let value = &colors.samples[i * c..(i + 1) * c];
@@ -542,9 +543,10 @@ impl MipMap {
                         + (i - mc.face_offset[f])
                 };
                 self.data[at * c..(at + 1) * c].copy_from_slice(value);
+                written.push((at, at + 1));
             }
         }
-        Ok(self.recompute(colors, &adjacency, dirty, list))
+        Ok(self.recompute(colors, &adjacency, dirty, list, written))
     }
 
     /// Brings the pyramid up to date after the resolutions of `faces`
@@ -638,8 +640,11 @@ impl MipMap {
             cache.relayout(colors, &listed);
         }
         // The finest values of the primitives that did not move.
+        let mut written = Vec::new();
         for v in (0..t.vertex_count).filter(|&v| !keep_vertex[v]) {
-            let at = (self.vertex_offset[v] + colors.vertex_level[v] as usize) * c;
+            let at = self.vertex_offset[v] + colors.vertex_level[v] as usize;
+            written.push((at, at + 1));
+            let at = at * c;
             self.data[at..at + c].copy_from_slice(&colors.samples[v * c..(v + 1) * c]);
             for &f in adjacency.faces_of(v) {
                 mark(f as usize);
@@ -648,7 +653,9 @@ impl MipMap {
         for e in (0..t.edges.len()).filter(|&e| !keep_edge[e]) {
             let n = colors.edge_level[e];
             let (from, len) = (colors.edge_offset[e] * c, ((1usize << n) - 1) * c);
-            let at = (self.edge_offset[e] + edge_level_offset(n)) * c;
+            let at = self.edge_offset[e] + edge_level_offset(n);
+            written.push((at, at + len / c));
+            let at = at * c;
             self.data[at..at + len].copy_from_slice(&colors.samples[from..from + len]);
             for &f in &t.edge_faces[e] {
                 if f != NO_FACE {
@@ -662,7 +669,9 @@ impl MipMap {
                 colors.face_offset[f] * c,
                 samples_per_face(1 << n) as usize * c,
             );
-            let at = (self.face_offset[f] + FACE_LEVEL_OFFSET[n as usize]) * c;
+            let at = self.face_offset[f] + FACE_LEVEL_OFFSET[n as usize];
+            written.push((at, at + len / c));
+            let at = at * c;
             self.data[at..at + len].copy_from_slice(&colors.samples[from..from + len]);
             mark(f);
         }
@@ -674,19 +683,23 @@ impl MipMap {
         mine.vertex_level.clone_from(&colors.vertex_level);
         mine.edge_offset.clone_from(&colors.edge_offset);
         mine.face_offset.clone_from(&colors.face_offset);
-        Ok(self.recompute(colors, &adjacency, dirty, list))
+        Ok(self.recompute(colors, &adjacency, dirty, list, written))
     }
 
     /// Recomputes the levels below the finest of the faces `list` (marked
     /// in `dirty`) and one more ring of faces per level, then their
     /// caches; returns the value spans rewritten (see
-    /// [`MipMap::refresh`]). The finest values must be in place.
+    /// [`MipMap::refresh`]): `written`, the finest values the caller put
+    /// in place, and the levels recomputed. Only those: a face of the
+    /// outer rings has its coarse levels rewritten, not its finest (most
+    /// of its values), so a page is sent no more than changed.
     fn recompute(
         &mut self,
         colors: &MeshColors,
         adjacency: &Adjacency,
         mut dirty: Vec<bool>,
         mut list: Vec<usize>,
+        mut spans: Vec<(usize, usize)>,
     ) -> Vec<(usize, usize)> {
         let t = &colors.topology;
         let faces_of = |v: usize| adjacency.faces_of(v);
@@ -707,27 +720,48 @@ impl MipMap {
             }
         };
         let top = colors.vertex_level.iter().copied().max().unwrap_or(0);
+        // Per primitive, the finest level recomputed (NONE: none). The
+        // levels run from the top down, and a primitive once reached is
+        // recomputed at every level below, down to 0: its levels 0..=top
+        // are one span of its block.
+        const NONE: u8 = u8::MAX;
+        let mut face_top = vec![NONE; t.faces.len()];
+        let mut edge_top = vec![NONE; t.edges.len()];
+        let mut vertex_top = vec![NONE; t.vertex_count];
         for l in (0..top).rev() {
             grow(&mut dirty, &mut list);
             let subset = Subset::of(colors, &list, l);
             self.build_level(l, vertex_edges, Some(&subset));
-        }
-        // The spans rewritten: every primitive of the faces reached.
-        let mut spans: Vec<(usize, usize)> = Vec::new();
-        let mc = colors;
-        for &f in &list {
-            spans.push((
-                self.face_offset[f],
-                self.face_offset[f] + FACE_LEVEL_OFFSET[mc.face_level[f] as usize + 1],
-            ));
-            for k in 0..3 {
-                let v = t.faces[f][k] as usize;
-                let e = t.face_edges[f][k] as usize;
-                let o = self.vertex_offset[v];
-                spans.push((o, o + mc.vertex_level[v] as usize + 1));
-                let o = self.edge_offset[e];
-                spans.push((o, o + edge_level_offset(mc.edge_level[e] + 1)));
+            let firsts = [
+                (&subset.faces, &mut face_top),
+                (&subset.edges, &mut edge_top),
+                (&subset.vertices, &mut vertex_top),
+            ];
+            for (ids, tops) in firsts {
+                for &i in ids {
+                    if tops[i] == NONE {
+                        tops[i] = l;
+                    }
+                }
             }
+        }
+        let reached = |tops: &[u8]| {
+            (0..tops.len())
+                .filter(|&i| tops[i] != NONE)
+                .map(|i| (i, tops[i] + 1))
+                .collect::<Vec<_>>()
+        };
+        for (f, n) in reached(&face_top) {
+            let o = self.face_offset[f];
+            spans.push((o, o + FACE_LEVEL_OFFSET[n as usize]));
+        }
+        for (e, n) in reached(&edge_top) {
+            let o = self.edge_offset[e];
+            spans.push((o, o + edge_level_offset(n)));
+        }
+        for (v, n) in reached(&vertex_top) {
+            let o = self.vertex_offset[v];
+            spans.push((o, o + n as usize));
         }
         spans.sort_unstable();
         let mut merged: Vec<(usize, usize)> = Vec::with_capacity(spans.len());
@@ -847,31 +881,35 @@ impl MipMap {
     /// interior order.
     fn face_level_values(&self, f: usize, l: u8) -> (usize, Vec<f32>) {
         let c = self.colors.channels;
-        let q = l + 1;
         let r = 1u32 << l;
-        let (mut tmp, mut sum, mut val) = (
-            [0.0f32; MAX_CHANNELS],
-            [0.0f64; MAX_CHANNELS],
-            [0.0f32; MAX_CHANNELS],
-        );
-        let (tmp, sum, val) = (&mut tmp[..c], &mut sum[..c], &mut val[..c]);
+        let r2 = r << 1;
+        // Level l + 1's interior samples: the centre (2i, 2j) of a level-l
+        // sample (i, j ≥ 1, i + j < r) and its six neighbours all have
+        // three positive coordinates, so all are interior samples of the
+        // face, read straight from its block (as `lattice` would).
+        let fine = self.face_offset[f] + FACE_LEVEL_OFFSET[l as usize + 1];
+        let src = &self.data[fine * c..(fine + samples_per_face(r2) as usize) * c];
         let first = self.face_offset[f] + FACE_LEVEL_OFFSET[l as usize];
         let mut values = vec![0.0f32; samples_per_face(r) as usize * c];
+        let mut sum = [0.0f64; MAX_CHANNELS];
+        let sum = &mut sum[..c];
+        let mut out = values.chunks_exact_mut(c);
         for i in 1..r {
             for j in 1..r - i {
-                let k = r - i - j;
-                let centre = [2 * i, 2 * j, 2 * k];
+                let (ci, cj) = (2 * i, 2 * j);
                 sum.fill(0.0);
                 for d in HEX {
-                    let a = [0, 1, 2].map(|m| (centre[m] as i32 + d[m]) as u32);
-                    tmp.fill(0.0);
-                    lattice(self, f, q, q, a, 1.0, false, tmp);
-                    accumulate(sum, tmp);
+                    let a = interior_index(
+                        r2,
+                        ci.wrapping_add_signed(d[0]),
+                        cj.wrapping_add_signed(d[1]),
+                    ) * c;
+                    accumulate(sum, &src[a..a + c]);
                 }
-                let idx = interior_index(1 << q, centre[0], centre[1]);
-                combine(self.face_at(f, q, idx), sum, 6, val);
-                let at = interior_index(r, i, j) * c;
-                values[at..at + c].copy_from_slice(val);
+                let centre = interior_index(r2, ci, cj) * c;
+                if let Some(val) = out.next() {
+                    combine(&src[centre..centre + c], sum, 6, val);
+                }
             }
         }
         (first, values)
@@ -1130,3 +1168,68 @@ impl MeshColors {
 
 /// The query level that reads every primitive at its finest.
 pub const FINEST_LEVEL: u8 = FINEST;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Topology;
+
+    /// Eq. 5 at level `l` of face `f` through the general lattice lookup
+    /// (vertices, edges and the face's interior alike): the reference the
+    /// direct read of [`MipMap::face_level_values`] must equal bit for bit.
+    fn face_level_by_lattice(m: &MipMap, f: usize, l: u8) -> Vec<f32> {
+        let c = m.colors.channels;
+        let (q, r) = (l + 1, 1u32 << l);
+        let mut values = Vec::new();
+        for i in 1..r {
+            for j in 1..r - i {
+                let centre = [2 * i, 2 * j, 2 * (r - i - j)];
+                let mut sum = vec![0.0f64; c];
+                for d in HEX {
+                    let a = [0, 1, 2].map(|k| (centre[k] as i32 + d[k]) as u32);
+                    let mut x = vec![0.0f32; c];
+                    lattice(m, f, q, q, a, 1.0, false, &mut x);
+                    accumulate(&mut sum, &x);
+                }
+                let mut val = vec![0.0f32; c];
+                let idx = interior_index(1 << q, centre[0], centre[1]);
+                combine(m.face_at(f, q, idx), &sum, 6, &mut val);
+                values.extend(val);
+            }
+        }
+        values
+    }
+
+    #[test]
+    fn face_levels_read_directly_equal_eq5_through_the_lattice_lookup() {
+        let n = 6u32;
+        let at = |x: u32, y: u32| y * (n + 1) + x;
+        let mut faces = Vec::new();
+        for y in 0..n {
+            for x in 0..n {
+                faces.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
+                faces.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
+            }
+        }
+        let topology = Topology::new(((n + 1) * (n + 1)) as usize, &faces).unwrap();
+        let levels: Vec<u32> = (0..faces.len()).map(|f| 1 << (f * 7 % 6)).collect();
+        let mut colors = MeshColors::new(topology, &levels, 3).unwrap();
+        for (i, x) in colors.samples_mut().iter_mut().enumerate() {
+            *x = (i as f32 * 0.37).sin() * if i % 11 == 0 { -0.0 } else { 1.0 };
+        }
+        let m = MipMap::new(colors);
+        let c = m.colors.channels;
+        let mut checked = 0;
+        for f in 0..faces.len() {
+            for l in 2..m.colors.face_level[f] {
+                let first = m.face_offset[f] + FACE_LEVEL_OFFSET[l as usize];
+                let got = &m.data[first * c..][..samples_per_face(1 << l) as usize * c];
+                let want = face_level_by_lattice(&m, f, l);
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(got), bits(&want), "face {f}, level {l}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 20, "{checked} face levels checked");
+    }
+}

@@ -21,7 +21,7 @@ use serde_json::json;
 use super::protocol::{ExportKind, Request};
 use super::scatter::{ScatterState, Updated};
 use super::{Document, LIMITS, MAGIC, Options, PAGE, VERSION};
-use crate::web::frame::{HEADER, Header, put_f32, put_u32};
+use crate::web::frame::{HEADER, Header, LeWord, put_f32, put_slice, put_u32};
 use crate::web::{App, Idle, Inbox, Limits, Out, Outbox, ReplyTo};
 
 /// Widest texture row the page is sent (WebGL2 guarantees 2048).
@@ -34,6 +34,10 @@ const AUTOSAVE_PAUSE: Duration = Duration::from_secs(10);
 /// are folded into it (folding copies the whole texture, tens of ms for
 /// a large one: not between one gesture and the next).
 const FOLD_PAUSE: Duration = Duration::from_millis(500);
+/// Appended updates of this many times the textures' size are folded
+/// without waiting for the pause (the memory they hold is bounded; below
+/// it, detail brushing at a steady pace is never held up by a fold).
+const FOLD_WITHOUT_PAUSE: usize = 2;
 
 const SLOT_HELLO: usize = 0;
 const SLOT_MESH: usize = 1;
@@ -57,7 +61,8 @@ pub(crate) struct Worker {
     /// Texel updates appended to the textures' slot since it was last
     /// folded.
     appended: usize,
-    /// Their bytes (folded at once when they outgrow the textures).
+    /// Their bytes (folded at once when they outgrow the textures
+    /// [`FOLD_WITHOUT_PAUSE`] times).
     appended_bytes: usize,
     /// A stroke is being painted (its updates are folded after it ends:
     /// folding copies the whole texture).
@@ -107,6 +112,13 @@ impl Worker {
     }
 
     fn frame(kind: u8, a: u32, b: u32, payload: &[u8]) -> Out {
+        Self::frame_with(kind, a, b, payload.len(), |f| f.extend_from_slice(payload))
+    }
+
+    /// A frame whose payload `fill` appends (`len` bytes, as room to
+    /// reserve) behind the header: a payload of megabytes is written once,
+    /// not copied again behind a header.
+    fn frame_with(kind: u8, a: u32, b: u32, len: usize, fill: impl FnOnce(&mut Vec<u8>)) -> Out {
         let header = Header {
             magic: *MAGIC,
             version: VERSION,
@@ -116,7 +128,10 @@ impl Worker {
             a,
             b,
         };
-        Out::Binary(Bytes::from(header.frame(payload)))
+        let mut frame = Vec::with_capacity(HEADER + len);
+        frame.extend_from_slice(&header.bytes());
+        fill(&mut frame);
+        Out::Binary(Bytes::from(frame))
     }
 
     fn hello(&self) -> Out {
@@ -150,24 +165,23 @@ impl Worker {
 
     fn textures(&self) -> Vec<Out> {
         let w = self.gpu.width();
-        let mut faces = Vec::new();
-        put_u32(&mut faces, self.gpu.face_texels().iter().copied());
-        let mut samples = Vec::new();
-        put_f32(&mut samples, self.gpu.sample_texels().iter().copied());
+        let (faces, samples) = (self.gpu.face_texels(), self.gpu.sample_texels());
         vec![
-            Self::frame(2, w, self.gpu.face_height(), &faces),
-            Self::frame(3, w, self.gpu.sample_height(), &samples),
+            Self::frame_with(2, w, self.gpu.face_height(), 4 * faces.len(), |f| {
+                put_slice(f, faces);
+            }),
+            Self::frame_with(3, w, self.gpu.sample_height(), 4 * samples.len(), |f| {
+                put_slice(f, samples);
+            }),
         ]
     }
 
     /// The sample texels of `rects`, as absolute values.
     fn sample_rects(&self, rects: &[TexelRect]) -> Out {
-        let w = self.gpu.width() as usize;
-        let mut payload = Vec::new();
-        put_rects(&mut payload, w, rects, self.gpu.sample_texels(), |x| {
-            x.to_bits()
-        });
-        Self::frame(4, rects.len() as u32, w as u32, &payload)
+        let w = self.gpu.width();
+        Self::frame_with(4, rects.len() as u32, w, rect_bytes(rects), |f| {
+            put_rects(f, w as usize, rects, self.gpu.sample_texels());
+        })
     }
 
     /// Kind 7: the sample and face-table texels a resolution change
@@ -175,35 +189,12 @@ impl Worker {
     /// before it draws again).
     fn layout_rects(&self, changes: &Changes) -> Out {
         let w = self.gpu.width() as usize;
-        let bytes = |rs: &[TexelRect]| {
-            rs.iter()
-                .map(|r| 16 + 16 * r.width as usize * r.height as usize)
-                .sum::<usize>()
-        };
-        // The header's room first, so that the payload (megabytes after a
-        // large detail change) is not copied again behind it.
-        let mut frame =
-            Vec::with_capacity(HEADER + bytes(&changes.samples) + bytes(&changes.faces));
-        frame.resize(HEADER, 0);
-        put_rects(
-            &mut frame,
-            w,
-            &changes.samples,
-            self.gpu.sample_texels(),
-            |x| x.to_bits(),
-        );
-        put_rects(&mut frame, w, &changes.faces, self.gpu.face_texels(), |x| x);
-        let header = Header {
-            magic: *MAGIC,
-            version: VERSION,
-            kind: 7,
-            flags: 0,
-            tag: 0,
-            a: changes.samples.len() as u32,
-            b: changes.faces.len() as u32,
-        };
-        frame[..HEADER].copy_from_slice(&header.bytes());
-        Out::Binary(Bytes::from(frame))
+        let (samples, faces) = (&changes.samples, &changes.faces);
+        let len = rect_bytes(samples) + rect_bytes(faces);
+        Self::frame_with(7, samples.len() as u32, faces.len() as u32, len, |f| {
+            put_rects(f, w, samples, self.gpu.sample_texels());
+            put_rects(f, w, faces, self.gpu.face_texels());
+        })
     }
 
     /// Sends `frame` and appends it to the textures' slot.
@@ -604,12 +595,11 @@ fn has_extension(path: &Path, ext: &str) -> bool {
 
 /// Appends each of `rects` of `texels` (a texture `w` texels wide, 4
 /// words a texel): `x, y, w, h`, then its rows.
-fn put_rects<T: Copy>(
+fn put_rects<T: bytemuck::NoUninit + LeWord>(
     payload: &mut Vec<u8>,
     w: usize,
     rects: &[TexelRect],
     texels: &[T],
-    word: impl Fn(T) -> u32 + Copy,
 ) {
     for r in rects {
         put_u32(payload, [r.x, r.y, r.width, r.height]);
@@ -618,9 +608,17 @@ fn put_rects<T: Copy>(
             let row = texels
                 .get(start..start + r.width as usize * 4)
                 .unwrap_or(&[]);
-            put_u32(payload, row.iter().map(|&x| word(x)));
+            put_slice(payload, row);
         }
     }
+}
+
+/// The bytes [`put_rects`] writes for `rects`.
+fn rect_bytes(rects: &[TexelRect]) -> usize {
+    rects
+        .iter()
+        .map(|r| 16 + 16 * r.width as usize * r.height as usize)
+        .sum()
 }
 
 /// Sorted, distinct sample indices as runs `(first, count)`.
@@ -692,7 +690,7 @@ impl App for Worker {
         let mut fold_in = None;
         if self.appended > 0 && !self.stroke_open {
             let whole = 4 * (self.gpu.sample_texels().len() + self.gpu.face_texels().len());
-            if waited >= FOLD_PAUSE || self.appended_bytes >= whole {
+            if waited >= FOLD_PAUSE || self.appended_bytes >= FOLD_WITHOUT_PAUSE * whole {
                 out.keep(SLOT_TEXTURES, self.textures());
                 (self.appended, self.appended_bytes) = (0, 0);
             } else {

@@ -79,6 +79,35 @@ pub fn put_u32(out: &mut Vec<u8>, values: impl IntoIterator<Item = u32>) {
     put_words(out, values.into_iter());
 }
 
+/// Appends a slice of `f32` or `u32` (a texture's texels, tens of
+/// megabytes) little-endian: one copy on a little-endian machine, word by
+/// word on another.
+pub fn put_slice<T: bytemuck::NoUninit + LeWord>(out: &mut Vec<u8>, words: &[T]) {
+    if cfg!(target_endian = "little") {
+        out.extend_from_slice(bytemuck::cast_slice(words));
+    } else {
+        put_words(out, words.iter().map(|w| w.word()));
+    }
+}
+
+/// A 4-byte word of a frame.
+pub trait LeWord: Copy {
+    /// Its bits as a `u32`.
+    fn word(self) -> u32;
+}
+
+impl LeWord for f32 {
+    fn word(self) -> u32 {
+        self.to_bits()
+    }
+}
+
+impl LeWord for u32 {
+    fn word(self) -> u32 {
+        self
+    }
+}
+
 /// Appends `words` little-endian, reserving their size once: a paint
 /// page's sample texture is tens of megabytes, which growing by doubling
 /// would copy again and again.
@@ -101,6 +130,21 @@ fn put_words(out: &mut Vec<u8>, mut words: impl Iterator<Item = u32>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_slice_is_written_as_its_words_one_by_one() {
+        let floats = [1.5f32, -0.0, f32::MAX, f32::from_bits(0x7fc0_0001), 3.0e-39];
+        let (mut fast, mut slow) = (vec![7u8], vec![7u8]);
+        put_slice(&mut fast, &floats);
+        put_f32(&mut slow, floats);
+        assert_eq!(fast, slow);
+        let words = [0u32, 1, 0xdead_beef, u32::MAX];
+        let (mut fast, mut slow) = (Vec::new(), Vec::new());
+        put_slice(&mut fast, &words);
+        put_u32(&mut slow, words);
+        assert_eq!(fast, slow);
+        assert_eq!(&fast[8..12], &[0xef, 0xbe, 0xad, 0xde]);
+    }
 
     #[test]
     fn a_header_reads_back_and_short_input_is_none() {
