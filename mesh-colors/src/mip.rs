@@ -923,35 +923,39 @@ impl MipMap {
         let q = l + 1;
         let r = 1u32 << l;
         let r2 = 1u32 << q;
-        let (mut tmp, mut sum, mut val) = (
-            [0.0f32; MAX_CHANNELS],
-            [0.0f64; MAX_CHANNELS],
-            [0.0f32; MAX_CHANNELS],
-        );
-        let (tmp, sum, val) = (&mut tmp[..c], &mut sum[..c], &mut val[..c]);
+        // Its level l + 1: node p (1 ≤ p < r2) at (p − 1)·c.
+        let at = self.edge_offset[e] + edge_level_offset(q);
+        let edge = &self.data[at * c..(at + r2 as usize - 1) * c];
+        // Each face beside it: its level-(l + 1) interior samples, and
+        // where the edge lies in it. The two neighbours a node takes from
+        // a face lie one step inside it, so they are interior samples,
+        // read straight from the block (as `lattice` would).
+        let sides: Vec<(&[f32], [usize; 3], bool)> = (mc.topology.edge_faces[e].iter())
+            .filter(|&&f| f != NO_FACE)
+            .filter_map(|&f| {
+                let f = f as usize;
+                let k = (0..3).find(|&k| mc.topology.face_edges[f][k] as usize == e)?;
+                let face = mc.topology.faces[f];
+                let at = self.face_offset[f] + FACE_LEVEL_OFFSET[q as usize];
+                let block = &self.data[at * c..(at + samples_per_face(r2) as usize) * c];
+                Some((
+                    block,
+                    [k, (k + 1) % 3, (k + 2) % 3],
+                    face[k] < face[(k + 1) % 3],
+                ))
+            })
+            .collect();
+        let (mut sum, mut val) = ([0.0f64; MAX_CHANNELS], [0.0f32; MAX_CHANNELS]);
+        let (sum, val) = (&mut sum[..c], &mut val[..c]);
+        let node = |p: u32| &edge[(p as usize - 1) * c..p as usize * c];
         let mut values = Vec::with_capacity((r as usize - 1) * c);
         for s in 1..r {
             sum.fill(0.0);
-            let mut n = 0;
-            for p in [2 * s - 1, 2 * s + 1] {
-                accumulate(sum, self.edge_at(e, q, p));
-                n += 1;
-            }
-            for &f in &mc.topology.edge_faces[e] {
-                if f == NO_FACE {
-                    continue;
-                }
-                let f = f as usize;
-                let face = mc.topology.faces[f];
-                let Some(k) = (0..3).find(|&k| mc.topology.face_edges[f][k] as usize == e) else {
-                    continue;
-                };
-                let (k1, m) = ((k + 1) % 3, (k + 2) % 3);
-                let t = if face[k] < face[k1] {
-                    2 * s
-                } else {
-                    r2 - 2 * s
-                };
+            accumulate(sum, node(2 * s - 1));
+            accumulate(sum, node(2 * s + 1));
+            let mut n = 2;
+            for &(block, [k, k1, m], forward) in &sides {
+                let t = if forward { 2 * s } else { r2 - 2 * s };
                 let mut a = [0u32; 3];
                 a[k] = r2 - t;
                 a[k1] = t;
@@ -960,13 +964,12 @@ impl MipMap {
                     b[k] -= dk;
                     b[k1] -= dk1;
                     b[m] += 1;
-                    tmp.fill(0.0);
-                    lattice(self, f, q, q, b, 1.0, false, tmp);
-                    accumulate(sum, tmp);
+                    let i = interior_index(r2, b[0], b[1]) * c;
+                    accumulate(sum, &block[i..i + c]);
                     n += 1;
                 }
             }
-            combine(self.edge_at(e, q, 2 * s), sum, n, val);
+            combine(node(2 * s), sum, n, val);
             values.extend_from_slice(val);
         }
         (self.edge_offset[e] + edge_level_offset(l), values)
@@ -1200,8 +1203,55 @@ mod tests {
         values
     }
 
+    /// The edge rule at level `l` of edge `e` with every off-edge
+    /// neighbour read through the general lattice lookup: the reference
+    /// for [`MipMap::edge_level_values`].
+    fn edge_level_by_lattice(m: &MipMap, e: usize, l: u8) -> Vec<f32> {
+        let mc = &m.colors;
+        let c = mc.channels;
+        let (q, r) = (l + 1, 1u32 << l);
+        let r2 = 1u32 << q;
+        let mut values = Vec::new();
+        for s in 1..r {
+            let mut sum = vec![0.0f64; c];
+            accumulate(&mut sum, m.edge_at(e, q, 2 * s - 1));
+            accumulate(&mut sum, m.edge_at(e, q, 2 * s + 1));
+            let mut n = 2;
+            for &f in &mc.topology.edge_faces[e] {
+                if f == NO_FACE {
+                    continue;
+                }
+                let f = f as usize;
+                let face = mc.topology.faces[f];
+                let k = (0..3)
+                    .find(|&k| mc.topology.face_edges[f][k] as usize == e)
+                    .unwrap();
+                let (k1, k2) = ((k + 1) % 3, (k + 2) % 3);
+                let t = if face[k] < face[k1] {
+                    2 * s
+                } else {
+                    r2 - 2 * s
+                };
+                for (dk, dk1) in [(1, 0), (0, 1)] {
+                    let mut b = [0u32; 3];
+                    b[k] = r2 - t - dk;
+                    b[k1] = t - dk1;
+                    b[k2] = 1;
+                    let mut x = vec![0.0f32; c];
+                    lattice(m, f, q, q, b, 1.0, false, &mut x);
+                    accumulate(&mut sum, &x);
+                    n += 1;
+                }
+            }
+            let mut val = vec![0.0f32; c];
+            combine(m.edge_at(e, q, 2 * s), &sum, n, &mut val);
+            values.extend(val);
+        }
+        values
+    }
+
     #[test]
-    fn face_levels_read_directly_equal_eq5_through_the_lattice_lookup() {
+    fn levels_read_directly_equal_the_rules_through_the_lattice_lookup() {
         let n = 6u32;
         let at = |x: u32, y: u32| y * (n + 1) + x;
         let mut faces = Vec::new();
@@ -1231,5 +1281,17 @@ mod tests {
             }
         }
         assert!(checked > 20, "{checked} face levels checked");
+        let mut checked = 0;
+        for e in 0..m.colors.edge_level.len() {
+            for l in 1..m.colors.edge_level[e] {
+                let first = m.edge_offset[e] + edge_level_offset(l);
+                let got = &m.data[first * c..][..((1usize << l) - 1) * c];
+                let want = edge_level_by_lattice(&m, e, l);
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(got), bits(&want), "edge {e}, level {l}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 20, "{checked} edge levels checked");
     }
 }
