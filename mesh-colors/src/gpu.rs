@@ -336,13 +336,29 @@ impl GpuLayout {
     /// [`Error::TooLarge`] when the samples or the face table need more
     /// than `max_width` rows, or an index would not fit the table's `u32`.
     pub fn new(mip: &MipMap, max_width: u32) -> Result<Self, Error> {
+        Self::packed(mip, max_width, false)
+    }
+
+    /// As [`GpuLayout::new`], with half the sample rows again spare (up to
+    /// `max_width` rows, as a repack leaves them): room for the faces that
+    /// [`GpuLayout::refresh_resolutions`] raises, so that the first raise
+    /// after loading does not pack everything again. The spare rows are
+    /// zeros after the first [`GpuLayout::used_sample_rows`].
+    ///
+    /// # Errors
+    /// As for [`GpuLayout::new`].
+    pub fn with_spare_rows(mip: &MipMap, max_width: u32) -> Result<Self, Error> {
+        Self::packed(mip, max_width, true)
+    }
+
+    fn packed(mip: &MipMap, max_width: u32, spare: bool) -> Result<Self, Error> {
         if max_width == 0 {
             return Err(Error::InvalidArgument {
                 argument: "max_width",
                 reason: "must be at least 1 texel",
             });
         }
-        let (parts, blocks) = pack(mip, max_width, false)?;
+        let (parts, blocks) = pack(mip, max_width, spare)?;
         Ok(Self {
             max_width,
             parts,
@@ -397,6 +413,20 @@ impl GpuLayout {
     /// Rows of the sample texture.
     pub fn sample_height(&self) -> u32 {
         (self.parts.samples.len() / (4 * self.parts.width as usize)) as u32
+    }
+
+    /// Rows of the sample texture that hold values: every row after them
+    /// is zeros (spare room), so a page can be sent these and allocate
+    /// [`GpuLayout::sample_height`].
+    pub fn used_sample_rows(&self) -> u32 {
+        let w = self.parts.width as usize;
+        match &self.blocks {
+            Some(b) => {
+                let p = self.parts.channels.div_ceil(4);
+                ((b.end * p).div_ceil(w).max(1) as u32).min(self.sample_height())
+            }
+            None => self.sample_height(),
+        }
     }
 
     /// Rows of the face table.

@@ -89,7 +89,9 @@ impl Worker {
     ) -> Result<Self, String> {
         let session = super::open_session(&doc, log.unwrap_or(&[]), options.history)?;
         let mip = MipMap::new(session.colors().clone());
-        let gpu = GpuLayout::new(&mip, TEXTURE_WIDTH).map_err(|e| e.to_string())?;
+        // Spare rows for the detail brush: its first raise then writes
+        // into them instead of packing (and sending) everything again.
+        let gpu = GpuLayout::with_spare_rows(&mip, TEXTURE_WIDTH).map_err(|e| e.to_string())?;
         // Replayed edits are not saved anywhere yet: the autosave keeps them.
         let unsaved = log.map_or(0, <[Edit]>::len);
         Ok(Self {
@@ -166,12 +168,15 @@ impl Worker {
     fn textures(&self) -> Vec<Out> {
         let w = self.gpu.width();
         let (faces, samples) = (self.gpu.face_texels(), self.gpu.sample_texels());
+        let used = &samples[..(self.gpu.used_sample_rows() * w * 4) as usize];
         vec![
             Self::frame_with(2, w, self.gpu.face_height(), 4 * faces.len(), |f| {
                 put_slice(f, faces);
             }),
-            Self::frame_with(3, w, self.gpu.sample_height(), 4 * samples.len(), |f| {
-                put_slice(f, samples);
+            // The rows in use; the page allocates all `sample_height`
+            // (the rest are zeros, spare room for resolution changes).
+            Self::frame_with(3, w, self.gpu.sample_height(), 4 * used.len(), |f| {
+                put_slice(f, used);
             }),
         ]
     }

@@ -589,3 +589,42 @@ fn resolution_changes_send_only_the_runs_that_changed() {
     assert!(!changes.resized);
     assert!(mismatches(&wrong, &mc, 77).0 > 0);
 }
+
+#[test]
+fn spare_rows_hold_the_first_raise_and_stay_zeros_past_the_used_rows() {
+    let mut mc = wide(21);
+    let mut mip = mc.mip_map();
+    let mut plain = GpuLayout::new(&mip, 256).unwrap();
+    let mut spare = GpuLayout::with_spare_rows(&mip, 256).unwrap();
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    // The same packing, with zero rows after it.
+    assert!(spare.sample_height() > plain.sample_height());
+    assert_eq!(spare.used_sample_rows(), plain.sample_height());
+    assert_eq!(plain.used_sample_rows(), plain.sample_height());
+    let n = plain.sample_texels().len();
+    assert_eq!(
+        bits(&spare.sample_texels()[..n]),
+        bits(plain.sample_texels())
+    );
+    assert!(spare.sample_texels()[n..].iter().all(|&x| x.to_bits() == 0));
+    assert_eq!(mismatches(&spare, &mc, 1).0, 0);
+    // The first raise: the plain layout packs everything again, the one
+    // with spare rows writes the raised faces into them.
+    let requests: Vec<(usize, u32)> = (0..8)
+        .map(|f| (f, 2 * mc.face_resolution(f).unwrap()))
+        .collect();
+    let change = mc.set_face_resolutions(&requests).unwrap();
+    let faces: Vec<usize> = change.faces().map(|f| f.0).collect();
+    let spans = mip.refresh_resolutions(&mc, &faces).unwrap();
+    assert!(plain.refresh_resolutions(&mip, &spans).unwrap().resized);
+    let changes = spare.refresh_resolutions(&mip, &spans).unwrap();
+    assert!(!changes.resized);
+    assert_eq!(mismatches(&spare, &mc, 2).0, 0);
+    let used = spare.used_sample_rows() as usize * 4 * spare.width() as usize;
+    assert!(used > n && used < spare.sample_texels().len());
+    assert!(
+        spare.sample_texels()[used..]
+            .iter()
+            .all(|&x| x.to_bits() == 0)
+    );
+}

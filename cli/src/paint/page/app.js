@@ -81,7 +81,8 @@ function onFrame(f) {
   } else if (f.kind === 2) {
     state.pendingFaces = new Uint32Array(f.payload);
   } else if (f.kind === 3) {
-    state.layout = { width: f.a, channels: state.hello.channels.length + 2, samples: new Float32Array(f.payload), faces: state.pendingFaces };
+    // The rows in use; the texture has f.b rows (the rest spare zeros).
+    state.layout = { width: f.a, rows: f.b, channels: state.hello.channels.length + 2, samples: new Float32Array(f.payload), faces: state.pendingFaces };
     renderer.setLayout(state.layout);
   } else if (f.kind === 4) {
     renderer.updateRects({ resized: false, samples: readRects(f, f.a, 0, Float32Array).rects, faces: [] }, null);

@@ -510,27 +510,37 @@ export class MeshColorsRenderer {
 
   /**
    * A GpuLayout's parts: {width, channels, samples: Float32Array,
-   * faces: Uint32Array} (GpuParts; both arrays RGBA per texel, row-major,
-   * whole rows of `width` texels). Allocates both textures (texImage2D):
-   * at the start and whenever GpuLayout::update reports `resized`.
+   * faces: Uint32Array, rows} (GpuParts; both arrays RGBA per texel,
+   * row-major, whole rows of `width` texels; `rows`, if given, the sample
+   * texture's height when `samples` holds only its first rows, the rest
+   * zeros). Allocates both textures (texImage2D): at the start and
+   * whenever GpuLayout::update reports `resized`.
    */
   setLayout(parts) {
     const gl = this.gl;
     const w = parts.width;
     this.layout = { width: w, channels: parts.channels, perValue: Math.ceil(parts.channels / 4) };
-    const upload = (tex, f, data) => {
+    const upload = (tex, f, data, rows) => {
       gl.activeTexture(gl.TEXTURE0 + f.unit);
       gl.bindTexture(gl.TEXTURE_2D, tex);
       gl.pixelStorei(gl.UNPACK_ROW_LENGTH, 0);
       gl.pixelStorei(gl.UNPACK_ALIGNMENT, 4);
-      gl.texImage2D(gl.TEXTURE_2D, 0, f.internal, w, data.length / (4 * w), 0, f.format, f.type, data);
+      const given = data.length / (4 * w);
+      if (rows > given) {
+        // Zeros first (WebGL fills a texture made from null with them),
+        // then the rows that hold values.
+        gl.texImage2D(gl.TEXTURE_2D, 0, f.internal, w, rows, 0, f.format, f.type, null);
+        gl.texSubImage2D(gl.TEXTURE_2D, 0, 0, 0, w, given, f.format, f.type, data);
+      } else {
+        gl.texImage2D(gl.TEXTURE_2D, 0, f.internal, w, given, 0, f.format, f.type, data);
+      }
       // texelFetch reads exact texels; NEAREST keeps the texture complete
       // (float and integer textures are not filterable).
       gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
       gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
     };
-    upload(this.textures.samples, SAMPLES(gl), parts.samples);
-    upload(this.textures.faces, FACES(gl), parts.faces);
+    upload(this.textures.samples, SAMPLES(gl), parts.samples, parts.rows || 0);
+    upload(this.textures.faces, FACES(gl), parts.faces, 0);
   }
 
   /**
