@@ -76,6 +76,8 @@ mod parallel;
 mod reach;
 pub mod session;
 mod structure;
+#[cfg(test)]
+mod test_mesh;
 mod texture;
 mod topology;
 pub mod undo;

@@ -1252,16 +1252,8 @@ mod tests {
 
     #[test]
     fn levels_read_directly_equal_the_rules_through_the_lattice_lookup() {
-        let n = 6u32;
-        let at = |x: u32, y: u32| y * (n + 1) + x;
-        let mut faces = Vec::new();
-        for y in 0..n {
-            for x in 0..n {
-                faces.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
-                faces.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
-            }
-        }
-        let topology = Topology::new(((n + 1) * (n + 1)) as usize, &faces).unwrap();
+        let (positions, faces) = crate::test_mesh::wavy_grid(6);
+        let topology = Topology::new(positions.len(), &faces).unwrap();
         let levels: Vec<u32> = (0..faces.len()).map(|f| 1 << (f * 7 % 6)).collect();
         let mut colors = MeshColors::new(topology, &levels, 3).unwrap();
         for (i, x) in colors.samples_mut().iter_mut().enumerate() {

@@ -768,21 +768,7 @@ mod tests {
 
     /// A wavy `n × n` grid of quads, two triangles each, at mixed levels.
     fn wavy(n: u32) -> (Vec<Vec3>, MeshColors) {
-        let mut positions = Vec::new();
-        for y in 0..=n {
-            for x in 0..=n {
-                let (u, v) = (x as f32 / n as f32, y as f32 / n as f32);
-                positions.push(Vec3::new(u, v, 0.1 * (7.0 * u).sin() * (5.0 * v).cos()));
-            }
-        }
-        let at = |x: u32, y: u32| y * (n + 1) + x;
-        let mut faces = Vec::new();
-        for y in 0..n {
-            for x in 0..n {
-                faces.push([at(x, y), at(x + 1, y), at(x + 1, y + 1)]);
-                faces.push([at(x, y), at(x + 1, y + 1), at(x, y + 1)]);
-            }
-        }
+        let (positions, faces) = crate::test_mesh::wavy_grid(n);
         let topology = Topology::new(positions.len(), &faces).unwrap();
         let levels: Vec<u32> = (0..faces.len()).map(|f| 1 << (f * 7 % 4)).collect();
         let mut colors = MeshColors::new(topology, &levels, 3).unwrap();
