@@ -322,6 +322,20 @@ impl Blocks {
     }
 }
 
+/// The sample texels a [`GpuLayout`] needs for colours on `topology` with
+/// every face at `resolution` (a power of two; beyond `2^MAX_LEVEL` it
+/// counts as that) and `channels` channels: every MIP level of every
+/// vertex, edge and face, `⌈channels / 4⌉` texels a value. Lets a caller
+/// refuse a resolution before building colours that would not fit its
+/// textures (the rows a layout has are these divided by its width).
+pub fn uniform_sample_texels(topology: &crate::Topology, resolution: u32, channels: usize) -> u64 {
+    let n = resolution.max(1).ilog2().min(u32::from(MAX_LEVEL)) as usize;
+    let values = topology.vertex_count() as u64 * (n as u64 + 1)
+        + topology.edges().len() as u64 * edge_level_offset(n as u8 + 1) as u64
+        + topology.faces().len() as u64 * FACE_LEVEL_OFFSET[n + 1] as u64;
+    values.saturating_mul(channels.div_ceil(4) as u64)
+}
+
 /// Changed spans closer than this many texels are uploaded as one.
 const MERGE_GAP: usize = 64;
 

@@ -225,6 +225,20 @@ pub struct PaintSession {
     history: History,
     log: Vec<Edit>,
     open: Option<OpenStroke>,
+    /// How to take back the last edit, when it changed resolutions
+    /// ([`PaintSession::withdraw`]).
+    withdraw: Option<Withdraw>,
+}
+
+/// What the last edit did to the history when it changed resolutions.
+#[derive(Debug, Clone, Copy)]
+enum Withdraw {
+    /// Pushed a new step (a detail change or a global resolution).
+    Pushed,
+    /// Undid a step.
+    Undid,
+    /// Redid a step.
+    Redid,
 }
 
 /// A stroke being painted dab by dab ([`PaintSession::begin_stroke`]).
@@ -280,6 +294,7 @@ impl PaintSession {
             history: History::new(history),
             log: Vec::new(),
             open: None,
+            withdraw: None,
         })
     }
 
@@ -391,6 +406,7 @@ impl PaintSession {
     /// exist, and the errors of the resolution change.
     pub fn apply(&mut self, edit: Edit) -> Result<Changed, Error> {
         self.end_stroke();
+        self.withdraw = None;
         let changed = match &edit {
             Edit::Stroke { brush, dabs } => self.stroke(brush, dabs)?,
             Edit::Fill { face, brush } => self.fill(*face, brush)?,
@@ -403,8 +419,54 @@ impl PaintSession {
             Edit::Undo => self.walk(true)?,
             Edit::Redo => self.walk(false)?,
         };
+        if let Changed::Layout(_) = changed {
+            self.withdraw = Some(match edit {
+                Edit::Undo => Withdraw::Undid,
+                Edit::Redo => Withdraw::Redid,
+                _ => Withdraw::Pushed,
+            });
+        }
         self.log.push(edit);
         Ok(changed)
+    }
+
+    /// Takes back the last edit [`Self::apply`] applied, when it changed
+    /// resolutions (a detail change, a global resolution, or an undo or
+    /// redo of one), as if it had not been made: for a caller that cannot
+    /// show the result (a GPU texture it does not fit). The colours and the
+    /// history are as before it and the edit leaves the log; a new change
+    /// had also dropped the steps undone before it, as any new edit does,
+    /// and they stay dropped. Returns the faces resampled back.
+    ///
+    /// # Errors
+    /// [`Error::InvalidArgument`] naming `edit` when the last edit changed
+    /// no resolution or was already taken back, or `history` when the
+    /// history keeps no steps (a limit of 0); nothing changes then.
+    pub fn withdraw(&mut self) -> Result<Changed, Error> {
+        let Some(how) = self.withdraw else {
+            return Err(Error::InvalidArgument {
+                argument: "edit",
+                reason: "the last edit changed no resolution (or was taken back)",
+            });
+        };
+        let step = match how {
+            Withdraw::Pushed | Withdraw::Redid => self.history.undo(&mut self.colors)?,
+            Withdraw::Undid => self.history.redo(&mut self.colors)?,
+        };
+        let Some(Step::Resolution(change)) = step else {
+            return Err(Error::InvalidArgument {
+                argument: "history",
+                reason: "keeps no steps, so the change cannot be taken back",
+            });
+        };
+        let faces = resampled(change);
+        if let Withdraw::Pushed = how {
+            self.history.drop_undone();
+        }
+        self.colors.shrink_to_fit();
+        self.log.pop();
+        self.withdraw = None;
+        Ok(Changed::Layout(faces))
     }
 
     /// Replays `log` on a new session (the arguments of [`Self::new`]):
@@ -821,6 +883,71 @@ mod tests {
             assert!(!expected.is_empty(), "{what}: dab {k} reaches nothing");
             assert_eq!(got, expected, "{what}: dab {k}");
         }
+    }
+
+    #[test]
+    fn a_withdrawn_resolution_change_leaves_colours_history_and_log_as_before() {
+        let (positions, colors) = wavy(6);
+        let centre = positions[20];
+        let mut s = PaintSession::new(positions, colors, vec![0.5; 3], 50, None).unwrap();
+        let detail = |levels| Edit::Detail {
+            center: centre,
+            radius: 0.3,
+            levels,
+        };
+        // Nothing to take back yet, nor after a paint edit.
+        assert!(s.withdraw().is_err());
+        let brush = Brush {
+            mode: BrushMode::Mix,
+            color: vec![1.0, 0.0, 0.0],
+            first_channel: 0,
+            strength: 1.0,
+            hardness: 0.5,
+            mirror_x: None,
+            eye: None,
+        };
+        s.apply(Edit::Fill { face: 3, brush }).unwrap();
+        assert!(s.withdraw().is_err());
+        let before = (s.colors.clone(), s.log.len(), s.history.undo_len());
+        // A new change: back to before it, with nothing to redo.
+        let changed = s.apply(detail(1)).unwrap();
+        assert!(matches!(changed, Changed::Layout(_)));
+        assert_ne!(s.colors, before.0);
+        assert_eq!(s.withdraw().unwrap(), changed);
+        assert_eq!(
+            (s.colors.clone(), s.log.len(), s.history.undo_len()),
+            before
+        );
+        assert_eq!(s.history.redo_len(), 0);
+        assert!(s.withdraw().is_err(), "taken back once only");
+        // The undo of a lowering (a raise): back to lowered, redo kept.
+        s.apply(detail(-1)).unwrap();
+        let lowered = (s.colors.clone(), s.log.len());
+        s.apply(Edit::Undo).unwrap();
+        s.withdraw().unwrap();
+        assert_eq!((s.colors.clone(), s.log.len()), lowered);
+        assert_eq!((s.history.undo_len(), s.history.redo_len()), (2, 0));
+        // A redo of a raise: back to undone, the redo still there.
+        s.apply(detail(1)).unwrap();
+        s.apply(Edit::Undo).unwrap();
+        let undone = (s.colors.clone(), s.log.len(), s.history.redo_len());
+        s.apply(Edit::Redo).unwrap();
+        s.withdraw().unwrap();
+        assert_eq!(
+            (s.colors.clone(), s.log.len(), s.history.redo_len()),
+            undone
+        );
+        // The log replays to the same colours.
+        let again = PaintSession::replay(
+            s.positions.clone(),
+            wavy(6).1,
+            vec![0.5; 3],
+            50,
+            None,
+            &s.log,
+        )
+        .unwrap();
+        assert_eq!(again.colors, s.colors);
     }
 
     #[test]

@@ -433,6 +433,12 @@ impl History {
         Ok(Some(&self.steps[k]))
     }
 
+    /// Forgets the undone steps (what a new step does before it is
+    /// pushed).
+    pub(crate) fn drop_undone(&mut self) {
+        self.steps.truncate(self.done);
+    }
+
     /// Steps that can be undone.
     pub fn undo_len(&self) -> usize {
         self.done

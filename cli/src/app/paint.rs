@@ -249,6 +249,7 @@ fn start_colors(
     let topology = surface
         .topology()
         .map_err(|e| super::at(mesh_path.display(), e))?;
+    check_fits(&topology, r, 3 + channel_starts(&args.channels)?.1.len())?;
     let mut colors = MeshColors::uniform(topology, r, 3)
         .map_err(|e| arg_error(format!("--resolution {r}"), e))?;
     colors.samples_mut().fill(0.8);
@@ -257,6 +258,33 @@ fn start_colors(
         colors,
         json!({"flat": [0.8, 0.8, 0.8], "resolution": r}),
     ))
+}
+
+/// That colours at resolution `r` on every face, with `channels`
+/// channels, fit the page's textures, before they are built (a
+/// resolution too fine for the mesh would otherwise take seconds and
+/// gigabytes to fail); else the error names `--resolution` and the
+/// finest that fits.
+fn check_fits(topology: &mesh_colors::Topology, r: u32, channels: usize) -> Result<()> {
+    let budget = u64::from(trilux::paint::TEXTURE_WIDTH).pow(2);
+    let texels = |r: u32| mesh_colors::gpu::uniform_sample_texels(topology, r, channels);
+    if texels(r) <= budget {
+        return Ok(());
+    }
+    let finest = (0..=mesh_colors::MAX_LEVEL)
+        .rev()
+        .map(|l| 1u32 << l)
+        .find(|&r| texels(r) <= budget);
+    let w = trilux::paint::TEXTURE_WIDTH;
+    let problem = format!(
+        "the page's textures would need {} rows of {w} texels, more than WebGL2's {w}; {}",
+        texels(r).div_ceil(u64::from(w)),
+        match finest {
+            Some(f) => format!("--resolution {f} is the finest that fits this mesh"),
+            None => "the mesh has too many faces for any resolution".into(),
+        }
+    );
+    Err(arg_error(format!("--resolution {r}"), problem))
 }
 
 /// The power of two that gives about [`START_SAMPLES`] samples on `faces`

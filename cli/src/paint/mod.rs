@@ -147,6 +147,9 @@ pub struct Options {
 /// brush, so a count of steps alone does not bound the memory).
 pub const HISTORY_BYTES: usize = 256 << 20;
 
+/// The page's textures' width and most rows (WebGL2 guarantees 2048).
+pub const TEXTURE_WIDTH: u32 = 2048;
+
 impl Default for Options {
     fn default() -> Self {
         Self {

@@ -24,8 +24,7 @@ use super::{Document, LIMITS, MAGIC, Options, PAGE, VERSION};
 use crate::web::frame::{HEADER, Header, LeWord, put_f32, put_slice, put_u32};
 use crate::web::{App, Idle, Inbox, Limits, Out, Outbox, ReplyTo};
 
-/// Widest texture row the page is sent (WebGL2 guarantees 2048).
-const TEXTURE_WIDTH: u32 = 2048;
+use super::TEXTURE_WIDTH;
 /// Edits between autosaves while painting.
 const AUTOSAVE_EVERY: usize = 5;
 /// A pause after which unsaved edits are autosaved.
@@ -273,14 +272,10 @@ impl Worker {
                 }
             }
             Changed::Layout(faces) => {
-                let spans = self
-                    .mip
-                    .refresh_resolutions(colors, &faces)
-                    .map_err(|e| e.to_string())?;
-                let changes = self
-                    .gpu
-                    .refresh_resolutions(&self.mip, &spans)
-                    .map_err(|e| e.to_string())?;
+                let changes = match self.refresh_layout(&faces) {
+                    Ok(changes) => changes,
+                    Err(e) => return Err(self.take_back(&faces, &e)),
+                };
                 if changes.resized {
                     out.publish(SLOT_TEXTURES, self.textures());
                     (self.appended, self.appended_bytes) = (0, 0);
@@ -297,6 +292,43 @@ impl Worker {
             }
         }
         Ok(())
+    }
+
+    /// The pyramid and the textures after a resolution change of `faces`.
+    fn refresh_layout(&mut self, faces: &[usize]) -> Result<Changes, String> {
+        let colors = self.session.colors();
+        let spans = self
+            .mip
+            .refresh_resolutions(colors, faces)
+            .map_err(|e| e.to_string())?;
+        self.gpu
+            .refresh_resolutions(&self.mip, &spans)
+            .map_err(|e| e.to_string())
+    }
+
+    /// A resolution change the textures cannot hold (`problem`) is taken
+    /// back: the session as before it (colours, history, log) and the
+    /// pyramid again (the textures refuse a change whole, so they are as
+    /// before). Returns the error for the page.
+    fn take_back(&mut self, faces: &[usize], problem: &str) -> String {
+        let back = self
+            .session
+            .withdraw()
+            .map_err(|e| e.to_string())
+            .and_then(|_| {
+                let colors = self.session.colors();
+                self.mip
+                    .refresh_resolutions(colors, faces)
+                    .map_err(|e| e.to_string())
+            });
+        match back {
+            Ok(_) => {
+                // The edit was counted as unsaved; it is gone.
+                self.unsaved = self.unsaved.saturating_sub(1);
+                format!("no more detail fits the GPU textures ({problem}); the change was not made")
+            }
+            Err(e) => format!("{problem}; taking the change back failed too: {e}"),
+        }
     }
 
     /// The session's brush for the page's: the channel by name, the

@@ -884,6 +884,8 @@ fn errors_are_one_line_naming_the_file_or_argument_first_in_every_subcommand() {
             "--budget 0: ",
         ),
         (&["bench", "sampling", "--repeats", "0"], "--repeats 0: "),
+        // Checked before gigabytes of colours are built.
+        (&["paint", "--resolution", "1024"], "--resolution 1024: "),
     ];
     for &(args, start) in cases {
         fails(d, args, &[start]);

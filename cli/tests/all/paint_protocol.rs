@@ -294,6 +294,48 @@ async fn paint_detail_undo_save_and_replay_through_the_protocol() {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_resolution_the_textures_cannot_hold_is_refused_and_taken_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let r = server(dir.path()).await;
+    let mut s = connect(&r).await;
+    let mut seen = Seen::default();
+    until(&mut s, "hello", &mut seen).await;
+    let start = until(&mut s, "status", &mut seen).await;
+    // Level 8 on the blob's 320 faces: 10⁷ samples, which the colours
+    // allow but whose pyramid needs more than WebGL2's 2048² texels.
+    send(&mut s, json!({"seq": 1, "op": "resolution", "level": 8})).await;
+    let e = error_of(&mut s, 1).await;
+    let message = e["message"].as_str().unwrap();
+    assert!(
+        message.contains("GPU textures") && message.contains("not made"),
+        "{e}"
+    );
+    let after = status_of(&mut s, 1, &mut seen).await;
+    for key in ["samples", "memory", "undo", "redo", "edits", "finest_level"] {
+        assert_eq!(after[key], start[key], "{key}");
+    }
+    // The session goes on: a dab is painted and sent as texels.
+    seen.frames.clear();
+    let p = document().surface.positions[0];
+    send(&mut s, json!({"seq": 2, "op": "begin", "brush": brush()})).await;
+    send(
+        &mut s,
+        json!({"seq": 3, "op": "dabs", "dabs": [[p.x, p.y, p.z, 0.2, 1.0]]}),
+    )
+    .await;
+    send(&mut s, json!({"seq": 4, "op": "end"})).await;
+    let painted = status_of(&mut s, 4, &mut seen).await;
+    assert_eq!(painted["undo"], 1);
+    assert!(seen.frames.contains(&4), "{:?}", seen.frames);
+    // And a resolution that fits still does.
+    send(&mut s, json!({"seq": 5, "op": "resolution", "level": 4})).await;
+    let raised = status_of(&mut s, 5, &mut seen).await;
+    assert_eq!(raised["finest_level"], 4);
+    assert_eq!(raised["undo"], 2);
+    r.stop().await.unwrap();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn bad_messages_get_an_error_naming_the_field_and_change_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let r = server(dir.path()).await;

@@ -628,3 +628,29 @@ fn spare_rows_hold_the_first_raise_and_stay_zeros_past_the_used_rows() {
             .all(|&x| x.to_bits() == 0)
     );
 }
+
+#[test]
+fn the_texels_a_uniform_resolution_needs_are_those_a_layout_has() {
+    let (positions, faces) = support::grid(5, 0.2);
+    let topology = Topology::new(positions.len(), &faces).unwrap();
+    for (r, channels) in [(1, 3), (2, 3), (4, 4), (16, 3), (8, 5), (32, 8)] {
+        let mip = MeshColors::uniform(topology.clone(), r, channels)
+            .unwrap()
+            .mip_map();
+        let values = (mip.data().len() / channels) as u64;
+        let texels = mesh_colors::gpu::uniform_sample_texels(&topology, r, channels);
+        assert_eq!(
+            texels,
+            values * channels.div_ceil(4) as u64,
+            "R = {r}, {channels} channels"
+        );
+        // The rows a layout has at its width.
+        let layout = GpuLayout::new(&mip, 1024).unwrap();
+        let w = u64::from(layout.width());
+        assert_eq!(
+            u64::from(layout.used_sample_rows()),
+            texels.div_ceil(w),
+            "R = {r}"
+        );
+    }
+}
