@@ -74,13 +74,15 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
         Some(path) => Some(read_session(path, &doc)?),
         None => None,
     };
-    let autosave = args
-        .export_dir
-        .join(format!("{}.autosave.meshcolors", stem(&args.mesh)));
-    if autosave.exists() && args.colors.as_deref() != Some(autosave.as_path()) {
+    // Absolute, so the page's messages say where files are, not "./".
+    let export_dir = std::path::absolute(&args.export_dir).unwrap_or(args.export_dir.clone());
+    let (autosave, earlier) =
+        autosave_paths(&export_dir, &stem(&args.mesh), args.colors.as_deref());
+    if let Some(newest) = earlier.last() {
         eprintln!(
-            "note: {} holds colours autosaved by an earlier trilux paint of this model; resume with --colors {} (it is replaced at the next autosave)",
-            autosave.display(),
+            "note: an earlier trilux paint of this model left autosaved colours in {}; resume them with --colors {} (this session autosaves to {}, so they are kept)",
+            newest.display(),
+            newest.display(),
             autosave.display()
         );
     }
@@ -89,8 +91,9 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     let options = Options {
         host: args.serve.host,
         port: args.serve.port,
-        export_dir: args.export_dir.clone(),
+        export_dir,
         autosave: Some(autosave),
+        earlier_autosaves: earlier,
         ..Default::default()
     };
     let start = trilux::paint::start(doc, log, options);
@@ -161,6 +164,39 @@ fn check_channels(names: &[String]) -> Result<()> {
 }
 
 /// The file name's stem, `model` for the built-in one.
+/// Where this session autosaves, in `dir`: `STEM.autosave.meshcolors`,
+/// or `STEM.autosave-N.meshcolors` with the first `N` free, so that an
+/// earlier session's autosave (after a crash, or one never resumed) is
+/// never overwritten; the colours being resumed (`--colors` naming one of
+/// them) are saved back where they came from. Also returns the earlier
+/// autosaves found, oldest first, without the one resumed.
+fn autosave_paths(dir: &Path, stem: &str, resumed: Option<&Path>) -> (PathBuf, Vec<PathBuf>) {
+    let name = |k: usize| match k {
+        1 => dir.join(format!("{stem}.autosave.meshcolors")),
+        k => dir.join(format!("{stem}.autosave-{k}.meshcolors")),
+    };
+    let resumed = resumed.and_then(|p| p.canonicalize().ok());
+    let mut earlier = Vec::new();
+    let mut own = None;
+    let mut k = 1;
+    // Ends at the first free name: the folder holds finitely many files.
+    let free = loop {
+        let path = name(k);
+        if !path.exists() {
+            break path;
+        }
+        if own.is_none() && path.canonicalize().ok() == resumed {
+            own = Some(path);
+        } else {
+            earlier.push(path);
+        }
+        k += 1;
+    };
+    let modified = |p: &PathBuf| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    earlier.sort_by_key(modified);
+    (own.unwrap_or(free), earlier)
+}
+
 fn stem(mesh: &Option<PathBuf>) -> String {
     mesh.as_ref()
         .and_then(|p| p.file_stem())
@@ -331,6 +367,37 @@ fn read_session(path: &Path, doc: &Document) -> Result<Vec<mesh_colors::session:
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn an_earlier_autosave_is_kept_and_named_unless_it_is_resumed() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let name = |s: &str| d.join(s);
+        let first = name("cow.autosave.meshcolors");
+        assert_eq!(autosave_paths(d, "cow", None), (first.clone(), vec![]));
+        std::fs::write(&first, "earlier").unwrap();
+        let second = name("cow.autosave-2.meshcolors");
+        assert_eq!(
+            autosave_paths(d, "cow", None),
+            (second.clone(), vec![first.clone()])
+        );
+        // Resuming the first saves back to it.
+        assert_eq!(
+            autosave_paths(d, "cow", Some(&first)),
+            (first.clone(), vec![])
+        );
+        std::fs::write(&second, "later").unwrap();
+        let (own, earlier) = autosave_paths(d, "cow", Some(&second));
+        assert_eq!((own, earlier), (second.clone(), vec![first.clone()]));
+        let (own, earlier) = autosave_paths(d, "cow", None);
+        assert_eq!(own, name("cow.autosave-3.meshcolors"));
+        assert_eq!(earlier.len(), 2);
+        // Another model's autosaves are not this one's.
+        assert_eq!(
+            autosave_paths(d, "pig", None).1,
+            Vec::<std::path::PathBuf>::new()
+        );
+    }
+
     use super::*;
 
     #[test]

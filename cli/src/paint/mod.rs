@@ -137,6 +137,9 @@ pub struct Options {
     pub export_dir: PathBuf,
     /// Where the colours are autosaved (none: no autosave).
     pub autosave: Option<PathBuf>,
+    /// Autosaves that earlier sessions of this model left (the page
+    /// offers them: restart with `--colors` to resume one).
+    pub earlier_autosaves: Vec<PathBuf>,
     /// Undo steps kept (within [`HISTORY_BYTES`]).
     pub history: usize,
 }
@@ -158,6 +161,7 @@ impl Default for Options {
             token: None,
             export_dir: PathBuf::from("."),
             autosave: None,
+            earlier_autosaves: Vec::new(),
             history: 200,
         }
     }

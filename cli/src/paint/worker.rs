@@ -27,8 +27,9 @@ use crate::web::{App, Idle, Inbox, Limits, Out, Outbox, ReplyTo};
 use super::TEXTURE_WIDTH;
 /// Edits between autosaves while painting.
 const AUTOSAVE_EVERY: usize = 5;
-/// A pause after which unsaved edits are autosaved.
-const AUTOSAVE_PAUSE: Duration = Duration::from_secs(10);
+/// A pause after which unsaved edits are autosaved (short: a crash soon
+/// after a few strokes should not lose them).
+const AUTOSAVE_PAUSE: Duration = Duration::from_secs(3);
 /// A pause after which the texel updates appended to the textures' slot
 /// are folded into it (folding copies the whole texture, tens of ms for
 /// a large one: not between one gesture and the next).
@@ -55,6 +56,8 @@ pub(crate) struct Worker {
     gpu: GpuLayout,
     export_dir: PathBuf,
     autosave: Option<PathBuf>,
+    /// Autosaves of earlier sessions, for the page to offer.
+    earlier_autosaves: Vec<PathBuf>,
     /// Edits since the last autosave.
     unsaved: usize,
     /// Texel updates appended to the textures' slot since it was last
@@ -100,6 +103,7 @@ impl Worker {
             gpu,
             export_dir: options.export_dir,
             autosave: options.autosave,
+            earlier_autosaves: options.earlier_autosaves,
             unsaved,
             appended: 0,
             appended_bytes: 0,
@@ -148,6 +152,7 @@ impl Worker {
                 "faces": self.doc.surface.faces.len(),
                 "area": self.doc.area(),
                 "autosave": self.autosave.as_ref().map(|p| p.display().to_string()),
+                "earlier_autosaves": self.earlier_autosaves.iter().map(|p| p.display().to_string()).collect::<Vec<_>>(),
                 "max_level": mesh_colors::MAX_LEVEL,
             })
             .to_string(),
@@ -754,8 +759,9 @@ impl App for Worker {
         self.autosave();
         // Say where the colours are as the server stops (Ctrl+C).
         if let (Some(path), true) = (&self.autosave, unsaved > 0 && self.unsaved == 0) {
+            let edits = if unsaved == 1 { "edit" } else { "edits" };
             eprintln!(
-                "trilux paint: {unsaved} unsaved edits autosaved to {} (resume with --colors {})",
+                "trilux paint: {unsaved} unsaved {edits} autosaved to {} (resume with --colors {})",
                 path.display(),
                 path.display()
             );

@@ -304,13 +304,30 @@ async fn a_resolution_the_textures_cannot_hold_is_refused_and_taken_back() {
     // Level 8 on the blob's 320 faces: 10⁷ samples, which the colours
     // allow but whose pyramid needs more than WebGL2's 2048² texels.
     send(&mut s, json!({"seq": 1, "op": "resolution", "level": 8})).await;
-    let e = error_of(&mut s, 1).await;
+    // The error (a reply) and the status (to every page) come by two
+    // queues: in either order.
+    let (mut error, mut after) = (None, None);
+    while error.is_none() || after.is_none() {
+        let m = tokio::time::timeout(Duration::from_secs(120), s.next())
+            .await
+            .expect("the server answers")
+            .unwrap()
+            .unwrap();
+        if let Message::Text(t) = m {
+            let v: Value = serde_json::from_str(&t).unwrap();
+            if v["type"] == "error" && v["seq"] == 1 {
+                error = Some(v);
+            } else if v["type"] == "status" && v["seqs"].as_array().unwrap().contains(&json!(1)) {
+                after = Some(v);
+            }
+        }
+    }
+    let (e, after) = (error.unwrap(), after.unwrap());
     let message = e["message"].as_str().unwrap();
     assert!(
         message.contains("GPU textures") && message.contains("not made"),
         "{e}"
     );
-    let after = status_of(&mut s, 1, &mut seen).await;
     for key in ["samples", "memory", "undo", "redo", "edits", "finest_level"] {
         assert_eq!(after[key], start[key], "{key}");
     }

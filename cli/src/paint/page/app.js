@@ -45,8 +45,18 @@ function onText(m) {
     fillLevels(m.max_level);
     fillScatter(m);
     if (m.autosave) {
-      $('autosaveNote').textContent = 'Autosaved to ' + m.autosave;
+      $('autosaveNote').textContent = 'Autosave: ' + m.autosave + ' (every few strokes and when trilux paint stops)';
       $('autosaveHelp').textContent = ', to ' + m.autosave;
+    }
+    // Colours an earlier session autosaved (a crash, or never resumed):
+    // kept, and how to resume them.
+    const earlier = m.earlier_autosaves || [];
+    if (earlier.length) {
+      const newest = earlier[earlier.length - 1];
+      $('earlierNote').textContent = 'An earlier session of this model autosaved colours to ' + newest +
+        (earlier.length > 1 ? ' (and ' + (earlier.length - 1) + ' older)' : '') +
+        '. They are kept; to resume them, restart with: trilux paint MESH --colors ' + newest;
+      $('earlierNote').hidden = false;
     }
   } else if (m.type === 'status') {
     state.status = m;
@@ -517,9 +527,17 @@ $('channel').onchange = () => {
 $('shade').onchange = () => { dirty = true; };
 
 addEventListener('keydown', (e) => {
-  if (e.target.tagName === 'INPUT' && e.target.type !== 'range' && e.target.type !== 'checkbox') return;
+  // Typing goes to a text or number box; a slider, tick box or colour
+  // well with focus leaves the keys to the page.
+  if (e.target.tagName === 'INPUT' && !['range', 'checkbox', 'color'].includes(e.target.type)) return;
   const k = e.key.toLowerCase();
   if (e.key === 'Escape') { $('helpbox').hidden = true; return; }
+  // Frame the model again (Blender's Home).
+  if (e.key === 'Home' || (k === 'f' && !e.ctrlKey && !e.metaKey)) {
+    state.camera = new Camera(state.hello.bounds[0], state.hello.bounds[1]);
+    dirty = pickDirty = true;
+    return;
+  }
   if ((e.ctrlKey || e.metaKey) && k === 'z') { net.send(e.shiftKey ? 'redo' : 'undo'); e.preventDefault(); return; }
   if ((e.ctrlKey || e.metaKey) && k === 'y') { net.send('redo'); e.preventDefault(); return; }
   if ((e.ctrlKey || e.metaKey) && k === 's') { $('save').onclick(); e.preventDefault(); return; }
