@@ -306,7 +306,7 @@ fn main() {
         d.sort_by(f32::total_cmp);
         let reach = d[999.min(d.len() - 1)];
         let mut detail_ms = Vec::new();
-        for _ in 0..5 {
+        for _ in 0..9 {
             let t = Instant::now();
             let seq = c
                 .send("detail", json!({"center": centre.to_array(), "radius": reach, "levels": 1}))

@@ -353,7 +353,7 @@ impl GpuLayout {
         Self::packed(mip, max_width, false)
     }
 
-    /// As [`GpuLayout::new`], with half the sample rows again spare (up to
+    /// As [`GpuLayout::new`], with as many sample rows again spare (up to
     /// `max_width` rows, as a repack leaves them): room for the faces that
     /// [`GpuLayout::refresh_resolutions`] raises, so that the first raise
     /// after loading does not pack everything again. The spare rows are
@@ -576,7 +576,7 @@ impl GpuLayout {
     /// levels or blocks changed: the rectangles returned, for
     /// `texSubImage2D`. The textures keep their size unless the sample
     /// texture is full: then everything is packed again as by
-    /// [`GpuLayout::new`] with spare rows (half the rows needed again, up
+    /// [`GpuLayout::new`] with spare rows (as many rows again as needed, up
     /// to `max_width` rows) for the changes to come, and `resized` is set.
     /// Either way [`GpuLayout::lookup`] gives what a new layout of `mip`
     /// gives, bit for bit. The cost is a pass over the faces, edges and
@@ -798,7 +798,10 @@ fn pack(mip: &MipMap, max_width: u32, spare: bool) -> Result<(GpuParts, Blocks),
         });
     }
     let sample_rows = if spare {
-        (rows(texels) + (rows(texels) / 2).max(1)).min(max_width as usize)
+        // A detail brush raising a thousand faces of a converted model
+        // adds half its samples again; a face that grows leaves its old
+        // block free, so room for as much again spares most repacks.
+        (2 * rows(texels)).min(max_width as usize)
     } else {
         rows(texels)
     };

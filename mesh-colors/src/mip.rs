@@ -3,7 +3,7 @@
 //! anisotropic filtering from screen-space derivatives (Sec. 4.3).
 
 use crate::filter::{FINEST, Place, Store, check, edge_point, eval_at, lattice, place, triangle};
-use crate::parallel::map_ordered;
+use crate::parallel::{join, map_ordered};
 use crate::structure::{MeshColors, interior_index, move_segments, samples_per_face};
 use crate::topology::NO_FACE;
 use std::sync::{Arc, OnceLock};
@@ -634,7 +634,13 @@ impl MipMap {
             let len = FACE_LEVEL_OFFSET[colors.face_level[f] as usize + 1];
             segments.push((self.face_offset[f], fo[f], len, !listed[f]));
         }
-        move_segments(&mut self.data, c, &segments, total);
+        // The pyramid moves to the new layout while the colours' samples
+        // are copied: two memory-bound passes over different arrays.
+        let (data, samples) = (&mut self.data, &mut self.colors.samples);
+        join(
+            || move_segments(data, c, &segments, total),
+            || samples.clone_from(&colors.samples),
+        );
         (self.vertex_offset, self.edge_offset, self.face_offset) = (vo, eo, fo);
         if let Some(cache) = self.cache.get_mut() {
             cache.relayout(colors, &listed);
@@ -675,9 +681,8 @@ impl MipMap {
             self.data[at..at + len].copy_from_slice(&colors.samples[from..from + len]);
             mark(f);
         }
-        // The colours themselves, reusing their allocations.
+        // The rest of the colours, reusing their allocations.
         let mine = &mut self.colors;
-        mine.samples.clone_from(&colors.samples);
         mine.face_level.clone_from(&colors.face_level);
         mine.edge_level.clone_from(&colors.edge_level);
         mine.vertex_level.clone_from(&colors.vertex_level);

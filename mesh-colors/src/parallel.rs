@@ -27,3 +27,17 @@ pub(crate) fn map_ordered<I: Sync, T: Send>(
     let _ = samples;
     items.iter().map(f).collect()
 }
+
+/// `a` and `b` at once (on two threads with the `rayon` feature): for two
+/// large memory moves that touch different arrays.
+pub(crate) fn join(a: impl FnOnce() + Send, b: impl FnOnce() + Send) {
+    #[cfg(feature = "rayon")]
+    {
+        rayon::join(a, b);
+    }
+    #[cfg(not(feature = "rayon"))]
+    {
+        a();
+        b();
+    }
+}
