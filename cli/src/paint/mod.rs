@@ -95,6 +95,15 @@ pub struct Document {
 }
 
 impl Document {
+    /// The model's name: its file's stem (`spot` for `spot.obj`), or
+    /// `model` for the built-in one.
+    pub fn model_name(&self) -> String {
+        self.source["mesh"]
+            .as_str()
+            .and_then(|p| std::path::Path::new(p).file_stem())
+            .map_or_else(|| "model".to_string(), |s| s.to_string_lossy().into_owned())
+    }
+
     /// The surface's area, in model units squared (the scatter panel's
     /// rate is per unit area).
     pub fn area(&self) -> f64 {

@@ -476,6 +476,15 @@ impl Worker {
                     &mesh_colors::atlas::Options::default(),
                 )?;
                 let (mut baked, _) = crate::colors::atlas_mesh(&self.doc.surface, &atlas, None);
+                // Named after the model: Blender lists the object, mesh,
+                // material and texture by these names.
+                let model = self.doc.model_name();
+                for object in &mut baked.objects {
+                    object.name.clone_from(&model);
+                }
+                for material in &mut baked.materials {
+                    material.name.clone_from(&model);
+                }
                 // The scalar channels as textures of their own (GLB), not
                 // as the base colour's alpha.
                 crate::colors::attach_scalar_channels(&mut baked, &atlas, &self.doc.scalars)?;

@@ -148,23 +148,28 @@ pub fn nonzero(v: DVec3, field: &str) -> Parsed<DVec3> {
     Ok(v)
 }
 
-/// A plain file name ending in `.ext` (any case): letters, digits,
-/// `-`, `_` and `.`, at most 128 bytes, no folder and no hidden file, so
-/// a page can only name files inside the export folder.
+/// A plain file name ending in `.ext` (any case): letters of any script,
+/// digits, inner spaces and `- _ . ( ) + ,`, at most 128 bytes, no folder
+/// and no hidden file, so a page can only name files inside the export
+/// folder.
 ///
 /// # Errors
 /// `name`: what is wrong with it.
 pub fn file_name(name: &str, ext: &str) -> Parsed<()> {
+    // Any letters (`kráva.glb`) and inner spaces (`my cow.glb`); never a
+    // folder, a hidden or reserved name, or a character some file system
+    // refuses.
     let plain = !name.is_empty()
         && name.len() <= 128
-        && !name.starts_with('.')
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+        && !name.starts_with(['.', ' '])
+        && !name.ends_with(' ')
+        && name.chars().all(|c| {
+            c.is_alphanumeric() || matches!(c, '-' | '_' | '.' | ' ' | '(' | ')' | '+' | ',')
+        });
     if !plain {
         return Err(BadField::new(
             "name",
-            "expected a plain file name (letters, digits, - _ .), no folder",
+            "expected a plain file name (letters, digits, spaces, - _ . ( ) + ,), no folder",
         ));
     }
     if !name.to_ascii_lowercase().ends_with(&format!(".{ext}")) {
@@ -176,6 +181,36 @@ pub fn file_name(name: &str, ext: &str) -> Parsed<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_file_name_may_have_any_letters_and_spaces_but_no_folder() {
+        for good in [
+            "cow.glb",
+            "my cow.glb",
+            "kráva.GLB",
+            "cow (2).glb",
+            "a+b,c_d-e.f.glb",
+        ] {
+            assert!(file_name(good, "glb").is_ok(), "{good}");
+        }
+        for bad in [
+            "",
+            "a/b.glb",
+            "a\\b.glb",
+            "../b.glb",
+            ".hidden.glb",
+            " cow.glb",
+            "a:b.glb",
+            "a\u{0}b.glb",
+            "tab\tname.glb",
+            "cow.png",
+            "cow.glb ",
+            "*.glb",
+        ] {
+            assert_eq!(file_name(bad, "glb").unwrap_err().field, "name", "{bad:?}");
+        }
+        assert!(file_name(&format!("{}.glb", "x".repeat(125)), "glb").is_err());
+    }
 
     #[test]
     fn the_envelope_names_what_is_wrong() {

@@ -239,6 +239,9 @@ pub async fn bind(serve: &Serve, name: &str) -> Result<Bound, String> {
                 std::io::ErrorKind::AddrNotAvailable => {
                     "not an address of this machine (--host)".to_string()
                 }
+                std::io::ErrorKind::PermissionDenied if serve.port < 1024 => format!(
+                    "{e}: ports below 1024 need an administrator; choose --port 1024 or above, or leave --port out for a free one"
+                ),
                 _ => e.to_string(),
             };
             format!("{}:{}: {why}", serve.host, serve.port)

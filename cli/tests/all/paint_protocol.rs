@@ -619,6 +619,9 @@ fn glb_has_the_density_as_its_own_texture(path: &std::path::Path) {
     let doc: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
     let bin = &bytes[20 + json_len + 8..];
     let material = &doc["materials"][0];
+    // Named after the model (the built-in one here), not "atlas".
+    assert_eq!(material["name"], "model", "{doc:#}");
+    assert_eq!(doc["meshes"][0]["name"], "model", "{doc:#}");
     let density = material["extras"]["scalar_textures"]["density"]
         .as_u64()
         .unwrap() as usize;

@@ -69,6 +69,7 @@ function onText(m) {
     state.picked = m.color;
     if (state.channelIndex() === 0) $('color').value = toHex(m.color);
     else $('value').value = m.color[2 + state.channelIndex()];
+    if (state.tool === 'pick') setTool(state.beforePick || 'paint');
   } else if (m.type === 'export') {
     state.exported.push(m.path);
     flash('written: ' + m.path);
@@ -200,6 +201,8 @@ function brush(tool) {
 }
 
 function setTool(t) {
+  // The eyedropper picks once, then hands back the tool it interrupted.
+  if (t === 'pick' && state.tool !== 'pick') state.beforePick = state.tool;
   state.tool = t;
   document.querySelectorAll('#tools button').forEach((b) => b.classList.toggle('on', b.dataset.tool === t));
 }
