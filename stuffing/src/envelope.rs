@@ -501,6 +501,45 @@ pub(crate) fn keeps_angles(before: [DVec3; 4], after: [DVec3; 4]) -> bool {
     if signed_volume(after) <= 0.0 {
         return false;
     }
+    // Most moves keep every angle well inside the range: their cosines say
+    // so without an arc cosine. Near a bound the exact test decides.
+    if surely_within(after) {
+        return true;
+    }
+    keeps_angles_exactly(before, after)
+}
+
+/// How far inside the bounds a dihedral angle's cosine must be for
+/// [`surely_within`] to decide: far above the rounding of either way of
+/// computing it (about 1e-15), so its answer is the exact test's.
+const COSINE_MARGIN: f64 = 1e-9;
+
+/// Whether every dihedral angle of the positively oriented tetrahedron
+/// `p` is surely within [`MIN_DIHEDRAL_DEG`]–[`MAX_DIHEDRAL_DEG`]: at edge
+/// `(i, j)`, the interior angle's cosine is minus the dot product of the
+/// outward unit normals of the two faces through it (the faces opposite
+/// the other two vertices). False when unsure (near a bound, or NaN).
+fn surely_within(p: [DVec3; 4]) -> bool {
+    let lo = MIN_DIHEDRAL_DEG.to_radians().cos() - COSINE_MARGIN;
+    let hi = MAX_DIHEDRAL_DEG.to_radians().cos() + COSINE_MARGIN;
+    // The outward normal of the face opposite vertex k.
+    let normal = |k: usize| {
+        let [a, b, c] = [(k + 1) % 4, (k + 2) % 4, (k + 3) % 4].map(|v| p[v]);
+        let n = (b - a).cross(c - a).normalize();
+        if n.dot(p[k] - a) > 0.0 { -n } else { n }
+    };
+    let n = [normal(0), normal(1), normal(2), normal(3)];
+    (0..4).all(|k| {
+        (k + 1..4).all(|l| {
+            let cos = -n[k].dot(n[l]);
+            cos <= lo && cos >= hi
+        })
+    })
+}
+
+/// [`keeps_angles`] by the angles themselves (for a tetrahedron with
+/// positive volume).
+fn keeps_angles_exactly(before: [DVec3; 4], after: [DVec3; 4]) -> bool {
     // None for a degenerate tetrahedron (NaN angles).
     let range = |p: [DVec3; 4]| {
         let a = dihedral_angles(p).map(f64::to_degrees);
@@ -525,6 +564,48 @@ pub(crate) fn keeps_angles(before: [DVec3; 4], after: [DVec3; 4]) -> bool {
 mod tests {
     use super::*;
     use crate::tests::{cuboid, sphere};
+
+    #[test]
+    fn the_cosine_shortcut_agrees_with_the_angles_themselves() {
+        let mut rng = test_support::SplitMix64(17);
+        let regular = [
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ];
+        assert!(signed_volume(regular) > 0.0);
+        let (mut sure, mut kept, mut near) = (0, 0, 0);
+        for k in 0..200_000 {
+            // Perturbations from slight to wild, so that many angles land
+            // near 10° and 165°.
+            let scale = [0.05, 0.8, 2.0, 4.0][k % 4];
+            let p = regular
+                .map(|q| q + scale * DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, rng.f64() - 0.5));
+            if signed_volume(p) <= 0.0 {
+                continue;
+            }
+            // From the regular tetrahedron (within the range), so the
+            // exact test keeps exactly the moves within the range.
+            let exact = keeps_angles_exactly(regular, p);
+            if surely_within(p) {
+                assert!(exact, "{p:?}: the shortcut keeps what the angles refuse");
+                sure += 1;
+            }
+            let a = dihedral_angles(p).map(f64::to_degrees);
+            kept += usize::from(
+                a.iter()
+                    .all(|&d| (MIN_DIHEDRAL_DEG..=MAX_DIHEDRAL_DEG).contains(&d)),
+            );
+            near += usize::from(a.iter().any(|&d| {
+                (d - MIN_DIHEDRAL_DEG).abs() < 0.5 || (d - MAX_DIHEDRAL_DEG).abs() < 0.5
+            }));
+        }
+        // It decides nearly every tetrahedron within the range, and the
+        // test reached the bounds often.
+        assert!(kept > 50_000 && sure * 100 >= kept * 99, "{sure} of {kept}");
+        assert!(near > 1000, "{near} near a bound");
+    }
 
     #[test]
     fn a_box_has_its_twelve_edges_sharp_and_its_face_diagonals_not() {
