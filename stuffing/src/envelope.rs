@@ -565,15 +565,18 @@ mod tests {
     use super::*;
     use crate::tests::{cuboid, sphere};
 
+    /// A regular tetrahedron, positively oriented.
+    const REGULAR: [DVec3; 4] = [
+        DVec3::new(1.0, 1.0, 1.0),
+        DVec3::new(-1.0, 1.0, -1.0),
+        DVec3::new(1.0, -1.0, -1.0),
+        DVec3::new(-1.0, -1.0, 1.0),
+    ];
+
     #[test]
     fn the_cosine_shortcut_agrees_with_the_angles_themselves() {
         let mut rng = test_support::SplitMix64(17);
-        let regular = [
-            DVec3::new(1.0, 1.0, 1.0),
-            DVec3::new(-1.0, 1.0, -1.0),
-            DVec3::new(1.0, -1.0, -1.0),
-            DVec3::new(-1.0, -1.0, 1.0),
-        ];
+        let regular = REGULAR;
         assert!(signed_volume(regular) > 0.0);
         let (mut sure, mut kept, mut near) = (0, 0, 0);
         for k in 0..200_000 {
@@ -624,12 +627,7 @@ mod tests {
 
     #[test]
     fn a_move_that_flattens_or_inverts_a_tetrahedron_is_refused() {
-        let regular = [
-            DVec3::new(1.0, 1.0, 1.0),
-            DVec3::new(-1.0, 1.0, -1.0),
-            DVec3::new(1.0, -1.0, -1.0),
-            DVec3::new(-1.0, -1.0, 1.0),
-        ];
+        let regular = REGULAR;
         assert!(signed_volume(regular) > 0.0);
         let moved = |to: DVec3| {
             let mut p = regular;
