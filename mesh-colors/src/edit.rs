@@ -15,7 +15,7 @@ use std::collections::{HashMap, HashSet};
 
 use glam::Vec3;
 
-use crate::filter::{FINEST, Store, edge_point, eval, lattice};
+use crate::filter::{FINEST, Store, edge_point, eval, lattice, triangle};
 use crate::parallel::map_ordered;
 use crate::structure::{
     MeshColors, interior_index, lattice_points, level_of, move_segments, sample_position,
@@ -605,43 +605,23 @@ fn resample_step(staged: &Staged<'_>, step: &Step) -> (Vec<f32>, [Option<Vec<f32
 /// A raised face's new samples into `fv`: what `eval` at each new
 /// sample's barycentrics gives (the linear filter of the face's current
 /// colours), the same products summed in the same order, bit for bit.
-/// The new sample `(i, j)` of resolution `R = r·2^d` lies at `(i, j) / 2^d`
-/// on the current lattice of resolution `r`, exactly in `f32` (dyadic),
-/// so its lattice triangle and weights come from integers; a triangle of
-/// three interior samples (most of them) is read straight from the
-/// face's block, any other point through `lattice`.
+/// The new sample `(i, j)` of resolution `R = r·2^d` has the barycentrics
+/// `(i, j, R − i − j) / R`, exact in `f32` (dyadic), so `triangle` gives
+/// the lattice triangle and weights `eval` computes; a triangle of three
+/// interior samples (most of them) is read straight from the face's
+/// block, any other point through `lattice`.
 fn raise_face(staged: &Staged<'_>, step: &Step, fv: &mut Vec<f32>, value: &mut [f32]) {
     let c = staged.mc.channels;
     let f = step.face;
     // The level `eval` reads the face at: the one the batch left it at.
     let from = staged.mc.face_level[f];
-    let (r, d) = (1u32 << from, step.to - from);
-    let big = r << d;
-    let scale = 1.0 / (1u32 << d) as f32;
+    let (r, big) = (1u32 << from, 1u32 << step.to);
+    let scale = 1.0 / big as f32;
     let old = staged.face_block(f, r);
     for i in 1..big {
         for j in 1..big - i {
-            // `triangle` of the point: x = c_0 · r, y = c_1 · r, exact.
-            let (x, y) = (i as f32 * scale, j as f32 * scale);
-            let i0 = (i >> d).min(r - 1);
-            let j0 = (j >> d).min(r - 1 - i0);
-            let (fx, fy) = (x - i0 as f32, y - j0 as f32);
-            let k0 = r - i0 - j0;
-            let (pts, ws) = if fx + fy <= 1.0 || k0 == 1 {
-                (
-                    [[i0, j0, k0], [i0 + 1, j0, k0 - 1], [i0, j0 + 1, k0 - 1]],
-                    [1.0 - fx - fy, fx, fy],
-                )
-            } else {
-                (
-                    [
-                        [i0 + 1, j0 + 1, k0 - 2],
-                        [i0 + 1, j0, k0 - 1],
-                        [i0, j0 + 1, k0 - 1],
-                    ],
-                    [fx + fy - 1.0, 1.0 - fy, 1.0 - fx],
-                )
-            };
+            let b = [i, j, big - i - j].map(|x| x as f32 * scale);
+            let (pts, ws) = triangle(b, r);
             value.fill(0.0);
             if pts.iter().all(|p| p[0] >= 1 && p[1] >= 1 && p[2] >= 1) {
                 for (p, &w) in pts.iter().zip(&ws) {

@@ -77,7 +77,7 @@ pub(crate) fn run(context: &mut Context, args: Args) -> Result<()> {
     // Absolute, so the page's messages say where files are, not "./".
     let export_dir = std::path::absolute(&args.export_dir).unwrap_or(args.export_dir.clone());
     let (autosave, earlier) =
-        autosave_paths(&export_dir, &stem(&args.mesh), args.colors.as_deref());
+        autosave_paths(&export_dir, &doc.model_name(), args.colors.as_deref());
     if let Some(newest) = earlier.last() {
         eprintln!(
             "note: an earlier trilux paint of this model left autosaved colours in {}; resume them with --colors {} (this session autosaves to {}, so they are kept)",
@@ -195,12 +195,6 @@ fn autosave_paths(dir: &Path, stem: &str, resumed: Option<&Path>) -> (PathBuf, V
     let modified = |p: &PathBuf| std::fs::metadata(p).and_then(|m| m.modified()).ok();
     earlier.sort_by_key(modified);
     (own.unwrap_or(free), earlier)
-}
-
-fn stem(mesh: &Option<PathBuf>) -> String {
-    mesh.as_ref()
-        .and_then(|p| p.file_stem())
-        .map_or_else(|| "model".to_string(), |s| s.to_string_lossy().into_owned())
 }
 
 /// The surface and its starting colours, as the arguments say.
