@@ -99,11 +99,19 @@ pub(crate) fn fit(
         return Fitted::default();
     }
     let sharp = sharp_edges(input_positions, &kept);
-    let input_bvh = Bvh::build(input_positions, &kept);
+    // The winding number's tree is the same tree when every triangle
+    // encloses volume (the usual case).
+    let own_bvh;
+    let input_bvh = if kept.len() == wn.triangles().len() {
+        wn.bvh()
+    } else {
+        own_bvh = Bvh::build(input_positions, &kept);
+        &own_bvh
+    };
     let input = Surface {
         positions: input_positions,
         triangles: &kept,
-        bvh: &input_bvh,
+        bvh: input_bvh,
     };
     let targets = points_to_hold(&input, &sharp, h, mesh.boundary.len());
     let (mut moved, mut touched) = pull_rounds(&input, mesh, &targets, h, eps);
@@ -278,6 +286,10 @@ struct Mover<'a> {
     moved: Vec<bool>,
     /// Vertices moved at all.
     touched: Vec<bool>,
+    /// The boundary triangles' distances from the input, kept between
+    /// moves: a vertex's ring is measured again and again as points try
+    /// it, while only moves change it.
+    centroid_off: CentroidDistances,
 }
 
 impl<'a> Mover<'a> {
@@ -301,6 +313,7 @@ impl<'a> Mover<'a> {
             eps,
             moved,
             touched,
+            centroid_off: CentroidDistances(vec![f64::NAN; boundary.len()]),
         }
     }
 
@@ -329,6 +342,10 @@ impl<'a> Mover<'a> {
             .filter_map(|&i| {
                 let i = i as usize;
                 let s = targets[i];
+                // Most points are near: a bounded query says so for less.
+                if surface.within(s, eps) {
+                    return None;
+                }
                 let (_, d2, t) = surface.nearest(s);
                 if d2 <= eps * eps || t == u32::MAX {
                     return None;
@@ -420,7 +437,7 @@ impl<'a> Mover<'a> {
     /// as near the input as they were (or within the envelope); the step
     /// taken, if any.
     fn try_move(
-        &self,
+        &mut self,
         positions: &mut [DVec3],
         v: u32,
         target: DVec3,
@@ -455,11 +472,21 @@ impl<'a> Mover<'a> {
                     continue 'steps;
                 }
             }
-            let before = *off_before.get_or_insert_with(|| self.ring_off_input(positions, v, from));
+            let before = match off_before {
+                Some(d) => d,
+                None => *off_before.insert(self.centroid_off.ring(
+                    &self.faces,
+                    self.boundary,
+                    self.input,
+                    positions,
+                    v,
+                )),
+            };
             if !self.ring_within(positions, v, to, before.max(self.eps)) {
                 continue;
             }
             positions[v as usize] = to;
+            self.centroid_off.forget(&self.faces, v);
             return Some(s);
         }
         None
@@ -467,22 +494,9 @@ impl<'a> Mover<'a> {
 }
 
 impl Mover<'_> {
-    /// How far the boundary triangles around `v`, with `v` at `at`, lie
-    /// from the input: the largest distance of their centroids.
-    fn ring_off_input(&self, positions: &[DVec3], v: u32, at: DVec3) -> f64 {
-        let mut off: f64 = 0.0;
-        for &f in self.faces.of(v) {
-            let corners =
-                self.boundary[f as usize].map(|u| if u == v { at } else { positions[u as usize] });
-            let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
-            off = off.max(self.input.nearest(centroid).1);
-        }
-        off.sqrt()
-    }
-
     /// Whether every boundary triangle around `v`, with `v` at `at`, has
     /// its centroid within `limit` of the input: the same answer as
-    /// `ring_off_input(..) <= limit`, with bounded queries that stop at
+    /// [`CentroidDistances::ring`] `<= limit`, with bounded queries that stop at
     /// the first triangle near enough (the fit's most frequent query).
     fn ring_within(&self, positions: &[DVec3], v: u32, at: DVec3, limit: f64) -> bool {
         self.faces.of(v).iter().all(|&f| {
@@ -491,6 +505,42 @@ impl Mover<'_> {
             let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
             self.input.within(centroid, limit)
         })
+    }
+}
+
+/// Per boundary triangle, the squared distance of its centroid from the
+/// input, once asked for (NaN before, and again once a corner moves).
+struct CentroidDistances(Vec<f64>);
+
+impl CentroidDistances {
+    /// How far the boundary triangles around `v` lie from the input: the
+    /// largest distance of their centroids.
+    fn ring(
+        &mut self,
+        faces: &Incidence,
+        boundary: &[[u32; 3]],
+        input: &Surface<'_>,
+        positions: &[DVec3],
+        v: u32,
+    ) -> f64 {
+        let mut off: f64 = 0.0;
+        for &f in faces.of(v) {
+            let known = &mut self.0[f as usize];
+            if known.is_nan() {
+                let corners = boundary[f as usize].map(|u| positions[u as usize]);
+                let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+                *known = input.nearest(centroid).1;
+            }
+            off = off.max(*known);
+        }
+        off.sqrt()
+    }
+
+    /// `v` moved: its triangles' distances are no longer known.
+    fn forget(&mut self, faces: &Incidence, v: u32) {
+        for &f in faces.of(v) {
+            self.0[f as usize] = f64::NAN;
+        }
     }
 }
 
@@ -608,6 +658,77 @@ mod tests {
         // test reached the bounds often.
         assert!(kept > 50_000 && sure * 100 >= kept * 99, "{sure} of {kept}");
         assert!(near > 1000, "{near} near a bound");
+    }
+
+    #[test]
+    fn kept_ring_distances_are_those_measured_afresh_after_moves() {
+        let (p, t) = sphere(16, 1.0, DVec3::ZERO);
+        let mut m = crate::tetrahedralize(&p, &t, &crate::Options::new(0.25)).unwrap();
+        let bvh = Bvh::build(&p, &t);
+        let input = Surface {
+            positions: &p,
+            triangles: &t,
+            bvh: &bvh,
+        };
+        let n = m.positions.len();
+        let mut mover = Mover::new(
+            &m.tets,
+            &m.boundary,
+            &input,
+            1e-3,
+            vec![false; n],
+            vec![false; n],
+        );
+        let fresh = |mover: &Mover<'_>, positions: &[DVec3], v: u32| {
+            let mut blank = CentroidDistances(vec![f64::NAN; m.boundary.len()]);
+            blank.ring(&mover.faces, mover.boundary, mover.input, positions, v)
+        };
+        let mut on_boundary: Vec<u32> = m.boundary.iter().flatten().copied().collect();
+        on_boundary.sort_unstable();
+        on_boundary.dedup();
+        let mut rng = test_support::SplitMix64(5);
+        let mut moves = 0;
+        for k in 0..400 {
+            let v = on_boundary[k * 7919 % on_boundary.len()];
+            let to = m.positions[v as usize]
+                + 0.08 * DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, rng.f64() - 0.5);
+            moves += usize::from(
+                mover
+                    .try_move(&mut m.positions, v, to, f64::INFINITY)
+                    .is_some(),
+            );
+            // The ring of a neighbour (sharing a triangle with v) and v's own.
+            let f = mover.faces.of(v)[k % mover.faces.of(v).len()];
+            for u in m.boundary[f as usize] {
+                let kept = mover.centroid_off.ring(
+                    &mover.faces,
+                    mover.boundary,
+                    mover.input,
+                    &m.positions,
+                    u,
+                );
+                assert_eq!(
+                    kept,
+                    fresh(&mover, &m.positions, u),
+                    "vertex {u} after move {k}"
+                );
+            }
+        }
+        assert!(moves > 100, "{moves} moves");
+        // A move the cache is not told of leaves it stale: the comparison
+        // above would see it.
+        let v = on_boundary[0];
+        let before =
+            mover
+                .centroid_off
+                .ring(&mover.faces, mover.boundary, mover.input, &m.positions, v);
+        m.positions[v as usize] *= 1.1;
+        let stale =
+            mover
+                .centroid_off
+                .ring(&mover.faces, mover.boundary, mover.input, &m.positions, v);
+        assert_eq!(stale, before);
+        assert_ne!(stale, fresh(&mover, &m.positions, v));
     }
 
     #[test]
