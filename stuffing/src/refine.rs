@@ -30,6 +30,8 @@
 //! count by default, the cost bound); what the budget or the
 //! angle check leaves far stays far, and the measured distance says so.
 
+use std::collections::HashMap;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -70,9 +72,10 @@ pub(crate) fn refine(
     // Boundary vertices whose edges to look at: all at first, then those
     // of far edges and of changed triangles (elsewhere nothing moved).
     let mut watched = vec![true; mesh.positions.len()];
+    let mut known = HashMap::new();
     for _ in 0..ROUNDS {
         let mut jobs = far_input(&mesh, targets, &candidates, eps);
-        let far_edges = far_boundary(wn, input, &mesh, eps, &watched);
+        let far_edges = far_boundary(wn, input, &mesh, eps, &watched, &mut known);
         watched = vec![false; mesh.positions.len()];
         for job in &far_edges {
             if let Some((a, b)) = job.edge {
@@ -156,6 +159,10 @@ fn far_input(mesh: &Dynamic<'_>, targets: &[DVec3], candidates: &[u32], eps: f64
         .par_iter()
         .filter_map(|&i| {
             let target = targets[i as usize];
+            // Most points are near: a bounded query says so for less.
+            if surface.within(target, eps) {
+                return None;
+            }
             let (_, d2, triangle) = surface.nearest(target);
             (d2 > eps * eps && triangle != u32::MAX).then_some(Job {
                 d2,
@@ -173,13 +180,17 @@ fn far_input(mesh: &Dynamic<'_>, targets: &[DVec3], candidates: &[u32], eps: f64
 /// midpoint of every boundary edge (where a chord between two vertices on
 /// the input is farthest from it), but not on hole caps
 /// ([`on_hole_cap`]): split that edge towards the input point nearest its
-/// midpoint. Only edges with a `watched` end are looked at.
+/// midpoint. Only edges with a `watched` end are looked at. `known` keeps
+/// each edge's answer (the squared distance and the input point, for a
+/// far one): splits add vertices but move none, so an edge's answer never
+/// changes, while its ends stay watched round after round.
 fn far_boundary(
     wn: &WindingNumber,
     input: &Surface<'_>,
     mesh: &Dynamic<'_>,
     eps: f64,
     watched: &[bool],
+    known: &mut HashMap<(u32, u32), Option<(f64, DVec3)>>,
 ) -> Vec<Job> {
     let edges: Vec<(u32, u32, u32)> = mesh
         .boundary
@@ -194,16 +205,30 @@ fn far_boundary(
             })
         })
         .collect();
-    edges
+    let new: Vec<(u32, u32)> = edges
+        .iter()
+        .filter(|&&(a, b, _)| !known.contains_key(&(a, b)))
+        .map(|&(a, b, _)| (a, b))
+        .collect();
+    let answers: Vec<Option<(f64, DVec3)>> = new
         .par_iter()
-        .enumerate()
-        .filter_map(|(k, &(a, b, f))| {
-            let mid = 0.5 * (mesh.positions[a as usize] + mesh.positions[b as usize]);
+        .map(|&(a, b)| {
+            let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
+            let mid = 0.5 * (pa + pb);
             let (target, d2, _) = input.nearest(mid);
-            let length2 = mesh.positions[a as usize].distance_squared(mesh.positions[b as usize]);
             // Far, within an edge's length of the input (not across a
             // gap), and not where the input is missing.
-            (d2 > eps * eps && d2 <= length2 && !on_hole_cap(wn, mid)).then_some(Job {
+            (d2 > eps * eps && d2 <= pa.distance_squared(pb) && !on_hole_cap(wn, mid))
+                .then_some((d2, target))
+        })
+        .collect();
+    known.extend(new.into_iter().zip(answers));
+    edges
+        .iter()
+        .enumerate()
+        .filter_map(|(k, &(a, b, f))| {
+            let (d2, target) = known[&(a, b)]?;
+            Some(Job {
                 d2,
                 order: (1, k as u32),
                 triangle: f,
@@ -357,15 +382,11 @@ impl<'a> Dynamic<'a> {
                 })
                 .collect()
         };
-        let off = |corners: Vec<DVec3>| {
-            let centroid = corners.iter().sum::<DVec3>() / 3.0;
-            input.nearest(centroid).1.sqrt()
-        };
-        // The old triangles' distance, with the new vertex at the midpoint.
-        let before = faces
-            .iter()
-            .flat_map(|&f| [b, a].map(|x| off(at(&self.boundary[f as usize], x, mid))))
-            .fold(0.0f64, f64::max);
+        let centroid = |corners: Vec<DVec3>| corners.iter().sum::<DVec3>() / 3.0;
+        // The old triangles' distance, with the new vertex at the midpoint:
+        // found only when a step's new triangles are not all within `eps`
+        // (the limit is at least that).
+        let mut before = None;
         'steps: for step in STEPS {
             let p = mid.lerp(s, step);
             for &t in &tets {
@@ -384,14 +405,29 @@ impl<'a> Dynamic<'a> {
                     }
                 }
             }
-            for &f in &faces {
-                for x in [a, b] {
-                    if off(at(&self.boundary[f as usize], x, p)) > before.max(eps) {
-                        continue 'steps;
-                    }
-                }
+            let halves: Vec<DVec3> = faces
+                .iter()
+                .flat_map(|&f| [a, b].map(|x| centroid(at(&self.boundary[f as usize], x, p))))
+                .collect();
+            if halves.iter().all(|&c| input.within(c, eps)) {
+                return Some(p);
             }
-            return Some(p);
+            let limit = before
+                .get_or_insert_with(|| {
+                    faces
+                        .iter()
+                        .flat_map(|&f| {
+                            [b, a].map(|x| {
+                                let c = centroid(at(&self.boundary[f as usize], x, mid));
+                                input.nearest(c).1.sqrt()
+                            })
+                        })
+                        .fold(0.0f64, f64::max)
+                })
+                .max(eps);
+            if halves.iter().all(|&c| input.within(c, limit)) {
+                return Some(p);
+            }
         }
         None
     }
@@ -441,5 +477,58 @@ fn relink(of: &mut [Vec<u32>], old: &[u32], a: u32, b: u32, m: u32, kept: u32, n
         if u != a && u != b {
             of[u as usize].push(new);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tests::sphere;
+    use crate::winding::DEFAULT_BETA;
+
+    #[test]
+    fn an_edges_kept_answer_is_the_one_found_afresh_after_splits() {
+        let (p, t) = sphere(16, 1.0, DVec3::ZERO);
+        let m = crate::tetrahedralize(&p, &t, &crate::Options::new(0.25)).unwrap();
+        let (mut positions, mut tets, mut boundary) = (m.positions, m.tets, m.boundary);
+        let wn = WindingNumber::new(&p, &t, DEFAULT_BETA).unwrap();
+        let bvh = Bvh::build(&p, &t);
+        let input = Surface {
+            positions: &p,
+            triangles: &t,
+            bvh: &bvh,
+        };
+        let mut mesh = Dynamic::new(&mut positions, &mut tets, &mut boundary);
+        // Chords of a unit sphere at this spacing sag by about 0.01.
+        let eps = 1e-3;
+        let mut known = HashMap::new();
+        let all = vec![true; mesh.positions.len()];
+        let first = far_boundary(&wn, &input, &mesh, eps, &all, &mut known);
+        assert!(first.len() > 50, "{} far edges", first.len());
+        let old = mesh.positions.clone();
+        for job in first.iter().step_by(3) {
+            let (a, b) = job.edge.unwrap();
+            mesh.split(a, b, job.target);
+        }
+        // The cache's premise: splits add vertices and move none.
+        assert_eq!(mesh.positions[..old.len()], old[..]);
+        let all = vec![true; mesh.positions.len()];
+        let answers = |jobs: Vec<Job>| -> Vec<_> {
+            jobs.into_iter()
+                .map(|j| (j.d2, j.order, j.triangle, j.edge, j.target))
+                .collect()
+        };
+        let kept = answers(far_boundary(&wn, &input, &mesh, eps, &all, &mut known));
+        let fresh = answers(far_boundary(
+            &wn,
+            &input,
+            &mesh,
+            eps,
+            &all,
+            &mut HashMap::new(),
+        ));
+        assert_eq!(kept, fresh);
+        // The new edges were asked about too, and some are far.
+        assert!(kept.iter().any(|j| j.3.unwrap().1 as usize >= old.len()));
     }
 }
