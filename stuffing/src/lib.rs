@@ -418,58 +418,26 @@ fn run<P: Position>(
     }
     let wn = winding::WindingNumber::new(&pos, triangles, options.winding_beta)?;
     let lattice = lattice_for(&pos, triangles, options)?;
-
-    let mut signs = cuts::classify(&lattice, &wn, |_| true);
-    let inside = signs.iter().filter(|&&s| s == Sign::In).count();
-    if inside == 0 {
-        return Err(empty(&wn, h));
-    }
-    // BCC has 6 tetrahedra per lattice vertex.
-    let estimated = 6 * inside as u128;
-    if estimated > options.max_tets as u128 {
-        return Err(Error::TooManyTetrahedra {
-            h,
-            estimated,
-            limit: options.max_tets,
-        });
-    }
-    let mut cut_list = cuts::cut_points(&lattice, &wn, &signs);
-    let warped = warp::warp(
-        &lattice,
-        &mut signs,
-        &mut cut_list,
-        options.params.alpha_long(),
-        options.params.alpha_short(),
-    );
-    let ctx = Context {
-        lattice: &lattice,
-        signs: &signs,
-        cuts: &cut_list,
-        warped: &warped,
-    };
-    let background = options
-        .graded
-        .then(|| graded::background(&lattice, &signs, options.graded_levels, |v| ctx.position(v)));
-    let mut cells = ctx.stuff(background.as_ref().map(|b| &b.fine[..]), rule);
-    if let Some(b) = &background {
-        cells.extend(b.coarse.iter().map(|t| {
-            t.map(|v| Point {
-                id: v,
-                pos: ctx.position(v),
-            })
-        }));
-    }
-    if cells.is_empty() {
-        return Err(empty(&wn, h));
-    }
-    let mut m = mesh::assemble(cells);
     // Which input triangles enclose volume: the fit and the measurement
-    // both leave the others out.
-    let bounding = if options.envelope.is_some() || options.distance_samples > 0 {
-        distance::bounding_triangles(&wn)
-    } else {
-        Vec::new()
-    };
+    // both leave the others out. One winding number per triangle,
+    // independent of the lattice, so it runs beside the stuffing and
+    // fills the cores the stuffing's sequential steps leave idle.
+    let needs_bounding = options.envelope.is_some() || options.distance_samples > 0;
+    let (bounding, stuffed) = rayon::join(
+        || {
+            if needs_bounding {
+                distance::bounding_triangles(&wn)
+            } else {
+                Vec::new()
+            }
+        },
+        || stuff(&wn, &lattice, options, rule),
+    );
+    let Stuffed {
+        mesh: mut m,
+        cut_points,
+        warped_vertices,
+    } = stuffed?;
     let fitted = options.envelope.map(|eps| {
         let (lo, hi) = used_bounds(&pos, triangles);
         let diagonal = lo.distance(hi);
@@ -498,8 +466,8 @@ fn run<P: Position>(
         min_cot: q.min_cot,
         max_cot: q.max_cot,
         lattice_vertices: lattice.vertex_count(),
-        cut_points: cut_list.len(),
-        warped_vertices: warped.len(),
+        cut_points,
+        warped_vertices,
         fitted_vertices: fitted.map_or(0, |f| f.moved),
         sharp_edges: fitted.map_or(0, |f| f.sharp_edges),
         split_edges: fitted.map_or(0, |f| f.split_edges),
@@ -511,6 +479,72 @@ fn run<P: Position>(
         tets: m.tets,
         boundary: m.boundary,
         report,
+    })
+}
+
+/// What the stuffing proper (steps 1–5 of the crate docs) made.
+struct Stuffed {
+    mesh: mesh::Assembled,
+    cut_points: usize,
+    warped_vertices: usize,
+}
+
+/// Steps 1–5 of the crate docs: classification, cut points, warping, the
+/// stencils (and the graded interior), assembled into one mesh.
+fn stuff(
+    wn: &winding::WindingNumber,
+    lattice: &Lattice,
+    options: &Options,
+    rule: FaceRule,
+) -> Result<Stuffed, Error> {
+    let h = options.h;
+    let mut signs = cuts::classify(lattice, wn, |_| true);
+    let inside = signs.iter().filter(|&&s| s == Sign::In).count();
+    if inside == 0 {
+        return Err(empty(wn, h));
+    }
+    // BCC has 6 tetrahedra per lattice vertex.
+    let estimated = 6 * inside as u128;
+    if estimated > options.max_tets as u128 {
+        return Err(Error::TooManyTetrahedra {
+            h,
+            estimated,
+            limit: options.max_tets,
+        });
+    }
+    let mut cut_list = cuts::cut_points(lattice, wn, &signs);
+    let warped = warp::warp(
+        lattice,
+        &mut signs,
+        &mut cut_list,
+        options.params.alpha_long(),
+        options.params.alpha_short(),
+    );
+    let ctx = Context {
+        lattice,
+        signs: &signs,
+        cuts: &cut_list,
+        warped: &warped,
+    };
+    let background = options
+        .graded
+        .then(|| graded::background(lattice, &signs, options.graded_levels, |v| ctx.position(v)));
+    let mut cells = ctx.stuff(background.as_ref().map(|b| &b.fine[..]), rule);
+    if let Some(b) = &background {
+        cells.extend(b.coarse.iter().map(|t| {
+            t.map(|v| Point {
+                id: v,
+                pos: ctx.position(v),
+            })
+        }));
+    }
+    if cells.is_empty() {
+        return Err(empty(wn, h));
+    }
+    Ok(Stuffed {
+        mesh: mesh::assemble(cells),
+        cut_points: cut_list.len(),
+        warped_vertices: warped.len(),
     })
 }
 
