@@ -497,9 +497,18 @@ impl Mover<'_> {
     /// Whether every boundary triangle around `v`, with `v` at `at`, has
     /// its centroid within `limit` of the input: the same answer as
     /// [`CentroidDistances::ring`] `<= limit`, with bounded queries that stop at
-    /// the first triangle near enough (the fit's most frequent query).
+    /// the first triangle near enough (the fit's most frequent query). A
+    /// triangle whose kept distance plus the way its centroid moves is
+    /// within `limit` (with a margin far above rounding) needs no query:
+    /// the distance to a surface changes by at most the way moved.
     fn ring_within(&self, positions: &[DVec3], v: u32, at: DVec3, limit: f64) -> bool {
+        let shift = positions[v as usize].distance(at) / 3.0;
+        let sure = limit * (1.0 - SHIFT_MARGIN);
         self.faces.of(v).iter().all(|&f| {
+            let known = self.centroid_off.0[f as usize];
+            if known.sqrt() + shift <= sure {
+                return true;
+            }
             let corners =
                 self.boundary[f as usize].map(|u| if u == v { at } else { positions[u as usize] });
             let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
@@ -507,6 +516,11 @@ impl Mover<'_> {
         })
     }
 }
+
+/// Relative margin below a limit within which [`Mover::ring_within`]
+/// still asks the query rather than trusting its bound: far above the
+/// rounding of the bound (about 1e-15), so its answers are the query's.
+const SHIFT_MARGIN: f64 = 1e-9;
 
 /// Per boundary triangle, the squared distance of its centroid from the
 /// input, once asked for (NaN before, and again once a corner moves).
@@ -715,6 +729,46 @@ mod tests {
             }
         }
         assert!(moves > 100, "{moves} moves");
+        // The ring check with its bound answers as the queries do, at the
+        // new ring's own distances and just below them.
+        let by_query = |positions: &[DVec3], v: u32, at: DVec3| {
+            mover
+                .faces
+                .of(v)
+                .iter()
+                .map(|&f| {
+                    let c = m.boundary[f as usize]
+                        .map(|u| if u == v { at } else { positions[u as usize] });
+                    input.nearest((c[0] + c[1] + c[2]) / 3.0).1.sqrt()
+                })
+                .fold(0.0f64, f64::max)
+        };
+        let mut bound_decided = 0;
+        for k in 0..2000 {
+            let v = on_boundary[k * 104_729 % on_boundary.len()];
+            let from = m.positions[v as usize];
+            let at = from + 0.05 * DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, rng.f64() - 0.5);
+            mover
+                .centroid_off
+                .ring(&mover.faces, mover.boundary, mover.input, &m.positions, v);
+            let worst = by_query(&m.positions, v, at);
+            for limit in [worst, worst * (1.0 - 1e-6), worst * 1.5 + 0.01] {
+                let expected = by_query(&m.positions, v, at) <= limit;
+                assert_eq!(
+                    mover.ring_within(&m.positions, v, at, limit),
+                    expected,
+                    "{v} {limit}"
+                );
+                let shift = from.distance(at) / 3.0;
+                bound_decided += usize::from(mover.faces.of(v).iter().any(|&f| {
+                    mover.centroid_off.0[f as usize].sqrt() + shift <= limit * (1.0 - SHIFT_MARGIN)
+                }));
+            }
+        }
+        assert!(
+            bound_decided > 1000,
+            "the bound decided {bound_decided} times"
+        );
         // A move the cache is not told of leaves it stale: the comparison
         // above would see it.
         let v = on_boundary[0];
