@@ -503,10 +503,8 @@ impl Mover<'_> {
     /// the distance to a surface changes by at most the way moved.
     fn ring_within(&self, positions: &[DVec3], v: u32, at: DVec3, limit: f64) -> bool {
         let shift = positions[v as usize].distance(at) / 3.0;
-        let sure = limit * (1.0 - SHIFT_MARGIN);
         self.faces.of(v).iter().all(|&f| {
-            let known = self.centroid_off.0[f as usize];
-            if known.sqrt() + shift <= sure {
+            if self.centroid_off.surely_within(f, shift, limit) {
                 return true;
             }
             let corners =
@@ -517,7 +515,7 @@ impl Mover<'_> {
     }
 }
 
-/// Relative margin below a limit within which [`Mover::ring_within`]
+/// Relative margin below a limit within which [`CentroidDistances::surely_within`]
 /// still asks the query rather than trusting its bound: far above the
 /// rounding of the bound (about 1e-15), so its answers are the query's.
 const SHIFT_MARGIN: f64 = 1e-9;
@@ -548,6 +546,13 @@ impl CentroidDistances {
             off = off.max(*known);
         }
         off.sqrt()
+    }
+
+    /// Whether triangle `f`'s centroid, moved by `shift`, is surely
+    /// within `limit` of the input by its kept distance alone (false when
+    /// none is kept, or when only a query can tell).
+    fn surely_within(&self, f: u32, shift: f64, limit: f64) -> bool {
+        self.0[f as usize].sqrt() + shift <= limit * (1.0 - SHIFT_MARGIN)
     }
 
     /// `v` moved: its triangles' distances are no longer known.
@@ -760,9 +765,13 @@ mod tests {
                     "{v} {limit}"
                 );
                 let shift = from.distance(at) / 3.0;
-                bound_decided += usize::from(mover.faces.of(v).iter().any(|&f| {
-                    mover.centroid_off.0[f as usize].sqrt() + shift <= limit * (1.0 - SHIFT_MARGIN)
-                }));
+                bound_decided += usize::from(
+                    mover
+                        .faces
+                        .of(v)
+                        .iter()
+                        .any(|&f| mover.centroid_off.surely_within(f, shift, limit)),
+                );
             }
         }
         assert!(
